@@ -1,0 +1,81 @@
+//! The one place where the GPU and CPU builds differ: atomics.
+//!
+//! On SPIR-V these are `OpAtomic*` instructions (rust-gpu's Vulkan memory
+//! model; device-scope atomics need the `VulkanMemoryModelDeviceScope`
+//! capability and therefore wgpu's SPIR-V passthrough). On the host they are
+//! `core::sync::atomic` operations. The CPU runner executes invocations one
+//! after another, so the host versions never race; they are atomics only so
+//! that the code means the same thing on both sides.
+#[cfg(target_arch = "spirv")]
+use spirv_std::memory::{Scope, Semantics};
+
+#[cfg(target_arch = "spirv")]
+const DEVICE: u32 = Scope::Device as u32;
+#[cfg(target_arch = "spirv")]
+const WORKGROUP: u32 = Scope::Workgroup as u32;
+/// Acquire-release on storage buffers, with availability and visibility
+/// operations (the Vulkan memory model needs them to publish plain writes).
+#[cfg(target_arch = "spirv")]
+const ACQ_REL_STORAGE: u32 = Semantics::ACQUIRE_RELEASE.bits()
+    | Semantics::UNIFORM_MEMORY.bits()
+    | Semantics::MAKE_AVAILABLE.bits()
+    | Semantics::MAKE_VISIBLE.bits();
+#[cfg(target_arch = "spirv")]
+const RELAXED: u32 = Semantics::NONE.bits();
+
+/// Adds `value` to a storage-buffer counter with device scope and
+/// acquire-release ordering; returns the previous value.
+#[inline]
+pub fn add_device(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_i_add::<u32, DEVICE, ACQ_REL_STORAGE>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        use core::sync::atomic::{AtomicU32, Ordering};
+        AtomicU32::from_mut(slot).fetch_add(value, Ordering::AcqRel)
+    }
+}
+
+/// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).
+#[inline]
+pub fn add_workgroup(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_i_add::<u32, WORKGROUP, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        let old = *slot;
+        *slot = old.wrapping_add(value);
+        old
+    }
+}
+
+/// Device-scope relaxed store of an `f32`, for data another invocation reads
+/// after synchronizing through [`add_device`].
+#[inline]
+pub fn store_f32(slot: &mut f32, value: f32) {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_store::<f32, DEVICE, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        *slot = value;
+    }
+}
+
+/// Device-scope relaxed load of an `f32` (see [`store_f32`]).
+#[inline]
+pub fn load_f32(slot: &f32) -> f32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_load::<f32, DEVICE, RELAXED>(slot)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        *slot
+    }
+}

@@ -1,0 +1,67 @@
+//! Bottom-up bounds (Karras 2012, section 4): one invocation per leaf writes
+//! its leaf, then climbs towards the root. At each internal node an atomic
+//! counter lets the first arrival stop and the second, which knows both
+//! children are done, write the union of their boxes and go on. Every
+//! internal node is thus written exactly once, by the last of its children.
+//!
+//! On the GPU the boxes cross invocations, so they are written and read with
+//! device-scope atomics, ordered by the acquire-release counter (under the
+//! Vulkan memory model plain accesses would not be made visible).
+use crate::aabb::Aabb;
+use crate::atomics;
+use crate::layout::{Node, INVALID, LEAF_BIT};
+use crate::radix_tree::leaf_node;
+
+#[inline]
+fn store_box(node: &mut Node, b: &Aabb) {
+    for k in 0..3 {
+        atomics::store_f32(&mut node.min[k], b.min[k]);
+        atomics::store_f32(&mut node.max[k], b.max[k]);
+    }
+}
+
+#[inline]
+fn load_box(node: &Node) -> Aabb {
+    let mut b = Aabb::EMPTY;
+    for k in 0..3 {
+        b.min[k] = atomics::load_f32(&node.min[k]);
+        b.max[k] = atomics::load_f32(&node.max[k]);
+    }
+    b
+}
+
+/// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
+/// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
+pub fn fit_kernel(
+    i: u32,
+    n: u32,
+    sorted_prims: &[u32],
+    prim_boxes: &[Aabb],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    flags: &mut [u32],
+) {
+    if i >= n {
+        return;
+    }
+    let leaf = leaf_node(n, i);
+    let b = prim_boxes[sorted_prims[i as usize] as usize];
+    nodes[leaf as usize].left = i;
+    nodes[leaf as usize].right = LEAF_BIT | 1;
+    store_box(&mut nodes[leaf as usize], &b);
+    if n == 1 {
+        parents[0] = INVALID;
+        return;
+    }
+    let mut current = leaf;
+    while current != 0 {
+        let parent = parents[current as usize];
+        if atomics::add_device(&mut flags[parent as usize], 1) == 0 {
+            return; // The sibling's invocation will finish this node.
+        }
+        let left = load_box(&nodes[nodes[parent as usize].left as usize]);
+        let right = load_box(&nodes[nodes[parent as usize].right as usize]);
+        store_box(&mut nodes[parent as usize], &left.union(&right));
+        current = parent;
+    }
+}

@@ -1,0 +1,116 @@
+//! Buffer types shared by the GPU and CPU builds.
+//!
+//! Every type is `#[repr(C)]`, `Pod`, and sized in multiples of 16 bytes with
+//! visible padding, so the host (bytemuck) and the shader (rust-gpu's explicit
+//! offsets) agree on one layout. The size assertions run in both builds.
+//! No `Vec3` in buffers: its alignment differs between the two targets.
+use bytemuck::{Pod, Zeroable};
+
+use crate::aabb::Aabb;
+
+/// Marks a missing link: the root's parent.
+pub const INVALID: u32 = u32::MAX;
+/// Set in [`Node::right`] of a leaf; the low bits then hold its primitive count.
+pub const LEAF_BIT: u32 = 1 << 31;
+
+/// A sphere: centre and radius. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Sphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+}
+const _: () = assert!(core::mem::size_of::<Sphere>() == 16);
+
+impl Sphere {
+    pub const fn new(center: [f32; 3], radius: f32) -> Self {
+        Self { center, radius }
+    }
+}
+
+/// A BVH node. repr(C), Pod, 32 bytes.
+///
+/// * internal: `left` and `right` are node indices of the two children;
+/// * leaf: `right` has [`LEAF_BIT`] set and its low bits count the primitives,
+///   `left` is the first of them in the sorted primitive-index array.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Node {
+    pub min: [f32; 3],
+    pub left: u32,
+    pub max: [f32; 3],
+    pub right: u32,
+}
+const _: () = assert!(core::mem::size_of::<Node>() == 32);
+
+impl Node {
+    #[inline]
+    pub fn is_leaf(&self) -> bool {
+        self.right & LEAF_BIT != 0
+    }
+    /// Number of primitives under a leaf (0 for internal nodes).
+    #[inline]
+    pub fn prim_count(&self) -> u32 {
+        if self.is_leaf() {
+            self.right & !LEAF_BIT
+        } else {
+            0
+        }
+    }
+    #[inline]
+    pub fn aabb(&self) -> Aabb {
+        Aabb::from_arrays(self.min, self.max)
+    }
+    #[inline]
+    pub fn set_aabb(&mut self, b: Aabb) {
+        self.min = b.min;
+        self.max = b.max;
+    }
+}
+
+/// Parameters of the per-primitive and tree stages. repr(C), Pod, 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct BuildParams {
+    /// Number of primitives (leaves).
+    pub n: u32,
+    /// Number of elements the bounds reduction reads in this pass.
+    pub reduce_len: u32,
+    /// 1 when the reduction reads primitive boxes and reduces their centroids.
+    pub reduce_centroids: u32,
+    pub _pad0: u32,
+    /// Centroid bounds of the scene (Morton quantization frame).
+    pub frame: Aabb,
+}
+const _: () = assert!(core::mem::size_of::<BuildParams>() == 48);
+
+/// Parameters of one radix-sort pass. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct SortParams {
+    /// Number of keys.
+    pub n: u32,
+    /// Bit offset of this pass's digit.
+    pub shift: u32,
+    /// Number of sort tiles (workgroups of the histogram and scatter kernels).
+    pub blocks: u32,
+    pub _pad0: u32,
+}
+const _: () = assert!(core::mem::size_of::<SortParams>() == 16);
+
+/// Parameters of an exclusive prefix sum. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct ScanParams {
+    /// Number of elements to scan.
+    pub len: u32,
+    /// Number of scan tiles (= number of partial sums).
+    pub tiles: u32,
+    pub _pad0: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<ScanParams>() == 16);

@@ -1,0 +1,17 @@
+//! Compiles the `shader` crate to one SPIR-V module with rust-gpu and exposes
+//! its path to the host as `env!("treelet_shader.spv")`.
+use spirv_builder::{Capability, SpirvBuilder};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let shader = concat!(env!("CARGO_MANIFEST_DIR"), "/../shader");
+    let mut builder = SpirvBuilder::new(shader, "spirv-unknown-vulkan1.2")
+        // u64 Morton codes and radix-sort keys.
+        .capability(Capability::Int64)
+        // Device-scope atomics (bottom-up fit): needs SPIR-V passthrough in wgpu.
+        .capability(Capability::VulkanMemoryModelDeviceScope);
+    builder.release = true;
+    builder.build_script.defaults = true;
+    builder.build_script.env_shader_spv_path = Some(true);
+    builder.build()?;
+    Ok(())
+}

@@ -1,0 +1,71 @@
+//! What a build needs from a device: buffers, dispatches, readback and
+//! per-stage times. The GPU ([`crate::gpu::GpuBackend`]) and the CPU
+//! ([`crate::cpu_runner::CpuBackend`]) implement it, so the order of stages
+//! of a build is written once ([`crate::lbvh`]).
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use bytemuck::Pod;
+
+use crate::kernels::Kernel;
+
+/// Milliseconds per named stage, in the order the stages first ran.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct StageTimes {
+    pub order: Vec<&'static str>,
+    pub ms: BTreeMap<&'static str, f64>,
+    /// How the times were taken: "gpu-timestamps", "wall-clock".
+    pub source: &'static str,
+}
+
+impl StageTimes {
+    pub fn add(&mut self, stage: &'static str, ms: f64) {
+        if !self.ms.contains_key(stage) {
+            self.order.push(stage);
+        }
+        *self.ms.entry(stage).or_insert(0.0) += ms;
+    }
+    pub fn total(&self) -> f64 {
+        self.ms.values().sum()
+    }
+    pub fn get(&self, stage: &str) -> f64 {
+        self.ms.get(stage).copied().unwrap_or(0.0)
+    }
+}
+
+pub trait Backend {
+    /// A device buffer; cloning clones the handle, not the data.
+    type Buffer: Clone;
+
+    /// Adapter name ("cpu" for the CPU runner).
+    fn adapter(&self) -> String;
+    /// "gpu" or "cpu".
+    fn device_kind(&self) -> &'static str;
+    /// Largest buffer this device accepts in one binding, in bytes.
+    fn max_buffer_bytes(&self) -> u64;
+    /// A buffer holding `data`.
+    fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
+    /// A zero-filled buffer of at least `bytes` bytes.
+    fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer>;
+    /// Dispatches that follow belong to `stage` (for timing).
+    fn stage(&mut self, stage: &'static str);
+    /// Runs `kernel` over `groups` workgroups with these bindings (params first).
+    fn dispatch(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32);
+    /// Waits for all work so far and returns the first `count` elements.
+    fn read<T: Pod>(&mut self, buffer: &Self::Buffer, count: usize) -> Result<Vec<T>>;
+    /// Waits for all work so far and returns the stage times since the last call.
+    fn take_times(&mut self) -> Result<StageTimes>;
+}
+
+/// Checks that a buffer of `bytes` fits the device; names the buffer if not.
+pub fn check_fits<B: Backend>(backend: &B, label: &str, bytes: u64) -> Result<()> {
+    let max = backend.max_buffer_bytes();
+    if bytes > max {
+        anyhow::bail!(
+            "scene too large for this device: buffer `{label}` needs {bytes} bytes, \
+             the adapter `{}` allows {max} bytes per binding",
+            backend.adapter()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,190 @@
+//! The CPU runner: the same kernel functions of `treelet-core` the shaders
+//! call, run over every invocation id (and, for workgroup kernels, every
+//! workgroup with [`CpuWorkgroup`]'s phase-by-phase schedule). Invocations run
+//! one after another, so results are deterministic and equal the GPU's
+//! wherever the kernels are (the sort is stable, the tree unique).
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::time::Instant;
+
+use anyhow::Result;
+use bytemuck::Pod;
+use treelet_core::aabb::Aabb;
+use treelet_core::workgroup::{CpuWorkgroup, WG, WORKGROUP_SIZE};
+use treelet_core::{bounds, fit, morton, radix_tree, scan, scene, sort};
+
+use crate::backend::{Backend, StageTimes};
+use crate::kernels::Kernel;
+
+/// A CPU buffer: 8-byte words, so that any Pod type of alignment ≤ 8 views it.
+pub type CpuBuffer = Rc<RefCell<Vec<u64>>>;
+
+#[derive(Default)]
+pub struct CpuBackend {
+    times: StageTimes,
+    current: Option<(&'static str, Instant)>,
+}
+
+impl CpuBackend {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn close_stage(&mut self) {
+        if let Some((stage, start)) = self.current.take() {
+            self.times.add(stage, start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+}
+
+/// The whole-element prefix of a word buffer, as `T`s.
+fn view<T: Pod>(words: &mut [u64]) -> &mut [T] {
+    let bytes: &mut [u8] = bytemuck::cast_slice_mut(words);
+    let whole = bytes.len() / std::mem::size_of::<T>() * std::mem::size_of::<T>();
+    bytemuck::cast_slice_mut(&mut bytes[..whole])
+}
+
+fn params<T: Pod>(words: &mut [u64]) -> T {
+    view::<T>(words)[0]
+}
+
+/// Invocation ids of a dispatch of `groups` workgroups.
+fn ids(groups: u32) -> std::ops::Range<u32> {
+    0..groups * WORKGROUP_SIZE
+}
+
+impl Backend for CpuBackend {
+    type Buffer = CpuBuffer;
+
+    fn adapter(&self) -> String {
+        "cpu".into()
+    }
+    fn device_kind(&self) -> &'static str {
+        "cpu"
+    }
+    fn max_buffer_bytes(&self) -> u64 {
+        u64::MAX
+    }
+
+    fn upload<T: Pod>(&mut self, _label: &'static str, data: &[T]) -> Result<CpuBuffer> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let mut words = vec![0u64; bytes.len().div_ceil(8).max(1)];
+        bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
+        Ok(Rc::new(RefCell::new(words)))
+    }
+
+    fn zeroed(&mut self, _label: &'static str, bytes: u64) -> Result<CpuBuffer> {
+        Ok(Rc::new(RefCell::new(vec![0u64; (bytes as usize).div_ceil(8).max(1)])))
+    }
+
+    fn stage(&mut self, stage: &'static str) {
+        self.close_stage();
+        self.current = Some((stage, Instant::now()));
+    }
+
+    fn dispatch(&mut self, kernel: Kernel, bindings: &[&CpuBuffer], groups: u32) {
+        assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
+        let mut guards: Vec<_> = bindings.iter().map(|b| b.borrow_mut()).collect();
+        let mut b: Vec<&mut [u64]> = guards.iter_mut().map(|g| g.as_mut_slice()).collect();
+        run_kernel(kernel, &mut b, groups);
+    }
+
+    fn read<T: Pod>(&mut self, buffer: &CpuBuffer, count: usize) -> Result<Vec<T>> {
+        let mut words = buffer.borrow_mut();
+        Ok(view::<T>(&mut words)[..count].to_vec())
+    }
+
+    fn take_times(&mut self) -> Result<StageTimes> {
+        self.close_stage();
+        let mut times = std::mem::take(&mut self.times);
+        times.source = "wall-clock";
+        Ok(times)
+    }
+}
+
+/// Calls the core function of `kernel` for every invocation of the dispatch.
+fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
+    match (kernel, b) {
+        (Kernel::SphereBoxes, [p, spheres, boxes]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (spheres, boxes) = (view(spheres), view(boxes));
+            for id in ids(groups) {
+                scene::sphere_boxes_kernel(id, p.n, spheres, boxes);
+            }
+        }
+        (Kernel::ReduceBounds, [p, input, output]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (input, output) = (view(input), view(output));
+            let mut shared = [Aabb::EMPTY; WG];
+            for g in 0..groups {
+                bounds::reduce_bounds_kernel(&mut CpuWorkgroup, g, &p, input, output, &mut shared);
+            }
+        }
+        (Kernel::Morton, [p, boxes, keys, values]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (boxes, keys, values) = (view(boxes), view(keys), view(values));
+            for id in ids(groups) {
+                morton::morton_kernel(id, &p, boxes, keys, values);
+            }
+        }
+        (Kernel::SortHistogram, [p, keys, hist]) => {
+            let p: treelet_core::SortParams = params(p);
+            let (keys, hist) = (view(keys), view(hist));
+            let mut counts = [0u32; WG];
+            for g in 0..groups {
+                sort::histogram(&mut CpuWorkgroup, g, &p, keys, hist, &mut counts);
+            }
+        }
+        (Kernel::ScanReduce, [p, data, partials]) => {
+            let p: treelet_core::ScanParams = params(p);
+            let (data, partials) = (view(data), view(partials));
+            let mut sums = [0u32; WG];
+            for g in 0..groups {
+                scan::scan_reduce(&mut CpuWorkgroup, g, &p, data, partials, &mut sums);
+            }
+        }
+        (Kernel::ScanSpine, [p, partials]) => {
+            let p: treelet_core::ScanParams = params(p);
+            let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
+            for _ in 0..groups {
+                scan::scan_spine(&mut CpuWorkgroup, &p, view(partials), &mut a, &mut b);
+            }
+        }
+        (Kernel::ScanDownsweep, [p, data, partials]) => {
+            let p: treelet_core::ScanParams = params(p);
+            let (data, partials) = (view(data), view(partials));
+            let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
+            for g in 0..groups {
+                scan::scan_downsweep(&mut CpuWorkgroup, g, &p, data, partials, &mut a, &mut b);
+            }
+        }
+        (Kernel::SortScatter, [p, keys_in, values_in, offsets, keys_out, values_out]) => {
+            let p: treelet_core::SortParams = params(p);
+            let (keys_in, values_in, offsets) = (view(keys_in), view(values_in), view(offsets));
+            let (keys_out, values_out) = (view(keys_out), view(values_out));
+            let (mut running, mut digits, mut counts) = ([0u32; WG], [0u32; WG], [0u32; WG]);
+            for g in 0..groups {
+                sort::scatter(
+                    &mut CpuWorkgroup, g, &p, keys_in, values_in, offsets, keys_out, values_out,
+                    &mut running, &mut digits, &mut counts,
+                );
+            }
+        }
+        (Kernel::RadixTree, [p, keys, nodes, parents]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (keys, nodes, parents) = (view(keys), view(nodes), view(parents));
+            for id in ids(groups) {
+                radix_tree::radix_tree_kernel(id, p.n, keys, nodes, parents);
+            }
+        }
+        (Kernel::Fit, [p, prims, boxes, nodes, parents, flags]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
+            let (parents, flags) = (view(parents), view(flags));
+            for id in ids(groups) {
+                fit::fit_kernel(id, p.n, prims, boxes, nodes, parents, flags);
+            }
+        }
+        (kernel, b) => panic!("{kernel:?} dispatched with {} bindings", b.len()),
+    }
+}

@@ -1,0 +1,73 @@
+//! The table of kernels: one entry per compute entry point of the shader
+//! crate, with its bindings. The GPU backend builds one pipeline per entry;
+//! the CPU runner matches on the same enum to call the same core function.
+
+/// How a kernel uses one storage binding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    Read,
+    ReadWrite,
+}
+use Access::{Read, ReadWrite};
+
+/// Every compute kernel of Treelet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Kernel {
+    SphereBoxes,
+    ReduceBounds,
+    Morton,
+    SortHistogram,
+    ScanReduce,
+    ScanSpine,
+    ScanDownsweep,
+    SortScatter,
+    RadixTree,
+    Fit,
+}
+
+impl Kernel {
+    pub const ALL: [Kernel; 10] = [
+        Kernel::SphereBoxes,
+        Kernel::ReduceBounds,
+        Kernel::Morton,
+        Kernel::SortHistogram,
+        Kernel::ScanReduce,
+        Kernel::ScanSpine,
+        Kernel::ScanDownsweep,
+        Kernel::SortScatter,
+        Kernel::RadixTree,
+        Kernel::Fit,
+    ];
+
+    /// Name of the entry point in the shader crate (`<module>::<name>`).
+    pub fn entry_point(self) -> &'static str {
+        match self {
+            Kernel::SphereBoxes => "scene::sphere_boxes_cs",
+            Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
+            Kernel::Morton => "morton::morton_cs",
+            Kernel::SortHistogram => "sort::sort_histogram_cs",
+            Kernel::ScanReduce => "scan::scan_reduce_cs",
+            Kernel::ScanSpine => "scan::scan_spine_cs",
+            Kernel::ScanDownsweep => "scan::scan_downsweep_cs",
+            Kernel::SortScatter => "sort::sort_scatter_cs",
+            Kernel::RadixTree => "radix_tree::radix_tree_cs",
+            Kernel::Fit => "fit::fit_cs",
+        }
+    }
+
+    /// Bindings in order; binding 0 is always the parameter struct.
+    pub fn bindings(self) -> &'static [Access] {
+        match self {
+            Kernel::SphereBoxes => &[Read, Read, ReadWrite],
+            Kernel::ReduceBounds => &[Read, Read, ReadWrite],
+            Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite],
+            Kernel::SortHistogram => &[Read, Read, ReadWrite],
+            Kernel::ScanReduce => &[Read, Read, ReadWrite],
+            Kernel::ScanSpine => &[Read, ReadWrite],
+            Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
+            Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
+            Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
+            Kernel::Fit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+        }
+    }
+}

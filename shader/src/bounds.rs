@@ -1,0 +1,23 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::BuildParams;
+use treelet_core::bounds;
+use treelet_core::workgroup::{barrier, linear_group, WG};
+use treelet_core::Aabb;
+
+#[spirv(compute(threads(256)))]
+pub fn reduce_bounds_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] input: &[Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] output: &mut [Aabb],
+    #[spirv(workgroup)] shared: &mut [Aabb; WG],
+) {
+    let group = linear_group(group.x, group.y, groups.x);
+    for phase in 0..bounds::REDUCE_PHASES {
+        bounds::reduce_bounds_phase(phase, lid, group, params, input, output, shared);
+        barrier();
+    }
+}

@@ -1,0 +1,20 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::BuildParams;
+use treelet_core::workgroup::linear_id;
+use treelet_core::{Aabb, Node};
+
+#[spirv(compute(threads(256)))]
+pub fn fit_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] sorted_prims: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] prim_boxes: &[Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::fit::fit_kernel(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
+}

@@ -1,0 +1,18 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::BuildParams;
+use treelet_core::workgroup::linear_id;
+use treelet_core::Aabb;
+
+#[spirv(compute(threads(256)))]
+pub fn morton_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] boxes: &[Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] keys: &mut [u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] values: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::morton::morton_kernel(id, params, boxes, keys, values);
+}

@@ -1,0 +1,18 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::BuildParams;
+use treelet_core::workgroup::linear_id;
+use treelet_core::Node;
+
+#[spirv(compute(threads(256)))]
+pub fn radix_tree_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::radix_tree::radix_tree_kernel(id, params.n, keys, nodes, parents);
+}
