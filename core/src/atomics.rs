@@ -13,29 +13,40 @@ use spirv_std::memory::{Scope, Semantics};
 const DEVICE: u32 = Scope::Device as u32;
 #[cfg(target_arch = "spirv")]
 const WORKGROUP: u32 = Scope::Workgroup as u32;
-/// Acquire-release on storage buffers, with availability and visibility
-/// operations (the Vulkan memory model needs them to publish plain writes).
+/// Acquire-release on storage buffers.
 #[cfg(target_arch = "spirv")]
-const ACQ_REL_STORAGE: u32 = Semantics::ACQUIRE_RELEASE.bits()
-    | Semantics::UNIFORM_MEMORY.bits()
-    | Semantics::MAKE_AVAILABLE.bits()
-    | Semantics::MAKE_VISIBLE.bits();
+const ACQ_REL_STORAGE: u32 = Semantics::ACQUIRE_RELEASE.bits() | Semantics::UNIFORM_MEMORY.bits();
 #[cfg(target_arch = "spirv")]
 const RELAXED: u32 = Semantics::NONE.bits();
 
-/// Adds `value` to a storage-buffer counter with device scope and
-/// acquire-release ordering; returns the previous value.
+/// Adds `value` to a storage-buffer counter with device scope, relaxed;
+/// returns the previous value. Order it with [`fence_device`].
 #[inline]
 pub fn add_device(slot: &mut u32, value: u32) -> u32 {
     #[cfg(target_arch = "spirv")]
     unsafe {
-        spirv_std::arch::atomic_i_add::<u32, DEVICE, ACQ_REL_STORAGE>(slot, value)
+        spirv_std::arch::atomic_i_add::<u32, DEVICE, RELAXED>(slot, value)
     }
     #[cfg(not(target_arch = "spirv"))]
     {
         use core::sync::atomic::{AtomicU32, Ordering};
-        AtomicU32::from_mut(slot).fetch_add(value, Ordering::AcqRel)
+        AtomicU32::from_mut(slot).fetch_add(value, Ordering::Relaxed)
     }
+}
+
+/// Device-scope acquire-release fence on storage buffers.
+///
+/// Mesa's lavapipe (22.3) mis-executes memory barriers in divergent control
+/// flow (and atomics that carry acquire-release semantics, which it lowers to
+/// barriers): kernels that need a fence there come in a fenced and an
+/// unfenced variant, and the host picks the unfenced one on CPU adapters,
+/// whose threads share coherent caches.
+#[inline]
+pub fn fence_device() {
+    #[cfg(target_arch = "spirv")]
+    spirv_std::arch::memory_barrier::<DEVICE, ACQ_REL_STORAGE>();
+    #[cfg(not(target_arch = "spirv"))]
+    core::sync::atomic::fence(core::sync::atomic::Ordering::AcqRel);
 }
 
 /// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).

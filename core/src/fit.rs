@@ -5,8 +5,8 @@
 //! internal node is thus written exactly once, by the last of its children.
 //!
 //! On the GPU the boxes cross invocations, so they are written and read with
-//! device-scope atomics, ordered by the acquire-release counter (under the
-//! Vulkan memory model plain accesses would not be made visible).
+//! device-scope atomics (under the Vulkan memory model plain accesses would
+//! not be made visible), ordered by fences around the counter.
 use crate::aabb::Aabb;
 use crate::atomics;
 use crate::layout::{Node, INVALID, LEAF_BIT};
@@ -32,7 +32,9 @@ fn load_box(node: &Node) -> Aabb {
 
 /// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
 /// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
-pub fn fit_kernel(
+/// `FENCED` puts device fences around the counter (see
+/// [`atomics::fence_device`] for the one device that needs them left out).
+pub fn fit_kernel<const FENCED: bool>(
     i: u32,
     n: u32,
     sorted_prims: &[u32],
@@ -56,7 +58,14 @@ pub fn fit_kernel(
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
-        if atomics::add_device(&mut flags[parent as usize], 1) == 0 {
+        if FENCED {
+            atomics::fence_device(); // Publish this subtree's boxes...
+        }
+        let first = atomics::add_device(&mut flags[parent as usize], 1) == 0;
+        if FENCED {
+            atomics::fence_device(); // ...and see the sibling's.
+        }
+        if first {
             return; // The sibling's invocation will finish this node.
         }
         let left = load_box(&nodes[nodes[parent as usize].left as usize]);

@@ -19,6 +19,18 @@
 //! instead: `δ = 64 + clz(i ^ j)`, so identical keys still give a valid tree.
 use crate::layout::{Node, INVALID};
 
+/// Leading zeros of a u64 from two 32-bit counts: rust-gpu's 64-bit
+/// `leading_zeros` gave wrong results on lavapipe when the high word is set.
+#[inline]
+pub fn clz64(x: u64) -> u32 {
+    let hi = (x >> 32) as u32;
+    if hi != 0 {
+        hi.leading_zeros()
+    } else {
+        32 + (x as u32).leading_zeros()
+    }
+}
+
 /// δ(i, j): common prefix length of sorted keys i and j, with the key index
 /// as tie-break; -1 when j is out of range.
 #[inline]
@@ -29,7 +41,7 @@ pub fn delta(keys: &[u64], n: u32, i: i32, j: i32) -> i32 {
     let a = keys[i as usize];
     let b = keys[j as usize];
     if a != b {
-        (a ^ b).leading_zeros() as i32
+        clz64(a ^ b) as i32
     } else {
         64 + (i as u32 ^ j as u32).leading_zeros() as i32
     }
@@ -120,6 +132,13 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&c| c == 1), "keys {keys:?}: visits {seen:?}");
+    }
+
+    #[test]
+    fn clz64_matches_leading_zeros() {
+        for x in [0u64, 1, 0xffff_ffff, 1 << 32, 0x7fff_ffff_ffff_ffff, u64::MAX, 0x36db_6db6_db6d_b6db] {
+            assert_eq!(clz64(x), x.leading_zeros(), "{x:#x}");
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The CPU runner: the same kernel functions of `treelet-core` the shaders
 //! call, run over every invocation id (and, for workgroup kernels, every
-//! workgroup with [`CpuWorkgroup`]'s phase-by-phase schedule). Invocations run
+//! workgroup phase by phase, each phase over all local ids: see
+//! `treelet_core::workgroup`). Invocations run
 //! one after another, so results are deterministic and equal the GPU's
 //! wherever the kernels are (the sort is stable, the tree unique).
 use std::cell::RefCell;
@@ -10,7 +11,7 @@ use std::time::Instant;
 use anyhow::Result;
 use bytemuck::Pod;
 use treelet_core::aabb::Aabb;
-use treelet_core::workgroup::{CpuWorkgroup, WG, WORKGROUP_SIZE};
+use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::{bounds, fit, morton, radix_tree, scan, scene, sort};
 
 use crate::backend::{Backend, StageTimes};
@@ -46,6 +47,19 @@ fn view<T: Pod>(words: &mut [u64]) -> &mut [T] {
 
 fn params<T: Pod>(words: &mut [u64]) -> T {
     view::<T>(words)[0]
+}
+
+/// Runs a phased workgroup kernel: for each workgroup, each phase, each local
+/// id, `f(group, phase, local_id)`. Workgroup memory is the caller's, reused
+/// across workgroups as on the GPU (where it starts undefined).
+fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
+    for group in 0..groups {
+        for phase in 0..phases {
+            for lid in 0..WORKGROUP_SIZE {
+                f(group, phase, lid);
+            }
+        }
+    }
 }
 
 /// Invocation ids of a dispatch of `groups` workgroups.
@@ -116,9 +130,9 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let p: treelet_core::BuildParams = params(p);
             let (input, output) = (view(input), view(output));
             let mut shared = [Aabb::EMPTY; WG];
-            for g in 0..groups {
-                bounds::reduce_bounds_kernel(&mut CpuWorkgroup, g, &p, input, output, &mut shared);
-            }
+            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
+                bounds::reduce_bounds_phase(phase, lid, g, &p, input, output, &mut shared)
+            });
         }
         (Kernel::Morton, [p, boxes, keys, values]) => {
             let p: treelet_core::BuildParams = params(p);
@@ -131,44 +145,45 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let p: treelet_core::SortParams = params(p);
             let (keys, hist) = (view(keys), view(hist));
             let mut counts = [0u32; WG];
-            for g in 0..groups {
-                sort::histogram(&mut CpuWorkgroup, g, &p, keys, hist, &mut counts);
-            }
+            workgroups(groups, sort::HISTOGRAM_PHASES, |g, phase, lid| {
+                sort::histogram_phase(phase, lid, g, &p, keys, hist, &mut counts)
+            });
         }
         (Kernel::ScanReduce, [p, data, partials]) => {
             let p: treelet_core::ScanParams = params(p);
             let (data, partials) = (view(data), view(partials));
             let mut sums = [0u32; WG];
-            for g in 0..groups {
-                scan::scan_reduce(&mut CpuWorkgroup, g, &p, data, partials, &mut sums);
-            }
+            workgroups(groups, scan::SCAN_REDUCE_PHASES, |g, phase, lid| {
+                scan::scan_reduce_phase(phase, lid, g, &p, data, partials, &mut sums)
+            });
         }
         (Kernel::ScanSpine, [p, partials]) => {
             let p: treelet_core::ScanParams = params(p);
+            let partials = view(partials);
             let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
-            for _ in 0..groups {
-                scan::scan_spine(&mut CpuWorkgroup, &p, view(partials), &mut a, &mut b);
-            }
+            workgroups(groups, scan::SCAN_SWEEP_PHASES, |_, phase, lid| {
+                scan::scan_spine_phase(phase, lid, &p, partials, &mut a, &mut b)
+            });
         }
         (Kernel::ScanDownsweep, [p, data, partials]) => {
             let p: treelet_core::ScanParams = params(p);
             let (data, partials) = (view(data), view(partials));
             let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
-            for g in 0..groups {
-                scan::scan_downsweep(&mut CpuWorkgroup, g, &p, data, partials, &mut a, &mut b);
-            }
+            workgroups(groups, scan::SCAN_SWEEP_PHASES, |g, phase, lid| {
+                scan::scan_downsweep_phase(phase, lid, g, &p, data, partials, &mut a, &mut b)
+            });
         }
         (Kernel::SortScatter, [p, keys_in, values_in, offsets, keys_out, values_out]) => {
             let p: treelet_core::SortParams = params(p);
             let (keys_in, values_in, offsets) = (view(keys_in), view(values_in), view(offsets));
             let (keys_out, values_out) = (view(keys_out), view(values_out));
             let (mut running, mut digits, mut counts) = ([0u32; WG], [0u32; WG], [0u32; WG]);
-            for g in 0..groups {
-                sort::scatter(
-                    &mut CpuWorkgroup, g, &p, keys_in, values_in, offsets, keys_out, values_out,
+            workgroups(groups, sort::SCATTER_PHASES, |g, phase, lid| {
+                sort::scatter_phase(
+                    phase, lid, g, &p, keys_in, values_in, offsets, keys_out, values_out,
                     &mut running, &mut digits, &mut counts,
-                );
-            }
+                )
+            });
         }
         (Kernel::RadixTree, [p, keys, nodes, parents]) => {
             let p: treelet_core::BuildParams = params(p);
@@ -177,12 +192,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 radix_tree::radix_tree_kernel(id, p.n, keys, nodes, parents);
             }
         }
-        (Kernel::Fit, [p, prims, boxes, nodes, parents, flags]) => {
+        (Kernel::Fit | Kernel::FitUnfenced, [p, prims, boxes, nodes, parents, flags]) => {
             let p: treelet_core::BuildParams = params(p);
             let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
             let (parents, flags) = (view(parents), view(flags));
             for id in ids(groups) {
-                fit::fit_kernel(id, p.n, prims, boxes, nodes, parents, flags);
+                fit::fit_kernel::<true>(id, p.n, prims, boxes, nodes, parents, flags);
             }
         }
         (kernel, b) => panic!("{kernel:?} dispatched with {} bindings", b.len()),

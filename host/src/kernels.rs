@@ -23,10 +23,12 @@ pub enum Kernel {
     SortScatter,
     RadixTree,
     Fit,
+    /// [`Kernel::Fit`] without device fences, for CPU adapters.
+    FitUnfenced,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 10] = [
+    pub const ALL: [Kernel; 11] = [
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
         Kernel::Morton,
@@ -37,6 +39,7 @@ impl Kernel {
         Kernel::SortScatter,
         Kernel::RadixTree,
         Kernel::Fit,
+        Kernel::FitUnfenced,
     ];
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
@@ -52,6 +55,7 @@ impl Kernel {
             Kernel::SortScatter => "sort::sort_scatter_cs",
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
+            Kernel::FitUnfenced => "fit::fit_unfenced_cs",
         }
     }
 
@@ -67,7 +71,7 @@ impl Kernel {
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::Fit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::Fit | Kernel::FitUnfenced => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
         }
     }
 }

@@ -4,6 +4,7 @@ use treelet_core::layout::BuildParams;
 use treelet_core::workgroup::linear_id;
 use treelet_core::{Aabb, Node};
 
+/// The bottom-up fit with device fences: for GPUs.
 #[spirv(compute(threads(256)))]
 pub fn fit_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -16,5 +17,22 @@ pub fn fit_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::fit::fit_kernel(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
+    treelet_core::fit::fit_kernel::<true>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
+}
+
+/// The bottom-up fit without fences: for CPU adapters (lavapipe), see
+/// `treelet_core::atomics::fence_device`.
+#[spirv(compute(threads(256)))]
+pub fn fit_unfenced_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] sorted_prims: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] prim_boxes: &[Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::fit::fit_kernel::<false>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
 }

@@ -1,0 +1,115 @@
+//! `treelet bench ...`: sweeps of build sizes, reporting per-stage medians.
+use anyhow::Result;
+use clap::Subcommand;
+use indicatif::{ProgressBar, ProgressStyle};
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::{GpuBackend, GpuContext};
+use treelet::lbvh::{self, STAGES};
+use treelet::scene::random_spheres;
+
+use crate::Device;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// LBVH build times over random:N scenes.
+    Build {
+        /// Primitive counts (the seed's table, then millions).
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
+        sizes: Vec<usize>,
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: Device,
+        /// Timed repeats per size (after one warm-up build).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Also write the rows as JSON to this file.
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
+}
+
+#[derive(serde::Serialize)]
+struct Row {
+    primitives: usize,
+    median_ms: std::collections::BTreeMap<&'static str, f64>,
+    total_median_ms: f64,
+    total_min_ms: f64,
+    total_max_ms: f64,
+    mprims_per_s: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) }
+}
+
+fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result<Vec<Row>> {
+    let bar = ProgressBar::new((sizes.len() * (repeats + 1)) as u64);
+    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} builds {msg}").unwrap());
+    let mut rows = Vec::new();
+    for &n in sizes {
+        bar.set_message(format!("N = {n}"));
+        let spheres = random_spheres(n, 1);
+        let mut per_stage: Vec<Vec<f64>> = vec![Vec::new(); STAGES.len()];
+        let mut totals = Vec::new();
+        for rep in 0..=repeats {
+            let (_, times) = lbvh::build(b, &spheres)?;
+            bar.inc(1);
+            if rep == 0 {
+                continue; // warm-up
+            }
+            for (k, s) in STAGES.iter().enumerate() {
+                per_stage[k].push(times.get(s));
+            }
+            totals.push(times.total());
+        }
+        let total_median_ms = median(totals.clone());
+        rows.push(Row {
+            primitives: n,
+            median_ms: STAGES.iter().zip(per_stage).map(|(s, v)| (*s, median(v))).collect(),
+            total_median_ms,
+            total_min_ms: totals.iter().copied().fold(f64::MAX, f64::min),
+            total_max_ms: totals.iter().copied().fold(0.0, f64::max),
+            mprims_per_s: n as f64 / total_median_ms / 1e3,
+        });
+    }
+    bar.finish_and_clear();
+    Ok(rows)
+}
+
+pub fn run(cmd: BenchCommand) -> Result<()> {
+    match cmd {
+        BenchCommand::Build { sizes, device, repeats, json } => {
+            let (adapter, timing, rows) = match device {
+                Device::Gpu => {
+                    let mut b = GpuBackend::new(GpuContext::new()?);
+                    let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
+                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats)?)
+                }
+                Device::Cpu => {
+                    let mut b = CpuBackend::new();
+                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats)?)
+                }
+            };
+            println!("LBVH build, {adapter} ({timing}), median of {repeats} (ms)");
+            print!("{:>10}", "N");
+            for s in STAGES {
+                print!("{s:>9}");
+            }
+            println!("{:>10}{:>10}", "total", "Mprims/s");
+            for r in &rows {
+                print!("{:>10}", r.primitives);
+                for s in STAGES {
+                    print!("{:>9.3}", r.median_ms[s]);
+                }
+                println!("{:>10.3}{:>10.1}", r.total_median_ms, r.mprims_per_s);
+            }
+            if let Some(path) = json {
+                let doc = serde_json::json!({ "adapter": adapter, "timing": timing, "repeats": repeats, "rows": rows });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,238 @@
+//! The GPU [`Backend`]: dispatches are recorded per stage and submitted when
+//! a result is read. Each stage becomes one compute pass, timed with
+//! timestamp queries where the adapter has them (otherwise each stage is
+//! submitted alone and timed by the wall clock around its completion).
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use bytemuck::Pod;
+use treelet_core::workgroup::dispatch_grid;
+use wgpu::util::DeviceExt;
+
+use super::context::GpuContext;
+use crate::backend::{Backend, StageTimes};
+use crate::kernels::Kernel;
+
+/// Readbacks are copied in pieces no larger than this.
+const READBACK_CHUNK: u64 = 64 << 20;
+/// Every buffer has at least this many bytes (wgpu rejects empty bindings).
+const MIN_BUFFER: u64 = 16;
+
+struct Dispatch {
+    kernel: Kernel,
+    bind_group: wgpu::BindGroup,
+    grid: [u32; 2],
+}
+
+struct Segment {
+    stage: &'static str,
+    dispatches: Vec<Dispatch>,
+}
+
+pub struct GpuBackend {
+    ctx: Arc<GpuContext>,
+    stage: &'static str,
+    pending: Vec<Segment>,
+    times: StageTimes,
+}
+
+impl GpuBackend {
+    pub fn new(ctx: Arc<GpuContext>) -> Self {
+        Self { ctx, stage: "unnamed", pending: Vec::new(), times: StageTimes::default() }
+    }
+
+    pub fn context(&self) -> &Arc<GpuContext> {
+        &self.ctx
+    }
+
+    fn encode_segment(&self, encoder: &mut wgpu::CommandEncoder, seg: &Segment, ts: Option<(&wgpu::QuerySet, u32)>) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(seg.stage),
+            timestamp_writes: ts.map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(2 * i),
+                end_of_pass_write_index: Some(2 * i + 1),
+            }),
+        });
+        for d in &seg.dispatches {
+            pass.set_pipeline(&self.ctx.pipeline(d.kernel).pipeline);
+            pass.set_bind_group(0, &d.bind_group, &[]);
+            pass.dispatch_workgroups(d.grid[0], d.grid[1], 1);
+        }
+    }
+
+    fn wait(&self) -> Result<()> {
+        self.ctx.device.poll(wgpu::PollType::wait_indefinitely()).context("GPU did not finish its work")?;
+        Ok(())
+    }
+
+    /// Submits every recorded dispatch and waits; adds their stage times.
+    fn flush(&mut self) -> Result<()> {
+        let segments = std::mem::take(&mut self.pending);
+        if segments.is_empty() {
+            return Ok(());
+        }
+        let device = &self.ctx.device;
+        if !self.ctx.timestamps {
+            for seg in &segments {
+                let start = Instant::now();
+                let mut encoder = device.create_command_encoder(&Default::default());
+                self.encode_segment(&mut encoder, seg, None);
+                self.ctx.queue.submit([encoder.finish()]);
+                self.wait()?;
+                self.times.add(seg.stage, start.elapsed().as_secs_f64() * 1e3);
+            }
+            self.times.source = "wall-clock";
+            return Ok(());
+        }
+        let count = 2 * segments.len() as u32;
+        let query_set = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("stage timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
+        let bytes = count as u64 * 8;
+        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamp resolve"),
+            size: bytes,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamp readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for (i, seg) in segments.iter().enumerate() {
+            self.encode_segment(&mut encoder, seg, Some((&query_set, i as u32)));
+        }
+        encoder.resolve_query_set(&query_set, 0..count, &resolve, 0);
+        encoder.copy_buffer_to_buffer(&resolve, 0, &staging, 0, bytes);
+        self.ctx.queue.submit([encoder.finish()]);
+        let ticks: Vec<u64> = self.map_read(&staging, bytes)?;
+        let period_ns = self.ctx.queue.get_timestamp_period() as f64;
+        for (i, seg) in segments.iter().enumerate() {
+            let ticks = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
+            self.times.add(seg.stage, ticks as f64 * period_ns / 1e6);
+        }
+        self.times.source = "gpu-timestamps";
+        Ok(())
+    }
+
+    /// Maps a MAP_READ buffer (after its copy was submitted) and returns its contents.
+    fn map_read<T: Pod>(&self, staging: &wgpu::Buffer, bytes: u64) -> Result<Vec<T>> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, 0..bytes, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv().context("readback callback lost")?.context("could not map a readback buffer")?;
+        let out = bytemuck::cast_slice::<u8, T>(&staging.get_mapped_range(0..bytes)?).to_vec();
+        staging.unmap();
+        Ok(out)
+    }
+}
+
+impl Backend for GpuBackend {
+    type Buffer = wgpu::Buffer;
+
+    fn adapter(&self) -> String {
+        self.ctx.info.name.clone()
+    }
+    fn device_kind(&self) -> &'static str {
+        "gpu"
+    }
+    fn fences_in_divergent_flow(&self) -> bool {
+        self.ctx.info.device_type != wgpu::DeviceType::Cpu
+    }
+    fn max_buffer_bytes(&self) -> u64 {
+        self.ctx.max_binding_bytes()
+    }
+
+    fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        crate::backend::check_fits(self, label, bytes.len() as u64)?;
+        let padded_len = (bytes.len() as u64).max(MIN_BUFFER).next_multiple_of(4) as usize;
+        let contents: std::borrow::Cow<[u8]> = if padded_len == bytes.len() {
+            bytes.into()
+        } else {
+            let mut v = bytes.to_vec();
+            v.resize(padded_len, 0);
+            v.into()
+        };
+        Ok(self.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &contents,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        }))
+    }
+
+    fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
+        crate::backend::check_fits(self, label, bytes)?;
+        // wgpu zero-initializes every new buffer.
+        Ok(self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(MIN_BUFFER).next_multiple_of(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }))
+    }
+
+    fn stage(&mut self, stage: &'static str) {
+        self.stage = stage;
+    }
+
+    fn dispatch(&mut self, kernel: Kernel, bindings: &[&wgpu::Buffer], groups: u32) {
+        assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
+        if groups == 0 {
+            return;
+        }
+        let entries: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        let bind_group = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(kernel.entry_point()),
+            layout: &self.ctx.pipeline(kernel).layout,
+            entries: &entries,
+        });
+        let dispatch = Dispatch { kernel, bind_group, grid: dispatch_grid(groups) };
+        match self.pending.last_mut() {
+            Some(seg) if seg.stage == self.stage => seg.dispatches.push(dispatch),
+            _ => self.pending.push(Segment { stage: self.stage, dispatches: vec![dispatch] }),
+        }
+    }
+
+    fn read<T: Pod>(&mut self, buffer: &wgpu::Buffer, count: usize) -> Result<Vec<T>> {
+        self.flush()?;
+        let total = (count * std::mem::size_of::<T>()) as u64;
+        let mut bytes = Vec::with_capacity(total as usize);
+        let mut offset = 0;
+        while offset < total {
+            let len = (total - offset).min(READBACK_CHUNK);
+            let padded = len.next_multiple_of(4);
+            let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("readback"),
+                size: padded,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, padded);
+            self.ctx.queue.submit([encoder.finish()]);
+            let chunk: Vec<u8> = self.map_read(&staging, padded)?;
+            bytes.extend_from_slice(&chunk[..len as usize]);
+            offset += len;
+        }
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    fn take_times(&mut self) -> Result<StageTimes> {
+        self.flush()?;
+        Ok(std::mem::take(&mut self.times))
+    }
+}

@@ -1,0 +1,9 @@
+//! The wgpu runtime: device set-up ([`context`]) and the [`Backend`]
+//! implementation that records, times and submits dispatches ([`backend`]).
+//!
+//! [`Backend`]: crate::backend::Backend
+pub mod backend;
+pub mod context;
+
+pub use backend::GpuBackend;
+pub use context::GpuContext;

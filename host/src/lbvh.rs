@@ -1,0 +1,100 @@
+//! The LBVH build of Karras 2012, stage by stage, over any [`Backend`]:
+//! primitive boxes → centroid bounds → Morton codes → radix sort →
+//! radix tree → bottom-up fit. The kernels live in `treelet-core`.
+use anyhow::Result;
+use treelet_core::aabb::Aabb;
+use treelet_core::bounds::REDUCE_TILE;
+use treelet_core::layout::{BuildParams, Node, Sphere};
+use treelet_core::morton::{MortonFrame, KEY_BITS};
+use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+
+use crate::backend::{check_fits, Backend, StageTimes};
+use crate::kernels::Kernel;
+
+/// The stages of a build, in order, as named in timings and reports.
+pub const STAGES: [&str; 5] = ["bounds", "morton", "sort", "tree", "fit"];
+
+/// A built BVH, read back from the device.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    /// `2n - 1` nodes (none for an empty scene); the root is node 0.
+    pub nodes: Vec<Node>,
+    /// Parent of each node; `INVALID` for the root.
+    pub parents: Vec<u32>,
+    /// Primitive index of each sorted position (leaves point into this).
+    pub prim_indices: Vec<u32>,
+    /// Morton keys in sorted order.
+    pub sorted_keys: Vec<u64>,
+    /// Centroid bounds used for the Morton frame.
+    pub centroid_bounds: Aabb,
+}
+
+/// Builds the LBVH of `spheres` on `b`. Inputs must be finite (see
+/// [`crate::scene::validate_spheres`]). Returns the tree and stage times.
+pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTimes)> {
+    let n = u32::try_from(spheres.len())
+        .ok()
+        .filter(|&n| n <= MAX_PRIMITIVES)
+        .ok_or_else(|| anyhow::anyhow!("{} primitives: at most {MAX_PRIMITIVES} are supported", spheres.len()))?;
+    if n == 0 {
+        return Ok((Bvh::default(), b.take_times()?));
+    }
+    let node_count = 2 * n as u64 - 1;
+    // Fail before any GPU work when the largest buffer does not fit.
+    check_fits(b, "nodes", node_count * std::mem::size_of::<Node>() as u64)?;
+
+    b.stage("bounds");
+    let mut params = BuildParams { n, ..Default::default() };
+    let spheres_buf = b.upload("spheres", spheres)?;
+    let boxes = b.zeroed("primitive boxes", n as u64 * 32)?;
+    let p = b.upload("build params", &[params])?;
+    b.dispatch(Kernel::SphereBoxes, &[&p, &spheres_buf, &boxes], groups_for(n, WORKGROUP_SIZE));
+    // Reduce centroids, then partial boxes, until one box remains.
+    let (mut input, mut len, mut centroids) = (boxes.clone(), n, 1);
+    let centroid_bounds = loop {
+        let groups = groups_for(len, REDUCE_TILE);
+        let output = b.zeroed("bounds partials", groups as u64 * 32)?;
+        let rp = b.upload(
+            "reduce params",
+            &[BuildParams { reduce_len: len, reduce_centroids: centroids, ..params }],
+        )?;
+        b.dispatch(Kernel::ReduceBounds, &[&rp, &input, &output], groups);
+        if groups == 1 {
+            break b.read::<Aabb>(&output, 1)?[0];
+        }
+        (input, len, centroids) = (output, groups, 0);
+    };
+
+    b.stage("morton");
+    MortonFrame::new(&centroid_bounds).to_params(&mut params);
+    let p = b.upload("build params", &[params])?;
+    let keys = b.zeroed("morton keys", n as u64 * 8)?;
+    let values = b.zeroed("primitive indices", n as u64 * 4)?;
+    b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
+
+    b.stage("sort");
+    let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, KEY_BITS)?;
+
+    b.stage("tree");
+    let nodes = b.zeroed("nodes", node_count * 32)?;
+    let parents = b.zeroed("parents", node_count * 4)?;
+    b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
+
+    b.stage("fit");
+    let flags = b.zeroed("fit flags", (n as u64 - 1) * 4)?;
+    let fit = if b.fences_in_divergent_flow() { Kernel::Fit } else { Kernel::FitUnfenced };
+    b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
+
+    let times = b.take_times()?;
+    let bvh = Bvh {
+        nodes: b.read(&nodes, node_count as usize)?,
+        parents: b.read(&parents, node_count as usize)?,
+        prim_indices: b.read(&values, n as usize)?,
+        sorted_keys: b.read(&keys, n as usize)?,
+        centroid_bounds,
+    };
+    Ok((bvh, times))
+}
+
+/// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.
+pub const MAX_PRIMITIVES: u32 = 1 << 30;

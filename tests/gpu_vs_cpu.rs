@@ -1,0 +1,75 @@
+//! GPU results against the CPU run of the same kernel functions, on fresh
+//! random inputs: integer stages bit for bit, boxes exactly (min and max are
+//! exact in floating point), plus invariants that do not use the builder.
+use rand::{Rng, SeedableRng};
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::GpuBackend;
+use treelet::lbvh;
+use treelet::scene::random_spheres;
+use treelet::validate::validate;
+use treelet_core::Sphere;
+use treelet_tests::gpu;
+
+fn fresh_seed() -> u64 {
+    let seed = rand::rng().random();
+    eprintln!("seed {seed}");
+    seed
+}
+
+fn compare_builds(spheres: &[Sphere], what: &str) {
+    let Some(ctx) = gpu() else { return };
+    let (g, _) = lbvh::build(&mut GpuBackend::new(ctx), spheres).unwrap();
+    let (c, _) = lbvh::build(&mut CpuBackend::new(), spheres).unwrap();
+    assert_eq!(g.centroid_bounds, c.centroid_bounds, "{what}: centroid bounds");
+    if let Some(i) = (0..c.sorted_keys.len()).find(|&i| g.sorted_keys[i] != c.sorted_keys[i]) {
+        panic!("{what}: sorted keys differ first at {i}: gpu {:#x} cpu {:#x}", g.sorted_keys[i], c.sorted_keys[i]);
+    }
+    assert_eq!(g.prim_indices, c.prim_indices, "{what}: sorted primitive order");
+    if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
+        panic!("{what}: node {i} differs: gpu {:?} cpu {:?}", g.nodes[i], c.nodes[i]);
+    }
+    assert_eq!(g.parents, c.parents, "{what}: parents");
+    let v = validate(spheres, &g.nodes, &g.parents, &g.prim_indices);
+    assert!(v.is_valid(), "{what}: GPU tree invalid: {:?}", v.errors);
+}
+
+#[test]
+fn lbvh_matches_cpu_on_random_scenes() {
+    let seed = fresh_seed();
+    for n in [1usize, 2, 3, 7, 8, 1000, 4096, 30_000] {
+        compare_builds(&random_spheres(n, seed ^ n as u64), &format!("random:{n}:{seed}"));
+    }
+}
+
+#[test]
+fn sort_matches_cpu_and_std_on_random_keys() {
+    let Some(ctx) = gpu() else { return };
+    let seed = fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    for n in [1u32, 255, 256, 2049, 70_000] {
+        // Few distinct high bits, so that many keys tie on some passes.
+        let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
+        let values: Vec<u32> = (0..n).collect();
+        let sort_on = |b: &mut dyn FnMut(&[u64], &[u32]) -> (Vec<u64>, Vec<u32>)| b(&keys, &values);
+        let mut gpu_sort = |k: &[u64], v: &[u32]| run_sort(&mut GpuBackend::new(ctx.clone()), k, v);
+        let mut cpu_sort = |k: &[u64], v: &[u32]| run_sort(&mut CpuBackend::new(), k, v);
+        let g = sort_on(&mut gpu_sort);
+        let c = sort_on(&mut cpu_sort);
+        let mut expected: Vec<(u64, u32)> = keys.iter().copied().zip(values.iter().copied()).collect();
+        expected.sort_by_key(|&(k, _)| k); // stable, like the radix sort
+        let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
+        assert_eq!(c.0, ek, "cpu keys, n = {n}");
+        assert_eq!(c.1, ev, "cpu values (stability), n = {n}");
+        assert_eq!(g.0, ek, "gpu keys, n = {n}");
+        assert_eq!(g.1, ev, "gpu values (stability), n = {n}");
+    }
+}
+
+fn run_sort<B: Backend>(b: &mut B, keys: &[u64], values: &[u32]) -> (Vec<u64>, Vec<u32>) {
+    let n = keys.len() as u32;
+    let kb = b.upload("keys", keys).unwrap();
+    let vb = b.upload("values", values).unwrap();
+    let (k, v) = treelet::sort::radix_sort(b, &kb, &vb, n, 64).unwrap();
+    (b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap())
+}
