@@ -5,38 +5,13 @@ use rand::{Rng, SeedableRng};
 use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
-use treelet::lbvh;
 use treelet::scene::random_spheres;
-use treelet::validate::validate;
-use treelet_core::Sphere;
-use treelet_tests::gpu;
+use treelet_tests::{compare_builds, gpu};
 
-fn fresh_seed() -> u64 {
-    let seed = rand::rng().random();
-    eprintln!("seed {seed}");
-    seed
-}
-
-fn compare_builds(spheres: &[Sphere], what: &str) {
-    let Some(ctx) = gpu() else { return };
-    let (g, _) = lbvh::build(&mut GpuBackend::new(ctx), spheres).unwrap();
-    let (c, _) = lbvh::build(&mut CpuBackend::new(), spheres).unwrap();
-    assert_eq!(g.centroid_bounds, c.centroid_bounds, "{what}: centroid bounds");
-    if let Some(i) = (0..c.sorted_keys.len()).find(|&i| g.sorted_keys[i] != c.sorted_keys[i]) {
-        panic!("{what}: sorted keys differ first at {i}: gpu {:#x} cpu {:#x}", g.sorted_keys[i], c.sorted_keys[i]);
-    }
-    assert_eq!(g.prim_indices, c.prim_indices, "{what}: sorted primitive order");
-    if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
-        panic!("{what}: node {i} differs: gpu {:?} cpu {:?}", g.nodes[i], c.nodes[i]);
-    }
-    assert_eq!(g.parents, c.parents, "{what}: parents");
-    let v = validate(spheres, &g.nodes, &g.parents, &g.prim_indices);
-    assert!(v.is_valid(), "{what}: GPU tree invalid: {:?}", v.errors);
-}
 
 #[test]
 fn lbvh_matches_cpu_on_random_scenes() {
-    let seed = fresh_seed();
+    let seed = treelet_tests::fresh_seed();
     for n in [1usize, 2, 3, 7, 8, 1000, 4096, 30_000] {
         compare_builds(&random_spheres(n, seed ^ n as u64), &format!("random:{n}:{seed}"));
     }
@@ -45,7 +20,7 @@ fn lbvh_matches_cpu_on_random_scenes() {
 #[test]
 fn sort_matches_cpu_and_std_on_random_keys() {
     let Some(ctx) = gpu() else { return };
-    let seed = fresh_seed();
+    let seed = treelet_tests::fresh_seed();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     for n in [1u32, 255, 256, 2049, 70_000] {
         // Few distinct high bits, so that many keys tie on some passes.

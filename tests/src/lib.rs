@@ -16,3 +16,46 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
         }
     }
 }
+
+use rand::Rng;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::GpuBackend;
+use treelet::lbvh::{self, Bvh};
+use treelet::validate::validate;
+use treelet_core::Sphere;
+
+/// A fresh random seed, printed so that a failure can be replayed.
+pub fn fresh_seed() -> u64 {
+    let seed = rand::rng().random();
+    eprintln!("seed {seed}");
+    seed
+}
+
+/// Builds on the CPU runner, checks the tree with the independent validator.
+pub fn build_cpu_checked(spheres: &[Sphere], what: &str) -> Bvh {
+    treelet::scene::validate_spheres(spheres).unwrap();
+    let (c, _) = lbvh::build(&mut CpuBackend::new(), spheres).unwrap();
+    let v = validate(spheres, &c.nodes, &c.parents, &c.prim_indices);
+    assert!(v.is_valid(), "{what}: CPU tree invalid: {:?}", v.errors);
+    c
+}
+
+/// Builds on the GPU and on the CPU runner; requires identical keys, order,
+/// topology and boxes, and a valid tree. Without a GPU (outside CI), checks
+/// the CPU tree alone and says so.
+pub fn compare_builds(spheres: &[Sphere], what: &str) {
+    let c = build_cpu_checked(spheres, what);
+    let Some(ctx) = gpu() else { return };
+    let (g, _) = lbvh::build(&mut GpuBackend::new(ctx), spheres).unwrap();
+    assert_eq!(g.centroid_bounds, c.centroid_bounds, "{what}: centroid bounds");
+    if let Some(i) = (0..c.sorted_keys.len()).find(|&i| g.sorted_keys[i] != c.sorted_keys[i]) {
+        panic!("{what}: sorted keys differ first at {i}: gpu {:#x} cpu {:#x}", g.sorted_keys[i], c.sorted_keys[i]);
+    }
+    assert_eq!(g.prim_indices, c.prim_indices, "{what}: sorted primitive order");
+    if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
+        panic!("{what}: node {i} differs: gpu {:?} cpu {:?}", g.nodes[i], c.nodes[i]);
+    }
+    assert_eq!(g.parents, c.parents, "{what}: parents");
+    let v = validate(spheres, &g.nodes, &g.parents, &g.prim_indices);
+    assert!(v.is_valid(), "{what}: GPU tree invalid: {:?}", v.errors);
+}
