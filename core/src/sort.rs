@@ -1,16 +1,17 @@
 //! Stable LSD radix sort of `(u64 key, u32 value)` pairs, 8 bits per pass.
 //!
 //! Each pass runs three stages over tiles of [`SORT_TILE`] keys:
-//! 1. [`histogram`]: each workgroup counts the digits of its tile in
+//! 1. [`histogram_phase`]: each workgroup counts the digits of its tile in
 //!    workgroup memory and writes them *digit-major*:
 //!    `block_hist[digit * blocks + tile]`;
 //! 2. an exclusive prefix sum over that array ([`crate::scan`]), after which
 //!    entry `(digit, tile)` is where the tile's first key of that digit goes;
-//! 3. [`scatter`]: each workgroup walks its tile in rounds of
+//! 3. [`scatter_phase`]: each workgroup walks its tile in rounds of
 //!    `WORKGROUP_SIZE` consecutive keys; an invocation's rank among equal
 //!    digits of its round is the number of lower local ids holding the same
-//!    digit (a broadcast read of workgroup memory per id), so the scatter is
-//!    stable and the result is identical on every device and on the CPU.
+//!    digit, counted four at a time over digits packed into bytes
+//!    ([`rank_in_round`]), so the scatter is stable and the result is
+//!    identical on every device and on the CPU.
 //!
 //! Kernels are phase functions: see [`crate::workgroup`].
 //!
@@ -29,8 +30,6 @@ const _: () = assert!(RADIX == WORKGROUP_SIZE);
 pub const SORT_ITEMS: u32 = 8;
 /// Keys per workgroup of [`histogram`] and [`scatter`].
 pub const SORT_TILE: u32 = WORKGROUP_SIZE * SORT_ITEMS;
-/// Marks an invocation without a key in the current round.
-const NO_DIGIT: u32 = u32::MAX;
 
 /// Passes needed to sort keys of `key_bits` significant bits.
 #[inline]
@@ -76,9 +75,45 @@ pub fn histogram_phase(
     }
 }
 
-/// Phases of [`scatter_phase`]: load offsets, then three per round of
-/// `WORKGROUP_SIZE` keys (read digits; rank and move; advance offsets).
-pub const SCATTER_PHASES: u32 = 1 + 3 * SORT_ITEMS;
+/// Phases of [`scatter_phase`]: load offsets, then four per round of
+/// `WORKGROUP_SIZE` keys (read digits; pack them; rank and move; advance).
+pub const SCATTER_PHASES: u32 = 1 + 4 * SORT_ITEMS;
+/// Digits packed four to a word, one byte each.
+pub const PACKED_DIGITS: usize = WG / 4;
+
+/// Bit 7 of each byte of the result is set where that byte of `x` is zero
+/// (exact, no carries between bytes).
+#[inline]
+fn zero_bytes(x: u32) -> u32 {
+    let t = (x & 0x7f7f_7f7f) + 0x7f7f_7f7f;
+    !(t | x | 0x7f7f_7f7f)
+}
+
+/// Rank of invocation `lid`'s digit `d` among the first `valid` digits of the
+/// round, and whether a later invocation holds the same digit. Compares four
+/// packed digits per step, so a rank costs `WORKGROUP_SIZE / 4` steps.
+#[inline]
+pub fn rank_in_round(packed: &[u32; PACKED_DIGITS], valid: u32, lid: u32, d: u32) -> (u32, bool) {
+    let pattern = d * 0x0101_0101;
+    let words = valid.div_ceil(4);
+    let (my_word, my_byte) = (lid / 4, lid % 4);
+    let mut before = 0;
+    let mut total = 0;
+    for w in 0..words {
+        let mut hits = zero_bytes(packed[w as usize] ^ pattern);
+        if w == words - 1 && valid % 4 != 0 {
+            hits &= (1u32 << (8 * (valid % 4))) - 1; // bytes past `valid` hold no key
+        }
+        let count = hits.count_ones();
+        total += count;
+        if w < my_word {
+            before += count;
+        } else if w == my_word {
+            before += (hits & ((1u32 << (8 * my_byte)) - 1)).count_ones();
+        }
+    }
+    (before, total > before + 1)
+}
 
 /// Kernel: moves the tile's pairs to their sorted places. `offsets` is the
 /// scanned `block_hist`.
@@ -95,6 +130,7 @@ pub fn scatter_phase(
     values_out: &mut [u32],
     running: &mut [u32; WG],
     digits: &mut [u32; WG],
+    packed: &mut [u32; PACKED_DIGITS],
     round_count: &mut [u32; WG],
 ) {
     let l = lid as usize;
@@ -104,29 +140,28 @@ pub fn scatter_phase(
         }
         return;
     }
-    let round = (phase - 1) / 3;
-    let i = key_index(tile, round, lid);
-    match (phase - 1) % 3 {
+    let round = (phase - 1) / 4;
+    let first = key_index(tile, round, 0);
+    // Keys of the round sit at local ids 0..valid (only the last tile is short).
+    let valid = if first < params.n { (params.n - first).min(WORKGROUP_SIZE) } else { 0 };
+    let i = first + lid;
+    match (phase - 1) % 4 {
         0 => {
-            digits[l] = if i < params.n { digit(keys_in[i as usize], params.shift) } else { NO_DIGIT };
+            digits[l] = if lid < valid { digit(keys_in[i as usize], params.shift) } else { 0 };
         }
         1 => {
-            let d = digits[l];
+            if l < PACKED_DIGITS {
+                let b = 4 * l;
+                packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
+            }
+        }
+        2 => {
             // Nonzero only on the last invocation of each digit in this
             // round: how many keys of that digit the round held.
             round_count[l] = 0;
-            if d != NO_DIGIT {
-                let mut before = 0u32;
-                let mut later = false;
-                for j in 0..WORKGROUP_SIZE {
-                    if digits[j as usize] == d {
-                        if j < lid {
-                            before += 1;
-                        } else if j > lid {
-                            later = true;
-                        }
-                    }
-                }
+            if lid < valid {
+                let d = digits[l];
+                let (before, later) = rank_in_round(packed, valid, lid, d);
                 let dest = (running[d as usize] + before) as usize;
                 keys_out[dest] = keys_in[i as usize];
                 values_out[dest] = values_in[i as usize];
@@ -139,6 +174,39 @@ pub fn scatter_phase(
             let c = round_count[l];
             if c != 0 {
                 running[digits[l] as usize] += c;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zero_bytes_is_exact() {
+        for x in [0u32, 0x0100_0000, 0x0001_0001, 0x8000_0080, 0xffff_ff00, 0x00ff_00ff, 0x0101_0101] {
+            let expected = (0..4).filter(|b| (x >> (8 * b)) & 0xff == 0).fold(0, |m, b| m | 0x80 << (8 * b));
+            assert_eq!(zero_bytes(x), expected, "{x:#x}");
+        }
+    }
+
+    #[test]
+    fn rank_matches_a_direct_count() {
+        let mut digits = [0u32; WG];
+        for (i, d) in digits.iter_mut().enumerate() {
+            *d = ((i * 7919) % 13) as u32 * 17 % 256;
+        }
+        let mut packed = [0u32; PACKED_DIGITS];
+        for w in 0..PACKED_DIGITS {
+            packed[w] = (0..4).fold(0, |acc, b| acc | digits[4 * w + b] << (8 * b));
+        }
+        for valid in [0u32, 1, 5, 128, 255, 256] {
+            for lid in 0..valid {
+                let d = digits[lid as usize];
+                let before = (0..lid).filter(|&j| digits[j as usize] == d).count() as u32;
+                let later = (lid + 1..valid).any(|j| digits[j as usize] == d);
+                assert_eq!(rank_in_round(&packed, valid, lid, d), (before, later), "valid {valid} lid {lid}");
             }
         }
     }

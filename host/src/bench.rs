@@ -5,7 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
-use treelet::lbvh::{self, STAGES};
+use treelet::lbvh;
 use treelet::scene::random_spheres;
 
 use crate::Device;
@@ -25,13 +25,17 @@ pub enum BenchCommand {
         /// Also write the rows as JSON to this file.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
+        /// Time each kernel alone (GPU only) instead of each stage.
+        #[arg(long)]
+        per_kernel: bool,
     },
 }
 
 #[derive(serde::Serialize)]
 struct Row {
     primitives: usize,
-    median_ms: std::collections::BTreeMap<&'static str, f64>,
+    /// Median per stage (or per kernel, with --per-kernel), in the order run.
+    median_ms: Vec<(&'static str, f64)>,
     total_median_ms: f64,
     total_min_ms: f64,
     total_max_ms: f64,
@@ -51,7 +55,8 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
     for &n in sizes {
         bar.set_message(format!("N = {n}"));
         let spheres = random_spheres(n, 1);
-        let mut per_stage: Vec<Vec<f64>> = vec![Vec::new(); STAGES.len()];
+        let mut names: Vec<&'static str> = Vec::new();
+        let mut samples: std::collections::BTreeMap<&'static str, Vec<f64>> = Default::default();
         let mut totals = Vec::new();
         for rep in 0..=repeats {
             let (_, times) = lbvh::build(b, &spheres)?;
@@ -59,15 +64,18 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
             if rep == 0 {
                 continue; // warm-up
             }
-            for (k, s) in STAGES.iter().enumerate() {
-                per_stage[k].push(times.get(s));
+            for s in &times.order {
+                if !names.contains(s) {
+                    names.push(s);
+                }
+                samples.entry(s).or_default().push(times.get(s));
             }
             totals.push(times.total());
         }
         let total_median_ms = median(totals.clone());
         rows.push(Row {
             primitives: n,
-            median_ms: STAGES.iter().zip(per_stage).map(|(s, v)| (*s, median(v))).collect(),
+            median_ms: names.iter().map(|s| (*s, median(samples[s].clone()))).collect(),
             total_median_ms,
             total_min_ms: totals.iter().copied().fold(f64::MAX, f64::min),
             total_max_ms: totals.iter().copied().fold(0.0, f64::max),
@@ -80,10 +88,10 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
-        BenchCommand::Build { sizes, device, repeats, json } => {
+        BenchCommand::Build { sizes, device, repeats, json, per_kernel } => {
             let (adapter, timing, rows) = match device {
                 Device::Gpu => {
-                    let mut b = GpuBackend::new(GpuContext::new()?);
+                    let mut b = GpuBackend::new(GpuContext::new()?).with_per_kernel_times(per_kernel);
                     let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
                     (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats)?)
                 }
@@ -93,15 +101,18 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 }
             };
             println!("LBVH build, {adapter} ({timing}), median of {repeats} (ms)");
+            let names: Vec<&str> = rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
+            let short = |s: &str| s.rsplit("::").next().unwrap_or(s).trim_end_matches("_cs").to_string();
+            let width = names.iter().map(|s| short(s).len() + 2).max().unwrap_or(9).max(9);
             print!("{:>10}", "N");
-            for s in STAGES {
-                print!("{s:>9}");
+            for s in &names {
+                print!("{:>width$}", short(s));
             }
             println!("{:>10}{:>10}", "total", "Mprims/s");
             for r in &rows {
                 print!("{:>10}", r.primitives);
-                for s in STAGES {
-                    print!("{:>9.3}", r.median_ms[s]);
+                for (_, v) in &r.median_ms {
+                    print!("{v:>width$.3}");
                 }
                 println!("{:>10.3}{:>10.1}", r.total_median_ms, r.mprims_per_s);
             }

@@ -34,13 +34,14 @@ pub fn sort_scatter_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] values_out: &mut [u32],
     #[spirv(workgroup)] running: &mut [u32; WG],
     #[spirv(workgroup)] digits: &mut [u32; WG],
+    #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
     #[spirv(workgroup)] round_count: &mut [u32; WG],
 ) {
     let tile = linear_group(group.x, group.y, groups.x);
     for phase in 0..sort::SCATTER_PHASES {
         sort::scatter_phase(
             phase, lid, tile, params, keys_in, values_in, offsets, keys_out, values_out, running,
-            digits, round_count,
+            digits, packed, round_count,
         );
         barrier();
     }

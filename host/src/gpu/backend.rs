@@ -32,6 +32,8 @@ struct Segment {
 
 pub struct GpuBackend {
     ctx: Arc<GpuContext>,
+    /// Time each dispatch alone, under its kernel's name (profiling).
+    per_kernel: bool,
     stage: &'static str,
     pending: Vec<Segment>,
     times: StageTimes,
@@ -39,7 +41,14 @@ pub struct GpuBackend {
 
 impl GpuBackend {
     pub fn new(ctx: Arc<GpuContext>) -> Self {
-        Self { ctx, stage: "unnamed", pending: Vec::new(), times: StageTimes::default() }
+        Self { ctx, per_kernel: false, stage: "unnamed", pending: Vec::new(), times: StageTimes::default() }
+    }
+
+    /// Times every dispatch in its own pass, named by its entry point,
+    /// instead of one pass per stage. Adds a little overhead per dispatch.
+    pub fn with_per_kernel_times(mut self, on: bool) -> Self {
+        self.per_kernel = on;
+        self
     }
 
     pub fn context(&self) -> &Arc<GpuContext> {
@@ -201,6 +210,10 @@ impl Backend for GpuBackend {
             entries: &entries,
         });
         let dispatch = Dispatch { kernel, bind_group, grid: dispatch_grid(groups) };
+        if self.per_kernel {
+            self.pending.push(Segment { stage: kernel.entry_point(), dispatches: vec![dispatch] });
+            return;
+        }
         match self.pending.last_mut() {
             Some(seg) if seg.stage == self.stage => seg.dispatches.push(dispatch),
             _ => self.pending.push(Segment { stage: self.stage, dispatches: vec![dispatch] }),
