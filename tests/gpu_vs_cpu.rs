@@ -48,3 +48,19 @@ fn run_sort<B: Backend>(b: &mut B, keys: &[u64], values: &[u32]) -> (Vec<u64>, V
     let (k, v) = treelet::sort::radix_sort(b, &kb, &vb, n, 64).unwrap();
     (b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap())
 }
+
+/// Builds on one GPU backend reuse its buffers; stale contents (the fit's
+/// arrival counters above all) must never leak into the next build.
+#[test]
+fn repeated_builds_on_one_backend_stay_correct() {
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed();
+    let mut backend = GpuBackend::new(ctx);
+    for (k, n) in [5000usize, 5000, 5000, 777, 5000].into_iter().enumerate() {
+        let spheres = random_spheres(n, seed.wrapping_add(k as u64));
+        let (g, _) = treelet::lbvh::build(&mut backend, &spheres).unwrap();
+        let c = treelet_tests::build_cpu_checked(&spheres, "reuse");
+        assert_eq!(g.nodes, c.nodes, "build {k} (n = {n}) on a reused backend differs from the CPU");
+        assert_eq!(g.prim_indices, c.prim_indices, "build {k}");
+    }
+}

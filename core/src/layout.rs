@@ -114,3 +114,15 @@ pub struct ScanParams {
     pub _pad0: [u32; 2],
 }
 const _: () = assert!(core::mem::size_of::<ScanParams>() == 16);
+
+/// Parameters of [`crate::fill::fill_kernel`]. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct FillParams {
+    /// Number of u32s to write.
+    pub len: u32,
+    pub value: u32,
+    pub _pad0: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<FillParams>() == 16);

@@ -37,6 +37,7 @@
 pub mod aabb;
 pub mod atomics;
 pub mod bounds;
+pub mod fill;
 pub mod fit;
 pub mod layout;
 pub mod morton;
@@ -48,5 +49,5 @@ pub mod sort;
 pub mod workgroup;
 
 pub use aabb::Aabb;
-pub use layout::{BuildParams, Node, ScanParams, SortParams, Sphere, INVALID, LEAF_BIT};
+pub use layout::{BuildParams, FillParams, Node, ScanParams, SortParams, Sphere, INVALID, LEAF_BIT};
 pub use workgroup::WORKGROUP_SIZE;

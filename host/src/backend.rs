@@ -7,6 +7,9 @@ use std::collections::BTreeMap;
 use anyhow::Result;
 use bytemuck::Pod;
 
+use treelet_core::layout::FillParams;
+use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+
 use crate::kernels::Kernel;
 
 /// Milliseconds per named stage, in the order the stages first ran.
@@ -50,8 +53,21 @@ pub trait Backend {
     fn max_buffer_bytes(&self) -> u64;
     /// A buffer holding `data`.
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
-    /// A zero-filled buffer of at least `bytes` bytes.
-    fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer>;
+    /// A buffer of at least `bytes` bytes whose contents are undefined
+    /// (kernels overwrite it). May be a buffer of an earlier build.
+    fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer>;
+    /// A buffer of at least `bytes` bytes (a multiple of 4), zeroed by a
+    /// fill dispatch in the current stage, so the cost shows in its time.
+    fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer> {
+        let buffer = self.scratch(label, bytes)?;
+        let len = u32::try_from(bytes / 4).map_err(|_| anyhow::anyhow!("buffer `{label}` too large to fill"))?;
+        let params = self.upload("fill params", &[FillParams { len, value: 0, _pad0: [0; 2] }])?;
+        self.dispatch(Kernel::Fill, &[&params, &buffer], groups_for(len, WORKGROUP_SIZE));
+        Ok(buffer)
+    }
+    /// Starts a new build: buffers handed out for the previous one may be
+    /// handed out again (their results must have been read back).
+    fn begin_build(&mut self) {}
     /// Dispatches that follow belong to `stage` (for timing).
     fn stage(&mut self, stage: &'static str);
     /// Runs `kernel` over `groups` workgroups with these bindings (params first).

@@ -12,7 +12,7 @@ use anyhow::Result;
 use bytemuck::Pod;
 use treelet_core::aabb::Aabb;
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{bounds, fit, morton, radix_tree, scan, scene, sort};
+use treelet_core::{bounds, fill, fit, morton, radix_tree, scan, scene, sort};
 
 use crate::backend::{Backend, StageTimes};
 use crate::kernels::Kernel;
@@ -87,7 +87,7 @@ impl Backend for CpuBackend {
         Ok(Rc::new(RefCell::new(words)))
     }
 
-    fn zeroed(&mut self, _label: &'static str, bytes: u64) -> Result<CpuBuffer> {
+    fn scratch(&mut self, _label: &'static str, bytes: u64) -> Result<CpuBuffer> {
         Ok(Rc::new(RefCell::new(vec![0u64; (bytes as usize).div_ceil(8).max(1)])))
     }
 
@@ -119,6 +119,13 @@ impl Backend for CpuBackend {
 /// Calls the core function of `kernel` for every invocation of the dispatch.
 fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
     match (kernel, b) {
+        (Kernel::Fill, [p, data]) => {
+            let p: treelet_core::FillParams = params(p);
+            let data = view(data);
+            for id in ids(groups) {
+                fill::fill_kernel(id, &p, data);
+            }
+        }
         (Kernel::SphereBoxes, [p, spheres, boxes]) => {
             let p: treelet_core::BuildParams = params(p);
             let (spheres, boxes) = (view(spheres), view(boxes));

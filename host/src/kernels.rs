@@ -13,6 +13,7 @@ use Access::{Read, ReadWrite};
 /// Every compute kernel of Treelet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Kernel {
+    Fill,
     SphereBoxes,
     ReduceBounds,
     Morton,
@@ -28,7 +29,8 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 11] = [
+    pub const ALL: [Kernel; 12] = [
+        Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
         Kernel::Morton,
@@ -45,6 +47,7 @@ impl Kernel {
     /// Name of the entry point in the shader crate (`<module>::<name>`).
     pub fn entry_point(self) -> &'static str {
         match self {
+            Kernel::Fill => "fill::fill_cs",
             Kernel::SphereBoxes => "scene::sphere_boxes_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
@@ -62,6 +65,7 @@ impl Kernel {
     /// Bindings in order; binding 0 is always the parameter struct.
     pub fn bindings(self) -> &'static [Access] {
         match self {
+            Kernel::Fill => &[Read, ReadWrite],
             Kernel::SphereBoxes => &[Read, Read, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite],

@@ -36,6 +36,7 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
         .ok()
         .filter(|&n| n <= MAX_PRIMITIVES)
         .ok_or_else(|| anyhow::anyhow!("{} primitives: at most {MAX_PRIMITIVES} are supported", spheres.len()))?;
+    b.begin_build();
     if n == 0 {
         return Ok((Bvh::default(), b.take_times()?));
     }
@@ -46,14 +47,14 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
     b.stage("bounds");
     let mut params = BuildParams { n, ..Default::default() };
     let spheres_buf = b.upload("spheres", spheres)?;
-    let boxes = b.zeroed("primitive boxes", n as u64 * 32)?;
+    let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
     b.dispatch(Kernel::SphereBoxes, &[&p, &spheres_buf, &boxes], groups_for(n, WORKGROUP_SIZE));
     // Reduce centroids, then partial boxes, until one box remains.
     let (mut input, mut len, mut centroids) = (boxes.clone(), n, 1);
     let centroid_bounds = loop {
         let groups = groups_for(len, REDUCE_TILE);
-        let output = b.zeroed("bounds partials", groups as u64 * 32)?;
+        let output = b.scratch("bounds partials", groups as u64 * 32)?;
         let rp = b.upload(
             "reduce params",
             &[BuildParams { reduce_len: len, reduce_centroids: centroids, ..params }],
@@ -68,16 +69,16 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
     b.stage("morton");
     MortonFrame::new(&centroid_bounds).to_params(&mut params);
     let p = b.upload("build params", &[params])?;
-    let keys = b.zeroed("morton keys", n as u64 * 8)?;
-    let values = b.zeroed("primitive indices", n as u64 * 4)?;
+    let keys = b.scratch("morton keys", n as u64 * 8)?;
+    let values = b.scratch("primitive indices", n as u64 * 4)?;
     b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
     let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, KEY_BITS)?;
 
     b.stage("tree");
-    let nodes = b.zeroed("nodes", node_count * 32)?;
-    let parents = b.zeroed("parents", node_count * 4)?;
+    let nodes = b.scratch("nodes", node_count * 32)?;
+    let parents = b.scratch("parents", node_count * 4)?;
     b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
 
     b.stage("fit");

@@ -16,7 +16,7 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
         return Ok(());
     }
     let params = b.upload("scan params", &[ScanParams { len, tiles, _pad0: [0; 2] }])?;
-    let partials = b.zeroed("scan partials", tiles as u64 * 4)?;
+    let partials = b.scratch("scan partials", tiles as u64 * 4)?;
     b.dispatch(Kernel::ScanReduce, &[&params, data, &partials], tiles);
     b.dispatch(Kernel::ScanSpine, &[&params, &partials], 1);
     b.dispatch(Kernel::ScanDownsweep, &[&params, data, &partials], tiles);
@@ -38,9 +38,9 @@ pub fn radix_sort<B: Backend>(
     if n < 2 {
         return Ok(src);
     }
-    let mut dst = (b.zeroed("sort keys scratch", n as u64 * 8)?, b.zeroed("sort values scratch", n as u64 * 4)?);
+    let mut dst = (b.scratch("sort keys scratch", n as u64 * 8)?, b.scratch("sort values scratch", n as u64 * 4)?);
     let hist_len = RADIX * blocks;
-    let hist = b.zeroed("sort histogram", hist_len as u64 * 4)?;
+    let hist = b.scratch("sort histogram", hist_len as u64 * 4)?;
     for pass in 0..passes_for(key_bits) {
         let params = b.upload("sort params", &[SortParams { n, shift: pass * RADIX_BITS, blocks, _pad0: 0 }])?;
         b.dispatch(Kernel::SortHistogram, &[&params, &src.0, &hist], blocks);

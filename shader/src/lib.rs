@@ -7,6 +7,7 @@
 #![cfg_attr(target_arch = "spirv", no_std)]
 
 pub mod bounds;
+pub mod fill;
 pub mod fit;
 pub mod morton;
 pub mod radix_tree;

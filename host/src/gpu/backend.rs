@@ -8,7 +8,6 @@ use std::time::Instant;
 use anyhow::{Context as _, Result};
 use bytemuck::Pod;
 use treelet_core::workgroup::dispatch_grid;
-use wgpu::util::DeviceExt;
 
 use super::context::GpuContext;
 use crate::backend::{Backend, StageTimes};
@@ -30,8 +29,16 @@ struct Segment {
     dispatches: Vec<Dispatch>,
 }
 
+/// Buffers are pooled by label and size, so repeated builds of one scene
+/// size allocate nothing after the first.
+type PoolKey = (&'static str, u64);
+
 pub struct GpuBackend {
     ctx: Arc<GpuContext>,
+    /// Buffers of the previous build, free to hand out again.
+    free: std::collections::HashMap<PoolKey, Vec<wgpu::Buffer>>,
+    /// Buffers handed out since the last `begin_build`.
+    used: Vec<(PoolKey, wgpu::Buffer)>,
     /// Time each dispatch alone, under its kernel's name (profiling).
     per_kernel: bool,
     stage: &'static str,
@@ -41,7 +48,15 @@ pub struct GpuBackend {
 
 impl GpuBackend {
     pub fn new(ctx: Arc<GpuContext>) -> Self {
-        Self { ctx, per_kernel: false, stage: "unnamed", pending: Vec::new(), times: StageTimes::default() }
+        Self {
+            ctx,
+            free: Default::default(),
+            used: Vec::new(),
+            per_kernel: false,
+            stage: "unnamed",
+            pending: Vec::new(),
+            times: StageTimes::default(),
+        }
     }
 
     /// Times every dispatch in its own pass, named by its entry point,
@@ -69,6 +84,21 @@ impl GpuBackend {
             pass.set_bind_group(0, &d.bind_group, &[]);
             pass.dispatch_workgroups(d.grid[0], d.grid[1], 1);
         }
+    }
+
+    /// A storage buffer of exactly `size` bytes, from the pool if one is free.
+    fn take_buffer(&mut self, label: &'static str, size: u64) -> wgpu::Buffer {
+        let key = (label, size);
+        let buffer = self.free.get_mut(&key).and_then(Vec::pop).unwrap_or_else(|| {
+            self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
+        self.used.push((key, buffer.clone()));
+        buffer
     }
 
     fn wait(&self) -> Result<()> {
@@ -164,30 +194,30 @@ impl Backend for GpuBackend {
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         crate::backend::check_fits(self, label, bytes.len() as u64)?;
-        let padded_len = (bytes.len() as u64).max(MIN_BUFFER).next_multiple_of(4) as usize;
-        let contents: std::borrow::Cow<[u8]> = if padded_len == bytes.len() {
-            bytes.into()
+        let size = (bytes.len() as u64).max(MIN_BUFFER).next_multiple_of(4);
+        let buffer = self.take_buffer(label, size);
+        // Staged by the queue and copied before the next submission, which
+        // holds every dispatch recorded so far.
+        if bytes.len() % 4 == 0 {
+            self.ctx.queue.write_buffer(&buffer, 0, bytes);
         } else {
-            let mut v = bytes.to_vec();
-            v.resize(padded_len, 0);
-            v.into()
-        };
-        Ok(self.ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: &contents,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        }))
+            let mut padded = bytes.to_vec();
+            padded.resize(bytes.len().next_multiple_of(4), 0);
+            self.ctx.queue.write_buffer(&buffer, 0, &padded);
+        }
+        Ok(buffer)
     }
 
-    fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
+    fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
         crate::backend::check_fits(self, label, bytes)?;
-        // wgpu zero-initializes every new buffer.
-        Ok(self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: bytes.max(MIN_BUFFER).next_multiple_of(4),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        }))
+        Ok(self.take_buffer(label, bytes.max(MIN_BUFFER).next_multiple_of(4)))
+    }
+
+    fn begin_build(&mut self) {
+        self.free.clear();
+        for (key, buffer) in self.used.drain(..) {
+            self.free.entry(key).or_default().push(buffer);
+        }
     }
 
     fn stage(&mut self, stage: &'static str) {
