@@ -64,3 +64,17 @@ fn repeated_builds_on_one_backend_stay_correct() {
         assert_eq!(g.prim_indices, c.prim_indices, "build {k}");
     }
 }
+
+/// `zeroed` must clear a pooled buffer that held data in an earlier build.
+#[test]
+fn zeroed_clears_reused_buffers() {
+    let Some(ctx) = gpu() else { return };
+    let mut b = GpuBackend::new(ctx);
+    b.begin_build();
+    let dirty = b.upload("probe", &[0xdead_beefu32; 1000]).unwrap();
+    assert_eq!(b.read::<u32>(&dirty, 1000).unwrap(), vec![0xdead_beef; 1000]);
+    b.begin_build();
+    let clean = b.zeroed("probe", 4000).unwrap();
+    assert!(clean == dirty, "the pool should hand out the same buffer again");
+    assert_eq!(b.read::<u32>(&clean, 1000).unwrap(), vec![0; 1000]);
+}
