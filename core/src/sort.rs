@@ -9,9 +9,10 @@
 //! 3. [`scatter_phase`]: each workgroup walks its tile in rounds of
 //!    `WORKGROUP_SIZE` consecutive keys; an invocation's rank among equal
 //!    digits of its round is the number of lower local ids holding the same
-//!    digit, counted four at a time over digits packed into bytes
-//!    ([`rank_in_round`]), so the scatter is stable and the result is
-//!    identical on every device and on the CPU.
+//!    digit: per-chunk digit counts scanned over the round's chunks, plus a
+//!    count within its own chunk four digits at a time ([`count_before`]).
+//!    So the scatter is stable and the result is identical on every device
+//!    and on the CPU.
 //!
 //! Kernels are phase functions: see [`crate::workgroup`].
 //!
@@ -76,10 +77,18 @@ pub fn histogram_phase(
 }
 
 /// Phases of [`scatter_phase`]: load offsets, then four per round of
-/// `WORKGROUP_SIZE` keys (read digits; pack them; rank and move; advance).
+/// `WORKGROUP_SIZE` keys (read and count digits; pack them and scan counts;
+/// rank and move; advance offsets).
 pub const SCATTER_PHASES: u32 = 1 + 4 * SORT_ITEMS;
 /// Digits packed four to a word, one byte each.
 pub const PACKED_DIGITS: usize = WG / 4;
+/// Keys per chunk of a round: ranks are counted within a chunk, and chunk
+/// counts per digit are scanned, so no key compares against the whole round.
+pub const CHUNK: u32 = 32;
+/// Chunks per round.
+pub const CHUNKS: usize = (WORKGROUP_SIZE / CHUNK) as usize;
+/// Per-chunk digit counters: `chunk * RADIX + digit`.
+pub const CHUNK_COUNTS: usize = CHUNKS * RADIX as usize;
 
 /// Bit 7 of each byte of the result is set where that byte of `x` is zero
 /// (exact, no carries between bytes).
@@ -89,34 +98,29 @@ fn zero_bytes(x: u32) -> u32 {
     !(t | x | 0x7f7f_7f7f)
 }
 
-/// Rank of invocation `lid`'s digit `d` among the first `valid` digits of the
-/// round, and whether a later invocation holds the same digit. Compares four
-/// packed digits per step, so a rank costs `WORKGROUP_SIZE / 4` steps.
+/// How many of the digits at local ids `from..lid` equal `d`, counting four
+/// packed digits per step (`from` is a multiple of 4).
 #[inline]
-pub fn rank_in_round(packed: &[u32; PACKED_DIGITS], valid: u32, lid: u32, d: u32) -> (u32, bool) {
+pub fn count_before(packed: &[u32; PACKED_DIGITS], from: u32, lid: u32, d: u32) -> u32 {
     let pattern = d * 0x0101_0101;
-    let words = valid.div_ceil(4);
-    let (my_word, my_byte) = (lid / 4, lid % 4);
-    let mut before = 0;
-    let mut total = 0;
-    for w in 0..words {
-        let mut hits = zero_bytes(packed[w as usize] ^ pattern);
-        if w == words - 1 && valid % 4 != 0 {
-            hits &= (1u32 << (8 * (valid % 4))) - 1; // bytes past `valid` hold no key
-        }
-        let count = hits.count_ones();
-        total += count;
-        if w < my_word {
-            before += count;
-        } else if w == my_word {
-            before += (hits & ((1u32 << (8 * my_byte)) - 1)).count_ones();
-        }
+    let mut count = 0;
+    let mut w = from / 4;
+    while w < lid / 4 {
+        count += zero_bytes(packed[w as usize] ^ pattern).count_ones();
+        w += 1;
     }
-    (before, total > before + 1)
+    let partial = zero_bytes(packed[(lid / 4) as usize] ^ pattern) & ((1u32 << (8 * (lid % 4))) - 1);
+    count + partial.count_ones()
 }
 
 /// Kernel: moves the tile's pairs to their sorted places. `offsets` is the
 /// scanned `block_hist`.
+///
+/// In each round, invocation `lid` holds one key of digit `d`; its place is
+/// `running[d]` (keys of digit `d` placed by earlier rounds and tiles) plus
+/// the keys of digit `d` in earlier chunks of the round (`counts`, scanned
+/// over chunks by one invocation per digit) plus those before it in its own
+/// chunk (`count_before`).
 #[allow(clippy::too_many_arguments)]
 pub fn scatter_phase(
     phase: u32,
@@ -131,12 +135,16 @@ pub fn scatter_phase(
     running: &mut [u32; WG],
     digits: &mut [u32; WG],
     packed: &mut [u32; PACKED_DIGITS],
-    round_count: &mut [u32; WG],
+    counts: &mut [u32; CHUNK_COUNTS],
+    totals: &mut [u32; WG],
 ) {
     let l = lid as usize;
     if phase == 0 {
         if tile < params.blocks {
             running[l] = offsets[(lid * params.blocks + tile) as usize];
+        }
+        for c in 0..CHUNKS {
+            counts[c * WG + l] = 0;
         }
         return;
     }
@@ -145,35 +153,43 @@ pub fn scatter_phase(
     // Keys of the round sit at local ids 0..valid (only the last tile is short).
     let valid = if first < params.n { (params.n - first).min(WORKGROUP_SIZE) } else { 0 };
     let i = first + lid;
+    let chunk = lid / CHUNK;
     match (phase - 1) % 4 {
         0 => {
-            digits[l] = if lid < valid { digit(keys_in[i as usize], params.shift) } else { 0 };
+            let d = if lid < valid { digit(keys_in[i as usize], params.shift) } else { 0 };
+            digits[l] = d;
+            if lid < valid {
+                atomics::add_workgroup(&mut counts[(chunk * RADIX + d) as usize], 1);
+            }
         }
         1 => {
             if l < PACKED_DIGITS {
                 let b = 4 * l;
                 packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
             }
+            // Invocation `lid` scans digit `lid`'s counts over the chunks.
+            let mut sum = 0;
+            for c in 0..CHUNKS {
+                let k = c * WG + l;
+                let v = counts[k];
+                counts[k] = sum;
+                sum += v;
+            }
+            totals[l] = sum;
         }
         2 => {
-            // Nonzero only on the last invocation of each digit in this
-            // round: how many keys of that digit the round held.
-            round_count[l] = 0;
             if lid < valid {
                 let d = digits[l];
-                let (before, later) = rank_in_round(packed, valid, lid, d);
+                let before = counts[(chunk * RADIX + d) as usize] + count_before(packed, chunk * CHUNK, lid, d);
                 let dest = (running[d as usize] + before) as usize;
                 keys_out[dest] = keys_in[i as usize];
                 values_out[dest] = values_in[i as usize];
-                if !later {
-                    round_count[l] = before + 1;
-                }
             }
         }
         _ => {
-            let c = round_count[l];
-            if c != 0 {
-                running[digits[l] as usize] += c;
+            running[l] += totals[l];
+            for c in 0..CHUNKS {
+                counts[c * WG + l] = 0;
             }
         }
     }
@@ -192,7 +208,7 @@ mod tests {
     }
 
     #[test]
-    fn rank_matches_a_direct_count() {
+    fn count_before_matches_a_direct_count() {
         let mut digits = [0u32; WG];
         for (i, d) in digits.iter_mut().enumerate() {
             *d = ((i * 7919) % 13) as u32 * 17 % 256;
@@ -201,13 +217,11 @@ mod tests {
         for w in 0..PACKED_DIGITS {
             packed[w] = (0..4).fold(0, |acc, b| acc | digits[4 * w + b] << (8 * b));
         }
-        for valid in [0u32, 1, 5, 128, 255, 256] {
-            for lid in 0..valid {
-                let d = digits[lid as usize];
-                let before = (0..lid).filter(|&j| digits[j as usize] == d).count() as u32;
-                let later = (lid + 1..valid).any(|j| digits[j as usize] == d);
-                assert_eq!(rank_in_round(&packed, valid, lid, d), (before, later), "valid {valid} lid {lid}");
-            }
+        for lid in 0..WORKGROUP_SIZE {
+            let from = lid / CHUNK * CHUNK;
+            let d = digits[lid as usize];
+            let expected = (from..lid).filter(|&j| digits[j as usize] == d).count() as u32;
+            assert_eq!(count_before(&packed, from, lid, d), expected, "lid {lid}");
         }
     }
 }

@@ -184,12 +184,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let p: treelet_core::SortParams = params(p);
             let (keys_in, values_in, offsets) = (view(keys_in), view(values_in), view(offsets));
             let (keys_out, values_out) = (view(keys_out), view(values_out));
-            let (mut running, mut digits, mut counts) = ([0u32; WG], [0u32; WG], [0u32; WG]);
+            let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
             let mut packed = [0u32; sort::PACKED_DIGITS];
+            let mut counts = [0u32; sort::CHUNK_COUNTS];
             workgroups(groups, sort::SCATTER_PHASES, |g, phase, lid| {
                 sort::scatter_phase(
                     phase, lid, g, &p, keys_in, values_in, offsets, keys_out, values_out,
-                    &mut running, &mut digits, &mut packed, &mut counts,
+                    &mut running, &mut digits, &mut packed, &mut counts, &mut totals,
                 )
             });
         }

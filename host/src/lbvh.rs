@@ -29,16 +29,59 @@ pub struct Bvh {
     pub centroid_bounds: Aabb,
 }
 
-/// Builds the LBVH of `spheres` on `b`. Inputs must be finite (see
-/// [`crate::scene::validate_spheres`]). Returns the tree and stage times.
+/// A BVH still on the device, as a renderer uses it.
+pub struct DeviceBvh<B: Backend> {
+    pub n: u32,
+    pub nodes: B::Buffer,
+    pub parents: B::Buffer,
+    pub prim_indices: B::Buffer,
+    pub sorted_keys: B::Buffer,
+    pub centroid_bounds: Aabb,
+}
+
+impl<B: Backend> DeviceBvh<B> {
+    /// Copies the tree back to the host.
+    pub fn read(&self, b: &mut B) -> Result<Bvh> {
+        if self.n == 0 {
+            return Ok(Bvh::default());
+        }
+        let node_count = 2 * self.n as usize - 1;
+        Ok(Bvh {
+            nodes: b.read(&self.nodes, node_count)?,
+            parents: b.read(&self.parents, node_count)?,
+            prim_indices: b.read(&self.prim_indices, self.n as usize)?,
+            sorted_keys: b.read(&self.sorted_keys, self.n as usize)?,
+            centroid_bounds: self.centroid_bounds,
+        })
+    }
+}
+
+/// Builds the LBVH of `spheres` on `b` and reads it back. Inputs must be
+/// finite (see [`crate::scene::validate_spheres`]). Returns the tree and
+/// stage times.
 pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTimes)> {
+    let (device_bvh, times) = build_on_device(b, spheres)?;
+    Ok((device_bvh.read(b)?, times))
+}
+
+/// Builds the LBVH of `spheres` on `b` and leaves it there.
+pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(DeviceBvh<B>, StageTimes)> {
     let n = u32::try_from(spheres.len())
         .ok()
         .filter(|&n| n <= MAX_PRIMITIVES)
         .ok_or_else(|| anyhow::anyhow!("{} primitives: at most {MAX_PRIMITIVES} are supported", spheres.len()))?;
     b.begin_build();
     if n == 0 {
-        return Ok((Bvh::default(), b.take_times()?));
+        let empty = b.scratch("empty", 0)?;
+        let bvh = DeviceBvh {
+            n,
+            nodes: empty.clone(),
+            parents: empty.clone(),
+            prim_indices: empty.clone(),
+            sorted_keys: empty,
+            centroid_bounds: Aabb::EMPTY,
+        };
+        return Ok((bvh, b.take_times()?));
     }
     let node_count = 2 * n as u64 - 1;
     // Fail before any GPU work when the largest buffer does not fit.
@@ -87,14 +130,7 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
     b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
 
     let times = b.take_times()?;
-    let bvh = Bvh {
-        nodes: b.read(&nodes, node_count as usize)?,
-        parents: b.read(&parents, node_count as usize)?,
-        prim_indices: b.read(&values, n as usize)?,
-        sorted_keys: b.read(&keys, n as usize)?,
-        centroid_bounds,
-    };
-    Ok((bvh, times))
+    Ok((DeviceBvh { n, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
 }
 
 /// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.

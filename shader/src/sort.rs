@@ -35,13 +35,14 @@ pub fn sort_scatter_cs(
     #[spirv(workgroup)] running: &mut [u32; WG],
     #[spirv(workgroup)] digits: &mut [u32; WG],
     #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
-    #[spirv(workgroup)] round_count: &mut [u32; WG],
+    #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
+    #[spirv(workgroup)] totals: &mut [u32; WG],
 ) {
     let tile = linear_group(group.x, group.y, groups.x);
     for phase in 0..sort::SCATTER_PHASES {
         sort::scatter_phase(
             phase, lid, tile, params, keys_in, values_in, offsets, keys_out, values_out, running,
-            digits, packed, round_count,
+            digits, packed, counts, totals,
         );
         barrier();
     }
