@@ -20,7 +20,7 @@ const ACQ_REL_STORAGE: u32 = Semantics::ACQUIRE_RELEASE.bits() | Semantics::UNIF
 const RELAXED: u32 = Semantics::NONE.bits();
 
 /// Adds `value` to a storage-buffer counter with device scope, relaxed;
-/// returns the previous value. Order it with [`fence_device`].
+/// returns the previous value.
 #[inline]
 pub fn add_device(slot: &mut u32, value: u32) -> u32 {
     #[cfg(target_arch = "spirv")]
@@ -34,19 +34,24 @@ pub fn add_device(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
-/// Device-scope acquire-release fence on storage buffers.
+/// Adds `value` to a storage-buffer counter with device scope and
+/// acquire-release ordering on storage buffers; returns the previous value.
 ///
-/// Mesa's lavapipe (22.3) mis-executes memory barriers in divergent control
-/// flow (and atomics that carry acquire-release semantics, which it lowers to
-/// barriers): kernels that need a fence there come in a fenced and an
-/// unfenced variant, and the host picks the unfenced one on CPU adapters,
-/// whose threads share coherent caches.
+/// Mesa's lavapipe (22.3) mis-executes such atomics (and memory barriers) in
+/// divergent control flow: kernels that need one there come in an ordered
+/// and a relaxed variant, and the host picks the relaxed one on CPU
+/// adapters, whose threads share coherent caches.
 #[inline]
-pub fn fence_device() {
+pub fn add_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     #[cfg(target_arch = "spirv")]
-    spirv_std::arch::memory_barrier::<DEVICE, ACQ_REL_STORAGE>();
+    unsafe {
+        spirv_std::arch::atomic_i_add::<u32, DEVICE, ACQ_REL_STORAGE>(slot, value)
+    }
     #[cfg(not(target_arch = "spirv"))]
-    core::sync::atomic::fence(core::sync::atomic::Ordering::AcqRel);
+    {
+        use core::sync::atomic::{AtomicU32, Ordering};
+        AtomicU32::from_mut(slot).fetch_add(value, Ordering::AcqRel)
+    }
 }
 
 /// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).

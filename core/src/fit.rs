@@ -6,7 +6,7 @@
 //!
 //! On the GPU the boxes cross invocations, so they are written and read with
 //! device-scope atomics (under the Vulkan memory model plain accesses would
-//! not be made visible), ordered by fences around the counter.
+//! not be made visible), ordered by the counter's acquire-release semantics.
 use crate::aabb::Aabb;
 use crate::atomics;
 use crate::layout::{Node, INVALID, LEAF_BIT};
@@ -32,9 +32,9 @@ fn load_box(node: &Node) -> Aabb {
 
 /// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
 /// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
-/// `FENCED` puts device fences around the counter (see
-/// [`atomics::fence_device`] for the one device that needs them left out).
-pub fn fit_kernel<const FENCED: bool>(
+/// `ORDERED` gives the counter acquire-release semantics (see
+/// [`atomics::add_device_acq_rel`] for the one device that needs it relaxed).
+pub fn fit_kernel<const ORDERED: bool>(
     i: u32,
     n: u32,
     sorted_prims: &[u32],
@@ -58,14 +58,10 @@ pub fn fit_kernel<const FENCED: bool>(
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
-        if FENCED {
-            atomics::fence_device(); // Publish this subtree's boxes...
-        }
-        let first = atomics::add_device(&mut flags[parent as usize], 1) == 0;
-        if FENCED {
-            atomics::fence_device(); // ...and see the sibling's.
-        }
-        if first {
+        // Release this subtree's boxes; acquire the sibling's.
+        let counter = &mut flags[parent as usize];
+        let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
+        if previous == 0 {
             return; // The sibling's invocation will finish this node.
         }
         let left = load_box(&nodes[nodes[parent as usize].left as usize]);

@@ -44,9 +44,9 @@ pub trait Backend {
     fn adapter(&self) -> String;
     /// "gpu" or "cpu".
     fn device_kind(&self) -> &'static str;
-    /// False on devices that mis-execute fences in divergent control flow
-    /// (lavapipe): they get the unfenced variants of such kernels.
-    fn fences_in_divergent_flow(&self) -> bool {
+    /// False on devices that mis-execute ordered atomics in divergent control
+    /// flow (lavapipe): they get the relaxed variants of such kernels.
+    fn ordered_atomics_in_divergent_flow(&self) -> bool {
         true
     }
     /// Largest buffer this device accepts in one binding, in bytes.

@@ -201,7 +201,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 radix_tree::radix_tree_kernel(id, p.n, keys, nodes, parents);
             }
         }
-        (Kernel::Fit | Kernel::FitUnfenced, [p, prims, boxes, nodes, parents, flags]) => {
+        (Kernel::Fit | Kernel::FitRelaxed, [p, prims, boxes, nodes, parents, flags]) => {
             let p: treelet_core::BuildParams = params(p);
             let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
             let (parents, flags) = (view(parents), view(flags));

@@ -24,8 +24,8 @@ pub enum Kernel {
     SortScatter,
     RadixTree,
     Fit,
-    /// [`Kernel::Fit`] without device fences, for CPU adapters.
-    FitUnfenced,
+    /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
+    FitRelaxed,
 }
 
 impl Kernel {
@@ -41,7 +41,7 @@ impl Kernel {
         Kernel::SortScatter,
         Kernel::RadixTree,
         Kernel::Fit,
-        Kernel::FitUnfenced,
+        Kernel::FitRelaxed,
     ];
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
@@ -58,7 +58,7 @@ impl Kernel {
             Kernel::SortScatter => "sort::sort_scatter_cs",
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
-            Kernel::FitUnfenced => "fit::fit_unfenced_cs",
+            Kernel::FitRelaxed => "fit::fit_relaxed_cs",
         }
     }
 
@@ -75,7 +75,7 @@ impl Kernel {
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::Fit | Kernel::FitUnfenced => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
         }
     }
 }

@@ -126,7 +126,7 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
 
     b.stage("fit");
     let flags = b.zeroed("fit flags", (n as u64 - 1) * 4)?;
-    let fit = if b.fences_in_divergent_flow() { Kernel::Fit } else { Kernel::FitUnfenced };
+    let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
     b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
 
     let times = b.take_times()?;

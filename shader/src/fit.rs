@@ -4,7 +4,7 @@ use treelet_core::layout::BuildParams;
 use treelet_core::workgroup::linear_id;
 use treelet_core::{Aabb, Node};
 
-/// The bottom-up fit with device fences: for GPUs.
+/// The bottom-up fit with an acquire-release counter: for GPUs.
 #[spirv(compute(threads(256)))]
 pub fn fit_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -20,10 +20,10 @@ pub fn fit_cs(
     treelet_core::fit::fit_kernel::<true>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
 }
 
-/// The bottom-up fit without fences: for CPU adapters (lavapipe), see
-/// `treelet_core::atomics::fence_device`.
+/// The bottom-up fit with a relaxed counter: for CPU adapters (lavapipe), see
+/// `treelet_core::atomics::add_device_acq_rel`.
 #[spirv(compute(threads(256)))]
-pub fn fit_unfenced_cs(
+pub fn fit_relaxed_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,

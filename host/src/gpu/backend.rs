@@ -184,7 +184,7 @@ impl Backend for GpuBackend {
     fn device_kind(&self) -> &'static str {
         "gpu"
     }
-    fn fences_in_divergent_flow(&self) -> bool {
+    fn ordered_atomics_in_divergent_flow(&self) -> bool {
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
     }
     fn max_buffer_bytes(&self) -> u64 {
