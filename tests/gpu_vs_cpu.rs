@@ -8,7 +8,6 @@ use treelet::gpu::GpuBackend;
 use treelet::scene::random_spheres;
 use treelet_tests::{compare_builds, gpu};
 
-
 #[test]
 fn lbvh_matches_cpu_on_random_scenes() {
     let seed = treelet_tests::fresh_seed();
@@ -26,11 +25,8 @@ fn sort_matches_cpu_and_std_on_random_keys() {
         // Few distinct high bits, so that many keys tie on some passes.
         let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
         let values: Vec<u32> = (0..n).collect();
-        let sort_on = |b: &mut dyn FnMut(&[u64], &[u32]) -> (Vec<u64>, Vec<u32>)| b(&keys, &values);
-        let mut gpu_sort = |k: &[u64], v: &[u32]| run_sort(&mut GpuBackend::new(ctx.clone()), k, v);
-        let mut cpu_sort = |k: &[u64], v: &[u32]| run_sort(&mut CpuBackend::new(), k, v);
-        let g = sort_on(&mut gpu_sort);
-        let c = sort_on(&mut cpu_sort);
+        let g = run_sort(&mut GpuBackend::new(ctx.clone()), &keys, &values);
+        let c = run_sort(&mut CpuBackend::new(), &keys, &values);
         let mut expected: Vec<(u64, u32)> = keys.iter().copied().zip(values.iter().copied()).collect();
         expected.sort_by_key(|&(k, _)| k); // stable, like the radix sort
         let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();

@@ -81,9 +81,20 @@ fn validator_catches_corruption() {
     check(&|b| b.prim_indices[3] = b.prim_indices[4], "in 2 leaves");
     check(&|b| b.parents[5] = 17, "parent link");
     check(&|b| b.nodes[3].left = 0, "child index 0 invalid");
-    check(&|b| { let c = b.nodes[1].left; b.nodes[2].right = c; }, "reached twice");
+    check(
+        &|b| {
+            let c = b.nodes[1].left;
+            b.nodes[2].right = c;
+        },
+        "reached twice",
+    );
     check(&|b| b.parents[0] = 3, "root has parent");
-    check(&|b| { b.nodes.pop(); }, "nodes for 500 primitives");
+    check(
+        &|b| {
+            b.nodes.pop();
+        },
+        "nodes for 500 primitives",
+    );
     let leaf = good.nodes.iter().position(|n| n.is_leaf()).unwrap();
     check(&|b| b.nodes[leaf].min[1] = b.nodes[leaf].max[1], "does not contain primitive");
 }

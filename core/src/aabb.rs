@@ -26,12 +26,7 @@ impl Default for Aabb {
 
 impl Aabb {
     /// The identity of [`Aabb::union`].
-    pub const EMPTY: Aabb = Aabb {
-        min: [f32::MAX; 3],
-        _pad0: 0,
-        max: [-f32::MAX; 3],
-        _pad1: 0,
-    };
+    pub const EMPTY: Aabb = Aabb { min: [f32::MAX; 3], _pad0: 0, max: [-f32::MAX; 3], _pad1: 0 };
 
     #[inline]
     pub fn from_arrays(min: [f32; 3], max: [f32; 3]) -> Self {

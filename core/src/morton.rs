@@ -43,7 +43,11 @@ impl MortonFrame {
             if e > 0.0 {
                 let s = CELLS / e;
                 // Extents near the smallest normal overflow the division.
-                if s <= f32::MAX { s } else { f32::MAX }
+                if s <= f32::MAX {
+                    s
+                } else {
+                    f32::MAX
+                }
             } else {
                 0.0
             }

@@ -144,10 +144,8 @@ mod tests {
     #[test]
     fn paper_figure_example() {
         // The eight 5-bit keys of Karras 2012, figure 3.
-        let keys: Vec<u64> = [0b00001, 0b00010, 0b00100, 0b00101, 0b10011, 0b11000, 0b11001, 0b11110]
-            .iter()
-            .map(|&k| k << 59)
-            .collect();
+        let keys: Vec<u64> =
+            [0b00001, 0b00010, 0b00100, 0b00101, 0b10011, 0b11000, 0b11001, 0b11110].iter().map(|&k| k << 59).collect();
         let n = 8;
         assert_eq!(children(&keys, n, 0), (3, 4));
         assert_eq!(children(&keys, n, 1), (leaf_node(n, 0), leaf_node(n, 1)));

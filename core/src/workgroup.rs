@@ -37,7 +37,7 @@ pub const SCAN_STEPS: u32 = 2 * WG_LOG2;
 pub fn hillis_steele_step(step: u32, lid: u32, a: &mut [u32; WG], b: &mut [u32; WG]) {
     let l = lid as usize;
     let offset = 1u32 << (step / 2);
-    if step % 2 == 0 {
+    if step.is_multiple_of(2) {
         let prev = if lid >= offset { a[l - offset as usize] } else { 0 };
         b[l] = a[l] + prev;
     } else {

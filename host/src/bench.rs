@@ -45,7 +45,11 @@ struct Row {
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let m = v.len() / 2;
-    if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) }
+    if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    }
 }
 
 fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result<Vec<Row>> {
@@ -105,7 +109,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 }
             };
             println!("LBVH build, {adapter} ({timing}), median of {repeats} (ms)");
-            let names: Vec<&str> = rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
+            let names: Vec<&str> =
+                rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
             let short = |s: &str| s.rsplit("::").next().unwrap_or(s).trim_end_matches("_cs").to_string();
             let width = names.iter().map(|s| short(s).len() + 2).max().unwrap_or(9).max(9);
             print!("{:>10}", "N");

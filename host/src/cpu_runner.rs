@@ -189,8 +189,20 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let mut counts = [0u32; sort::CHUNK_COUNTS];
             workgroups(groups, sort::SCATTER_PHASES, |g, phase, lid| {
                 sort::scatter_phase(
-                    phase, lid, g, &p, keys_in, values_in, offsets, keys_out, values_out,
-                    &mut running, &mut digits, &mut packed, &mut counts, &mut totals,
+                    phase,
+                    lid,
+                    g,
+                    &p,
+                    keys_in,
+                    values_in,
+                    offsets,
+                    keys_out,
+                    values_out,
+                    &mut running,
+                    &mut digits,
+                    &mut packed,
+                    &mut counts,
+                    &mut totals,
                 )
             });
         }

@@ -98,10 +98,8 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
     let centroid_bounds = loop {
         let groups = groups_for(len, REDUCE_TILE);
         let output = b.scratch("bounds partials", groups as u64 * 32)?;
-        let rp = b.upload(
-            "reduce params",
-            &[BuildParams { reduce_len: len, reduce_centroids: centroids, ..params }],
-        )?;
+        let rp =
+            b.upload("reduce params", &[BuildParams { reduce_len: len, reduce_centroids: centroids, ..params }])?;
         b.dispatch(Kernel::ReduceBounds, &[&rp, &input, &output], groups);
         if groups == 1 {
             break b.read::<Aabb>(&output, 1)?[0];

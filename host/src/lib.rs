@@ -17,7 +17,7 @@ pub mod cpu_runner;
 pub mod gpu;
 pub mod kernels;
 pub mod lbvh;
+pub mod report;
 pub mod scene;
 pub mod sort;
 pub mod validate;
-pub mod report;

@@ -20,12 +20,8 @@ impl Scene {
         let mut parts = spec.split(':');
         match parts.next() {
             Some("random") => {
-                let n = parts
-                    .next()
-                    .with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
-                let n: usize = n
-                    .parse()
-                    .with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
+                let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
                 let seed = match parts.next() {
                     Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
                     None => 1,
@@ -65,7 +61,11 @@ pub fn random_spheres(n: usize, seed: u64) -> Vec<Sphere> {
 pub fn validate_spheres(spheres: &[Sphere]) -> Result<()> {
     for (i, s) in spheres.iter().enumerate() {
         if let Some(k) = s.center.iter().position(|c| !c.is_finite()) {
-            bail!("sphere {i}: centre coordinate {} is {} (every coordinate must be finite)", "xyz".as_bytes()[k] as char, s.center[k]);
+            bail!(
+                "sphere {i}: centre coordinate {} is {} (every coordinate must be finite)",
+                "xyz".as_bytes()[k] as char,
+                s.center[k]
+            );
         }
         if !s.radius.is_finite() || s.radius < 0.0 {
             bail!("sphere {i}: radius is {} (must be finite and non-negative)", s.radius);

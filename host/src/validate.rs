@@ -55,7 +55,12 @@ pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indice
         return v;
     }
     if parents.len() != nodes.len() || prim_indices.len() != n {
-        err(format!("{} parents and {} primitive indices for {} nodes", parents.len(), prim_indices.len(), nodes.len()));
+        err(format!(
+            "{} parents and {} primitive indices for {} nodes",
+            parents.len(),
+            prim_indices.len(),
+            nodes.len()
+        ));
         return v;
     }
     if parents[0] != NO_PARENT {
@@ -108,7 +113,10 @@ pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indice
         }
     }
     if let Some(i) = visited.iter().position(|&x| !x) {
-        err(format!("node {i} is not reachable from the root ({} unreachable)", visited.iter().filter(|&&x| !x).count()));
+        err(format!(
+            "node {i} is not reachable from the root ({} unreachable)",
+            visited.iter().filter(|&&x| !x).count()
+        ));
     }
     for (p, &count) in prim_seen.iter().enumerate() {
         if count != 1 {

@@ -1,7 +1,7 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::BuildParams;
 use treelet_core::bounds;
+use treelet_core::layout::BuildParams;
 use treelet_core::workgroup::{barrier, linear_group, WG};
 use treelet_core::Aabb;
 

@@ -41,8 +41,8 @@ pub fn sort_scatter_cs(
     let tile = linear_group(group.x, group.y, groups.x);
     for phase in 0..sort::SCATTER_PHASES {
         sort::scatter_phase(
-            phase, lid, tile, params, keys_in, values_in, offsets, keys_out, values_out, running,
-            digits, packed, counts, totals,
+            phase, lid, tile, params, keys_in, values_in, offsets, keys_out, values_out, running, digits, packed,
+            counts, totals,
         );
         barrier();
     }

@@ -198,7 +198,7 @@ impl Backend for GpuBackend {
         let buffer = self.take_buffer(label, size);
         // Staged by the queue and copied before the next submission, which
         // holds every dispatch recorded so far.
-        if bytes.len() % 4 == 0 {
+        if bytes.len().is_multiple_of(4) {
             self.ctx.queue.write_buffer(&buffer, 0, bytes);
         } else {
             let mut padded = bytes.to_vec();
