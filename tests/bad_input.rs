@@ -21,9 +21,8 @@ fn non_finite_input_names_the_primitive() {
 
 #[test]
 fn run_build_rejects_nan_before_building() {
-    let mut spheres = treelet::scene::random_spheres(10, 1);
-    spheres[3].center[0] = f32::NEG_INFINITY;
-    let scene = Scene { name: "test".into(), spheres };
+    let mut scene = treelet::scene::random_scene("test", 10, 1);
+    scene.spheres[3].center[0] = f32::NEG_INFINITY;
     let e = treelet::report::run_build(&mut treelet::cpu_runner::CpuBackend::new(), &scene).unwrap_err();
     assert!(e.to_string().contains("sphere 3"), "{e}");
 }

@@ -126,3 +126,64 @@ pub struct FillParams {
     pub _pad0: [u32; 2],
 }
 const _: () = assert!(core::mem::size_of::<FillParams>() == 16);
+
+/// Surface kinds of smallpt.
+pub const DIFFUSE: u32 = 0;
+pub const MIRROR: u32 = 1;
+pub const GLASS: u32 = 2;
+
+/// A material. repr(C), Pod, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Material {
+    /// Emitted radiance.
+    pub emission: [f32; 3],
+    /// [`DIFFUSE`], [`MIRROR`] or [`GLASS`].
+    pub kind: u32,
+    /// Reflectance (diffuse, mirror) or transmittance (glass).
+    pub color: [f32; 3],
+    /// Index of refraction of glass (smallpt: 1.5).
+    pub ior: f32,
+}
+const _: () = assert!(core::mem::size_of::<Material>() == 32);
+
+/// A pinhole camera as smallpt builds it. repr(C), Pod, 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Camera {
+    pub origin: [f32; 3],
+    /// Primary rays start this far along their direction (smallpt: 140, to
+    /// start inside the box).
+    pub near: f32,
+    /// Unit view direction.
+    pub dir: [f32; 3],
+    pub _pad0: u32,
+    /// Image-plane x axis, scaled by the aspect ratio and field of view.
+    pub cx: [f32; 3],
+    pub _pad1: u32,
+    /// Image-plane y axis, scaled by the field of view.
+    pub cy: [f32; 3],
+    pub _pad2: u32,
+}
+const _: () = assert!(core::mem::size_of::<Camera>() == 64);
+
+/// Parameters of one render dispatch. repr(C), Pod, 96 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct RenderParams {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel of this dispatch.
+    pub samples: u32,
+    /// Index of this dispatch's first sample (the RNG counter).
+    pub first_sample: u32,
+    pub seed: u32,
+    /// Number of spheres.
+    pub prims: u32,
+    pub _pad0: [u32; 2],
+    pub camera: Camera,
+}
+const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);

@@ -19,5 +19,6 @@ pub mod kernels;
 pub mod lbvh;
 pub mod report;
 pub mod scene;
+pub mod scene_file;
 pub mod sort;
 pub mod validate;

@@ -34,15 +34,16 @@ pub struct BuildReport {
 
 /// Validates the input, builds, validates the tree, and reports.
 pub fn run_build<B: Backend>(backend: &mut B, scene: &Scene) -> Result<(Bvh, BuildReport)> {
-    validate_spheres(&scene.spheres)?;
+    let objects = scene.objects();
+    validate_spheres(objects)?;
     let start = Instant::now();
-    let (bvh, times) = lbvh::build(backend, &scene.spheres)?;
+    let (bvh, times) = lbvh::build(backend, objects)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let check = validate(&scene.spheres, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let ms = STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
     let report = BuildReport {
         scene: scene.name.clone(),
-        primitives: scene.spheres.len(),
+        primitives: objects.len(),
         builder: "lbvh",
         device: backend.device_kind(),
         adapter: backend.adapter(),

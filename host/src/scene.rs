@@ -1,27 +1,105 @@
 //! Scenes: parsing a scene name, generating random scenes, checking input.
 use anyhow::{bail, Context as _, Result};
 use rand::{Rng, SeedableRng};
-use treelet_core::layout::Sphere;
-
-/// A named set of primitives.
-#[derive(Clone, Debug)]
-pub struct Scene {
-    pub name: String,
-    pub spheres: Vec<Sphere>,
-}
+use glam::Vec3;
+use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
+use treelet_core::render::SMALLPT_FOV;
 
 /// Interior of smallpt's Cornell box, where random scenes place spheres.
 pub const RANDOM_BOX_MIN: [f32; 3] = [1.0, 0.0, 0.0];
 pub const RANDOM_BOX_MAX: [f32; 3] = [99.0, 81.6, 170.0];
 
+/// A scene: spheres with one material each, and a camera.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    /// Every sphere a render traces. The last `room` of them are the room
+    /// (walls and light) a `random:N` scene is rendered in; the others are
+    /// the scene's objects, which `treelet build` builds over.
+    pub spheres: Vec<Sphere>,
+    /// One material per sphere.
+    pub materials: Vec<Material>,
+    pub room: usize,
+    pub camera: CameraSpec,
+}
+
+/// Where the camera is; the image size comes from the render.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    pub origin: [f32; 3],
+    pub direction: [f32; 3],
+    /// Primary rays start this far along their direction.
+    #[serde(default)]
+    pub near: f32,
+    /// Half-height of the image plane at unit distance.
+    #[serde(default = "default_fov")]
+    pub fov: f32,
+}
+
+fn default_fov() -> f32 {
+    SMALLPT_FOV
+}
+
+impl CameraSpec {
+    /// smallpt's camera.
+    pub const SMALLPT: CameraSpec =
+        CameraSpec { origin: [50.0, 52.0, 295.6], direction: [0.0, -0.042612, -1.0], near: 140.0, fov: SMALLPT_FOV };
+
+    pub fn camera(&self, width: u32, height: u32) -> Camera {
+        Camera::look(Vec3::from_array(self.origin), Vec3::from_array(self.direction), self.near, self.fov, width, height)
+    }
+}
+
+pub fn diffuse(color: [f32; 3]) -> Material {
+    Material { color, kind: DIFFUSE, ..Default::default() }
+}
+
+/// smallpt's scene: nine spheres, six of them walls of radius 1e5.
+pub fn cornell() -> Scene {
+    let (spheres, materials): (Vec<_>, Vec<_>) = cornell_room()
+        .into_iter()
+        .chain([
+            (Sphere::new([27.0, 16.5, 47.0], 16.5), Material { color: [0.999; 3], kind: MIRROR, ..Default::default() }),
+            (Sphere::new([73.0, 16.5, 78.0], 16.5), Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() }),
+        ])
+        .unzip();
+    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT }
+}
+
+/// smallpt's walls and light (radius 600, poking through the ceiling).
+pub fn cornell_room() -> Vec<(Sphere, Material)> {
+    vec![
+        (Sphere::new([1e5 + 1.0, 40.8, 81.6], 1e5), diffuse([0.75, 0.25, 0.25])),
+        (Sphere::new([-1e5 + 99.0, 40.8, 81.6], 1e5), diffuse([0.25, 0.25, 0.75])),
+        (Sphere::new([50.0, 40.8, 1e5], 1e5), diffuse([0.75; 3])),
+        (Sphere::new([50.0, 40.8, -1e5 + 170.0], 1e5), diffuse([0.0; 3])),
+        (Sphere::new([50.0, 1e5, 81.6], 1e5), diffuse([0.75; 3])),
+        (Sphere::new([50.0, -1e5 + 81.6, 81.6], 1e5), diffuse([0.75; 3])),
+        (Sphere::new([50.0, 681.6 - 0.27, 81.6], 600.0), Material { emission: [12.0; 3], ..diffuse([0.0; 3]) }),
+    ]
+}
+
 impl Scene {
-    /// Parses a scene name: `random:N[:SEED]`.
+    /// The spheres `treelet build` builds over: all but the room.
+    pub fn objects(&self) -> &[Sphere] {
+        &self.spheres[..self.spheres.len() - self.room]
+    }
+
+    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON scene file.
     pub fn from_spec(spec: &str) -> Result<Scene> {
+        if spec == "cornell" {
+            return Ok(cornell());
+        }
+        if spec.ends_with(".json") {
+            return crate::scene_file::load(std::path::Path::new(spec));
+        }
         let mut parts = spec.split(':');
         match parts.next() {
             Some("random") => {
                 let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
-                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
+                let n: usize =
+                    n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
                 let seed = match parts.next() {
                     Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
                     None => 1,
@@ -32,11 +110,36 @@ impl Scene {
                 if n > crate::lbvh::MAX_PRIMITIVES as usize {
                     bail!("scene `{spec}`: {n} primitives, at most {} are supported", crate::lbvh::MAX_PRIMITIVES);
                 }
-                Ok(Scene { name: spec.to_string(), spheres: random_spheres(n, seed) })
+                Ok(random_scene(spec, n, seed))
             }
-            _ => bail!("unknown scene `{spec}`: expected random:N[:SEED]"),
+            _ => bail!("unknown scene `{spec}`: expected cornell, random:N[:SEED] or a .json scene file"),
         }
     }
+}
+
+/// `random:N`: N spheres of mixed materials inside smallpt's room.
+pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
+    let mut spheres = random_spheres(n, seed);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed ^ 0x5eed);
+    let mut materials: Vec<Material> = (0..n)
+        .map(|_| {
+            let pick: f32 = rng.random();
+            if pick < 0.7 {
+                diffuse([0, 1, 2].map(|_| rng.random_range(0.2..0.9)))
+            } else if pick < 0.85 {
+                Material { color: [0.999; 3], kind: MIRROR, ..Default::default() }
+            } else {
+                Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() }
+            }
+        })
+        .collect();
+    let room = cornell_room();
+    let room_len = room.len();
+    for (s, m) in room {
+        spheres.push(s);
+        materials.push(m);
+    }
+    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT }
 }
 
 /// `n` spheres with uniform random centres inside the Cornell box and random
@@ -56,8 +159,8 @@ pub fn random_spheres(n: usize, seed: u64) -> Vec<Sphere> {
         .collect()
 }
 
-/// Rejects spheres a build cannot use, naming the first bad one: non-finite
-/// centre or radius, or a negative radius.
+/// Rejects spheres a build or render cannot use, naming the first bad one:
+/// non-finite centre or radius, or a negative radius.
 pub fn validate_spheres(spheres: &[Sphere]) -> Result<()> {
     for (i, s) in spheres.iter().enumerate() {
         if let Some(k) = s.center.iter().position(|c| !c.is_finite()) {

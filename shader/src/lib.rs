@@ -11,6 +11,7 @@ pub mod fill;
 pub mod fit;
 pub mod morton;
 pub mod radix_tree;
+pub mod render;
 pub mod scan;
 pub mod scene;
 pub mod sort;

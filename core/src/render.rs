@@ -1,0 +1,213 @@
+//! The path tracer of smallpt (Kevin Beason, "smallpt: Global Illumination
+//! in 99 lines of C++"), iterative so that it runs on a GPU:
+//!
+//! * 2x2 subpixels per pixel with a tent filter; sample `s` of a pixel falls
+//!   in subpixel `s % 4`, so `spp` counts all samples of the pixel;
+//! * diffuse (cosine-weighted), mirror, and glass with Schlick's Fresnel;
+//! * Russian roulette after depth 5 with the surface's largest reflectance.
+//!
+//! Departures from smallpt, all keeping the estimate unbiased unless said:
+//! smallpt splits glass paths into reflection and refraction below depth 3;
+//! a loop cannot recurse, so glass always picks one with probability
+//! `P = 1/4 + Re/2` and weights it (smallpt's own rule at depth 3 and more).
+//! Rays leave a surface from a point offset along the normal by a distance
+//! scaled to the point's magnitude ([`surface_offset`]) instead of smallpt's
+//! fixed 1e-4 epsilon. Paths stop after [`MAX_BOUNCES`] (a bias no render
+//! has shown: Russian roulette ends them long before).
+//! Random numbers are counter-based ([`crate::rng`]).
+use glam::Vec3;
+
+use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
+use crate::rng::BounceRng;
+use crate::traverse::{closest_hit_bvh, closest_hit_linear};
+
+/// Hard cap on path length.
+pub const MAX_BOUNCES: u32 = 512;
+/// Field of view of smallpt: the image plane half-height at unit distance.
+pub const SMALLPT_FOV: f32 = 0.5135;
+
+impl Camera {
+    /// A camera at `origin` looking along `dir`, `fov` being the half-height of
+    /// the image plane at unit distance (smallpt: 0.5135). "Up" is +y.
+    pub fn look(origin: Vec3, dir: Vec3, near: f32, fov: f32, width: u32, height: u32) -> Camera {
+        let dir = dir.normalize();
+        let side = if dir.cross(Vec3::Y).length_squared() > 1e-12 { dir.cross(Vec3::Y) } else { Vec3::X };
+        let cx = side.normalize() * (width as f32 * fov / height as f32);
+        let cy = cx.cross(dir).normalize() * fov;
+        Camera {
+            origin: origin.to_array(),
+            near,
+            dir: dir.to_array(),
+            cx: cx.to_array(),
+            cy: cy.to_array(),
+            ..Default::default()
+        }
+    }
+
+    /// Ray through pixel (`x`, `y`; y up from the bottom row, as smallpt),
+    /// subpixel `sub` (0..4), with the tent-filter offsets drawn from `rng`.
+    #[inline]
+    pub fn primary_ray(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, rng: &BounceRng) -> (Vec3, Vec3) {
+        let tent = |u: f32| {
+            let r = 2.0 * u;
+            if r < 1.0 {
+                libm::sqrtf(r) - 1.0
+            } else {
+                1.0 - libm::sqrtf(2.0 - r)
+            }
+        };
+        let (sx, sy) = ((sub % 2) as f32, (sub / 2) as f32);
+        let (dx, dy) = (tent(rng.uniform(0)), tent(rng.uniform(1)));
+        let fx = ((sx + 0.5 + dx) / 2.0 + x as f32) / width as f32 - 0.5;
+        let fy = ((sy + 0.5 + dy) / 2.0 + y as f32) / height as f32 - 0.5;
+        let d = Vec3::from_array(self.cx) * fx + Vec3::from_array(self.cy) * fy + Vec3::from_array(self.dir);
+        (Vec3::from_array(self.origin) + d * self.near, d.normalize())
+    }
+}
+
+/// Distance to push a ray off a surface at `p`: 2^-18 of its largest
+/// coordinate (about 32 ulps), so the new ray cannot hit the surface again
+/// through rounding, at any scale.
+#[inline]
+pub fn surface_offset(p: Vec3) -> f32 {
+    p.abs().max_element().max(1e-30) * (1.0 / 262_144.0)
+}
+
+/// Which closest-hit search a kernel uses.
+pub const ACCEL_NONE: u32 = 0;
+pub const ACCEL_BVH: u32 = 1;
+
+/// Scene buffers of a render.
+pub struct SceneRefs<'a> {
+    pub spheres: &'a [Sphere],
+    pub materials: &'a [Material],
+    pub nodes: &'a [Node],
+    pub prim_indices: &'a [u32],
+}
+
+/// Radiance along one path (smallpt's `radiance`, as a loop).
+#[inline]
+pub fn radiance<const ACCEL: u32>(
+    mut o: Vec3,
+    mut d: Vec3,
+    params: &RenderParams,
+    pixel: u32,
+    sample: u32,
+    scene: &SceneRefs,
+) -> Vec3 {
+    let mut result = Vec3::ZERO;
+    let mut throughput = Vec3::ONE;
+    let mut depth = 0u32;
+    while depth < MAX_BOUNCES {
+        let hit = if ACCEL == ACCEL_BVH {
+            closest_hit_bvh(o, d, scene.spheres, params.prims, scene.nodes, scene.prim_indices)
+        } else {
+            closest_hit_linear(o, d, scene.spheres, params.prims)
+        };
+        if !hit.is_hit() {
+            break;
+        }
+        let sphere = scene.spheres[hit.prim as usize];
+        let m = scene.materials[hit.prim as usize];
+        let x = o + d * hit.t;
+        let n = (x - Vec3::from_array(sphere.center)).normalize();
+        let nl = if n.dot(d) < 0.0 { n } else { -n };
+        let mut f = Vec3::from_array(m.color);
+        result += throughput * Vec3::from_array(m.emission);
+        depth += 1;
+        // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
+        let rng = BounceRng::new(params.seed, pixel, sample, depth);
+        if depth > 5 {
+            let p = f.max_element();
+            if rng.uniform(0) < p {
+                f /= p;
+            } else {
+                break;
+            }
+        }
+        throughput *= f;
+        let eps = surface_offset(x);
+        if m.kind == DIFFUSE {
+            let r1 = 2.0 * core::f32::consts::PI * rng.uniform(1);
+            let r2 = rng.uniform(2);
+            let r2s = libm::sqrtf(r2);
+            let w = nl;
+            let u = (if w.x.abs() > 0.1 { Vec3::Y } else { Vec3::X }).cross(w).normalize();
+            let v = w.cross(u);
+            d = (u * libm::cosf(r1) * r2s + v * libm::sinf(r1) * r2s + w * libm::sqrtf(1.0 - r2)).normalize();
+            o = x + nl * eps;
+        } else if m.kind == MIRROR {
+            d = d - n * 2.0 * n.dot(d);
+            o = x + nl * eps;
+        } else {
+            let reflected = d - n * 2.0 * n.dot(d);
+            let into = n.dot(nl) > 0.0;
+            let (nc, nt) = (1.0, m.ior);
+            let nnt = if into { nc / nt } else { nt / nc };
+            let ddn = d.dot(nl);
+            let cos2t = 1.0 - nnt * nnt * (1.0 - ddn * ddn);
+            if cos2t < 0.0 {
+                // Total internal reflection.
+                d = reflected;
+                o = x + nl * eps;
+            } else {
+                let sign = if into { 1.0 } else { -1.0 };
+                let tdir = (d * nnt - n * (sign * (ddn * nnt + libm::sqrtf(cos2t)))).normalize();
+                let (a, b) = (nt - nc, nt + nc);
+                let r0 = a * a / (b * b);
+                let c = 1.0 - if into { -ddn } else { tdir.dot(n) };
+                let re = r0 + (1.0 - r0) * c * c * c * c * c;
+                let tr = 1.0 - re;
+                let p = 0.25 + 0.5 * re;
+                if rng.uniform(3) < p {
+                    throughput *= re / p;
+                    d = reflected;
+                    o = x + nl * eps;
+                } else {
+                    throughput *= tr / (1.0 - p);
+                    d = tdir;
+                    o = x - nl * eps;
+                }
+            }
+        }
+    }
+    result
+}
+
+/// Kernel: `params.samples` samples of pixel `id` (row-major from the top
+/// row), starting at sample `params.first_sample`. Returns the sum of their
+/// radiance (rgb) and the sum of their squared luminance (w), for
+/// [`accumulate`].
+#[inline]
+pub fn render_pixel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &SceneRefs) -> [f32; 4] {
+    let (w, h) = (params.width, params.height);
+    let (x, y) = (id % w, h - 1 - id / w);
+    let mut sum = Vec3::ZERO;
+    let mut sum_sq = 0.0;
+    let mut s = 0;
+    while s < params.samples {
+        let sample = params.first_sample + s;
+        let rng = BounceRng::new(params.seed, id, sample, 0);
+        let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
+        let l = radiance::<ACCEL>(o, d, params, id, sample, scene);
+        sum += l;
+        let lum = luminance(l);
+        sum_sq += lum * lum;
+        s += 1;
+    }
+    [sum.x, sum.y, sum.z, sum_sq]
+}
+
+/// Rec. 709 luminance.
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// Adds one dispatch's [`render_pixel`] result to a pixel's running sums.
+#[inline]
+pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
+    for k in 0..4 {
+        acc[k] += add[k];
+    }
+}
