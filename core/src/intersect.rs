@@ -48,6 +48,16 @@ pub fn length_sq_minus_sq(v: Vec3, r: f32) -> f32 {
 /// sphere (`center`, `radius`) beyond `t_min`, or [`MISS`].
 #[inline]
 pub fn ray_sphere(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32) -> f32 {
+    ray_sphere_mode(o, d, center, radius, t_min, false)
+}
+
+/// As [`ray_sphere`], but with `far_only` only the far root counts: for a
+/// ray that leaves a sphere's surface into the sphere, whose near root is
+/// the surface it starts on. (Near a sphere of radius 1e5 centred 1e5 from
+/// the origin, f32 cannot place a point closer to the surface than about
+/// 0.004, so no offset makes that near root reliably negative.)
+#[inline]
+pub fn ray_sphere_mode(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32, far_only: bool) -> f32 {
     let f = o - center;
     let b = f.dot(d); // half of the usual b, as |d| = 1
     let c = length_sq_minus_sq(f, radius);
@@ -63,6 +73,9 @@ pub fn ray_sphere(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32) -> f3
     }
     let (t0, t1) = (c / q, q);
     let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+    if far_only {
+        return if far > t_min { far } else { MISS };
+    }
     if near > t_min {
         near
     } else if far > t_min {

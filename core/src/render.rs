@@ -10,16 +10,19 @@
 //! smallpt splits glass paths into reflection and refraction below depth 3;
 //! a loop cannot recurse, so glass always picks one with probability
 //! `P = 1/4 + Re/2` and weights it (smallpt's own rule at depth 3 and more).
-//! Rays leave a surface from a point offset along the normal by a distance
-//! scaled to the point's magnitude ([`surface_offset`]) instead of smallpt's
-//! fixed 1e-4 epsilon. Paths stop after [`MAX_BOUNCES`] (a bias no render
+//! A ray leaving a sphere ignores that sphere, or only takes its far side
+//! when it heads into it ([`Origin`]), instead of smallpt's fixed 1e-4
+//! epsilon, which no f32 epsilon could replace near 1e5-radius walls; the
+//! origin is still pushed off the surface by a distance scaled to the
+//! point's magnitude ([`surface_offset`]) for the benefit of other, touching
+//! surfaces. Paths stop after [`MAX_BOUNCES`] (a bias no render
 //! has shown: Russian roulette ends them long before).
 //! Random numbers are counter-based ([`crate::rng`]).
 use glam::Vec3;
 
 use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
 use crate::rng::BounceRng;
-use crate::traverse::{closest_hit_bvh, closest_hit_linear};
+use crate::traverse::{closest_hit_bvh, closest_hit_linear, Origin};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
@@ -73,6 +76,17 @@ pub fn surface_offset(p: Vec3) -> f32 {
     p.abs().max_element().max(1e-30) * (1.0 / 262_144.0)
 }
 
+/// A cosine-weighted direction about the unit normal `w` (smallpt's diffuse
+/// bounce) from two uniform numbers.
+#[inline]
+pub fn cosine_direction(w: Vec3, u1: f32, u2: f32) -> Vec3 {
+    let r1 = 2.0 * core::f32::consts::PI * u1;
+    let r2s = libm::sqrtf(u2);
+    let u = (if w.x.abs() > 0.1 { Vec3::Y } else { Vec3::X }).cross(w).normalize();
+    let v = w.cross(u);
+    (u * libm::cosf(r1) * r2s + v * libm::sinf(r1) * r2s + w * libm::sqrtf(1.0 - u2)).normalize()
+}
+
 /// Which closest-hit search a kernel uses.
 pub const ACCEL_NONE: u32 = 0;
 pub const ACCEL_BVH: u32 = 1;
@@ -98,11 +112,12 @@ pub fn radiance<const ACCEL: u32>(
     let mut result = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut depth = 0u32;
+    let mut from = Origin::NONE;
     while depth < MAX_BOUNCES {
         let hit = if ACCEL == ACCEL_BVH {
-            closest_hit_bvh(o, d, scene.spheres, params.prims, scene.nodes, scene.prim_indices)
+            closest_hit_bvh(o, d, from, scene.spheres, params.prims, scene.nodes, scene.prim_indices)
         } else {
-            closest_hit_linear(o, d, scene.spheres, params.prims)
+            closest_hit_linear(o, d, from, scene.spheres, params.prims)
         };
         if !hit.is_hit() {
             break;
@@ -128,13 +143,7 @@ pub fn radiance<const ACCEL: u32>(
         throughput *= f;
         let eps = surface_offset(x);
         if m.kind == DIFFUSE {
-            let r1 = 2.0 * core::f32::consts::PI * rng.uniform(1);
-            let r2 = rng.uniform(2);
-            let r2s = libm::sqrtf(r2);
-            let w = nl;
-            let u = (if w.x.abs() > 0.1 { Vec3::Y } else { Vec3::X }).cross(w).normalize();
-            let v = w.cross(u);
-            d = (u * libm::cosf(r1) * r2s + v * libm::sinf(r1) * r2s + w * libm::sqrtf(1.0 - r2)).normalize();
+            d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
             o = x + nl * eps;
         } else if m.kind == MIRROR {
             d = d - n * 2.0 * n.dot(d);
@@ -170,6 +179,9 @@ pub fn radiance<const ACCEL: u32>(
                 }
             }
         }
+        // The next ray leaves this sphere: into it when it heads against the
+        // outward normal.
+        from = Origin { prim: hit.prim, into: d.dot(n) < 0.0 };
     }
     result
 }
@@ -209,5 +221,30 @@ pub fn luminance(c: Vec3) -> f32 {
 pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
     for k in 0..4 {
         acc[k] += add[k];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::BounceRng;
+
+    #[test]
+    fn cosine_directions_have_the_right_moments() {
+        for w in [Vec3::Y, Vec3::new(0.3, -0.2, 0.9).normalize(), -Vec3::X] {
+            let n = 100_000;
+            let (mut mean_cos, mut mean_perp) = (0.0f64, Vec3::ZERO);
+            for i in 0..n {
+                let r = BounceRng::new(3, i, 0, 1);
+                let d = cosine_direction(w, r.uniform(1), r.uniform(2));
+                assert!((d.length() - 1.0).abs() < 1e-5);
+                assert!(d.dot(w) >= -1e-6, "below the surface");
+                mean_cos += d.dot(w) as f64;
+                mean_perp += d - w * d.dot(w);
+            }
+            // E[cos θ] = 2/3 for a cosine-weighted hemisphere.
+            assert!((mean_cos / n as f64 - 2.0 / 3.0).abs() < 0.005, "{}", mean_cos / n as f64);
+            assert!((mean_perp / n as f32).length() < 0.01);
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! Closest hit: by scanning every sphere, or through a BVH with a stack.
 use glam::Vec3;
 
-use crate::intersect::{ray_box, ray_sphere, safe_inverse, MISS};
+use crate::intersect::{ray_box, ray_sphere_mode, safe_inverse, MISS};
 use crate::layout::{Node, Sphere};
 
 /// Depth of the traversal stack. A tree deeper than this (possible for a
@@ -24,14 +24,39 @@ impl Hit {
     }
 }
 
+/// The surface a ray starts on, if any: a ray leaving sphere `prim` cannot
+/// hit it again (`into == false`), or hits only its far side (`into`).
+#[derive(Clone, Copy)]
+pub struct Origin {
+    pub prim: u32,
+    pub into: bool,
+}
+
+impl Origin {
+    /// A ray from no surface (a camera ray).
+    pub const NONE: Origin = Origin { prim: u32::MAX, into: false };
+
+    /// Distance to sphere `prim` along the ray, honouring the start surface.
+    #[inline]
+    fn distance(&self, o: Vec3, d: Vec3, s: &Sphere, prim: u32) -> f32 {
+        if prim == self.prim {
+            if !self.into {
+                return MISS;
+            }
+            return ray_sphere_mode(o, d, Vec3::from_array(s.center), s.radius, 0.0, true);
+        }
+        ray_sphere_mode(o, d, Vec3::from_array(s.center), s.radius, 0.0, false)
+    }
+}
+
 /// Tests every sphere.
 #[inline]
-pub fn closest_hit_linear(o: Vec3, d: Vec3, spheres: &[Sphere], count: u32) -> Hit {
+pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, spheres: &[Sphere], count: u32) -> Hit {
     let mut hit = Hit::NONE;
     let mut i = 0;
     while i < count {
         let s = spheres[i as usize];
-        let t = ray_sphere(o, d, Vec3::from_array(s.center), s.radius, 0.0);
+        let t = from.distance(o, d, &s, i);
         if t < hit.t {
             hit = Hit { t, prim: i };
         }
@@ -43,7 +68,15 @@ pub fn closest_hit_linear(o: Vec3, d: Vec3, spheres: &[Sphere], count: u32) -> H
 /// Walks the BVH rooted at node 0 (`2 * count - 1` nodes), nearest child
 /// first, pruning boxes beyond the closest hit so far.
 #[inline]
-pub fn closest_hit_bvh(o: Vec3, d: Vec3, spheres: &[Sphere], count: u32, nodes: &[Node], prim_indices: &[u32]) -> Hit {
+pub fn closest_hit_bvh(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    spheres: &[Sphere],
+    count: u32,
+    nodes: &[Node],
+    prim_indices: &[u32],
+) -> Hit {
     let mut hit = Hit::NONE;
     if count == 0 {
         return hit;
@@ -62,7 +95,7 @@ pub fn closest_hit_bvh(o: Vec3, d: Vec3, spheres: &[Sphere], count: u32, nodes: 
             while k < node.prim_count() {
                 let prim = prim_indices[(node.left + k) as usize];
                 let s = spheres[prim as usize];
-                let t = ray_sphere(o, d, Vec3::from_array(s.center), s.radius, 0.0);
+                let t = from.distance(o, d, &s, prim);
                 if t < hit.t {
                     hit = Hit { t, prim };
                 }

@@ -26,10 +26,14 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
+    /// Path tracing, closest hit by scanning every sphere.
+    RenderLinear,
+    /// Path tracing, closest hit through the BVH.
+    RenderBvh,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 12] = [
+    pub const ALL: [Kernel; 14] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
@@ -42,6 +46,8 @@ impl Kernel {
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
+        Kernel::RenderLinear,
+        Kernel::RenderBvh,
     ];
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
@@ -59,6 +65,8 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
+            Kernel::RenderLinear => "render::render_linear_cs",
+            Kernel::RenderBvh => "render::render_bvh_cs",
         }
     }
 
@@ -76,6 +84,7 @@ impl Kernel {
             Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
         }
     }
 }

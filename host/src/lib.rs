@@ -15,8 +15,10 @@
 pub mod backend;
 pub mod cpu_runner;
 pub mod gpu;
+pub mod image_io;
 pub mod kernels;
 pub mod lbvh;
+pub mod render;
 pub mod report;
 pub mod scene;
 pub mod scene_file;

@@ -5,13 +5,17 @@ use anyhow::Result;
 use clap::{Parser, Subcommand, ValueEnum};
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
+use indicatif::{ProgressBar, ProgressStyle};
+use treelet::backend::Backend;
+use treelet::image_io;
+use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, BuildReport};
 use treelet::scene::Scene;
 
 mod bench;
 
 #[derive(Parser)]
-#[command(name = "treelet", version, about = "GPU BVH construction (Karras 2012) and optimization, in Rust")]
+#[command(name = "treelet", version, about = "GPU BVH construction (Karras 2012) and a smallpt path tracer, in Rust")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -32,7 +36,7 @@ enum Builder {
 enum Command {
     /// Build a BVH over a scene, check it, and report its cost and stage times.
     Build {
-        /// Scene: random:N[:SEED] (N spheres in the Cornell box).
+        /// Scene: random:N[:SEED] (N spheres), cornell, or a .json scene file.
         #[arg(long, default_value = "random:100000")]
         scene: String,
         #[arg(long, value_enum, default_value = "lbvh")]
@@ -43,11 +47,99 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Path-trace a scene (smallpt) and write the image, with an error report.
+    Render(RenderArgs),
     /// Benchmarks (medians over repeats; GPU stage times from timestamp queries).
     Bench {
         #[command(subcommand)]
         what: bench::BenchCommand,
     },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), or a .json scene file.
+    #[arg(long, default_value = "cornell")]
+    scene: String,
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    #[arg(long, default_value_t = 384)]
+    height: u32,
+    /// Samples per pixel (taken in turn by the 2x2 subpixels).
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    #[arg(long, value_enum, default_value = "none")]
+    accel: Accel,
+    #[arg(long, value_enum, default_value = "gpu")]
+    device: Device,
+    #[arg(long, default_value_t = 0)]
+    seed: u32,
+    /// Output image: .png (gamma 2.2, clamped), .exr or .pfm (linear).
+    #[arg(long, default_value = "treelet.png")]
+    out: std::path::PathBuf,
+    /// Linear reference image (.exr or .pfm) to measure the error against.
+    #[arg(long)]
+    reference: Option<std::path::PathBuf>,
+    /// Write the error-against-time rows and run facts as JSON here.
+    #[arg(long)]
+    report: Option<std::path::PathBuf>,
+}
+
+fn run_render(args: RenderArgs) -> Result<()> {
+    let scene = Scene::from_spec(&args.scene)?;
+    let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
+    let settings = RenderSettings { width: args.width, height: args.height, spp: args.spp, seed: args.seed, accel: args.accel };
+    let bar = ProgressBar::new(args.spp as u64);
+    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
+    let on_pass = |row: &PassRow| {
+        bar.set_position(row.spp as u64);
+        let err = match (row.rmse, row.mean_std_error) {
+            (Some(e), _) => format!("rmse {e:.4}"),
+            (_, Some(e)) => format!("std error {e:.4}"),
+            _ => String::new(),
+        };
+        bar.set_message(err);
+    };
+    let (result, device, adapter) = match args.device {
+        Device::Gpu => {
+            let mut b = GpuBackend::new(GpuContext::new()?);
+            let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
+            (r, "gpu", b.adapter())
+        }
+        Device::Cpu => (render(&mut CpuBackend::new(), &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into()),
+    };
+    bar.finish_and_clear();
+    image_io::write(&args.out, &result.image)?;
+    let paths = args.width as f64 * args.height as f64 * args.spp as f64;
+    eprintln!(
+        "{}: {}x{} at {} spp on {adapter}, {:.3} s ({:.1} M camera paths/s), wrote {}",
+        scene.name,
+        args.width,
+        args.height,
+        args.spp,
+        result.total_s,
+        paths / result.total_s / 1e6,
+        args.out.display()
+    );
+    if let Some(path) = &args.report {
+        let doc = serde_json::json!({
+            "scene": scene.name,
+            "width": args.width,
+            "height": args.height,
+            "spp": args.spp,
+            "seed": args.seed,
+            "accel": args.accel,
+            "device": device,
+            "adapter": adapter,
+            "build_ms": result.build_ms,
+            "render_ms": result.render_ms,
+            "total_s": result.total_s,
+            "samples_per_s": paths / result.total_s,
+            "rows": result.rows,
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&doc)?)?;
+    }
+    Ok(())
 }
 
 fn print_summary(r: &BuildReport) {
@@ -77,6 +169,7 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(report.valid)
         }
+        Command::Render(args) => run_render(args).map(|_| true),
         Command::Bench { what } => bench::run(what).map(|_| true),
     }
 }

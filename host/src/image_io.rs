@@ -1,0 +1,160 @@
+//! Images in and out: PNG (gamma 2.2 and clamped, as smallpt writes them),
+//! and linear HDR as OpenEXR (through the `image` crate) or PFM.
+//!
+//! PFM (Portable Float Map) has no maintained crate; its whole format is a
+//! three-line text header (`PF`, `width height`, a negative scale for
+//! little-endian) and rows of f32 RGB from the bottom up, written here.
+use std::path::Path;
+
+use anyhow::{bail, Context as _, Result};
+
+/// A linear RGB image, rows from the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HdrImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// smallpt's `toInt`: clamp to [0, 1], gamma 2.2, round.
+pub fn to_srgb8(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0 + 0.5) as u8
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Writes `image` in the format its extension names: .png, .exr or .pfm.
+pub fn write(path: &Path, image: &HdrImage) -> Result<()> {
+    let (w, h) = (image.width, image.height);
+    match extension(path).as_str() {
+        "png" => {
+            let bytes: Vec<u8> = image.pixels.iter().flat_map(|p| p.map(to_srgb8)).collect();
+            image::RgbImage::from_raw(w, h, bytes)
+                .context("image size mismatch")?
+                .save(path)
+                .with_context(|| format!("cannot write {}", path.display()))
+        }
+        "exr" => {
+            let floats: Vec<f32> = image.pixels.iter().flatten().copied().collect();
+            image::Rgb32FImage::from_raw(w, h, floats)
+                .context("image size mismatch")?
+                .save_with_format(path, image::ImageFormat::OpenExr)
+                .with_context(|| format!("cannot write {}", path.display()))
+        }
+        "pfm" => {
+            let mut out = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+            for row in image.pixels.chunks(w as usize).rev() {
+                for v in row.iter().flatten() {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            std::fs::write(path, out).with_context(|| format!("cannot write {}", path.display()))
+        }
+        other => bail!("{}: unknown image format `.{other}` (use .png, .exr or .pfm)", path.display()),
+    }
+}
+
+/// Reads a linear HDR image (.exr or .pfm).
+pub fn read_hdr(path: &Path) -> Result<HdrImage> {
+    match extension(path).as_str() {
+        "exr" => {
+            let img = image::open(path).with_context(|| format!("cannot read {}", path.display()))?.into_rgb32f();
+            let (width, height) = img.dimensions();
+            let pixels = img.pixels().map(|p| p.0).collect();
+            Ok(HdrImage { width, height, pixels })
+        }
+        "pfm" => {
+            let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+            parse_pfm(&bytes).with_context(|| format!("{}: not a valid colour PFM file", path.display()))
+        }
+        other => bail!("{}: a reference must be .exr or .pfm, not `.{other}`", path.display()),
+    }
+}
+
+/// Parses a colour PFM (`PF`), either byte order.
+pub fn parse_pfm(bytes: &[u8]) -> Result<HdrImage> {
+    // The header is three whitespace-separated tokens after "PF", then one
+    // whitespace byte, then the data.
+    let mut tokens = Vec::new();
+    let mut pos = 0;
+    while tokens.len() < 4 {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if start == pos {
+            bail!("header ends early");
+        }
+        tokens.push(std::str::from_utf8(&bytes[start..pos]).context("header is not text")?);
+    }
+    pos += 1; // the single whitespace byte after the scale
+    if tokens[0] != "PF" {
+        bail!("starts with `{}`, expected `PF` (colour PFM)", tokens[0]);
+    }
+    let width: u32 = tokens[1].parse().context("bad width")?;
+    let height: u32 = tokens[2].parse().context("bad height")?;
+    let scale: f32 = tokens[3].parse().context("bad scale")?;
+    if width == 0 || height == 0 {
+        bail!("empty image {width}x{height}");
+    }
+    let count = width as usize * height as usize * 3;
+    let data = bytes.get(pos..).unwrap_or(&[]);
+    if data.len() != count * 4 {
+        bail!("{} bytes of pixel data, expected {} for {width}x{height}", data.len(), count * 4);
+    }
+    let floats: Vec<f32> = data
+        .chunks_exact(4)
+        .map(|c| {
+            let b = [c[0], c[1], c[2], c[3]];
+            if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) }
+        })
+        .collect();
+    let mut pixels: Vec<[f32; 3]> = floats.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    // Bottom-up rows to top-down.
+    let rows: Vec<Vec<[f32; 3]>> = pixels.chunks(width as usize).rev().map(|r| r.to_vec()).collect();
+    pixels = rows.concat();
+    Ok(HdrImage { width, height, pixels })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> HdrImage {
+        let pixels = (0..6).map(|i| [i as f32, 0.5 * i as f32, 100.0 - i as f32]).collect();
+        HdrImage { width: 3, height: 2, pixels }
+    }
+
+    #[test]
+    fn pfm_and_exr_round_trip() {
+        let dir = std::env::temp_dir().join(format!("treelet-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for ext in ["pfm", "exr"] {
+            let path = dir.join(format!("a.{ext}"));
+            write(&path, &sample()).unwrap();
+            assert_eq!(read_hdr(&path).unwrap(), sample(), "{ext}");
+        }
+        write(&dir.join("a.png"), &sample()).unwrap();
+        assert!(write(&dir.join("a.bmp"), &sample()).unwrap_err().to_string().contains("unknown image format"));
+    }
+
+    #[test]
+    fn malformed_pfm_is_an_error() {
+        assert!(parse_pfm(b"P6\n1 1\n255\n\0\0\0").is_err());
+        assert!(parse_pfm(b"PF\n2 2\n-1.0\n\0\0\0\0").unwrap_err().to_string().contains("bytes of pixel data"));
+        assert!(parse_pfm(b"PF\n2").is_err());
+    }
+
+    #[test]
+    fn smallpt_gamma() {
+        assert_eq!(to_srgb8(0.0), 0);
+        assert_eq!(to_srgb8(1.0), 255);
+        assert_eq!(to_srgb8(7.0), 255);
+        assert_eq!(to_srgb8(0.5), 186);
+    }
+}

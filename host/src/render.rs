@@ -1,0 +1,216 @@
+//! A render, pass by pass, over any [`Backend`]: the BVH (if any) is built
+//! on the device, then each pass adds samples to every pixel and the error
+//! is measured, against a reference image or from the per-pixel variance.
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use serde::Serialize;
+use treelet_core::layout::{Node, RenderParams};
+use treelet_core::render::luminance;
+use treelet_core::traverse::STACK_DEPTH;
+use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+
+use crate::backend::Backend;
+use crate::image_io::HdrImage;
+use crate::kernels::Kernel;
+use crate::lbvh;
+use crate::scene::{validate_spheres, Scene};
+
+/// How closest hits are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Accel {
+    /// Test every sphere.
+    None,
+    /// Traverse the LBVH (Karras 2012).
+    Lbvh,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel in all (smallpt's 2x2 subpixels take them in turn).
+    pub spp: u32,
+    pub seed: u32,
+    pub accel: Accel,
+}
+
+/// Camera paths per dispatch at most, so that no dispatch runs long enough
+/// for a driver to time it out, whatever the sample count.
+pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;
+
+/// The error of the image after one pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassRow {
+    pub pass: u32,
+    /// Samples per pixel so far.
+    pub spp: u32,
+    /// Seconds since the render started (BVH build included).
+    pub elapsed_s: f64,
+    /// Root mean square error against the reference (per channel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rmse: Option<f64>,
+    /// Mean of `(x - ref)² / (ref² + 0.01)` against the reference.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rel_mse: Option<f64>,
+    /// Without a reference: mean over pixels of the standard error of the
+    /// pixel's mean luminance, from its sample variance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_std_error: Option<f64>,
+}
+
+pub struct RenderResult {
+    pub image: HdrImage,
+    pub rows: Vec<PassRow>,
+    /// BVH build time on the device (ms; 0 without a BVH).
+    pub build_ms: f64,
+    /// Render-kernel time, summed (ms; GPU timestamps where available).
+    pub render_ms: f64,
+    pub total_s: f64,
+}
+
+/// Cumulative sample counts after each pass: 4, 8, 16, ... then `spp`.
+pub fn pass_schedule(spp: u32) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut s = 4u32.min(spp);
+    while s < spp {
+        out.push(s);
+        s = s.saturating_mul(2);
+    }
+    out.push(spp);
+    out
+}
+
+/// Renders `scene`; `on_pass` sees each pass's row as it completes.
+pub fn render<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    settings: &RenderSettings,
+    reference: Option<&HdrImage>,
+    mut on_pass: impl FnMut(&PassRow),
+) -> Result<RenderResult> {
+    let RenderSettings { width, height, spp, seed, accel } = *settings;
+    if width == 0 || height == 0 || spp == 0 {
+        bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
+    }
+    let pixels = width as u64 * height as u64;
+    if pixels > u32::MAX as u64 / 2 {
+        bail!("image size {width}x{height} is too large ({pixels} pixels)");
+    }
+    if let Some(r) = reference {
+        if (r.width, r.height) != (width, height) {
+            bail!("reference image is {}x{}, the render {width}x{height}", r.width, r.height);
+        }
+    }
+    validate_spheres(&scene.spheres)?;
+    let start = Instant::now();
+    let prims = scene.spheres.len() as u32;
+
+    let (nodes, prim_indices, build_ms) = match accel {
+        Accel::Lbvh => {
+            let (bvh, times) = lbvh::build_on_device(b, &scene.spheres)?;
+            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, (2 * prims as usize).saturating_sub(1))?);
+            if depth + 1 > STACK_DEPTH {
+                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
+            }
+            (bvh.nodes, bvh.prim_indices, times.total())
+        }
+        Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
+    };
+    let spheres = b.upload("spheres", &scene.spheres)?;
+    let materials = b.upload("materials", &scene.materials)?;
+    let accum = b.zeroed("accumulation", pixels * 16)?;
+    let camera = scene.camera.camera(width, height);
+    let kernel = match accel {
+        Accel::None => Kernel::RenderLinear,
+        Accel::Lbvh => Kernel::RenderBvh,
+    };
+    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
+
+    let mut rows = Vec::new();
+    let mut render_ms = 0.0;
+    let mut done = 0u32;
+    let mut sums: Vec<[f32; 4]> = Vec::new();
+    for (pass, target) in pass_schedule(spp).into_iter().enumerate() {
+        b.stage("render");
+        while done < target {
+            let samples = (target - done).min(per_dispatch);
+            let params = RenderParams { width, height, samples, first_sample: done, seed, prims, camera, ..Default::default() };
+            let p = b.upload("render params", &[params])?;
+            b.dispatch(kernel, &[&p, &spheres, &materials, &nodes, &prim_indices, &accum], groups_for(pixels as u32, WORKGROUP_SIZE));
+            done += samples;
+        }
+        sums = b.read(&accum, pixels as usize)?;
+        render_ms += b.take_times()?.get("render");
+        let row = error_row(pass as u32, done, start.elapsed().as_secs_f64(), &sums, reference);
+        on_pass(&row);
+        rows.push(row);
+    }
+    let image = HdrImage {
+        width,
+        height,
+        pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect(),
+    };
+    Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64() })
+}
+
+/// Longest root-to-leaf path (edges) of a tree rooted at node 0.
+fn tree_depth(nodes: &[Node]) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let n = &nodes[i];
+        if !n.is_leaf() {
+            stack.push((n.left as usize, d + 1));
+            stack.push((n.right as usize, d + 1));
+        }
+    }
+    deepest
+}
+
+fn error_row(pass: u32, spp: u32, elapsed_s: f64, sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
+    let n = spp as f64;
+    let mut row = PassRow { pass, spp, elapsed_s, rmse: None, rel_mse: None, mean_std_error: None };
+    match reference {
+        Some(r) => {
+            let (mut se, mut rel) = (0.0f64, 0.0f64);
+            for (s, rp) in sums.iter().zip(&r.pixels) {
+                for k in 0..3 {
+                    let x = s[k] as f64 / n;
+                    let y = rp[k] as f64;
+                    se += (x - y) * (x - y);
+                    rel += (x - y) * (x - y) / (y * y + 0.01);
+                }
+            }
+            let count = 3.0 * sums.len() as f64;
+            row.rmse = Some((se / count).sqrt());
+            row.rel_mse = Some(rel / count);
+        }
+        None if spp >= 2 => {
+            let mut total = 0.0f64;
+            for s in sums {
+                let mean = luminance(glam::Vec3::new(s[0], s[1], s[2])) as f64 / n;
+                let var = ((s[3] as f64 - n * mean * mean) / (n - 1.0)).max(0.0);
+                total += (var / n).sqrt();
+            }
+            row.mean_std_error = Some(total / sums.len() as f64);
+        }
+        None => {}
+    }
+    row
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedule_doubles_and_ends_at_spp() {
+        assert_eq!(pass_schedule(1), vec![1]);
+        assert_eq!(pass_schedule(4), vec![4]);
+        assert_eq!(pass_schedule(64), vec![4, 8, 16, 32, 64]);
+        assert_eq!(pass_schedule(100), vec![4, 8, 16, 32, 64, 100]);
+    }
+}
