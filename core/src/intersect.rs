@@ -192,10 +192,8 @@ mod tests {
     fn smallpt_walls_from_inside_the_box() {
         // The left wall of smallpt's Cornell box, seen from the camera area.
         let c = [1e5 + 1.0, 40.8, 81.6];
-        let cases: Vec<_> = directions()
-            .into_iter()
-            .map(|d| ([50.0, 52.0, 100.0], [-1.0, d[0], d[1]], c, 1e5))
-            .collect();
+        let cases: Vec<_> =
+            directions().into_iter().map(|d| ([50.0, 52.0, 100.0], [-1.0, d[0], d[1]], c, 1e5)).collect();
         let worst = worst_error(&cases);
         std::println!("smallpt wall: worst relative error {worst:e}");
         assert!(worst < 1e-5, "{worst}");
@@ -204,9 +202,7 @@ mod tests {
     #[test]
     fn tiny_sphere_far_away() {
         let c = [1e3, 0.0, 0.0];
-        let cases: Vec<_> = (0..40)
-            .map(|i| ([0.0; 3], [1.0, (i as f32 - 20.0) * 4e-8, 1e-7], c, 1e-3))
-            .collect();
+        let cases: Vec<_> = (0..40).map(|i| ([0.0; 3], [1.0, (i as f32 - 20.0) * 4e-8, 1e-7], c, 1e-3)).collect();
         let worst = worst_error(&cases);
         std::println!("radius 1e-3 at 1e3: worst relative error {worst:e}");
         assert!(worst < 1e-5, "{worst}");
@@ -215,9 +211,8 @@ mod tests {
     #[test]
     fn grazing_rays() {
         // Rays passing within a hair of the silhouette of a unit sphere.
-        let cases: Vec<_> = (0..40)
-            .map(|i| ([-10.0, 1.0 - i as f32 * 1e-3, 0.0], [1.0, 0.0, 0.0], [0.0; 3], 1.0))
-            .collect();
+        let cases: Vec<_> =
+            (0..40).map(|i| ([-10.0, 1.0 - i as f32 * 1e-3, 0.0], [1.0, 0.0, 0.0], [0.0; 3], 1.0)).collect();
         let worst = worst_error(&cases);
         std::println!("grazing: worst relative error {worst:e}");
         assert!(worst < 1e-3, "{worst}");

@@ -53,5 +53,7 @@ pub mod traverse;
 pub mod workgroup;
 
 pub use aabb::Aabb;
-pub use layout::{BuildParams, Camera, FillParams, Material, RenderParams, Node, ScanParams, SortParams, Sphere, INVALID, LEAF_BIT};
+pub use layout::{
+    BuildParams, Camera, FillParams, Material, Node, RenderParams, ScanParams, SortParams, Sphere, INVALID, LEAF_BIT,
+};
 pub use workgroup::WORKGROUP_SIZE;

@@ -76,15 +76,35 @@ pub fn surface_offset(p: Vec3) -> f32 {
     p.abs().max_element().max(1e-30) * (1.0 / 262_144.0)
 }
 
+/// `(sin 2πu, cos 2πu)` by quadrant reduction and the Cephes minimax
+/// polynomials (error about 1e-7). Written out, rather than the GPU's sin
+/// and cos instructions, so that the GPU and the CPU compute the same
+/// directions and their paths stay together.
+#[inline]
+pub fn sin_cos_turns(u: f32) -> (f32, f32) {
+    let a = u * 4.0;
+    let q = libm::roundf(a);
+    let r = (a - q) * core::f32::consts::FRAC_PI_2;
+    let r2 = r * r;
+    let s = r + r * r2 * (-1.666_665_5e-1 + r2 * (8.332_161e-3 + r2 * -1.951_529_6e-4));
+    let c = 1.0 - 0.5 * r2 + r2 * r2 * (4.166_664_6e-2 + r2 * (-1.388_731_6e-3 + r2 * 2.443_315_7e-5));
+    match (q as i32) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}
+
 /// A cosine-weighted direction about the unit normal `w` (smallpt's diffuse
 /// bounce) from two uniform numbers.
 #[inline]
 pub fn cosine_direction(w: Vec3, u1: f32, u2: f32) -> Vec3 {
-    let r1 = 2.0 * core::f32::consts::PI * u1;
+    let (sin, cos) = sin_cos_turns(u1);
     let r2s = libm::sqrtf(u2);
     let u = (if w.x.abs() > 0.1 { Vec3::Y } else { Vec3::X }).cross(w).normalize();
     let v = w.cross(u);
-    (u * libm::cosf(r1) * r2s + v * libm::sinf(r1) * r2s + w * libm::sqrtf(1.0 - u2)).normalize()
+    (u * cos * r2s + v * sin * r2s + w * libm::sqrtf(1.0 - u2)).normalize()
 }
 
 /// Which closest-hit search a kernel uses.
@@ -228,6 +248,48 @@ pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
 mod tests {
     use super::*;
     use crate::rng::BounceRng;
+
+    #[test]
+    fn sin_cos_turns_is_accurate() {
+        for i in 0..10_000 {
+            let u = i as f32 / 10_000.0;
+            let (s, c) = sin_cos_turns(u);
+            let a = 2.0 * core::f64::consts::PI * u as f64;
+            assert!((s as f64 - a.sin()).abs() < 3e-7 && (c as f64 - a.cos()).abs() < 3e-7, "u = {u}");
+        }
+    }
+
+    /// Rays bouncing off smallpt's walls, floor and ceiling (radius 1e5) must
+    /// never hit the surface they leave: f32 cannot resolve points within
+    /// 0.004 of such a sphere, which is what the start-surface rule is for.
+    #[test]
+    fn no_self_hits_on_huge_walls() {
+        use crate::layout::Sphere;
+        use crate::traverse::closest_hit_linear;
+        let walls = [
+            Sphere::new([1e5 + 1.0, 40.8, 81.6], 1e5),
+            Sphere::new([-1e5 + 99.0, 40.8, 81.6], 1e5),
+            Sphere::new([50.0, 40.8, 1e5], 1e5),
+            Sphere::new([50.0, 1e5, 81.6], 1e5),
+            Sphere::new([50.0, -1e5 + 81.6, 81.6], 1e5),
+        ];
+        for i in 0..20_000u32 {
+            let r = BounceRng::new(1, i, 0, 1);
+            let eye = Vec3::new(50.0, 40.0, 150.0);
+            let aim = Vec3::new(1.0 + 98.0 * r.uniform(5), 81.6 * r.uniform(6), 170.0 * r.uniform(7));
+            let d = (aim - eye).normalize();
+            let hit = closest_hit_linear(eye, d, Origin::NONE, &walls, walls.len() as u32);
+            assert!(hit.is_hit());
+            let x = eye + d * hit.t;
+            let n = (x - Vec3::from_array(walls[hit.prim as usize].center)).normalize();
+            let nl = if n.dot(d) < 0.0 { n } else { -n };
+            let d2 = cosine_direction(nl, r.uniform(1), r.uniform(2));
+            let from = Origin { prim: hit.prim, into: d2.dot(n) < 0.0 };
+            let next = closest_hit_linear(x + nl * surface_offset(x), d2, from, &walls, walls.len() as u32);
+            // Hitting the same wall again is only possible at its far side.
+            assert!(next.prim != hit.prim || next.t > 1e3, "bounce {i} hit its own wall {} away", next.t);
+        }
+    }
 
     #[test]
     fn cosine_directions_have_the_right_moments() {

@@ -10,10 +10,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use bytemuck::Pod;
-use treelet_core::aabb::Aabb;
-use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use rayon::prelude::*;
+use treelet_core::aabb::Aabb;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
+use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::{bounds, fill, fit, morton, radix_tree, scan, scene, sort};
 
 use crate::backend::{Backend, StageTimes};
@@ -226,7 +226,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.
             let p: treelet_core::RenderParams = params(p);
-            let scene = SceneRefs { spheres: view(spheres), materials: view(materials), nodes: view(nodes), prim_indices: view(prims) };
+            let scene = SceneRefs {
+                spheres: view(spheres),
+                materials: view(materials),
+                nodes: view(nodes),
+                prim_indices: view(prims),
+            };
             let accum: &mut [[f32; 4]] = view(accum);
             let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
             accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {

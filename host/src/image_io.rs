@@ -111,7 +111,11 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<HdrImage> {
         .chunks_exact(4)
         .map(|c| {
             let b = [c[0], c[1], c[2], c[3]];
-            if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) }
+            if scale < 0.0 {
+                f32::from_le_bytes(b)
+            } else {
+                f32::from_be_bytes(b)
+            }
         })
         .collect();
     let mut pixels: Vec<[f32; 3]> = floats.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();

@@ -3,10 +3,10 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand, ValueEnum};
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::{GpuBackend, GpuContext};
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::image_io;
 use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, BuildReport};
@@ -88,7 +88,8 @@ struct RenderArgs {
 fn run_render(args: RenderArgs) -> Result<()> {
     let scene = Scene::from_spec(&args.scene)?;
     let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
-    let settings = RenderSettings { width: args.width, height: args.height, spp: args.spp, seed: args.seed, accel: args.accel };
+    let settings =
+        RenderSettings { width: args.width, height: args.height, spp: args.spp, seed: args.seed, accel: args.accel };
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -106,7 +107,9 @@ fn run_render(args: RenderArgs) -> Result<()> {
             let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
             (r, "gpu", b.adapter())
         }
-        Device::Cpu => (render(&mut CpuBackend::new(), &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into()),
+        Device::Cpu => {
+            (render(&mut CpuBackend::new(), &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into())
+        }
     };
     bar.finish_and_clear();
     image_io::write(&args.out, &result.image)?;

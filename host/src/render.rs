@@ -136,9 +136,14 @@ pub fn render<B: Backend>(
         b.stage("render");
         while done < target {
             let samples = (target - done).min(per_dispatch);
-            let params = RenderParams { width, height, samples, first_sample: done, seed, prims, camera, ..Default::default() };
+            let params =
+                RenderParams { width, height, samples, first_sample: done, seed, prims, camera, ..Default::default() };
             let p = b.upload("render params", &[params])?;
-            b.dispatch(kernel, &[&p, &spheres, &materials, &nodes, &prim_indices, &accum], groups_for(pixels as u32, WORKGROUP_SIZE));
+            b.dispatch(
+                kernel,
+                &[&p, &spheres, &materials, &nodes, &prim_indices, &accum],
+                groups_for(pixels as u32, WORKGROUP_SIZE),
+            );
             done += samples;
         }
         sums = b.read(&accum, pixels as usize)?;
@@ -147,11 +152,8 @@ pub fn render<B: Backend>(
         on_pass(&row);
         rows.push(row);
     }
-    let image = HdrImage {
-        width,
-        height,
-        pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect(),
-    };
+    let image =
+        HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
     Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64() })
 }
 

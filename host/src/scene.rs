@@ -1,7 +1,7 @@
 //! Scenes: parsing a scene name, generating random scenes, checking input.
 use anyhow::{bail, Context as _, Result};
-use rand::{Rng, SeedableRng};
 use glam::Vec3;
+use rand::{Rng, SeedableRng};
 use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
 use treelet_core::render::SMALLPT_FOV;
 
@@ -47,7 +47,14 @@ impl CameraSpec {
         CameraSpec { origin: [50.0, 52.0, 295.6], direction: [0.0, -0.042612, -1.0], near: 140.0, fov: SMALLPT_FOV };
 
     pub fn camera(&self, width: u32, height: u32) -> Camera {
-        Camera::look(Vec3::from_array(self.origin), Vec3::from_array(self.direction), self.near, self.fov, width, height)
+        Camera::look(
+            Vec3::from_array(self.origin),
+            Vec3::from_array(self.direction),
+            self.near,
+            self.fov,
+            width,
+            height,
+        )
     }
 }
 
@@ -61,7 +68,10 @@ pub fn cornell() -> Scene {
         .into_iter()
         .chain([
             (Sphere::new([27.0, 16.5, 47.0], 16.5), Material { color: [0.999; 3], kind: MIRROR, ..Default::default() }),
-            (Sphere::new([73.0, 16.5, 78.0], 16.5), Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() }),
+            (
+                Sphere::new([73.0, 16.5, 78.0], 16.5),
+                Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() },
+            ),
         ])
         .unzip();
     Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT }
@@ -98,8 +108,7 @@ impl Scene {
         match parts.next() {
             Some("random") => {
                 let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
-                let n: usize =
-                    n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
                 let seed = match parts.next() {
                     Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
                     None => 1,

@@ -72,9 +72,8 @@ pub fn load(path: &Path) -> Result<Scene> {
 
 /// Parses scene-file text; `name` labels errors and the scene.
 pub fn parse(text: &str, name: &str) -> Result<Scene> {
-    let file: SceneFile = serde_json::from_str(text).map_err(|e| {
-        anyhow::anyhow!("scene file {name}: line {}, column {}: {e}", e.line(), e.column())
-    })?;
+    let file: SceneFile = serde_json::from_str(text)
+        .map_err(|e| anyhow::anyhow!("scene file {name}: line {}, column {}: {e}", e.line(), e.column()))?;
     let mut materials = BTreeMap::new();
     for (key, m) in &file.materials {
         let kind = match m.kind {

@@ -1,0 +1,112 @@
+//! The path tracer: GPU against the CPU run of the same kernel, BVH against
+//! linear scan, and the picture's sanity (no NaN, no black speckles).
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::GpuBackend;
+use treelet::render::{render, Accel, RenderSettings};
+use treelet::scene::{cornell, random_scene, Scene};
+use treelet_tests::gpu;
+
+fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> RenderSettings {
+    RenderSettings { width, height, spp, seed, accel }
+}
+
+fn pixels<B: Backend>(b: &mut B, scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {
+    render(b, scene, s, None, |_| {}).unwrap().image.pixels
+}
+
+/// Fraction of pixels whose channels differ by more than `tol` (relative to 1 + value).
+fn mismatch_fraction(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> f64 {
+    let bad = a.iter().zip(b).filter(|(x, y)| (0..3).any(|k| (x[k] - y[k]).abs() > tol * (1.0 + y[k].abs()))).count();
+    bad as f64 / a.len() as f64
+}
+
+#[test]
+fn gpu_render_matches_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed() as u32;
+    for (scene, accel) in [(cornell(), Accel::None), (random_scene("random:300", 300, seed as u64), Accel::Lbvh)] {
+        let s = settings(48, 36, 16, seed, accel);
+        let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
+        let c = pixels(&mut CpuBackend::new(), &scene, &s);
+        // The noise of the estimate itself: the CPU with another seed.
+        let other = pixels(&mut CpuBackend::new(), &scene, &settings(48, 36, 16, seed.wrapping_add(1), accel));
+        // Same random numbers, same code: most paths agree to the last bits.
+        // A few diverge where the GPU rounds differently (fused multiply-adds,
+        // its square root) and a path then takes another branch.
+        let same = 1.0 - mismatch_fraction(&g, &c, 1e-4);
+        let mean_abs = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+            a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>()).sum::<f64>()
+                / (3 * a.len()) as f64
+        };
+        let (gpu_cpu, noise) = (mean_abs(&g, &c), mean_abs(&c, &other));
+        eprintln!(
+            "{} {accel:?}: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}",
+            scene.name,
+            100.0 * same
+        );
+        // Scenes full of glass diverge more (every refraction is a branch).
+        assert!(same > 0.5, "{}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
+        assert!(gpu_cpu < 0.25 * noise, "{}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+    }
+}
+
+#[test]
+fn bvh_and_linear_scan_find_the_same_hits() {
+    let seed = treelet_tests::fresh_seed();
+    let scene = random_scene("random:400", 400, seed);
+    let none = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::None));
+    let bvh = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Lbvh));
+    assert_eq!(mismatch_fraction(&none, &bvh, 1e-6), 0.0, "BVH traversal missed or invented hits");
+}
+
+#[test]
+fn cornell_has_no_nan_and_no_black_speckles() {
+    // smallpt's box is closed and lit: after 256 samples a pixel can only be
+    // black if it sees the black front wall through the mirror or the glass.
+    // A black pixel on a diffuse surface means acne (rays hitting their own
+    // surface) or a leak.
+    let (w, h) = (32, 24);
+    let scene = cornell();
+    let s = settings(w, h, 256, 5, Accel::None);
+    let p = match gpu() {
+        Some(ctx) => pixels(&mut GpuBackend::new(ctx), &scene, &s),
+        None => pixels(&mut CpuBackend::new(), &scene, &s),
+    };
+    assert!(p.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "NaN, infinite or negative pixels");
+    let camera = scene.camera.camera(w, h);
+    let v = |a: [f32; 3]| glam::Vec3::from_array(a);
+    for (i, c) in p.iter().enumerate() {
+        if c.iter().any(|&x| x > 0.0) {
+            continue;
+        }
+        let (x, y) = ((i as u32 % w) as f32, (h - 1 - i as u32 / w) as f32);
+        let d =
+            v(camera.cx) * ((x + 0.5) / w as f32 - 0.5) + v(camera.cy) * ((y + 0.5) / h as f32 - 0.5) + v(camera.dir);
+        let o = v(camera.origin) + d * camera.near;
+        let hit = treelet_core::traverse::closest_hit_linear(
+            o,
+            d.normalize(),
+            treelet_core::traverse::Origin::NONE,
+            &scene.spheres,
+            scene.spheres.len() as u32,
+        );
+        let kind = scene.materials[hit.prim as usize].kind;
+        assert_ne!(kind, treelet_core::layout::DIFFUSE, "black pixel {i} on diffuse sphere {}", hit.prim);
+    }
+    let mean = p.iter().flatten().sum::<f32>() / (3 * p.len()) as f32;
+    assert!((0.3..1.2).contains(&mean), "mean {mean}");
+}
+
+#[test]
+fn render_rejects_bad_settings() {
+    let scene = cornell();
+    let mut b = CpuBackend::new();
+    for (w, h, spp) in [(0, 10, 4), (10, 0, 4), (10, 10, 0)] {
+        let e = render(&mut b, &scene, &settings(w, h, spp, 0, Accel::None), None, |_| {}).err().unwrap();
+        assert!(e.to_string().contains("must be positive"), "{e}");
+    }
+    let reference = treelet::image_io::HdrImage { width: 3, height: 3, pixels: vec![[0.0; 3]; 9] };
+    let e = render(&mut b, &scene, &settings(4, 4, 4, 0, Accel::None), Some(&reference), |_| {}).err().unwrap();
+    assert!(e.to_string().contains("reference image is 3x3"), "{e}");
+}
