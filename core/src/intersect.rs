@@ -150,7 +150,10 @@ mod tests {
     }
 
     /// Worst relative error of the f32 hit distance over a set of rays.
-    fn worst_error(cases: &[([f32; 3], [f32; 3], [f32; 3], f32)]) -> f64 {
+    /// (origin, direction, centre, radius)
+    type Case = ([f32; 3], [f32; 3], [f32; 3], f32);
+
+    fn worst_error(cases: &[Case]) -> f64 {
         let mut worst = 0.0f64;
         for &(o, d, c, r) in cases {
             let dn = Vec3::from_array(d).normalize();
