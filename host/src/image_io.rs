@@ -108,17 +108,12 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<HdrImage> {
         bail!("{} bytes of pixel data, expected {} for {width}x{height}", data.len(), count * 4);
     }
     let floats: Vec<f32> = data
-        .chunks_exact(4)
-        .map(|c| {
-            let b = [c[0], c[1], c[2], c[3]];
-            if scale < 0.0 {
-                f32::from_le_bytes(b)
-            } else {
-                f32::from_be_bytes(b)
-            }
-        })
+        .as_chunks::<4>()
+        .0
+        .iter()
+        .map(|&b| if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) })
         .collect();
-    let mut pixels: Vec<[f32; 3]> = floats.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let mut pixels: Vec<[f32; 3]> = floats.as_chunks::<3>().0.to_vec();
     // Bottom-up rows to top-down.
     let rows: Vec<Vec<[f32; 3]>> = pixels.chunks(width as usize).rev().map(|r| r.to_vec()).collect();
     pixels = rows.concat();
