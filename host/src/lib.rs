@@ -18,6 +18,7 @@ pub mod gpu;
 pub mod image_io;
 pub mod kernels;
 pub mod lbvh;
+pub mod plot;
 pub mod render;
 pub mod report;
 pub mod scene;

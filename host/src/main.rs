@@ -8,6 +8,7 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::image_io;
+use treelet::plot::Series;
 use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, BuildReport};
 use treelet::scene::Scene;
@@ -141,6 +142,22 @@ fn run_render(args: RenderArgs) -> Result<()> {
             "rows": result.rows,
         });
         std::fs::write(path, serde_json::to_string_pretty(&doc)?)?;
+        // The log-log plot of error against time, beside the report.
+        let (label, points): (&str, Vec<(f64, f64)>) = if reference.is_some() {
+            ("RMSE against the reference", result.rows.iter().filter_map(|r| Some((r.elapsed_s, r.rmse?))).collect())
+        } else {
+            (
+                "mean standard error (from sample variance)",
+                result.rows.iter().filter_map(|r| Some((r.elapsed_s, r.mean_std_error?))).collect(),
+            )
+        };
+        let plot_path = path.with_extension("png");
+        let title = format!("{}: {}x{}, {} spp, accel {:?}, {adapter}", scene.name, args.width, args.height, args.spp, args.accel);
+        let series = [Series { label: format!("{device} ({adapter})"), points }];
+        match treelet::plot::error_vs_time(&plot_path, &title, label, &series) {
+            Ok(()) => eprintln!("wrote {} and {}", path.display(), plot_path.display()),
+            Err(e) => eprintln!("wrote {}; no plot: {e:#}", path.display()),
+        }
     }
     Ok(())
 }
