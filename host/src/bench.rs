@@ -6,7 +6,8 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::lbvh;
-use treelet::scene::random_spheres;
+use treelet::render::{render, Accel, RenderSettings};
+use treelet::scene::{random_spheres, Scene};
 
 use crate::Device;
 
@@ -29,6 +30,100 @@ pub enum BenchCommand {
         #[arg(long)]
         per_kernel: bool,
     },
+    /// Render times: cornell against spp (1024x768), and random:N at 4 spp
+    /// with a linear scan against the LBVH (256x192).
+    Render {
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: Device,
+        /// Small sizes, for a CPU or lavapipe.
+        #[arg(long)]
+        quick: bool,
+        /// Also write the rows as JSON to this file.
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
+}
+
+/// Paths per second of a render, by wall clock and by render-kernel time.
+#[derive(serde::Serialize)]
+struct RenderRow {
+    scene: String,
+    accel: Accel,
+    width: u32,
+    height: u32,
+    spp: u32,
+    /// Whole render, BVH build and readbacks included (s).
+    total_s: f64,
+    /// Render kernels alone (GPU timestamps on a GPU) (s).
+    kernel_s: f64,
+    build_ms: f64,
+    /// Camera paths per second of kernel time.
+    paths_per_s: f64,
+}
+
+fn bench_render<B: Backend>(b: &mut B, scene: &Scene, width: u32, height: u32, spp: u32, accel: Accel) -> Result<RenderRow> {
+    let settings = RenderSettings { width, height, spp, seed: 1, accel };
+    let r = render(b, scene, &settings, None, |_| {})?;
+    let kernel_s = r.render_ms / 1e3;
+    Ok(RenderRow {
+        scene: scene.name.clone(),
+        accel,
+        width,
+        height,
+        spp,
+        total_s: r.total_s,
+        kernel_s,
+        build_ms: r.build_ms,
+        paths_per_s: width as f64 * height as f64 * spp as f64 / kernel_s,
+    })
+}
+
+fn print_render_rows(title: &str, rows: &[RenderRow]) {
+    println!("{title}");
+    println!("{:>14}{:>6}{:>11}{:>6}{:>10}{:>11}{:>10}{:>14}", "scene", "accel", "size", "spp", "total s", "kernel s", "build ms", "Mpaths/s");
+    for r in rows {
+        println!(
+            "{:>14}{:>6}{:>11}{:>6}{:>10.3}{:>11.4}{:>10.3}{:>14.1}",
+            r.scene,
+            format!("{:?}", r.accel).to_lowercase(),
+            format!("{}x{}", r.width, r.height),
+            r.spp,
+            r.total_s,
+            r.kernel_s,
+            r.build_ms,
+            r.paths_per_s / 1e6
+        );
+    }
+}
+
+fn render_sweeps<B: Backend>(b: &mut B, quick: bool) -> Result<(Vec<RenderRow>, Vec<RenderRow>)> {
+    // Graph 1 of the seed: cornell, time against samples per pixel.
+    let (w, h) = if quick { (256, 192) } else { (1024, 768) };
+    let spps: &[u32] = if quick { &[4, 16, 64] } else { &[4, 16, 64, 256, 1024] };
+    let sizes: &[usize] = if quick { &[100, 1000, 4000] } else { &[1000, 4000, 16000, 35000, 65000] };
+    let bar = ProgressBar::new((spps.len() + 2 * sizes.len()) as u64);
+    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} renders {msg}").unwrap());
+    let cornell = Scene::from_spec("cornell")?;
+    // Warm up pipelines and clocks.
+    bench_render(b, &cornell, 64, 48, 4, Accel::None)?;
+    let mut graph1 = Vec::new();
+    for &spp in spps {
+        bar.set_message(format!("cornell {spp} spp"));
+        graph1.push(bench_render(b, &cornell, w, h, spp, Accel::None)?);
+        bar.inc(1);
+    }
+    // Graph 2: random:N at 4 spp, linear scan against the LBVH.
+    let mut graph2 = Vec::new();
+    for &n in sizes {
+        let scene = Scene::from_spec(&format!("random:{n}"))?;
+        for accel in [Accel::None, Accel::Lbvh] {
+            bar.set_message(format!("random:{n} {accel:?}"));
+            graph2.push(bench_render(b, &scene, 256, 192, 4, accel)?);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok((graph1, graph2))
 }
 
 #[derive(serde::Serialize)]
@@ -96,6 +191,22 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
+        BenchCommand::Render { device, quick, json } => {
+            let (adapter, (graph1, graph2)) = match device {
+                Device::Gpu => {
+                    let mut b = GpuBackend::new(GpuContext::new()?);
+                    (b.adapter(), render_sweeps(&mut b, quick)?)
+                }
+                Device::Cpu => (CpuBackend::new().adapter(), render_sweeps(&mut CpuBackend::new(), quick)?),
+            };
+            print_render_rows(&format!("cornell against samples per pixel, {adapter}"), &graph1);
+            print_render_rows(&format!("random:N at 4 spp, linear scan against LBVH, {adapter}"), &graph2);
+            if let Some(path) = json {
+                let doc = serde_json::json!({ "adapter": adapter, "cornell": graph1, "random": graph2 });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
         BenchCommand::Build { sizes, device, repeats, json, per_kernel } => {
             let (adapter, timing, rows) = match device {
                 Device::Gpu => {
