@@ -54,6 +54,16 @@ impl Aabb {
     pub fn is_empty(&self) -> bool {
         self.min[0] > self.max[0] || self.min[1] > self.max[1] || self.min[2] > self.max[2]
     }
+    /// The smallest box holding both.
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use treelet_core::Aabb;
+    /// let a = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    /// let b = Aabb::point(Vec3::splat(3.0));
+    /// assert_eq!(a.union(&b), Aabb::new(Vec3::ZERO, Vec3::splat(3.0)));
+    /// assert_eq!(a.union(&Aabb::EMPTY), a);
+    /// ```
     #[inline]
     pub fn union(&self, other: &Aabb) -> Aabb {
         Aabb::new(self.lo().min(other.lo()), self.hi().max(other.hi()))

@@ -46,6 +46,14 @@ pub fn length_sq_minus_sq(v: Vec3, r: f32) -> f32 {
 
 /// Distance along the unit direction `d` from `o` to the first hit with the
 /// sphere (`center`, `radius`) beyond `t_min`, or [`MISS`].
+///
+/// ```
+/// use glam::Vec3;
+/// use treelet_core::intersect::{ray_sphere, MISS};
+/// let t = ray_sphere(Vec3::ZERO, Vec3::X, Vec3::new(10.0, 0.0, 0.0), 2.0, 0.0);
+/// assert_eq!(t, 8.0);
+/// assert_eq!(ray_sphere(Vec3::ZERO, -Vec3::X, Vec3::new(10.0, 0.0, 0.0), 2.0, 0.0), MISS);
+/// ```
 #[inline]
 pub fn ray_sphere(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32) -> f32 {
     ray_sphere_mode(o, d, center, radius, t_min, false)

@@ -75,6 +75,15 @@ impl MortonFrame {
         UVec3::new(cell.x as u32, cell.y as u32, cell.z as u32)
     }
 
+    /// The 63-bit Morton key of a centroid.
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use treelet_core::{morton::MortonFrame, Aabb};
+    /// let frame = MortonFrame::new(&Aabb::new(Vec3::ZERO, Vec3::splat(10.0)));
+    /// assert_eq!(frame.code(Vec3::ZERO), 0);
+    /// assert!(frame.code(Vec3::new(1.0, 1.0, 1.0)) < frame.code(Vec3::new(9.0, 9.0, 9.0)));
+    /// ```
     #[inline]
     pub fn code(&self, centroid: Vec3) -> u64 {
         let q = self.quantize(centroid);

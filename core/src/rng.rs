@@ -17,6 +17,14 @@ pub fn hash(mut x: u32) -> u32 {
 }
 
 /// The random stream of one bounce of one path.
+///
+/// ```
+/// use treelet_core::rng::BounceRng;
+/// let rng = BounceRng::new(7, 1234, 0, 2); // seed, pixel, sample, bounce
+/// let u = rng.uniform(0);
+/// assert!((0.0..1.0).contains(&u));
+/// assert_eq!(u, BounceRng::new(7, 1234, 0, 2).uniform(0)); // counter-based: repeatable
+/// ```
 #[derive(Clone, Copy)]
 pub struct BounceRng {
     key: u32,

@@ -50,6 +50,15 @@ impl Origin {
 }
 
 /// Tests every sphere.
+///
+/// ```
+/// use glam::Vec3;
+/// use treelet_core::traverse::{closest_hit_linear, Origin};
+/// use treelet_core::Sphere;
+/// let spheres = [Sphere::new([5.0, 0.0, 0.0], 1.0), Sphere::new([3.0, 0.0, 0.0], 1.0)];
+/// let hit = closest_hit_linear(Vec3::ZERO, Vec3::X, Origin::NONE, &spheres, 2);
+/// assert_eq!((hit.prim, hit.t), (1, 2.0));
+/// ```
 #[inline]
 pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, spheres: &[Sphere], count: u32) -> Hit {
     let mut hit = Hit::NONE;

@@ -61,7 +61,14 @@ struct RenderRow {
     paths_per_s: f64,
 }
 
-fn bench_render<B: Backend>(b: &mut B, scene: &Scene, width: u32, height: u32, spp: u32, accel: Accel) -> Result<RenderRow> {
+fn bench_render<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    spp: u32,
+    accel: Accel,
+) -> Result<RenderRow> {
     let settings = RenderSettings { width, height, spp, seed: 1, accel };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
@@ -80,7 +87,10 @@ fn bench_render<B: Backend>(b: &mut B, scene: &Scene, width: u32, height: u32, s
 
 fn print_render_rows(title: &str, rows: &[RenderRow]) {
     println!("{title}");
-    println!("{:>14}{:>6}{:>11}{:>6}{:>10}{:>11}{:>10}{:>14}", "scene", "accel", "size", "spp", "total s", "kernel s", "build ms", "Mpaths/s");
+    println!(
+        "{:>14}{:>6}{:>11}{:>6}{:>10}{:>11}{:>10}{:>14}",
+        "scene", "accel", "size", "spp", "total s", "kernel s", "build ms", "Mpaths/s"
+    );
     for r in rows {
         println!(
             "{:>14}{:>6}{:>11}{:>6}{:>10.3}{:>11.4}{:>10.3}{:>14.1}",

@@ -152,7 +152,10 @@ fn run_render(args: RenderArgs) -> Result<()> {
             )
         };
         let plot_path = path.with_extension("png");
-        let title = format!("{}: {}x{}, {} spp, accel {:?}, {adapter}", scene.name, args.width, args.height, args.spp, args.accel);
+        let title = format!(
+            "{}: {}x{}, {} spp, accel {:?}, {adapter}",
+            scene.name, args.width, args.height, args.spp, args.accel
+        );
         let series = [Series { label: format!("{device} ({adapter})"), points }];
         match treelet::plot::error_vs_time(&plot_path, &title, label, &series) {
             Ok(()) => eprintln!("wrote {} and {}", path.display(), plot_path.display()),

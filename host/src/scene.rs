@@ -62,9 +62,12 @@ pub fn diffuse(color: [f32; 3]) -> Material {
     Material { color, kind: DIFFUSE, ..Default::default() }
 }
 
-/// smallpt's scene: nine spheres, six of them walls of radius 1e5.
+/// smallpt's scene, in smallpt's order: six walls of radius 1e5, the
+/// mirror ball, the glass ball, the light.
 pub fn cornell() -> Scene {
-    let (spheres, materials): (Vec<_>, Vec<_>) = cornell_room()
+    let mut room = cornell_room();
+    let light = room.pop().expect("the room ends with its light");
+    let (spheres, materials): (Vec<_>, Vec<_>) = room
         .into_iter()
         .chain([
             (Sphere::new([27.0, 16.5, 47.0], 16.5), Material { color: [0.999; 3], kind: MIRROR, ..Default::default() }),
@@ -72,12 +75,14 @@ pub fn cornell() -> Scene {
                 Sphere::new([73.0, 16.5, 78.0], 16.5),
                 Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() },
             ),
+            light,
         ])
         .unzip();
     Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT }
 }
 
-/// smallpt's walls and light (radius 600, poking through the ceiling).
+/// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
+/// the light last.
 pub fn cornell_room() -> Vec<(Sphere, Material)> {
     vec![
         (Sphere::new([1e5 + 1.0, 40.8, 81.6], 1e5), diffuse([0.75, 0.25, 0.25])),
@@ -86,7 +91,8 @@ pub fn cornell_room() -> Vec<(Sphere, Material)> {
         (Sphere::new([50.0, 40.8, -1e5 + 170.0], 1e5), diffuse([0.0; 3])),
         (Sphere::new([50.0, 1e5, 81.6], 1e5), diffuse([0.75; 3])),
         (Sphere::new([50.0, -1e5 + 81.6, 81.6], 1e5), diffuse([0.75; 3])),
-        (Sphere::new([50.0, 681.6 - 0.27, 81.6], 600.0), Material { emission: [12.0; 3], ..diffuse([0.0; 3]) }),
+        // 681.6 - 0.27, rounded once as smallpt's double is.
+        (Sphere::new([50.0, 681.33, 81.6], 600.0), Material { emission: [12.0; 3], ..diffuse([0.0; 3]) }),
     ]
 }
 

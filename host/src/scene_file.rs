@@ -91,7 +91,8 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
         if kind == GLASS && m.ior <= 0.0 {
             bail!("scene file {name}: material `{key}` has index of refraction {} (must be positive)", m.ior);
         }
-        materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior: m.ior });
+        let ior = if kind == GLASS { m.ior } else { 0.0 }; // meaningful for glass alone
+        materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior });
     }
     if file.spheres.is_empty() {
         bail!("scene file {name}: no spheres");
@@ -114,4 +115,32 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
         bail!("scene file {name}: the camera needs a finite origin, a non-zero direction and a positive fov");
     }
     Ok(Scene { name: name.into(), spheres, materials: sphere_materials, room: 0, camera: file.camera })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shipped_cornell_file_is_smallpts_scene() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.json");
+        let file = load(Path::new(path)).unwrap();
+        let builtin = crate::scene::cornell();
+        assert_eq!(file.spheres, builtin.spheres);
+        assert_eq!(file.materials, builtin.materials);
+        assert_eq!(file.camera, builtin.camera);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = parse("{\n \"camera\": 3\n}", "x.json").unwrap_err().to_string();
+        assert!(e.contains("x.json: line 2"), "{e}");
+        let e = parse(r#"{"camera": {"origin": [0,0,0], "direction": [0,0,0]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "spheres": [{"center": [0,0,0], "radius": 1, "material": "w"}]}"#, "y.json").unwrap_err().to_string();
+        assert!(e.contains("non-zero direction"), "{e}");
+        let e =
+            parse(r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {}, "spheres": []}"#, "z.json")
+                .unwrap_err()
+                .to_string();
+        assert!(e.contains("no spheres"), "{e}");
+    }
 }

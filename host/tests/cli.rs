@@ -38,3 +38,104 @@ fn empty_scene_builds_an_empty_tree() {
     assert_eq!(v["nodes"], 0);
     assert_eq!(v["valid"], true);
 }
+
+fn stderr_of(args: &[&str]) -> String {
+    let out = treelet(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn render_bad_input_names_the_problem() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let broken = dir.join("broken.json");
+    std::fs::write(&broken, "{\n  \"camera\": { \"origin\": [0, 0, 0],\n  \"direction\": [0, 0, -1] \n").unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", broken.to_str().unwrap()]);
+    assert!(e.contains("broken.json") && e.contains("line 4"), "{e}");
+
+    let unknown = dir.join("unknown.json");
+    std::fs::write(
+        &unknown,
+        r#"{"camera": {"origin": [0,0,0], "direction": [0,0,-1]}, "materials": {},
+            "spheres": [{"center": [0,0,-5], "radius": 1, "material": "gold"}]}"#,
+    )
+    .unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", unknown.to_str().unwrap()]);
+    assert!(e.contains("sphere 0") && e.contains("unknown material `gold`"), "{e}");
+
+    let nan = dir.join("nan.json");
+    std::fs::write(
+        &nan,
+        r#"{"camera": {"origin": [0,0,0], "direction": [0,0,-1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}},
+            "spheres": [{"center": [0,0,-5], "radius": 1, "material": "w"}, {"center": [0,1e39,-5], "radius": 1, "material": "w"}]}"#,
+    )
+    .unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", nan.to_str().unwrap()]);
+    assert!(e.contains("sphere 1"), "{e}");
+
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", "nowhere.json"]);
+    assert!(e.contains("nowhere.json"), "{e}");
+    let e = stderr_of(&["render", "--device", "cpu", "--width", "0"]);
+    assert!(e.contains("must be positive"), "{e}");
+    let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "4", "--out", "x.bmp"]);
+    assert!(e.contains("unknown image format"), "{e}");
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", "teapot"]);
+    assert!(e.contains("unknown scene `teapot`"), "{e}");
+}
+
+#[test]
+fn render_writes_image_report_and_plot() {
+    let dir = std::env::temp_dir().join(format!("treelet-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (img, report) = (dir.join("c.pfm"), dir.join("c.json"));
+    let out = treelet(&[
+        "render",
+        "--device",
+        "cpu",
+        "--width",
+        "24",
+        "--height",
+        "18",
+        "--spp",
+        "16",
+        "--out",
+        img.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let image = treelet::image_io::read_hdr(&img).unwrap();
+    assert_eq!((image.width, image.height), (24, 18));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(v["spp"], 16);
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3); // 4, 8, 16 spp
+    assert!(dir.join("c.png").exists(), "the error plot beside the report");
+    // Against a reference: the error is measured and falls.
+    let out = treelet(&[
+        "render",
+        "--device",
+        "cpu",
+        "--width",
+        "24",
+        "--height",
+        "18",
+        "--spp",
+        "64",
+        "--seed",
+        "9",
+        "--out",
+        dir.join("d.exr").to_str().unwrap(),
+        "--reference",
+        img.to_str().unwrap(),
+        "--report",
+        dir.join("d.json").to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("d.json")).unwrap()).unwrap();
+    let rmse: Vec<f64> = v["rows"].as_array().unwrap().iter().map(|r| r["rmse"].as_f64().unwrap()).collect();
+    assert!(rmse.first() > rmse.last(), "{rmse:?}");
+}
