@@ -50,6 +50,7 @@ pub mod scan;
 pub mod scene;
 pub mod sort;
 pub mod traverse;
+pub mod treelet;
 pub mod workgroup;
 
 pub use aabb::Aabb;
