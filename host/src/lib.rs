@@ -24,4 +24,5 @@ pub mod report;
 pub mod scene;
 pub mod scene_file;
 pub mod sort;
+pub mod sweep;
 pub mod validate;

@@ -10,7 +10,7 @@ use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::image_io;
 use treelet::plot::Series;
 use treelet::render::{render, Accel, PassRow, RenderSettings};
-use treelet::report::{run_build, BuildReport};
+use treelet::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 
 mod bench;
@@ -30,7 +30,10 @@ pub enum Device {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Builder {
+    /// Karras 2012, on the chosen device.
     Lbvh,
+    /// Full-sweep SAH, top-down on the CPU: the quality reference.
+    Sweep,
 }
 
 #[derive(Subcommand)]
@@ -179,11 +182,15 @@ fn print_summary(r: &BuildReport) {
 
 fn run(cli: Cli) -> Result<bool> {
     match cli.command {
-        Command::Build { scene, builder: Builder::Lbvh, device, json } => {
+        Command::Build { scene, builder, device, json } => {
             let scene = Scene::from_spec(&scene)?;
-            let (_, report) = match device {
-                Device::Gpu => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene)?,
-                Device::Cpu => run_build(&mut CpuBackend::new(), &scene)?,
+            let (_, report) = match (builder, device) {
+                (Builder::Lbvh, Device::Gpu) => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene)?,
+                (Builder::Lbvh, Device::Cpu) => run_build(&mut CpuBackend::new(), &scene)?,
+                (Builder::Sweep, Device::Cpu) => run_build_sweep(&scene)?,
+                (Builder::Sweep, Device::Gpu) => {
+                    anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu")
+                }
             };
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

@@ -32,6 +32,34 @@ pub struct BuildReport {
     pub timing: &'static str,
 }
 
+/// The full-sweep SAH reference build (CPU only), reported like the others.
+pub fn run_build_sweep(scene: &Scene) -> Result<(Bvh, BuildReport)> {
+    let objects = scene.objects();
+    validate_spheres(objects)?;
+    let start = Instant::now();
+    let bvh = crate::sweep::build(objects);
+    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let mut ms = serde_json::Map::new();
+    ms.insert("sweep".into(), serde_json::json!(wall_ms));
+    let report = BuildReport {
+        scene: scene.name.clone(),
+        primitives: objects.len(),
+        builder: "sweep",
+        device: "cpu",
+        adapter: "cpu".into(),
+        nodes: bvh.nodes.len(),
+        sah_cost: sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA),
+        valid: check.is_valid(),
+        errors: check.errors,
+        total_ms: wall_ms,
+        wall_ms,
+        ms,
+        timing: "wall-clock",
+    };
+    Ok((bvh, report))
+}
+
 /// Validates the input, builds, validates the tree, and reports.
 pub fn run_build<B: Backend>(backend: &mut B, scene: &Scene) -> Result<(Bvh, BuildReport)> {
     let objects = scene.objects();
