@@ -5,9 +5,11 @@ use rand::{Rng, SeedableRng};
 use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
 use treelet_core::render::SMALLPT_FOV;
 
-/// Interior of smallpt's Cornell box, where random scenes place spheres.
+/// Where random scenes place sphere centres: smallpt's room, short of the
+/// plane (z about 155) where its camera rays start, so that no sphere
+/// encloses a camera ray's origin.
 pub const RANDOM_BOX_MIN: [f32; 3] = [1.0, 0.0, 0.0];
-pub const RANDOM_BOX_MAX: [f32; 3] = [99.0, 81.6, 170.0];
+pub const RANDOM_BOX_MAX: [f32; 3] = [99.0, 81.6, 140.0];
 
 /// A scene: spheres with one material each, and a camera.
 #[derive(Clone, Debug)]
