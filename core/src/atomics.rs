@@ -95,3 +95,29 @@ pub fn load_f32(slot: &f32) -> f32 {
         *slot
     }
 }
+
+/// Device-scope relaxed store of a `u32` (see [`store_f32`]).
+#[inline]
+pub fn store_u32(slot: &mut u32, value: u32) {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_store::<u32, DEVICE, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        *slot = value;
+    }
+}
+
+/// Device-scope relaxed load of a `u32` (see [`store_f32`]).
+#[inline]
+pub fn load_u32(slot: &u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_load::<u32, DEVICE, RELAXED>(slot)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        *slot
+    }
+}

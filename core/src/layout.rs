@@ -187,3 +187,24 @@ pub struct RenderParams {
     pub camera: Camera,
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);
+
+/// Parameters of the treelet kernels. repr(C), Pod, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct TreeletParams {
+    /// Number of primitives (leaves).
+    pub n: u32,
+    /// Height of the nodes this dispatch restructures.
+    pub level: u32,
+    /// Only subtrees of at least this many primitives are restructured.
+    pub gamma: u32,
+    pub _pad0: u32,
+    /// SAH cost per internal node and per primitive (per unit area).
+    pub node_cost: f32,
+    pub prim_cost: f32,
+    /// Boxes are scaled by this before taking areas.
+    pub inv_extent: f32,
+    pub _pad1: u32,
+}
+const _: () = assert!(core::mem::size_of::<TreeletParams>() == 32);

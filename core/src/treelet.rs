@@ -25,7 +25,8 @@
 //! Treelet departs from the paper in one way so far: the DP here runs in one
 //! invocation per treelet (the paper's warp-wide version is the speed target).
 use crate::aabb::Aabb;
-use crate::layout::Node;
+use crate::atomics;
+use crate::layout::{Node, TreeletParams};
 
 /// Leaves of a treelet (the paper's 7).
 pub const TREELET_LEAVES: usize = 7;
@@ -44,6 +45,14 @@ pub struct TreeletCosts {
     pub prim: f32,
     /// Boxes are scaled by this before taking areas (1 / the scene's extent).
     pub inv_extent: f32,
+}
+
+impl TreeletParams {
+    /// The cost constants of these parameters.
+    #[inline]
+    pub fn costs(&self) -> TreeletCosts {
+        TreeletCosts { node: self.node_cost, prim: self.prim_cost, inv_extent: self.inv_extent }
+    }
 }
 
 impl TreeletCosts {
@@ -110,7 +119,7 @@ pub fn form_treelet(root: u32, nodes: &[Node], costs: &TreeletCosts) -> Treelet 
 /// The optimal tree over a treelet's leaves: `partition[s]` is the subset of
 /// `s` that forms one child of the node covering `s` (the other is `s ^ p`).
 pub struct TreeletSolution {
-    pub partition: [u8; SUBSETS],
+    pub partition: [u32; SUBSETS],
     pub area: [f32; SUBSETS],
     pub cost: [f32; SUBSETS],
 }
@@ -124,7 +133,7 @@ pub fn optimize(
     leaf_costs: &[f32; TREELET_LEAVES],
     costs: &TreeletCosts,
 ) -> TreeletSolution {
-    let mut sol = TreeletSolution { partition: [0; SUBSETS], area: [0.0; SUBSETS], cost: [0.0; SUBSETS] };
+    let mut sol = TreeletSolution { partition: [0u32; SUBSETS], area: [0.0; SUBSETS], cost: [0.0; SUBSETS] };
     let full = (1u32 << n) - 1;
     // Areas of every subset's union.
     let mut s = 1u32;
@@ -170,7 +179,7 @@ pub fn optimize(
                     }
                 }
                 sol.cost[s as usize] = costs.node * sol.area[s as usize] + best;
-                sol.partition[s as usize] = best_p as u8;
+                sol.partition[s as usize] = best_p;
             }
             s += 1;
         }
@@ -197,7 +206,7 @@ pub fn apply(t: &Treelet, sol: &TreeletSolution, nodes: &mut [Node], parents: &m
         top -= 1;
         let s = stack_s[top];
         let node = stack_n[top];
-        let p = sol.partition[s as usize] as u32;
+        let p = sol.partition[s as usize];
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
@@ -278,6 +287,73 @@ pub fn restructure(
         node_costs[id] = node_cost(&nodes[id], (node_costs[l], node_costs[r]), costs);
     }
     true
+}
+
+/// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
+/// every node's primitive count, subtree SAH cost and height (leaves 0), an
+/// internal node once both children are done. `flags` are zeroed counters.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_init_kernel<const ORDERED: bool>(
+    i: u32,
+    params: &TreeletParams,
+    nodes: &[Node],
+    parents: &[u32],
+    flags: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+) {
+    let n = params.n;
+    if i >= n {
+        return;
+    }
+    let costs = params.costs();
+    // Leaves are found through the tree, not by index: restructuring moves
+    // internal nodes but never leaves, and leaf `i` stays at `n - 1 + i`.
+    let leaf = n - 1 + i;
+    let node = nodes[leaf as usize];
+    atomics::store_u32(&mut counts[leaf as usize], node.prim_count());
+    atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, (0.0, 0.0), &costs));
+    atomics::store_u32(&mut heights[leaf as usize], 0);
+    let mut current = leaf;
+    while current != 0 {
+        let parent = parents[current as usize];
+        let counter = &mut flags[parent as usize];
+        let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
+        if previous == 0 {
+            return;
+        }
+        let p = nodes[parent as usize];
+        let (l, r) = (p.left as usize, p.right as usize);
+        let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
+        let cost = node_cost(&p, (atomics::load_f32(&node_costs[l]), atomics::load_f32(&node_costs[r])), &costs);
+        let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
+        atomics::store_u32(&mut counts[parent as usize], count);
+        atomics::store_f32(&mut node_costs[parent as usize], cost);
+        atomics::store_u32(&mut heights[parent as usize], height);
+        current = parent;
+    }
+}
+
+/// Kernel (one invocation per internal node): restructures the treelet of
+/// node `i` when `i` has height `params.level` and at least `params.gamma`
+/// primitives. Nodes of one height never contain each other, so their
+/// treelets are disjoint; levels run as separate dispatches, bottom up.
+pub fn treelet_level_kernel(
+    i: u32,
+    params: &TreeletParams,
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &[u32],
+    node_costs: &mut [f32],
+    heights: &[u32],
+) {
+    if params.n < 2 || i >= params.n - 1 {
+        return;
+    }
+    if heights[i as usize] == params.level && counts[i as usize] >= params.gamma {
+        restructure(i, nodes, parents, node_costs, &params.costs());
+    }
 }
 
 #[cfg(test)]

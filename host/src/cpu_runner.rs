@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use treelet_core::aabb::Aabb;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{bounds, fill, fit, morton, radix_tree, scan, scene, sort};
+use treelet_core::{bounds, fill, fit, morton, radix_tree, scan, scene, sort, treelet};
 
 use crate::backend::{Backend, StageTimes};
 use crate::kernels::Kernel;
@@ -221,6 +221,22 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (parents, flags) = (view(parents), view(flags));
             for id in ids(groups) {
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, nodes, parents, flags);
+            }
+        }
+        (Kernel::TreeletInit | Kernel::TreeletInitRelaxed, [p, nodes, parents, flags, counts, costs, heights]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
+            let (counts, costs, heights) = (view(counts), view(costs), view(heights));
+            for id in ids(groups) {
+                treelet::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights);
+            }
+        }
+        (Kernel::TreeletLevel, [p, nodes, parents, counts, costs, heights]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (nodes, parents, counts) = (view(nodes), view(parents), view(counts));
+            let (costs, heights) = (view(costs), view(heights));
+            for id in ids(groups) {
+                treelet::treelet_level_kernel(id, &p, nodes, parents, counts, costs, heights);
             }
         }
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum]) => {

@@ -26,6 +26,12 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
+    /// Treelet optimization: per-node counts, costs, heights (bottom up).
+    TreeletInit,
+    /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
+    TreeletInitRelaxed,
+    /// Treelet optimization: restructure the treelets of one height.
+    TreeletLevel,
     /// Path tracing, closest hit by scanning every sphere.
     RenderLinear,
     /// Path tracing, closest hit through the BVH.
@@ -33,7 +39,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 14] = [
+    pub const ALL: [Kernel; 17] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
@@ -46,6 +52,9 @@ impl Kernel {
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
+        Kernel::TreeletInit,
+        Kernel::TreeletInitRelaxed,
+        Kernel::TreeletLevel,
         Kernel::RenderLinear,
         Kernel::RenderBvh,
     ];
@@ -65,6 +74,9 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
+            Kernel::TreeletInit => "treelet::treelet_init_cs",
+            Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
+            Kernel::TreeletLevel => "treelet::treelet_level_cs",
             Kernel::RenderLinear => "render::render_linear_cs",
             Kernel::RenderBvh => "render::render_bvh_cs",
         }
@@ -84,6 +96,10 @@ impl Kernel {
             Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
+                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+            }
+            Kernel::TreeletLevel => &[Read, ReadWrite, ReadWrite, Read, ReadWrite, Read],
             Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
         }
     }

@@ -25,4 +25,5 @@ pub mod scene;
 pub mod scene_file;
 pub mod sort;
 pub mod sweep;
+pub mod trbvh;
 pub mod validate;

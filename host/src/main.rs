@@ -12,6 +12,7 @@ use treelet::plot::Series;
 use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
+use treelet::trbvh::TreeletConfig;
 
 mod bench;
 
@@ -32,6 +33,8 @@ pub enum Device {
 enum Builder {
     /// Karras 2012, on the chosen device.
     Lbvh,
+    /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the chosen device.
+    Trbvh,
     /// Full-sweep SAH, top-down on the CPU: the quality reference.
     Sweep,
 }
@@ -47,6 +50,12 @@ enum Command {
         builder: Builder,
         #[arg(long, value_enum, default_value = "gpu")]
         device: Device,
+        /// Treelet optimization rounds (trbvh).
+        #[arg(long, default_value_t = 3)]
+        rounds: u32,
+        /// Smallest subtree restructured in the first round, doubled each round (trbvh).
+        #[arg(long, default_value_t = 7)]
+        gamma: u32,
         /// Print one JSON object instead of a summary.
         #[arg(long)]
         json: bool,
@@ -172,6 +181,9 @@ fn print_summary(r: &BuildReport) {
     println!("scene      {} ({} primitives)", r.scene, r.primitives);
     println!("device     {} ({})", r.device, r.adapter);
     println!("builder    {}: {} nodes, SAH {:.3}", r.builder, r.nodes, r.sah_cost);
+    if let (Some(before), Some(after)) = (r.sah_before, r.sah_after) {
+        println!("treelets   SAH {before:.3} -> {after:.3} ({:.1}% lower)", 100.0 * (1.0 - after / before));
+    }
     println!("valid      {}", r.valid);
     for e in &r.errors {
         println!("  error: {e}");
@@ -182,11 +194,18 @@ fn print_summary(r: &BuildReport) {
 
 fn run(cli: Cli) -> Result<bool> {
     match cli.command {
-        Command::Build { scene, builder, device, json } => {
+        Command::Build { scene, builder, device, rounds, gamma, json } => {
             let scene = Scene::from_spec(&scene)?;
             let (_, report) = match (builder, device) {
-                (Builder::Lbvh, Device::Gpu) => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene)?,
-                (Builder::Lbvh, Device::Cpu) => run_build(&mut CpuBackend::new(), &scene)?,
+                (Builder::Lbvh, Device::Gpu) => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene, None)?,
+                (Builder::Lbvh, Device::Cpu) => run_build(&mut CpuBackend::new(), &scene, None)?,
+                (Builder::Trbvh, Device::Gpu) => {
+                    let config = TreeletConfig { rounds, gamma };
+                    run_build(&mut GpuBackend::new(GpuContext::new()?), &scene, Some(&config))?
+                }
+                (Builder::Trbvh, Device::Cpu) => {
+                    run_build(&mut CpuBackend::new(), &scene, Some(&TreeletConfig { rounds, gamma }))?
+                }
                 (Builder::Sweep, Device::Cpu) => run_build_sweep(&scene)?,
                 (Builder::Sweep, Device::Gpu) => {
                     anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu")

@@ -15,6 +15,7 @@ use crate::image_io::HdrImage;
 use crate::kernels::Kernel;
 use crate::lbvh;
 use crate::scene::{validate_spheres, Scene};
+use crate::trbvh::{self, TreeletConfig};
 
 /// How closest hits are found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -24,6 +25,8 @@ pub enum Accel {
     None,
     /// Traverse the LBVH (Karras 2012).
     Lbvh,
+    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
+    Trbvh,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -108,13 +111,18 @@ pub fn render<B: Backend>(
     let prims = scene.spheres.len() as u32;
 
     let (nodes, prim_indices, build_ms) = match accel {
-        Accel::Lbvh => {
+        Accel::Lbvh | Accel::Trbvh => {
             let (bvh, times) = lbvh::build_on_device(b, &scene.spheres)?;
+            let mut build_ms = times.total();
+            if accel == Accel::Trbvh {
+                let root = trbvh::root_box(b, &bvh)?;
+                build_ms += trbvh::optimize(b, &bvh, &root, &TreeletConfig::default())?.total();
+            }
             let depth = tree_depth(&b.read::<Node>(&bvh.nodes, (2 * prims as usize).saturating_sub(1))?);
             if depth + 1 > STACK_DEPTH {
                 bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
             }
-            (bvh.nodes, bvh.prim_indices, times.total())
+            (bvh.nodes, bvh.prim_indices, build_ms)
         }
         Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
     };
@@ -124,7 +132,7 @@ pub fn render<B: Backend>(
     let camera = scene.camera.camera(width, height);
     let kernel = match accel {
         Accel::None => Kernel::RenderLinear,
-        Accel::Lbvh => Kernel::RenderBvh,
+        Accel::Lbvh | Accel::Trbvh => Kernel::RenderBvh,
     };
     let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
 

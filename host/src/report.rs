@@ -6,8 +6,11 @@ use serde::Serialize;
 use treelet_core::sah::{sah_cost, SahCosts};
 
 use crate::backend::Backend;
+use treelet_core::Aabb;
+
 use crate::lbvh::{self, Bvh, STAGES};
 use crate::scene::{validate_spheres, Scene};
+use crate::trbvh::{self, TreeletConfig};
 use crate::validate::validate;
 
 #[derive(Clone, Debug, Serialize)]
@@ -30,6 +33,18 @@ pub struct BuildReport {
     pub ms: serde_json::Map<String, serde_json::Value>,
     /// "gpu-timestamps" or "wall-clock".
     pub timing: &'static str,
+    /// Treelet optimization (builder `trbvh`): its settings, the SAH before
+    /// and after, and the time of each round (ms).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rounds: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gamma: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sah_before: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sah_after: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub round_ms: Option<Vec<f64>>,
 }
 
 /// The full-sweep SAH reference build (CPU only), reported like the others.
@@ -56,33 +71,63 @@ pub fn run_build_sweep(scene: &Scene) -> Result<(Bvh, BuildReport)> {
         wall_ms,
         ms,
         timing: "wall-clock",
+        rounds: None,
+        gamma: None,
+        sah_before: None,
+        sah_after: None,
+        round_ms: None,
     };
     Ok((bvh, report))
 }
 
-/// Validates the input, builds, validates the tree, and reports.
-pub fn run_build<B: Backend>(backend: &mut B, scene: &Scene) -> Result<(Bvh, BuildReport)> {
+/// Validates the input, builds (LBVH, then treelet rounds when `treelets`
+/// is given), validates the tree, and reports.
+pub fn run_build<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    treelets: Option<&TreeletConfig>,
+) -> Result<(Bvh, BuildReport)> {
     let objects = scene.objects();
     validate_spheres(objects)?;
     let start = Instant::now();
-    let (bvh, times) = lbvh::build(backend, objects)?;
+    let (device_bvh, times) = lbvh::build_on_device(backend, objects)?;
+    let mut bvh = device_bvh.read(backend)?;
+    let mut ms: serde_json::Map<String, serde_json::Value> =
+        STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
+    let mut total_ms = times.total();
+    let (mut sah_before, mut round_ms) = (None, None);
+    if let Some(config) = treelets {
+        sah_before = Some(sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA));
+        let root = bvh.nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
+        let rounds = trbvh::optimize(backend, &device_bvh, &root, config)?;
+        let per_round: Vec<f64> = rounds.order.iter().map(|s| rounds.get(s)).collect();
+        total_ms += rounds.total();
+        ms.insert("treelets".into(), serde_json::json!(rounds.total()));
+        round_ms = Some(per_round);
+        bvh = device_bvh.read(backend)?;
+    }
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
-    let ms = STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
+    let sah = sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA);
     let report = BuildReport {
         scene: scene.name.clone(),
         primitives: objects.len(),
-        builder: "lbvh",
+        builder: if treelets.is_some() { "trbvh" } else { "lbvh" },
         device: backend.device_kind(),
         adapter: backend.adapter(),
         nodes: bvh.nodes.len(),
-        sah_cost: sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA),
+        sah_cost: sah,
         valid: check.is_valid(),
         errors: check.errors,
-        total_ms: times.total(),
+        total_ms,
         wall_ms,
         ms,
         timing: if times.source.is_empty() { "wall-clock" } else { times.source },
+        rounds: treelets.map(|c| c.rounds),
+        gamma: treelets.map(|c| c.gamma),
+        sah_before,
+        sah_after: sah_before.map(|_| sah),
+        round_ms,
     };
     Ok((bvh, report))
 }

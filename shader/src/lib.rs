@@ -15,6 +15,7 @@ pub mod render;
 pub mod scan;
 pub mod scene;
 pub mod sort;
+pub mod treelet;
 
 // `#[spirv(compute(threads(256)))]` takes a literal: keep it in step.
 const _: () = assert!(treelet_core::WORKGROUP_SIZE == 256);

@@ -1,0 +1,55 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::{Node, TreeletParams};
+use treelet_core::treelet::{treelet_init_kernel, treelet_level_kernel};
+use treelet_core::workgroup::linear_id;
+
+/// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
+#[spirv(compute(threads(256)))]
+pub fn treelet_init_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_init_kernel::<true>(id, params, nodes, parents, flags, counts, costs, heights);
+}
+
+/// As `treelet_init_cs` with relaxed counters, for CPU adapters (lavapipe).
+#[spirv(compute(threads(256)))]
+pub fn treelet_init_relaxed_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_init_kernel::<false>(id, params, nodes, parents, flags, counts, costs, heights);
+}
+
+/// Restructures the treelets of one height.
+#[spirv(compute(threads(256)))]
+pub fn treelet_level_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] heights: &[u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_level_kernel(id, params, nodes, parents, counts, costs, heights);
+}
