@@ -30,6 +30,16 @@ fn load_box(node: &Node) -> Aabb {
     b
 }
 
+/// One child's arrival at its parent during a bottom-up climb: true for the
+/// second of the two children, which then knows both subtrees are done.
+/// `ORDERED` releases this subtree's writes and acquires the sibling's
+/// (see [`atomics::add_device_acq_rel`] for the device that needs it relaxed).
+#[inline]
+pub fn second_arrival<const ORDERED: bool>(counter: &mut u32) -> bool {
+    let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
+    previous != 0
+}
+
 /// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
 /// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
 /// `ORDERED` gives the counter acquire-release semantics (see
@@ -58,10 +68,7 @@ pub fn fit_kernel<const ORDERED: bool>(
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
-        // Release this subtree's boxes; acquire the sibling's.
-        let counter = &mut flags[parent as usize];
-        let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
-        if previous == 0 {
+        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
             return; // The sibling's invocation will finish this node.
         }
         let left = load_box(&nodes[nodes[parent as usize].left as usize]);

@@ -26,6 +26,7 @@
 //! invocation per treelet (the paper's warp-wide version is the speed target).
 use crate::aabb::Aabb;
 use crate::atomics;
+use crate::fit::second_arrival;
 use crate::layout::{Node, TreeletParams};
 
 /// Leaves of a treelet (the paper's 7).
@@ -318,9 +319,7 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
-        let counter = &mut flags[parent as usize];
-        let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
-        if previous == 0 {
+        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
             return;
         }
         let p = nodes[parent as usize];
