@@ -91,7 +91,7 @@ fn validator_catches_corruption() {
     check(&|b| b.parents[0] = 3, "root has parent");
     check(
         &|b| {
-            b.nodes.pop();
+            b.nodes.push(treelet_core::Node::default());
         },
         "nodes for 500 primitives",
     );

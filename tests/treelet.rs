@@ -1,5 +1,6 @@
 //! Treelet restructuring (Karras & Aila 2013) on CPU-built LBVHs: one
-//! sequential bottom-up round keeps every invariant and never raises the SAH.
+//! sequential bottom-up round keeps every invariant and never raises the SAH;
+//! the device pass (rounds, then the SAH leaf collapse) equals its CPU run.
 use treelet::validate::validate;
 use treelet_core::sah::{sah_cost, SahCosts};
 use treelet_core::treelet::{node_cost, restructure, TreeletCosts};
@@ -25,18 +26,22 @@ fn post_order(nodes: &[Node]) -> Vec<u32> {
     out
 }
 
-fn subtree_costs(nodes: &[Node], costs: &TreeletCosts) -> Vec<f32> {
+/// Every node's subtree cost and primitive count.
+fn subtree_costs(nodes: &[Node], costs: &TreeletCosts) -> (Vec<f32>, Vec<u32>) {
     let mut c = vec![0.0f32; nodes.len()];
+    let mut counts = vec![0u32; nodes.len()];
     for (i, n) in nodes.iter().enumerate() {
         if n.is_leaf() {
-            c[i] = node_cost(n, (0.0, 0.0), costs);
+            counts[i] = n.prim_count();
+            c[i] = node_cost(n, counts[i], (0.0, 0.0), costs);
         }
     }
     for i in post_order(nodes) {
         let n = nodes[i as usize];
-        c[i as usize] = node_cost(&n, (c[n.left as usize], c[n.right as usize]), costs);
+        counts[i as usize] = counts[n.left as usize] + counts[n.right as usize];
+        c[i as usize] = node_cost(&n, counts[i as usize], (c[n.left as usize], c[n.right as usize]), costs);
     }
-    c
+    (c, counts)
 }
 
 #[test]
@@ -47,12 +52,12 @@ fn one_round_keeps_invariants_and_lowers_sah() {
         let mut bvh = treelet_tests::build_cpu_checked(&spheres, "lbvh");
         let root_box: Aabb = bvh.nodes[0].aabb();
         let extent = root_box.extent().max_element().max(f32::MIN_POSITIVE);
-        let costs = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 1.0 / extent };
+        let costs = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 1.0 / extent, max_leaf: 1 };
         let before = sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA);
-        let mut node_costs = subtree_costs(&bvh.nodes, &costs);
+        let (mut node_costs, mut counts) = subtree_costs(&bvh.nodes, &costs);
         let mut changed = 0;
         for root in post_order(&bvh.nodes) {
-            if restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut node_costs, &costs) {
+            if restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut counts, &mut node_costs, &costs) {
                 changed += 1;
             }
         }
@@ -69,7 +74,8 @@ fn one_round_keeps_invariants_and_lowers_sah() {
 }
 
 /// The device pass (both backends): valid trees, SAH well below the LBVH's,
-/// and the GPU tree equal to the CPU run of the same kernels.
+/// leaves within the bound, and the GPU tree equal to the CPU run of the
+/// same kernels.
 #[test]
 fn device_optimization_matches_cpu_and_lowers_sah() {
     use treelet::backend::Backend;
@@ -78,33 +84,74 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
     use treelet::lbvh::{build_on_device, Bvh};
     use treelet::trbvh::{optimize, root_box, TreeletConfig};
 
-    fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere]) -> (Bvh, f64) {
+    fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], config: &TreeletConfig) -> (Bvh, f64) {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
         let before = sah_cost(&dbvh.read(b).unwrap().nodes, SahCosts::KARRAS_AILA);
         let rb = root_box(b, &dbvh).unwrap();
-        optimize(b, &dbvh, &rb, &TreeletConfig::default()).unwrap();
-        (dbvh.read(b).unwrap(), before)
+        let (optimized, _) = optimize(b, dbvh, &rb, config).unwrap();
+        (optimized.read(b).unwrap(), before)
     }
 
     let seed = treelet_tests::fresh_seed();
-    for n in [3usize, 7, 64, 1000, 30_000] {
-        let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
-        let (c, before) = run(&mut CpuBackend::new(), &spheres);
-        let v = validate(&spheres, &c.nodes, &c.parents, &c.prim_indices);
-        assert!(v.is_valid(), "cpu n = {n}: {:?}", v.errors);
-        let after = sah_cost(&c.nodes, SahCosts::KARRAS_AILA);
-        eprintln!("n = {n}: SAH {before:.2} -> {after:.2} after 3 rounds");
-        assert!(after <= before * (1.0 + 1e-6));
-        if n >= 1000 {
-            assert!(after < 0.95 * before, "n = {n}: {before} -> {after}");
+    for max_leaf in [1, 8] {
+        let config = TreeletConfig { max_leaf, ..Default::default() };
+        for n in [2usize, 3, 7, 64, 1000, 30_000] {
+            let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
+            let (c, before) = run(&mut CpuBackend::new(), &spheres, &config);
+            let v = validate(&spheres, &c.nodes, &c.parents, &c.prim_indices);
+            assert!(v.is_valid(), "cpu n = {n}: {:?}", v.errors);
+            let after = sah_cost(&c.nodes, SahCosts::KARRAS_AILA);
+            let leaves: Vec<u32> = c.nodes.iter().filter(|x| x.is_leaf()).map(|x| x.prim_count()).collect();
+            eprintln!(
+                "max_leaf {max_leaf}, n = {n}: SAH {before:.2} -> {after:.2}, {} leaves, largest {}",
+                leaves.len(),
+                leaves.iter().max().unwrap()
+            );
+            assert!(after <= before * (1.0 + 1e-6));
+            assert!(leaves.iter().all(|&k| k <= max_leaf), "n = {n}: a leaf above {max_leaf}");
+            if max_leaf == 1 {
+                assert_eq!(leaves.len(), n);
+            }
+            if n >= 1000 {
+                assert!(after < 0.95 * before, "n = {n}: {before} -> {after}");
+            }
+            // Depth-first order: every internal node's left child follows it.
+            for (i, x) in c.nodes.iter().enumerate() {
+                assert!(x.is_leaf() || x.left as usize == i + 1, "n = {n}: node {i} is not in depth-first order");
+            }
+            let Some(ctx) = treelet_tests::gpu() else { continue };
+            let (g, _) = run(&mut GpuBackend::new(ctx), &spheres, &config);
+            let v = validate(&spheres, &g.nodes, &g.parents, &g.prim_indices);
+            assert!(v.is_valid(), "gpu n = {n}: {:?}", v.errors);
+            assert_eq!(g.nodes.len(), c.nodes.len(), "n = {n}");
+            if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
+                panic!("n = {n}: node {i} differs: gpu {:?} cpu {:?}", g.nodes[i], c.nodes[i]);
+            }
+            assert_eq!(g.parents, c.parents, "n = {n}");
+            assert_eq!(g.prim_indices, c.prim_indices, "n = {n}");
         }
-        let Some(ctx) = treelet_tests::gpu() else { continue };
-        let (g, _) = run(&mut GpuBackend::new(ctx), &spheres);
-        let v = validate(&spheres, &g.nodes, &g.parents, &g.prim_indices);
-        assert!(v.is_valid(), "gpu n = {n}: {:?}", v.errors);
-        if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
-            panic!("n = {n}: node {i} differs: gpu {:?} cpu {:?}", g.nodes[i], c.nodes[i]);
-        }
-        assert_eq!(g.parents, c.parents, "n = {n}");
     }
+}
+
+/// The collapse alone on hand-made trees: identical spheres collapse into
+/// full leaves; with `max_leaf` 1 a tree is only reordered (same SAH).
+#[test]
+fn collapse_by_sah() {
+    use treelet::sweep::{build, build_collapsed};
+    let same: Vec<treelet_core::Sphere> = (0..100).map(|_| treelet_core::Sphere::new([1.0, 2.0, 3.0], 0.5)).collect();
+    let t = build_collapsed(&same, 8).unwrap();
+    assert!(validate(&same, &t.nodes, &t.parents, &t.prim_indices).is_valid());
+    let sizes: Vec<u32> = t.nodes.iter().filter(|x| x.is_leaf()).map(|x| x.prim_count()).collect();
+    assert_eq!(sizes.iter().sum::<u32>(), 100);
+    // Identical boxes: a leaf of k costs k, a node over it 1.2 + k: every full subtree collapses.
+    assert!(sizes.len() <= 100 / 4, "{} leaves for 100 identical spheres", sizes.len());
+    let spheres = treelet::scene::random_spheres(5000, treelet_tests::fresh_seed());
+    let plain = build(&spheres);
+    let reordered = build_collapsed(&spheres, 1).unwrap();
+    assert!(validate(&spheres, &reordered.nodes, &reordered.parents, &reordered.prim_indices).is_valid());
+    let (a, b) = (sah_cost(&plain.nodes, SahCosts::KARRAS_AILA), sah_cost(&reordered.nodes, SahCosts::KARRAS_AILA));
+    assert!((a - b).abs() <= 1e-9 * a, "reordering changed the SAH: {a} -> {b}");
+    let collapsed = build_collapsed(&spheres, 8).unwrap();
+    let c = sah_cost(&collapsed.nodes, SahCosts::KARRAS_AILA);
+    assert!(c < a, "collapse did not lower the sweep tree's SAH ({a} -> {c})");
 }

@@ -199,7 +199,8 @@ pub struct TreeletParams {
     pub level: u32,
     /// Only subtrees of at least this many primitives are restructured.
     pub gamma: u32,
-    pub _pad0: u32,
+    /// Largest leaf the SAH may collapse a subtree into (1: no collapse).
+    pub max_leaf: u32,
     /// SAH cost per internal node and per primitive (per unit area).
     pub node_cost: f32,
     pub prim_cost: f32,

@@ -16,6 +16,10 @@
 //! | radix tree | [`radix_tree`] | sorted keys | internal nodes' children, parent links |
 //! | fit | [`fit`] | tree, boxes | leaf and internal boxes, bottom-up with atomic flags |
 //!
+//! Treelet restructuring (Karras & Aila 2013) then rewrites the tree in
+//! place, round by round ([`treelet`]), and [`collapse`] compacts it into
+//! depth-first order with SAH-collapsed leaves of several primitives.
+//!
 //! Node layout: `n` leaves and `n - 1` internal nodes in one array of
 //! `2n - 1` [`Node`]s. Internal node `i` sits at index `i` (so the root is 0),
 //! leaf `j` (the `j`-th primitive in Morton order) at index `n - 1 + j`.
@@ -37,6 +41,7 @@
 pub mod aabb;
 pub mod atomics;
 pub mod bounds;
+pub mod collapse;
 pub mod fill;
 pub mod fit;
 pub mod intersect;

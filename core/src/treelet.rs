@@ -21,7 +21,10 @@
 //!
 //! Costs here are unnormalized SAH (`C_i·A` per internal node, `C_t·A·N` per
 //! leaf); areas are half surface areas of boxes scaled by the caller's
-//! `inv_extent`, so scenes near the f32 range do not overflow.
+//! `inv_extent`, so scenes near the f32 range do not overflow. As in the
+//! paper, a subtree of at most `max_leaf` primitives costs the cheaper of its
+//! tree and one leaf holding all its primitives (`C_t·A·N`): the DP and the
+//! rounds optimize for the tree that [`crate::collapse`] finally produces.
 //! Treelet departs from the paper in one way so far: the DP here runs in one
 //! invocation per treelet (the paper's warp-wide version is the speed target).
 use crate::aabb::Aabb;
@@ -46,13 +49,20 @@ pub struct TreeletCosts {
     pub prim: f32,
     /// Boxes are scaled by this before taking areas (1 / the scene's extent).
     pub inv_extent: f32,
+    /// Largest leaf a subtree may collapse into (1: never collapse).
+    pub max_leaf: u32,
 }
 
 impl TreeletParams {
     /// The cost constants of these parameters.
     #[inline]
     pub fn costs(&self) -> TreeletCosts {
-        TreeletCosts { node: self.node_cost, prim: self.prim_cost, inv_extent: self.inv_extent }
+        TreeletCosts {
+            node: self.node_cost,
+            prim: self.prim_cost,
+            inv_extent: self.inv_extent,
+            max_leaf: self.max_leaf,
+        }
     }
 }
 
@@ -65,6 +75,27 @@ impl TreeletCosts {
         }
         let e = b.extent() * self.inv_extent;
         e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    /// SAH cost of a subtree of `count` primitives whose root has area
+    /// `area` and whose children cost `children` together: the cheaper of
+    /// an internal node and, when `count <= max_leaf`, one leaf.
+    #[inline]
+    pub fn subtree(&self, area: f32, count: u32, children: f32) -> f32 {
+        let internal = self.node * area + children;
+        if count <= self.max_leaf {
+            let leaf = self.prim * area * count as f32;
+            if leaf <= internal {
+                return leaf;
+            }
+        }
+        internal
+    }
+
+    /// Whether a subtree collapses into one leaf (the choice of [`Self::subtree`]).
+    #[inline]
+    pub fn collapses(&self, area: f32, count: u32, children: f32) -> bool {
+        count <= self.max_leaf && self.prim * area * count as f32 <= self.node * area + children
     }
 }
 
@@ -126,12 +157,13 @@ pub struct TreeletSolution {
 }
 
 /// Algorithm 2's dynamic program over the subsets of `n` leaves with boxes
-/// `boxes` and subtree costs `leaf_costs`.
+/// `boxes`, subtree costs `leaf_costs` and primitive counts `leaf_counts`.
 #[inline]
 pub fn optimize(
     n: u32,
     boxes: &[Aabb; TREELET_LEAVES],
     leaf_costs: &[f32; TREELET_LEAVES],
+    leaf_counts: &[u32; TREELET_LEAVES],
     costs: &TreeletCosts,
 ) -> TreeletSolution {
     let mut sol = TreeletSolution { partition: [0u32; SUBSETS], area: [0.0; SUBSETS], cost: [0.0; SUBSETS] };
@@ -148,6 +180,14 @@ pub fn optimize(
             i += 1;
         }
         sol.area[s as usize] = costs.area(&b);
+        s += 1;
+    }
+    // Primitive counts of every subset, built from the subset minus its lowest leaf.
+    let mut count = [0u32; SUBSETS];
+    let mut s = 1u32;
+    while s <= full {
+        let low = s.trailing_zeros();
+        count[s as usize] = count[(s & (s - 1)) as usize] + leaf_counts[low as usize];
         s += 1;
     }
     // Leaves: their subtrees' costs.
@@ -179,7 +219,7 @@ pub fn optimize(
                         break;
                     }
                 }
-                sol.cost[s as usize] = costs.node * sol.area[s as usize] + best;
+                sol.cost[s as usize] = costs.subtree(sol.area[s as usize], count[s as usize], best);
                 sol.partition[s as usize] = best_p;
             }
             s += 1;
@@ -232,27 +272,29 @@ pub fn apply(t: &Treelet, sol: &TreeletSolution, nodes: &mut [Node], parents: &m
     }
 }
 
-/// SAH cost of one node given its children's (or, for a leaf, its primitives).
+/// SAH cost of the subtree under `node` with `count` primitives, given its
+/// children's costs (for a leaf: its primitives'), collapse included.
 #[inline]
-pub fn node_cost(node: &Node, child_costs: (f32, f32), costs: &TreeletCosts) -> f32 {
+pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &TreeletCosts) -> f32 {
     let area = costs.area(&node.aabb());
     if node.is_leaf() {
         costs.prim * area * node.prim_count() as f32
     } else {
-        costs.node * area + child_costs.0 + child_costs.1
+        costs.subtree(area, count, child_costs.0 + child_costs.1)
     }
 }
 
 /// Restructures the treelet rooted at internal node `root` in place:
 /// forms it, solves the DP, rewires it if that lowers its cost, and refits
 /// the boxes and costs of its internal nodes. `node_costs` holds every
-/// node's subtree cost (as [`node_cost`] defines it). Returns whether the
-/// treelet changed.
+/// node's subtree cost (as [`node_cost`] defines it) and `counts` its
+/// primitive count. Returns whether the treelet changed.
 #[inline]
 pub fn restructure(
     root: u32,
     nodes: &mut [Node],
     parents: &mut [u32],
+    counts: &mut [u32],
     node_costs: &mut [f32],
     costs: &TreeletCosts,
 ) -> bool {
@@ -262,13 +304,15 @@ pub fn restructure(
     }
     let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
     let mut leaf_costs = [0.0f32; TREELET_LEAVES];
+    let mut leaf_counts = [0u32; TREELET_LEAVES];
     let mut i = 0;
     while i < t.leaf_count as usize {
         boxes[i] = nodes[t.leaves[i] as usize].aabb();
         leaf_costs[i] = node_costs[t.leaves[i] as usize];
+        leaf_counts[i] = counts[t.leaves[i] as usize];
         i += 1;
     }
-    let sol = optimize(t.leaf_count, &boxes, &leaf_costs, costs);
+    let sol = optimize(t.leaf_count, &boxes, &leaf_costs, &leaf_counts, costs);
     let full = (1usize << t.leaf_count) - 1;
     // The current topology is one of the candidates: keep it unless the
     // optimum is strictly cheaper (avoids churn on ties and rounding).
@@ -285,13 +329,15 @@ pub fn restructure(
         let (l, r) = (nodes[id].left as usize, nodes[id].right as usize);
         let b = nodes[l].aabb().union(&nodes[r].aabb());
         nodes[id].set_aabb(b);
-        node_costs[id] = node_cost(&nodes[id], (node_costs[l], node_costs[r]), costs);
+        counts[id] = counts[l] + counts[r];
+        node_costs[id] = node_cost(&nodes[id], counts[id], (node_costs[l], node_costs[r]), costs);
     }
     true
 }
 
 /// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
-/// every node's primitive count, subtree SAH cost and height (leaves 0), an
+/// every node's primitive count, subtree SAH cost and height (leaves 0), and
+/// its number of leaves after the final collapse (1 where it collapses), an
 /// internal node once both children are done. `flags` are zeroed counters.
 #[allow(clippy::too_many_arguments)]
 pub fn treelet_init_kernel<const ORDERED: bool>(
@@ -303,6 +349,7 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     counts: &mut [u32],
     node_costs: &mut [f32],
     heights: &mut [u32],
+    tree_leaves: &mut [u32],
 ) {
     let n = params.n;
     if i >= n {
@@ -314,8 +361,9 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     let leaf = n - 1 + i;
     let node = nodes[leaf as usize];
     atomics::store_u32(&mut counts[leaf as usize], node.prim_count());
-    atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, (0.0, 0.0), &costs));
+    atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, node.prim_count(), (0.0, 0.0), &costs));
     atomics::store_u32(&mut heights[leaf as usize], 0);
+    atomics::store_u32(&mut tree_leaves[leaf as usize], 1);
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
@@ -325,11 +373,18 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
         let p = nodes[parent as usize];
         let (l, r) = (p.left as usize, p.right as usize);
         let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
-        let cost = node_cost(&p, (atomics::load_f32(&node_costs[l]), atomics::load_f32(&node_costs[r])), &costs);
+        let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);
+        let area = costs.area(&p.aabb());
         let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
+        let leaves = if costs.collapses(area, count, children) {
+            1
+        } else {
+            atomics::load_u32(&tree_leaves[l]) + atomics::load_u32(&tree_leaves[r])
+        };
         atomics::store_u32(&mut counts[parent as usize], count);
-        atomics::store_f32(&mut node_costs[parent as usize], cost);
+        atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
         atomics::store_u32(&mut heights[parent as usize], height);
+        atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
         current = parent;
     }
 }
@@ -343,7 +398,7 @@ pub fn treelet_level_kernel(
     params: &TreeletParams,
     nodes: &mut [Node],
     parents: &mut [u32],
-    counts: &[u32],
+    counts: &mut [u32],
     node_costs: &mut [f32],
     heights: &[u32],
 ) {
@@ -351,7 +406,7 @@ pub fn treelet_level_kernel(
         return;
     }
     if heights[i as usize] == params.level && counts[i as usize] >= params.gamma {
-        restructure(i, nodes, parents, node_costs, &params.costs());
+        restructure(i, nodes, parents, counts, node_costs, &params.costs());
     }
 }
 
@@ -362,47 +417,68 @@ mod tests {
     use glam::Vec3;
     use std::vec::Vec;
 
-    const COSTS: TreeletCosts = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 0.01 };
+    const COSTS: TreeletCosts = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 0.01, max_leaf: 1 };
 
-    /// Every binary tree over the leaves in `set`, by brute force: its best cost.
-    fn brute_force(set: u32, sol_area: &[f32; SUBSETS], leaf_costs: &[f32; TREELET_LEAVES]) -> f32 {
-        if set.count_ones() == 1 {
-            return leaf_costs[set.trailing_zeros() as usize];
-        }
-        let mut best = f32::MAX;
-        // Every ordered split into two non-empty parts (both orders: a superset of the DP's).
-        let mut p = (set - 1) & set;
-        while p != 0 {
-            let c = brute_force(p, sol_area, leaf_costs) + brute_force(set ^ p, sol_area, leaf_costs);
-            best = best.min(c);
-            p = (p - 1) & set;
-        }
-        COSTS.node * sol_area[set as usize] + best
+    /// A treelet's leaves for the brute force: boxes, subtree costs, counts.
+    struct Leaves {
+        boxes: [Aabb; TREELET_LEAVES],
+        costs: [f32; TREELET_LEAVES],
+        counts: [u32; TREELET_LEAVES],
     }
 
-    fn random_boxes(seed: u32, n: u32) -> ([Aabb; TREELET_LEAVES], [f32; TREELET_LEAVES]) {
-        let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
-        let mut leaf_costs = [0.0; TREELET_LEAVES];
+    /// The best cost over every binary tree on the leaves in `set`, each
+    /// subtree of at most `max_leaf` primitives also tried as one leaf; by
+    /// brute force over all ordered splits, with areas from the boxes.
+    fn brute_force(set: u32, leaves: &Leaves, costs: &TreeletCosts) -> f32 {
+        if set.count_ones() == 1 {
+            return leaves.costs[set.trailing_zeros() as usize];
+        }
+        let members = || (0..TREELET_LEAVES).filter(|&i| set & (1 << i) != 0);
+        let area = costs.area(&members().fold(Aabb::EMPTY, |b, i| b.union(&leaves.boxes[i])));
+        let count: u32 = members().map(|i| leaves.counts[i]).sum();
+        let mut best = f32::MAX;
+        let mut p = (set - 1) & set;
+        while p != 0 {
+            best = best.min(brute_force(p, leaves, costs) + brute_force(set ^ p, leaves, costs));
+            p = (p - 1) & set;
+        }
+        let tree = costs.node * area + best;
+        if count <= costs.max_leaf {
+            tree.min(costs.prim * area * count as f32)
+        } else {
+            tree
+        }
+    }
+
+    fn random_leaves(seed: u32, n: u32) -> Leaves {
+        let mut l = Leaves { boxes: [Aabb::EMPTY; TREELET_LEAVES], costs: [0.0; TREELET_LEAVES], counts: [0; 7] };
         for i in 0..n as usize {
             let r = crate::rng::BounceRng::new(seed, i as u32, 0, 0);
             let lo = Vec3::new(r.uniform(0), r.uniform(1), r.uniform(2)) * 100.0;
             let size = Vec3::new(r.uniform(3), r.uniform(4), r.uniform(5)) * 30.0;
-            boxes[i] = Aabb::new(lo, lo + size);
-            leaf_costs[i] = COSTS.area(&boxes[i]) * (1.0 + 3.0 * r.uniform(6));
+            l.boxes[i] = Aabb::new(lo, lo + size);
+            l.counts[i] = 1 + (r.uniform(7) * 3.0) as u32;
+            l.costs[i] = COSTS.area(&l.boxes[i]) * (1.0 + 3.0 * r.uniform(6));
         }
-        (boxes, leaf_costs)
+        l
     }
 
     #[test]
     fn dp_equals_brute_force() {
-        for n in 2..=TREELET_LEAVES as u32 {
-            for seed in 0..20 {
-                let (boxes, leaf_costs) = random_boxes(seed * 31 + n, n);
-                let sol = optimize(n, &boxes, &leaf_costs, &COSTS);
-                let full = (1u32 << n) - 1;
-                let expected = brute_force(full, &sol.area, &leaf_costs);
-                let got = sol.cost[full as usize];
-                assert!((got - expected).abs() <= 1e-5 * expected, "n {n} seed {seed}: dp {got} brute {expected}");
+        for max_leaf in [1, 4, 8, 64] {
+            let costs = TreeletCosts { max_leaf, ..COSTS };
+            for n in 2..=TREELET_LEAVES as u32 {
+                for seed in 0..20 {
+                    let l = random_leaves(seed * 31 + n, n);
+                    let sol = optimize(n, &l.boxes, &l.costs, &l.counts, &costs);
+                    let full = (1u32 << n) - 1;
+                    let expected = brute_force(full, &l, &costs);
+                    let got = sol.cost[full as usize];
+                    assert!(
+                        (got - expected).abs() <= 1e-5 * expected,
+                        "max_leaf {max_leaf} n {n} seed {seed}: dp {got} brute {expected}"
+                    );
+                }
             }
         }
     }

@@ -2,19 +2,24 @@
 use anyhow::Result;
 use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressStyle};
-use treelet::backend::Backend;
+use treelet::backend::{Backend, StageTimes};
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::lbvh;
 use treelet::render::{render, Accel, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
+use treelet::trbvh::{self, TreeletConfig};
+use treelet_core::Sphere;
 
 use crate::Device;
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
-    /// LBVH build times over random:N scenes.
+    /// LBVH (and treelet-optimization) build times over random:N scenes.
     Build {
+        /// lbvh: the Karras 2012 build; trbvh: the build plus treelet restructuring (stage times of both).
+        #[arg(long, value_enum, default_value = "lbvh")]
+        builder: TreeBuilder,
         /// Primitive counts (the seed's table, then millions).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
         sizes: Vec<usize>,
@@ -30,18 +35,47 @@ pub enum BenchCommand {
         #[arg(long)]
         per_kernel: bool,
     },
-    /// Render times: cornell against spp (1024x768), and random:N at 4 spp
-    /// with a linear scan against the LBVH (256x192).
+    /// Render times at 1024x768 (--quick: 256x192): cornell against spp, and
+    /// random:N at 4 spp with each closest-hit method.
     Render {
         #[arg(long, value_enum, default_value = "gpu")]
         device: Device,
         /// Small sizes, for a CPU or lavapipe.
         #[arg(long)]
         quick: bool,
+        /// Samples per pixel of the cornell renders (default 4..1024, --quick 4,16,64).
+        #[arg(long, value_delimiter = ',')]
+        spp: Option<Vec<u32>>,
+        /// Sphere counts of the random:N renders (default 1000..65000, --quick 100,1000,4000).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Option<Vec<usize>>,
+        /// Closest-hit methods compared on the random:N scenes.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![Accel::None, Accel::Lbvh, Accel::Trbvh])]
+        accels: Vec<Accel>,
         /// Also write the rows as JSON to this file.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+}
+
+/// The device builders `bench build` times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TreeBuilder {
+    Lbvh,
+    Trbvh,
+}
+
+/// One build on the device, the tree left there (as in a renderer).
+fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: TreeBuilder) -> Result<StageTimes> {
+    let (bvh, mut times) = lbvh::build_on_device(b, spheres)?;
+    if builder == TreeBuilder::Trbvh {
+        let root = trbvh::root_box(b, &bvh)?;
+        let (_, rounds) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
+        for s in &rounds.order {
+            times.add(s, rounds.get(s));
+        }
+    }
+    Ok(times)
 }
 
 /// Paths per second of a render, by wall clock and by render-kernel time.
@@ -106,29 +140,36 @@ fn print_render_rows(title: &str, rows: &[RenderRow]) {
     }
 }
 
-fn render_sweeps<B: Backend>(b: &mut B, quick: bool) -> Result<(Vec<RenderRow>, Vec<RenderRow>)> {
+/// What `bench render` sweeps.
+struct RenderSweep {
+    quick: bool,
+    spps: Vec<u32>,
+    sizes: Vec<usize>,
+    accels: Vec<Accel>,
+}
+
+fn render_sweeps<B: Backend>(b: &mut B, sweep: &RenderSweep) -> Result<(Vec<RenderRow>, Vec<RenderRow>)> {
     // Graph 1 of the seed: cornell, time against samples per pixel.
-    let (w, h) = if quick { (256, 192) } else { (1024, 768) };
-    let spps: &[u32] = if quick { &[4, 16, 64] } else { &[4, 16, 64, 256, 1024] };
-    let sizes: &[usize] = if quick { &[100, 1000, 4000] } else { &[1000, 4000, 16000, 35000, 65000] };
-    let bar = ProgressBar::new((spps.len() + 2 * sizes.len()) as u64);
+    let (w, h) = if sweep.quick { (256, 192) } else { (1024, 768) };
+    let (spps, sizes) = (&sweep.spps, &sweep.sizes);
+    let bar = ProgressBar::new((spps.len() + sweep.accels.len() * sizes.len()) as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} renders {msg}").unwrap());
     let cornell = Scene::from_spec("cornell")?;
     // Warm up pipelines and clocks.
     bench_render(b, &cornell, 64, 48, 4, Accel::None)?;
     let mut graph1 = Vec::new();
-    for &spp in spps {
+    for &spp in spps.iter() {
         bar.set_message(format!("cornell {spp} spp"));
         graph1.push(bench_render(b, &cornell, w, h, spp, Accel::None)?);
         bar.inc(1);
     }
-    // Graph 2: random:N at 4 spp, linear scan against the LBVH.
+    // Graph 2: random:N at 4 spp, linear scan against the trees.
     let mut graph2 = Vec::new();
-    for &n in sizes {
+    for &n in sizes.iter() {
         let scene = Scene::from_spec(&format!("random:{n}"))?;
-        for accel in [Accel::None, Accel::Lbvh] {
+        for &accel in &sweep.accels {
             bar.set_message(format!("random:{n} {accel:?}"));
-            graph2.push(bench_render(b, &scene, 256, 192, 4, accel)?);
+            graph2.push(bench_render(b, &scene, w, h, 4, accel)?);
             bar.inc(1);
         }
     }
@@ -157,7 +198,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result<Vec<Row>> {
+fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize, builder: TreeBuilder) -> Result<Vec<Row>> {
     let bar = ProgressBar::new((sizes.len() * (repeats + 1)) as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} builds {msg}").unwrap());
     let mut rows = Vec::new();
@@ -170,12 +211,12 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
         // Warm up (pipelines, buffer pool, GPU clocks) for at least half a second.
         let warm = std::time::Instant::now();
         while warm.elapsed().as_secs_f64() < 0.5 {
-            lbvh::build_on_device(b, &spheres)?;
+            build_once(b, &spheres, builder)?;
         }
         bar.inc(1);
         for _ in 0..repeats {
             // The tree stays on the device, as in a renderer: no readback.
-            let (_, times) = lbvh::build_on_device(b, &spheres)?;
+            let times = build_once(b, &spheres, builder)?;
             bar.inc(1);
             for s in &times.order {
                 if !names.contains(s) {
@@ -201,35 +242,47 @@ fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize) -> Result
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
-        BenchCommand::Render { device, quick, json } => {
+        BenchCommand::Render { device, quick, spp, sizes, accels, json } => {
+            let sweep = RenderSweep {
+                quick,
+                spps: spp.unwrap_or_else(|| if quick { vec![4, 16, 64] } else { vec![4, 16, 64, 256, 1024] }),
+                sizes: sizes.unwrap_or_else(|| {
+                    if quick {
+                        vec![100, 1000, 4000]
+                    } else {
+                        vec![1000, 4000, 16000, 35000, 65536]
+                    }
+                }),
+                accels,
+            };
             let (adapter, (graph1, graph2)) = match device {
                 Device::Gpu => {
                     let mut b = GpuBackend::new(GpuContext::new()?);
-                    (b.adapter(), render_sweeps(&mut b, quick)?)
+                    (b.adapter(), render_sweeps(&mut b, &sweep)?)
                 }
-                Device::Cpu => (CpuBackend::new().adapter(), render_sweeps(&mut CpuBackend::new(), quick)?),
+                Device::Cpu => (CpuBackend::new().adapter(), render_sweeps(&mut CpuBackend::new(), &sweep)?),
             };
             print_render_rows(&format!("cornell against samples per pixel, {adapter}"), &graph1);
-            print_render_rows(&format!("random:N at 4 spp, linear scan against LBVH, {adapter}"), &graph2);
+            print_render_rows(&format!("random:N at 4 spp, each closest-hit method, {adapter}"), &graph2);
             if let Some(path) = json {
                 let doc = serde_json::json!({ "adapter": adapter, "cornell": graph1, "random": graph2 });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())
         }
-        BenchCommand::Build { sizes, device, repeats, json, per_kernel } => {
+        BenchCommand::Build { builder, sizes, device, repeats, json, per_kernel } => {
             let (adapter, timing, rows) = match device {
                 Device::Gpu => {
                     let mut b = GpuBackend::new(GpuContext::new()?).with_per_kernel_times(per_kernel);
                     let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
-                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats)?)
+                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats, builder)?)
                 }
                 Device::Cpu => {
                     let mut b = CpuBackend::new();
-                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats)?)
+                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats, builder)?)
                 }
             };
-            println!("LBVH build, {adapter} ({timing}), median of {repeats} (ms)");
+            println!("{builder:?} build, {adapter} ({timing}), median of {repeats} (ms)");
             let names: Vec<&str> =
                 rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
             let short = |s: &str| s.rsplit("::").next().unwrap_or(s).trim_end_matches("_cs").to_string();
@@ -247,7 +300,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 println!("{:>10.3}{:>10.1}", r.total_median_ms, r.mprims_per_s);
             }
             if let Some(path) = json {
-                let doc = serde_json::json!({ "adapter": adapter, "timing": timing, "repeats": repeats, "rows": rows });
+                let builder = format!("{builder:?}").to_lowercase();
+                let doc = serde_json::json!({ "adapter": adapter, "builder": builder, "timing": timing, "repeats": repeats, "rows": rows });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use treelet_core::aabb::Aabb;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{bounds, fill, fit, morton, radix_tree, scan, scene, sort, treelet};
+use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet};
 
 use crate::backend::{Backend, StageTimes};
 use crate::kernels::Kernel;
@@ -223,12 +223,35 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, nodes, parents, flags);
             }
         }
-        (Kernel::TreeletInit | Kernel::TreeletInitRelaxed, [p, nodes, parents, flags, counts, costs, heights]) => {
+        (
+            Kernel::TreeletInit | Kernel::TreeletInitRelaxed,
+            [p, nodes, parents, flags, counts, costs, heights, tree_leaves],
+        ) => {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
-            let (counts, costs, heights) = (view(counts), view(costs), view(heights));
+            let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
             for id in ids(groups) {
-                treelet::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights);
+                treelet::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights, tree_leaves);
+            }
+        }
+        (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (nodes, parents, counts, tree_leaves) = (view(nodes), view(parents), view(counts), view(tree_leaves));
+            let (prims, out_nodes, out_parents, out_prims) =
+                (view(prims), view(out_nodes), view(out_parents), view(out_prims));
+            for id in ids(groups) {
+                collapse::collapse_kernel(
+                    id,
+                    p.n,
+                    nodes,
+                    parents,
+                    counts,
+                    tree_leaves,
+                    prims,
+                    out_nodes,
+                    out_parents,
+                    out_prims,
+                );
             }
         }
         (Kernel::TreeletLevel, [p, nodes, parents, counts, costs, heights]) => {

@@ -32,6 +32,8 @@ pub enum Kernel {
     TreeletInitRelaxed,
     /// Treelet optimization: restructure the treelets of one height.
     TreeletLevel,
+    /// SAH leaf collapse and depth-first compaction into fresh arrays.
+    Collapse,
     /// Path tracing, closest hit by scanning every sphere.
     RenderLinear,
     /// Path tracing, closest hit through the BVH.
@@ -39,7 +41,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 17] = [
+    pub const ALL: [Kernel; 18] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
@@ -55,6 +57,7 @@ impl Kernel {
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletLevel,
+        Kernel::Collapse,
         Kernel::RenderLinear,
         Kernel::RenderBvh,
     ];
@@ -77,6 +80,7 @@ impl Kernel {
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletLevel => "treelet::treelet_level_cs",
+            Kernel::Collapse => "treelet::collapse_cs",
             Kernel::RenderLinear => "render::render_linear_cs",
             Kernel::RenderBvh => "render::render_bvh_cs",
         }
@@ -97,9 +101,10 @@ impl Kernel {
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
-                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
-            Kernel::TreeletLevel => &[Read, ReadWrite, ReadWrite, Read, ReadWrite, Read],
+            Kernel::TreeletLevel => &[Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, Read],
+            Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
         }
     }

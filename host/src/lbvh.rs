@@ -17,13 +17,13 @@ pub const STAGES: [&str; 5] = ["bounds", "morton", "sort", "tree", "fit"];
 /// A built BVH, read back from the device.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    /// `2n - 1` nodes (none for an empty scene); the root is node 0.
+    /// `2n - 1` nodes (none for an empty scene; fewer after a leaf collapse); the root is node 0.
     pub nodes: Vec<Node>,
     /// Parent of each node; `INVALID` for the root.
     pub parents: Vec<u32>,
     /// Primitive index of each sorted position (leaves point into this).
     pub prim_indices: Vec<u32>,
-    /// Morton keys in sorted order.
+    /// Morton keys in the LBVH's sorted order.
     pub sorted_keys: Vec<u64>,
     /// Centroid bounds used for the Morton frame.
     pub centroid_bounds: Aabb,
@@ -31,7 +31,10 @@ pub struct Bvh {
 
 /// A BVH still on the device, as a renderer uses it.
 pub struct DeviceBvh<B: Backend> {
+    /// Primitives.
     pub n: u32,
+    /// Nodes: `2n - 1` after the build, `2 * leaves - 1` after a leaf collapse.
+    pub node_count: u32,
     pub nodes: B::Buffer,
     pub parents: B::Buffer,
     pub prim_indices: B::Buffer,
@@ -45,7 +48,7 @@ impl<B: Backend> DeviceBvh<B> {
         if self.n == 0 {
             return Ok(Bvh::default());
         }
-        let node_count = 2 * self.n as usize - 1;
+        let node_count = self.node_count as usize;
         Ok(Bvh {
             nodes: b.read(&self.nodes, node_count)?,
             parents: b.read(&self.parents, node_count)?,
@@ -75,6 +78,7 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
         let empty = b.scratch("empty", 0)?;
         let bvh = DeviceBvh {
             n,
+            node_count: 0,
             nodes: empty.clone(),
             parents: empty.clone(),
             prim_indices: empty.clone(),
@@ -128,7 +132,8 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
     b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
 
     let times = b.take_times()?;
-    Ok((DeviceBvh { n, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
+    let node_count = node_count as u32;
+    Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
 }
 
 /// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.

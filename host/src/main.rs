@@ -56,6 +56,9 @@ enum Command {
         /// Smallest subtree restructured in the first round, doubled each round (trbvh).
         #[arg(long, default_value_t = 7)]
         gamma: u32,
+        /// Largest leaf the final SAH collapse makes; 1 keeps one primitive per leaf (trbvh, sweep).
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
+        max_leaf: u32,
         /// Print one JSON object instead of a summary.
         #[arg(long)]
         json: bool,
@@ -180,7 +183,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
 fn print_summary(r: &BuildReport) {
     println!("scene      {} ({} primitives)", r.scene, r.primitives);
     println!("device     {} ({})", r.device, r.adapter);
-    println!("builder    {}: {} nodes, SAH {:.3}", r.builder, r.nodes, r.sah_cost);
+    println!("builder    {}: {} nodes, {} leaves, SAH {:.3}", r.builder, r.nodes, r.leaves, r.sah_cost);
     if let (Some(before), Some(after)) = (r.sah_before, r.sah_after) {
         println!("treelets   SAH {before:.3} -> {after:.3} ({:.1}% lower)", 100.0 * (1.0 - after / before));
     }
@@ -194,19 +197,17 @@ fn print_summary(r: &BuildReport) {
 
 fn run(cli: Cli) -> Result<bool> {
     match cli.command {
-        Command::Build { scene, builder, device, rounds, gamma, json } => {
+        Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
+            let config = TreeletConfig { rounds, gamma, max_leaf };
             let scene = Scene::from_spec(&scene)?;
             let (_, report) = match (builder, device) {
                 (Builder::Lbvh, Device::Gpu) => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene, None)?,
                 (Builder::Lbvh, Device::Cpu) => run_build(&mut CpuBackend::new(), &scene, None)?,
                 (Builder::Trbvh, Device::Gpu) => {
-                    let config = TreeletConfig { rounds, gamma };
                     run_build(&mut GpuBackend::new(GpuContext::new()?), &scene, Some(&config))?
                 }
-                (Builder::Trbvh, Device::Cpu) => {
-                    run_build(&mut CpuBackend::new(), &scene, Some(&TreeletConfig { rounds, gamma }))?
-                }
-                (Builder::Sweep, Device::Cpu) => run_build_sweep(&scene)?,
+                (Builder::Trbvh, Device::Cpu) => run_build(&mut CpuBackend::new(), &scene, Some(&config))?,
+                (Builder::Sweep, Device::Cpu) => run_build_sweep(&scene, max_leaf)?,
                 (Builder::Sweep, Device::Gpu) => {
                     anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu")
                 }

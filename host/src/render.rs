@@ -112,13 +112,15 @@ pub fn render<B: Backend>(
 
     let (nodes, prim_indices, build_ms) = match accel {
         Accel::Lbvh | Accel::Trbvh => {
-            let (bvh, times) = lbvh::build_on_device(b, &scene.spheres)?;
+            let (mut bvh, times) = lbvh::build_on_device(b, &scene.spheres)?;
             let mut build_ms = times.total();
             if accel == Accel::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
-                build_ms += trbvh::optimize(b, &bvh, &root, &TreeletConfig::default())?.total();
+                let (optimized, times) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
+                bvh = optimized;
+                build_ms += times.total();
             }
-            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, (2 * prims as usize).saturating_sub(1))?);
+            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?);
             if depth + 1 > STACK_DEPTH {
                 bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
             }

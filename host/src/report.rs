@@ -6,7 +6,7 @@ use serde::Serialize;
 use treelet_core::sah::{sah_cost, SahCosts};
 
 use crate::backend::Backend;
-use treelet_core::Aabb;
+use treelet_core::{Aabb, Node};
 
 use crate::lbvh::{self, Bvh, STAGES};
 use crate::scene::{validate_spheres, Scene};
@@ -33,6 +33,11 @@ pub struct BuildReport {
     pub ms: serde_json::Map<String, serde_json::Value>,
     /// "gpu-timestamps" or "wall-clock".
     pub timing: &'static str,
+    /// Leaves of the tree (fewer than the primitives after a leaf collapse).
+    pub leaves: usize,
+    /// Largest leaf the SAH collapse may make (trbvh, sweep).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_leaf: Option<u32>,
     /// Treelet optimization (builder `trbvh`): its settings, the SAH before
     /// and after, and the time of each round (ms).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -48,11 +53,11 @@ pub struct BuildReport {
 }
 
 /// The full-sweep SAH reference build (CPU only), reported like the others.
-pub fn run_build_sweep(scene: &Scene) -> Result<(Bvh, BuildReport)> {
+pub fn run_build_sweep(scene: &Scene, max_leaf: u32) -> Result<(Bvh, BuildReport)> {
     let objects = scene.objects();
     validate_spheres(objects)?;
     let start = Instant::now();
-    let bvh = crate::sweep::build(objects);
+    let bvh = crate::sweep::build_collapsed(objects, max_leaf)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let mut ms = serde_json::Map::new();
@@ -71,6 +76,8 @@ pub fn run_build_sweep(scene: &Scene) -> Result<(Bvh, BuildReport)> {
         wall_ms,
         ms,
         timing: "wall-clock",
+        leaves: leaf_count(&bvh.nodes),
+        max_leaf: Some(max_leaf),
         rounds: None,
         gamma: None,
         sah_before: None,
@@ -90,7 +97,7 @@ pub fn run_build<B: Backend>(
     let objects = scene.objects();
     validate_spheres(objects)?;
     let start = Instant::now();
-    let (device_bvh, times) = lbvh::build_on_device(backend, objects)?;
+    let (mut device_bvh, times) = lbvh::build_on_device(backend, objects)?;
     let mut bvh = device_bvh.read(backend)?;
     let mut ms: serde_json::Map<String, serde_json::Value> =
         STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
@@ -99,10 +106,13 @@ pub fn run_build<B: Backend>(
     if let Some(config) = treelets {
         sah_before = Some(sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA));
         let root = bvh.nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
-        let rounds = trbvh::optimize(backend, &device_bvh, &root, config)?;
-        let per_round: Vec<f64> = rounds.order.iter().map(|s| rounds.get(s)).collect();
+        let (optimized, rounds) = trbvh::optimize(backend, device_bvh, &root, config)?;
+        device_bvh = optimized;
+        let per_round: Vec<f64> =
+            rounds.order.iter().filter(|s| s.starts_with("round")).map(|s| rounds.get(s)).collect();
         total_ms += rounds.total();
-        ms.insert("treelets".into(), serde_json::json!(rounds.total()));
+        ms.insert("treelets".into(), serde_json::json!(per_round.iter().sum::<f64>()));
+        ms.insert("collapse".into(), serde_json::json!(rounds.get("collapse")));
         round_ms = Some(per_round);
         bvh = device_bvh.read(backend)?;
     }
@@ -123,6 +133,8 @@ pub fn run_build<B: Backend>(
         wall_ms,
         ms,
         timing: if times.source.is_empty() { "wall-clock" } else { times.source },
+        leaves: leaf_count(&bvh.nodes),
+        max_leaf: treelets.map(|c| c.max_leaf),
         rounds: treelets.map(|c| c.rounds),
         gamma: treelets.map(|c| c.gamma),
         sah_before,
@@ -130,4 +142,8 @@ pub fn run_build<B: Backend>(
         round_ms,
     };
     Ok((bvh, report))
+}
+
+fn leaf_count(nodes: &[Node]) -> usize {
+    nodes.iter().filter(|n| n.is_leaf()).count()
 }

@@ -4,15 +4,40 @@
 //! split position on every axis and takes the cheapest, then the three
 //! sorted lists are partitioned stably for the children.
 //!
-//! The tree has the LBVH's layout (`2n - 1` nodes, root 0, one primitive per
-//! leaf, parent links), so the validator, the SAH and the renderer take it
-//! as they are.
+//! The tree has the LBVH's layout (`2n - 1` nodes, internal nodes first with
+//! the root at 0, the leaf of sorted position `j` at `n - 1 + j`, parent
+//! links), so the validator, the SAH, the renderer and the leaf collapse of
+//! [`crate::trbvh::collapse`] take it as they are: [`build_collapsed`]
+//! collapses leaves by the same rule as the TRBVH.
 use treelet_core::layout::{Node, Sphere, INVALID, LEAF_BIT};
 use treelet_core::Aabb;
 
-use crate::lbvh::Bvh;
+use crate::cpu_runner::CpuBackend;
+use crate::lbvh::{Bvh, DeviceBvh};
 
-/// Builds the full-sweep SAH tree over `spheres`.
+/// The sweep tree with the SAH leaf collapse (leaves of up to `max_leaf`
+/// primitives), run by the CPU runner over the same kernels as the TRBVH's.
+pub fn build_collapsed(spheres: &[Sphere], max_leaf: u32) -> anyhow::Result<Bvh> {
+    let tree = build(spheres);
+    let n = spheres.len() as u32;
+    if n < 2 {
+        return Ok(tree);
+    }
+    let b = &mut CpuBackend::new();
+    use crate::backend::Backend;
+    let device = DeviceBvh {
+        n,
+        node_count: tree.nodes.len() as u32,
+        nodes: b.upload("nodes", &tree.nodes)?,
+        parents: b.upload("parents", &tree.parents)?,
+        prim_indices: b.upload("primitive indices", &tree.prim_indices)?,
+        sorted_keys: b.upload("keys", &vec![0u64; n as usize])?, // not read: the sweep sorts no keys
+        centroid_bounds: Aabb::EMPTY,
+    };
+    crate::trbvh::collapse(b, device, max_leaf)?.read(b).map(|t| Bvh { sorted_keys: Vec::new(), ..t })
+}
+
+/// Builds the full-sweep SAH tree over `spheres`, one primitive per leaf.
 pub fn build(spheres: &[Sphere]) -> Bvh {
     let n = spheres.len();
     if n == 0 {
@@ -30,9 +55,19 @@ pub fn build(spheres: &[Sphere]) -> Bvh {
     let mut in_left = vec![false; n];
     let mut scratch = vec![0u32; n];
     let mut right_areas = vec![0.0f64; n + 1];
-    // (node index, begin, end) of ranges still to split.
-    let mut stack = vec![(0usize, 0usize, n)];
-    let mut next = 1usize;
+    // (node index, begin, end) of ranges still to split; a one-primitive
+    // range [j, j + 1) is leaf j at node n - 1 + j, as in the LBVH.
+    let node_of = |begin: usize, end: usize, next: &mut usize| {
+        if end - begin == 1 {
+            n - 1 + begin
+        } else {
+            *next += 1;
+            *next - 1
+        }
+    };
+    let mut next_internal = 0usize;
+    let root = node_of(0, n, &mut next_internal);
+    let mut stack = vec![(root, 0usize, n)];
     while let Some((id, begin, end)) = stack.pop() {
         let count = end - begin;
         let range_box = order[0][begin..end].iter().fold(Aabb::EMPTY, |acc, &p| acc.union(&boxes[p as usize]));
@@ -83,8 +118,8 @@ pub fn build(spheres: &[Sphere]) -> Bvh {
             }
             list[begin..end].copy_from_slice(&scratch[begin..end]);
         }
-        let (left, right) = (next, next + 1);
-        next += 2;
+        let left = node_of(begin, best_split, &mut next_internal);
+        let right = node_of(best_split, end, &mut next_internal);
         nodes[id].left = left as u32;
         nodes[id].right = right as u32;
         parents[left] = id as u32;
@@ -108,6 +143,12 @@ mod tests {
             let sweep = build(&spheres);
             let v = validate(&spheres, &sweep.nodes, &sweep.parents, &sweep.prim_indices);
             assert!(v.is_valid(), "n = {n}: {:?}", v.errors);
+            let collapsed = build_collapsed(&spheres, 8).unwrap();
+            let v = validate(&spheres, &collapsed.nodes, &collapsed.parents, &collapsed.prim_indices);
+            assert!(v.is_valid(), "n = {n}, collapsed: {:?}", v.errors);
+            let (s, c) =
+                (sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA), sah_cost(&collapsed.nodes, SahCosts::KARRAS_AILA));
+            assert!(c <= s * (1.0 + 1e-6), "n = {n}: collapse raised the SAH from {s} to {c}");
             if n >= 1000 {
                 let (lbvh, _) = crate::lbvh::build(&mut crate::cpu_runner::CpuBackend::new(), &spheres).unwrap();
                 let (s, l) =

@@ -2,6 +2,8 @@
 //! round by round: a bottom-up pass computes each node's primitive count,
 //! SAH cost and height, then one dispatch per height, from the leaves up,
 //! restructures every treelet whose root has at least `gamma` primitives.
+//! Last, the SAH leaf collapse writes the tree anew in depth-first order
+//! with leaves of up to `max_leaf` primitives.
 //! Nodes of one height never contain each other, so each dispatch works on
 //! disjoint subtrees. (The paper instead restructures during one bottom-up
 //! climb with atomic counters; per-height dispatches trade some launches
@@ -24,60 +26,144 @@ pub struct TreeletConfig {
     /// Smallest subtree, in primitives, restructured in the first round;
     /// doubled each round (the paper: 7, i.e. one full treelet).
     pub gamma: u32,
+    /// Largest leaf the final SAH collapse makes (1: one primitive per leaf,
+    /// no collapse). The paper sets no bound; a bound keeps the worst leaf
+    /// a ray must test small.
+    pub max_leaf: u32,
 }
 
 impl Default for TreeletConfig {
     fn default() -> Self {
-        Self { rounds: 3, gamma: 7 }
+        Self { rounds: 3, gamma: 7, max_leaf: 8 }
     }
 }
 
-/// Optimizes `bvh` in place. `root_box` (the tree's root box) scales areas so
-/// that f32 costs cannot overflow. Stage times are named `round 1`, ...
+/// Per-node scratch the passes share.
+struct Scratch<B: Backend> {
+    counts: B::Buffer,
+    costs: B::Buffer,
+    heights: B::Buffer,
+    tree_leaves: B::Buffer,
+}
+
+/// Optimizes `bvh`: restructuring rounds in place, then the SAH leaf
+/// collapse into a new, compacted tree (depth-first order), which it
+/// returns. `root_box` (the tree's root box) scales areas so that f32 costs
+/// cannot overflow. Stage times are named `round 1`, ..., `collapse`.
 pub fn optimize<B: Backend>(
     b: &mut B,
-    bvh: &DeviceBvh<B>,
+    bvh: DeviceBvh<B>,
     root_box: &Aabb,
     config: &TreeletConfig,
-) -> Result<StageTimes> {
+) -> Result<(DeviceBvh<B>, StageTimes)> {
     let n = bvh.n;
-    if n < 3 {
-        return b.take_times();
+    if n < 2 {
+        return Ok((bvh, b.take_times()?));
     }
-    let node_count = 2 * n as u64 - 1;
-    let extent = root_box.extent().max_element();
-    let inv_extent = if extent > 0.0 { (1.0 / extent).min(f32::MAX) } else { 1.0 };
-    let sah = SahCosts::KARRAS_AILA;
-    let base =
-        TreeletParams { n, node_cost: sah.node as f32, prim_cost: sah.prim as f32, inv_extent, ..Default::default() };
-    let counts = b.scratch("treelet counts", node_count * 4)?;
-    let costs = b.scratch("treelet costs", node_count * 4)?;
-    let heights = b.scratch("treelet heights", node_count * 4)?;
-    let init = if b.ordered_atomics_in_divergent_flow() { Kernel::TreeletInit } else { Kernel::TreeletInitRelaxed };
+    let base = base_params(n, root_box, config);
+    let scratch = scratch(b, n)?;
     const ROUND_NAMES: [&str; 8] =
         ["round 1", "round 2", "round 3", "round 4", "round 5", "round 6", "round 7", "round 8"];
     let mut gamma = config.gamma;
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
-        let flags = b.zeroed("treelet flags", (n as u64 - 1) * 4)?;
-        let p = b.upload("treelet params", &[TreeletParams { gamma, ..base }])?;
-        b.dispatch(
-            init,
-            &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &heights],
-            groups_for(n, WORKGROUP_SIZE),
-        );
-        let root_height = b.read::<u32>(&heights, 1)?[0];
+        init_pass(b, &bvh, &scratch, &base)?;
+        let root_height = b.read::<u32>(&scratch.heights, 1)?[0];
         for level in 1..=root_height {
             let lp = b.upload("treelet params", &[TreeletParams { gamma, level, ..base }])?;
             b.dispatch(
                 Kernel::TreeletLevel,
-                &[&lp, &bvh.nodes, &bvh.parents, &counts, &costs, &heights],
+                &[&lp, &bvh.nodes, &bvh.parents, &scratch.counts, &scratch.costs, &scratch.heights],
                 groups_for(n - 1, WORKGROUP_SIZE),
             );
         }
         gamma = gamma.saturating_mul(2);
     }
-    b.take_times()
+    b.stage("collapse");
+    let collapsed = collapse_pass(b, &bvh, &scratch, &base)?;
+    Ok((collapsed, b.take_times()?))
+}
+
+/// Only the SAH leaf collapse and compaction (what [`optimize`] ends with),
+/// for trees built otherwise: `bvh` must have the LBVH layout (leaf `j` at
+/// node `n - 1 + j`, one primitive each).
+pub fn collapse<B: Backend>(b: &mut B, bvh: DeviceBvh<B>, max_leaf: u32) -> Result<DeviceBvh<B>> {
+    if bvh.n < 2 {
+        return Ok(bvh);
+    }
+    let root = root_box(b, &bvh)?;
+    let base = base_params(bvh.n, &root, &TreeletConfig { max_leaf, ..Default::default() });
+    let scratch = scratch(b, bvh.n)?;
+    collapse_pass(b, &bvh, &scratch, &base)
+}
+
+fn base_params(n: u32, root_box: &Aabb, config: &TreeletConfig) -> TreeletParams {
+    let extent = root_box.extent().max_element();
+    let inv_extent = if extent > 0.0 { (1.0 / extent).min(f32::MAX) } else { 1.0 };
+    let sah = SahCosts::KARRAS_AILA;
+    TreeletParams {
+        n,
+        node_cost: sah.node as f32,
+        prim_cost: sah.prim as f32,
+        inv_extent,
+        max_leaf: config.max_leaf.max(1),
+        ..Default::default()
+    }
+}
+
+fn scratch<B: Backend>(b: &mut B, n: u32) -> Result<Scratch<B>> {
+    let node_count = 2 * n as u64 - 1;
+    Ok(Scratch {
+        counts: b.scratch("treelet counts", node_count * 4)?,
+        costs: b.scratch("treelet costs", node_count * 4)?,
+        heights: b.scratch("treelet heights", node_count * 4)?,
+        tree_leaves: b.scratch("treelet tree leaves", node_count * 4)?,
+    })
+}
+
+/// Every node's count, cost, height and output leaf count, bottom up.
+fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &TreeletParams) -> Result<()> {
+    let n = bvh.n;
+    let init = if b.ordered_atomics_in_divergent_flow() { Kernel::TreeletInit } else { Kernel::TreeletInitRelaxed };
+    let flags = b.zeroed("treelet flags", (n as u64 - 1) * 4)?;
+    let p = b.upload("treelet params", &[*base])?;
+    b.dispatch(
+        init,
+        &[&p, &bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves],
+        groups_for(n, WORKGROUP_SIZE),
+    );
+    Ok(())
+}
+
+/// Fresh counts and costs, then the collapse into new arrays.
+fn collapse_pass<B: Backend>(
+    b: &mut B,
+    bvh: &DeviceBvh<B>,
+    s: &Scratch<B>,
+    base: &TreeletParams,
+) -> Result<DeviceBvh<B>> {
+    let n = bvh.n;
+    init_pass(b, bvh, s, base)?;
+    let leaves = b.read::<u32>(&s.tree_leaves, 1)?[0];
+    let node_count = 2 * leaves - 1;
+    let nodes = b.scratch("collapsed nodes", node_count as u64 * std::mem::size_of::<Node>() as u64)?;
+    let parents = b.scratch("collapsed parents", node_count as u64 * 4)?;
+    let prims = b.scratch("collapsed primitive indices", n as u64 * 4)?;
+    let p = b.upload("treelet params", &[*base])?;
+    b.dispatch(
+        Kernel::Collapse,
+        &[&p, &bvh.nodes, &bvh.parents, &s.counts, &s.tree_leaves, &bvh.prim_indices, &nodes, &parents, &prims],
+        groups_for(n, WORKGROUP_SIZE),
+    );
+    Ok(DeviceBvh {
+        n,
+        node_count,
+        nodes,
+        parents,
+        prim_indices: prims,
+        sorted_keys: bvh.sorted_keys.clone(),
+        centroid_bounds: bvh.centroid_bounds,
+    })
 }
 
 /// The root box of a device BVH (one node read back).
