@@ -195,8 +195,8 @@ const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);
 pub struct TreeletParams {
     /// Number of primitives (leaves).
     pub n: u32,
-    /// Height of the nodes this dispatch restructures.
-    pub level: u32,
+    /// Where this dispatch's treelet roots start in the list of roots.
+    pub level_offset: u32,
     /// Only subtrees of at least this many primitives are restructured.
     pub gamma: u32,
     /// Largest leaf the SAH may collapse a subtree into (1: no collapse).
@@ -206,6 +206,7 @@ pub struct TreeletParams {
     pub prim_cost: f32,
     /// Boxes are scaled by this before taking areas.
     pub inv_extent: f32,
-    pub _pad1: u32,
+    /// How many treelet roots this dispatch restructures.
+    pub level_count: u32,
 }
 const _: () = assert!(core::mem::size_of::<TreeletParams>() == 32);

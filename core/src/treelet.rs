@@ -25,8 +25,9 @@
 //! paper, a subtree of at most `max_leaf` primitives costs the cheaper of its
 //! tree and one leaf holding all its primitives (`C_t·A·N`): the DP and the
 //! rounds optimize for the tree that [`crate::collapse`] finally produces.
-//! Treelet departs from the paper in one way so far: the DP here runs in one
-//! invocation per treelet (the paper's warp-wide version is the speed target).
+//! On the device, [`treelet_wide_phase`] spreads the DP of each treelet over
+//! 32 lanes as the paper does; [`restructure`] is the same steps in one
+//! invocation (the CPU reference and tests).
 use crate::aabb::Aabb;
 use crate::atomics;
 use crate::fit::second_arrival;
@@ -149,15 +150,81 @@ pub fn form_treelet(root: u32, nodes: &[Node], costs: &TreeletCosts) -> Treelet 
 }
 
 /// The optimal tree over a treelet's leaves: `partition[s]` is the subset of
-/// `s` that forms one child of the node covering `s` (the other is `s ^ p`).
+/// `s` that forms one child of the node covering `s` (the other is `s ^ p`),
+/// `cost[s]` the cost of that best subtree.
 pub struct TreeletSolution {
     pub partition: [u32; SUBSETS],
-    pub area: [f32; SUBSETS],
     pub cost: [f32; SUBSETS],
 }
 
+/// Scaled area of the union of the leaves in subset `s` (in leaf order, so
+/// every caller rounds alike).
+#[inline]
+pub fn subset_area(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES], costs: &TreeletCosts) -> f32 {
+    let mut b = Aabb::EMPTY;
+    let mut i = 0;
+    while i < n {
+        if s & (1 << i) != 0 {
+            b = b.union(&boxes[i as usize]);
+        }
+        i += 1;
+    }
+    costs.area(&b)
+}
+
+/// Primitives under the leaves in subset `s`.
+#[inline]
+pub fn subset_count(s: u32, n: u32, leaf_counts: &[u32; TREELET_LEAVES]) -> u32 {
+    let mut c = 0;
+    let mut i = 0;
+    while i < n {
+        if s & (1 << i) != 0 {
+            c += leaf_counts[i as usize];
+        }
+        i += 1;
+    }
+    c
+}
+
+/// One step of the DP: the best partition of subset `s` (of at least two
+/// leaves) from the solved costs of its parts. Tables are rows of
+/// [`SUBSETS`] entries starting at `base` (several treelets share one table
+/// in the wide kernel).
+///
+/// Algorithm 3: partitions `(p, s ^ p)` with `p` inside `s` minus its lowest
+/// bit, each unordered pair once.
+#[inline]
+pub fn solve_subset<const N: usize>(
+    s: u32,
+    base: usize,
+    area: f32,
+    count: u32,
+    cost: &mut [f32; N],
+    partition: &mut [u32; N],
+    costs: &TreeletCosts,
+) {
+    let delta = (s - 1) & s;
+    let mut p = delta.wrapping_neg() & s;
+    let mut best = f32::MAX;
+    let mut best_p = 0u32;
+    loop {
+        let c = cost[base + p as usize] + cost[base + (s ^ p) as usize];
+        if c < best {
+            best = c;
+            best_p = p;
+        }
+        p = p.wrapping_sub(delta) & s;
+        if p == 0 {
+            break;
+        }
+    }
+    cost[base + s as usize] = costs.subtree(area, count, best);
+    partition[base + s as usize] = best_p;
+}
+
 /// Algorithm 2's dynamic program over the subsets of `n` leaves with boxes
-/// `boxes`, subtree costs `leaf_costs` and primitive counts `leaf_counts`.
+/// `boxes`, subtree costs `leaf_costs` and primitive counts `leaf_counts`,
+/// in one invocation (the wide kernel spreads the same steps over a team).
 #[inline]
 pub fn optimize(
     n: u32,
@@ -166,31 +233,8 @@ pub fn optimize(
     leaf_counts: &[u32; TREELET_LEAVES],
     costs: &TreeletCosts,
 ) -> TreeletSolution {
-    let mut sol = TreeletSolution { partition: [0u32; SUBSETS], area: [0.0; SUBSETS], cost: [0.0; SUBSETS] };
+    let mut sol = TreeletSolution { partition: [0u32; SUBSETS], cost: [0.0; SUBSETS] };
     let full = (1u32 << n) - 1;
-    // Areas of every subset's union.
-    let mut s = 1u32;
-    while s <= full {
-        let mut b = Aabb::EMPTY;
-        let mut i = 0;
-        while i < n {
-            if s & (1 << i) != 0 {
-                b = b.union(&boxes[i as usize]);
-            }
-            i += 1;
-        }
-        sol.area[s as usize] = costs.area(&b);
-        s += 1;
-    }
-    // Primitive counts of every subset, built from the subset minus its lowest leaf.
-    let mut count = [0u32; SUBSETS];
-    let mut s = 1u32;
-    while s <= full {
-        let low = s.trailing_zeros();
-        count[s as usize] = count[(s & (s - 1)) as usize] + leaf_counts[low as usize];
-        s += 1;
-    }
-    // Leaves: their subtrees' costs.
     let mut i = 0;
     while i < n {
         sol.cost[1 << i] = leaf_costs[i as usize];
@@ -202,25 +246,9 @@ pub fn optimize(
         let mut s = 1u32;
         while s <= full {
             if s.count_ones() == size {
-                // Algorithm 3: partitions (p, s^p) with p inside s minus its
-                // lowest bit, each unordered pair once.
-                let delta = (s - 1) & s;
-                let mut p = delta.wrapping_neg() & s;
-                let mut best = f32::MAX;
-                let mut best_p = 0u32;
-                loop {
-                    let c = sol.cost[p as usize] + sol.cost[(s ^ p) as usize];
-                    if c < best {
-                        best = c;
-                        best_p = p;
-                    }
-                    p = p.wrapping_sub(delta) & s;
-                    if p == 0 {
-                        break;
-                    }
-                }
-                sol.cost[s as usize] = costs.subtree(sol.area[s as usize], count[s as usize], best);
-                sol.partition[s as usize] = best_p;
+                let area = subset_area(s, n, boxes, costs);
+                let count = subset_count(s, n, leaf_counts);
+                solve_subset(s, 0, area, count, &mut sol.cost, &mut sol.partition, costs);
             }
             s += 1;
         }
@@ -229,11 +257,17 @@ pub fn optimize(
     sol
 }
 
-/// Rewires the treelet's internal nodes into the optimal tree (children and
-/// parent links only; boxes and costs are the caller's to refit). The root
+/// Rewires the treelet's internal nodes into the tree that `partition`
+/// (a row at `base`) describes: children and parent links only. The root
 /// keeps its index; the other internal nodes are reused in order.
 #[inline]
-pub fn apply(t: &Treelet, sol: &TreeletSolution, nodes: &mut [Node], parents: &mut [u32]) {
+pub fn apply<const N: usize>(
+    t: &Treelet,
+    partition: &[u32; N],
+    base: usize,
+    nodes: &mut [Node],
+    parents: &mut [u32],
+) {
     let n = t.leaf_count;
     let full = (1u32 << n) - 1;
     // Stack of (subset, node index), depth at most the number of internals.
@@ -247,7 +281,7 @@ pub fn apply(t: &Treelet, sol: &TreeletSolution, nodes: &mut [Node], parents: &m
         top -= 1;
         let s = stack_s[top];
         let node = stack_n[top];
-        let p = sol.partition[s as usize];
+        let p = partition[base + s as usize];
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
@@ -284,11 +318,46 @@ pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &Treel
     }
 }
 
-/// Restructures the treelet rooted at internal node `root` in place:
-/// forms it, solves the DP, rewires it if that lowers its cost, and refits
-/// the boxes and costs of its internal nodes. `node_costs` holds every
-/// node's subtree cost (as [`node_cost`] defines it) and `counts` its
-/// primitive count. Returns whether the treelet changed.
+/// Rewires treelet `t` into the solved tree if its cost `best` is lower
+/// than the subtree's current cost, then refits the boxes, counts and costs
+/// of its internal nodes. Returns whether the treelet changed.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn commit<const N: usize>(
+    t: &Treelet,
+    partition: &[u32; N],
+    base: usize,
+    best: f32,
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    costs: &TreeletCosts,
+) -> bool {
+    // The current topology is one of the candidates: keep it unless the
+    // optimum is strictly cheaper (avoids churn on ties and rounding).
+    if best >= node_costs[t.internals[0] as usize] * (1.0 - 1e-6) {
+        return false;
+    }
+    apply(t, partition, base, nodes, parents);
+    // Children are assigned after their parents, so refit in reverse.
+    let mut k = t.leaf_count as usize - 1;
+    while k > 0 {
+        k -= 1;
+        let id = t.internals[k] as usize;
+        let (l, r) = (nodes[id].left as usize, nodes[id].right as usize);
+        let b = nodes[l].aabb().union(&nodes[r].aabb());
+        nodes[id].set_aabb(b);
+        counts[id] = counts[l] + counts[r];
+        node_costs[id] = node_cost(&nodes[id], counts[id], (node_costs[l], node_costs[r]), costs);
+    }
+    true
+}
+
+/// Restructures the treelet rooted at internal node `root` in place, in one
+/// invocation: forms it, solves the DP, and commits the result if cheaper.
+/// `node_costs` holds every node's subtree cost (as [`node_cost`] defines
+/// it) and `counts` its primitive count. Returns whether the treelet changed.
 #[inline]
 pub fn restructure(
     root: u32,
@@ -314,25 +383,7 @@ pub fn restructure(
     }
     let sol = optimize(t.leaf_count, &boxes, &leaf_costs, &leaf_counts, costs);
     let full = (1usize << t.leaf_count) - 1;
-    // The current topology is one of the candidates: keep it unless the
-    // optimum is strictly cheaper (avoids churn on ties and rounding).
-    if sol.cost[full] >= node_costs[root as usize] * (1.0 - 1e-6) {
-        return false;
-    }
-    apply(&t, &sol, nodes, parents);
-    // Children are assigned after their parents, so refit in reverse.
-    let internal_count = t.leaf_count as usize - 1;
-    let mut k = internal_count;
-    while k > 0 {
-        k -= 1;
-        let id = t.internals[k] as usize;
-        let (l, r) = (nodes[id].left as usize, nodes[id].right as usize);
-        let b = nodes[l].aabb().union(&nodes[r].aabb());
-        nodes[id].set_aabb(b);
-        counts[id] = counts[l] + counts[r];
-        node_costs[id] = node_cost(&nodes[id], counts[id], (node_costs[l], node_costs[r]), costs);
-    }
-    true
+    commit(&t, &sol.partition, 0, sol.cost[full], nodes, parents, counts, node_costs, costs)
 }
 
 /// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
@@ -389,24 +440,171 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     }
 }
 
-/// Kernel (one invocation per internal node): restructures the treelet of
-/// node `i` when `i` has height `params.level` and at least `params.gamma`
-/// primitives. Nodes of one height never contain each other, so their
-/// treelets are disjoint; levels run as separate dispatches, bottom up.
-pub fn treelet_level_kernel(
+/// Heights the level lists hold; the last slot counts deeper nodes (an
+/// error for the host: traversal refuses such trees anyway).
+pub const MAX_LEVELS: usize = 256;
+
+/// Whether internal node `i` roots a treelet this round, and at which height.
+#[inline]
+fn treelet_root(i: u32, params: &TreeletParams, counts: &[u32], heights: &[u32]) -> Option<usize> {
+    if params.n < 2 || i >= params.n - 1 || counts[i as usize] < params.gamma {
+        return None;
+    }
+    Some((heights[i as usize] as usize).min(MAX_LEVELS - 1))
+}
+
+/// Kernel (one invocation per internal node): counts the treelet roots of
+/// each height into `level_counts` (zeroed, [`MAX_LEVELS`] entries).
+pub fn treelet_histogram_kernel(
     i: u32,
     params: &TreeletParams,
+    counts: &[u32],
+    heights: &[u32],
+    level_counts: &mut [u32],
+) {
+    if let Some(h) = treelet_root(i, params, counts, heights) {
+        atomics::add_device(&mut level_counts[h], 1);
+    }
+}
+
+/// Kernel (one invocation per internal node): appends each treelet root to
+/// its height's list; `cursors` start at each list's offset. Order within a
+/// list does not matter: the treelets of one height are disjoint.
+pub fn treelet_scatter_kernel(
+    i: u32,
+    params: &TreeletParams,
+    counts: &[u32],
+    heights: &[u32],
+    cursors: &mut [u32],
+    roots: &mut [u32],
+) {
+    if let Some(h) = treelet_root(i, params, counts, heights) {
+        let slot = atomics::add_device(&mut cursors[h], 1);
+        roots[slot as usize] = i;
+    }
+}
+
+/// Lanes that solve one treelet together in the wide kernel (the paper's
+/// warp; a plain workgroup slice here, so no subgroup size is assumed).
+pub const TEAM: u32 = 32;
+/// Treelets per workgroup of the wide kernel.
+pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
+/// Shared DP tables: one row of [`SUBSETS`] per team.
+pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
+/// Shared treelet descriptions: per team, 7 leaves, the leaf count, 6 internals.
+pub const TEAM_SLOTS: usize = TEAMS * 16;
+/// Phases of [`treelet_wide_phase`]: form, areas, one per subset size 2..=7, commit.
+pub const WIDE_PHASES: u32 = 3 + TREELET_LEAVES as u32 - 1;
+
+/// Kernel (workgroups of [`TEAMS`] teams of [`TEAM`] lanes; phase by phase):
+/// restructures the treelets rooted at `roots[level_offset..][..level_count]`,
+/// one per team, the DP spread over the team's lanes (Karras & Aila's
+/// warp-wide scheme): each lane takes every 32nd subset of each size, sizes
+/// in increasing order with a barrier between them. The steps are those of
+/// [`restructure`], so the result is the same tree.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_wide_phase(
+    phase: u32,
+    lid: u32,
+    group: u32,
+    params: &TreeletParams,
+    roots: &[u32],
     nodes: &mut [Node],
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
-    heights: &[u32],
+    slots: &mut [u32; TEAM_SLOTS],
+    area: &mut [f32; TEAM_TABLE],
+    sub_count: &mut [u32; TEAM_TABLE],
+    cost: &mut [f32; TEAM_TABLE],
+    partition: &mut [u32; TEAM_TABLE],
 ) {
-    if params.n < 2 || i >= params.n - 1 {
+    let team = (lid / TEAM) as usize;
+    let lane = lid % TEAM;
+    let sb = team * 16; // this team's slots
+    let tb = team * SUBSETS; // this team's table row
+    let costs = params.costs();
+    if phase == 0 {
+        if lane == 0 {
+            let index = group * TEAMS as u32 + team as u32;
+            let mut leaf_count = 0;
+            if index < params.level_count {
+                let t = form_treelet(roots[(params.level_offset + index) as usize], nodes, &costs);
+                if t.leaf_count >= 3 {
+                    leaf_count = t.leaf_count;
+                    let mut i = 0;
+                    while i < TREELET_LEAVES {
+                        slots[sb + i] = t.leaves[i];
+                        i += 1;
+                    }
+                    let mut i = 0;
+                    while i < TREELET_INTERNALS {
+                        slots[sb + 8 + i] = t.internals[i];
+                        i += 1;
+                    }
+                }
+            }
+            slots[sb + 7] = leaf_count;
+        }
         return;
     }
-    if heights[i as usize] == params.level && counts[i as usize] >= params.gamma {
-        restructure(i, nodes, parents, counts, node_costs, &params.costs());
+    let n = slots[sb + 7];
+    if n == 0 {
+        return;
+    }
+    let full = (1u32 << n) - 1;
+    if phase == 1 {
+        // Areas and counts of this lane's subsets; the leaves' own costs.
+        let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
+        let mut leaf_counts = [0u32; TREELET_LEAVES];
+        let mut i = 0;
+        while i < n as usize {
+            let leaf = slots[sb + i] as usize;
+            boxes[i] = nodes[leaf].aabb();
+            leaf_counts[i] = counts[leaf];
+            i += 1;
+        }
+        let mut s = lane + 1;
+        while s <= full {
+            area[tb + s as usize] = subset_area(s, n, &boxes, &costs);
+            sub_count[tb + s as usize] = subset_count(s, n, &leaf_counts);
+            if s.count_ones() == 1 {
+                cost[tb + s as usize] = node_costs[slots[sb + s.trailing_zeros() as usize] as usize];
+            }
+            s += TEAM;
+        }
+    } else if phase < WIDE_PHASES - 1 {
+        // Subsets of one size, dealt round-robin to the lanes.
+        let size = phase;
+        if size > n {
+            return;
+        }
+        let mut rank = 0u32;
+        let mut s = 1u32;
+        while s <= full {
+            if s.count_ones() == size {
+                if rank % TEAM == lane {
+                    let (a, c) = (area[tb + s as usize], sub_count[tb + s as usize]);
+                    solve_subset(s, tb, a, c, cost, partition, &costs);
+                }
+                rank += 1;
+            }
+            s += 1;
+        }
+    } else if lane == 0 {
+        let mut t = Treelet { leaves: [0; TREELET_LEAVES], leaf_count: n, internals: [0; TREELET_INTERNALS] };
+        let mut i = 0;
+        while i < TREELET_LEAVES {
+            t.leaves[i] = slots[sb + i];
+            i += 1;
+        }
+        let mut i = 0;
+        while i < TREELET_INTERNALS {
+            t.internals[i] = slots[sb + 8 + i];
+            i += 1;
+        }
+        let best = cost[tb + full as usize];
+        commit(&t, partition, tb, best, nodes, parents, counts, node_costs, &costs);
     }
 }
 

@@ -20,6 +20,13 @@ pub enum BenchCommand {
         /// lbvh: the Karras 2012 build; trbvh: the build plus treelet restructuring (stage times of both).
         #[arg(long, value_enum, default_value = "lbvh")]
         builder: TreeBuilder,
+        /// Treelet rounds, first gamma and largest collapsed leaf (trbvh).
+        #[arg(long, default_value_t = 3)]
+        rounds: u32,
+        #[arg(long, default_value_t = 7)]
+        gamma: u32,
+        #[arg(long, default_value_t = 8)]
+        max_leaf: u32,
         /// Primitive counts (the seed's table, then millions).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
         sizes: Vec<usize>,
@@ -66,11 +73,11 @@ pub enum TreeBuilder {
 }
 
 /// One build on the device, the tree left there (as in a renderer).
-fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: TreeBuilder) -> Result<StageTimes> {
+fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&TreeletConfig>) -> Result<StageTimes> {
     let (bvh, mut times) = lbvh::build_on_device(b, spheres)?;
-    if builder == TreeBuilder::Trbvh {
+    if let Some(config) = builder {
         let root = trbvh::root_box(b, &bvh)?;
-        let (_, rounds) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
+        let (_, rounds) = trbvh::optimize(b, bvh, &root, config)?;
         for s in &rounds.order {
             times.add(s, rounds.get(s));
         }
@@ -127,7 +134,7 @@ fn print_render_rows(title: &str, rows: &[RenderRow]) {
     );
     for r in rows {
         println!(
-            "{:>14}{:>6}{:>11}{:>6}{:>10.3}{:>11.4}{:>10.3}{:>14.1}",
+            "{:>14}{:>6}{:>11}{:>6}{:>10.3}{:>11.4}{:>10.3}{:>14.3}",
             r.scene,
             format!("{:?}", r.accel).to_lowercase(),
             format!("{}x{}", r.width, r.height),
@@ -198,7 +205,12 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-fn bench_sizes<B: Backend>(b: &mut B, sizes: &[usize], repeats: usize, builder: TreeBuilder) -> Result<Vec<Row>> {
+fn bench_sizes<B: Backend>(
+    b: &mut B,
+    sizes: &[usize],
+    repeats: usize,
+    builder: Option<&TreeletConfig>,
+) -> Result<Vec<Row>> {
     let bar = ProgressBar::new((sizes.len() * (repeats + 1)) as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} builds {msg}").unwrap());
     let mut rows = Vec::new();
@@ -270,16 +282,18 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Build { builder, sizes, device, repeats, json, per_kernel } => {
+        BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
+            let config = TreeletConfig { rounds, gamma, max_leaf };
+            let treelets = (builder == TreeBuilder::Trbvh).then_some(&config);
             let (adapter, timing, rows) = match device {
                 Device::Gpu => {
                     let mut b = GpuBackend::new(GpuContext::new()?).with_per_kernel_times(per_kernel);
                     let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
-                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats, builder)?)
+                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats, treelets)?)
                 }
                 Device::Cpu => {
                     let mut b = CpuBackend::new();
-                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats, builder)?)
+                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats, treelets)?)
                 }
             };
             println!("{builder:?} build, {adapter} ({timing}), median of {repeats} (ms)");
@@ -301,7 +315,10 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             if let Some(path) = json {
                 let builder = format!("{builder:?}").to_lowercase();
-                let doc = serde_json::json!({ "adapter": adapter, "builder": builder, "timing": timing, "repeats": repeats, "rows": rows });
+                let doc = serde_json::json!({
+                    "adapter": adapter, "builder": builder, "treelets": treelets,
+                    "timing": timing, "repeats": repeats, "rows": rows
+                });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())

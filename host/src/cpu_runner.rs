@@ -254,13 +254,47 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             }
         }
-        (Kernel::TreeletLevel, [p, nodes, parents, counts, costs, heights]) => {
+        (Kernel::TreeletHistogram, [p, counts, heights, level_counts]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
-            let (nodes, parents, counts) = (view(nodes), view(parents), view(counts));
-            let (costs, heights) = (view(costs), view(heights));
+            let (counts, heights, level_counts) = (view(counts), view(heights), view(level_counts));
             for id in ids(groups) {
-                treelet::treelet_level_kernel(id, &p, nodes, parents, counts, costs, heights);
+                treelet::treelet_histogram_kernel(id, &p, counts, heights, level_counts);
             }
+        }
+        (Kernel::TreeletScatter, [p, counts, heights, cursors, roots]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (counts, heights, cursors, roots) = (view(counts), view(heights), view(cursors), view(roots));
+            for id in ids(groups) {
+                treelet::treelet_scatter_kernel(id, &p, counts, heights, cursors, roots);
+            }
+        }
+        (Kernel::TreeletWide, [p, roots, nodes, parents, counts, costs]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
+            let (counts, costs) = (view(counts), view(costs));
+            let mut slots = [0u32; treelet::TEAM_SLOTS];
+            let mut area = [0f32; treelet::TEAM_TABLE];
+            let mut sub_count = [0u32; treelet::TEAM_TABLE];
+            let mut cost = [0f32; treelet::TEAM_TABLE];
+            let mut partition = [0u32; treelet::TEAM_TABLE];
+            workgroups(groups, treelet::WIDE_PHASES, |group, phase, lid| {
+                treelet::treelet_wide_phase(
+                    phase,
+                    lid,
+                    group,
+                    &p,
+                    roots,
+                    nodes,
+                    parents,
+                    counts,
+                    costs,
+                    &mut slots,
+                    &mut area,
+                    &mut sub_count,
+                    &mut cost,
+                    &mut partition,
+                );
+            });
         }
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.

@@ -30,8 +30,12 @@ pub enum Kernel {
     TreeletInit,
     /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
     TreeletInitRelaxed,
-    /// Treelet optimization: restructure the treelets of one height.
-    TreeletLevel,
+    /// Treelet optimization: count treelet roots per height.
+    TreeletHistogram,
+    /// Treelet optimization: list treelet roots by height.
+    TreeletScatter,
+    /// Treelet optimization: restructure the treelets of one height, a team of lanes each.
+    TreeletWide,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
     /// Path tracing, closest hit by scanning every sphere.
@@ -41,7 +45,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 18] = [
+    pub const ALL: [Kernel; 20] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
@@ -56,7 +60,9 @@ impl Kernel {
         Kernel::FitRelaxed,
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
-        Kernel::TreeletLevel,
+        Kernel::TreeletHistogram,
+        Kernel::TreeletScatter,
+        Kernel::TreeletWide,
         Kernel::Collapse,
         Kernel::RenderLinear,
         Kernel::RenderBvh,
@@ -79,7 +85,9 @@ impl Kernel {
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
-            Kernel::TreeletLevel => "treelet::treelet_level_cs",
+            Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
+            Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
+            Kernel::TreeletWide => "treelet::treelet_wide_cs",
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::RenderLinear => "render::render_linear_cs",
             Kernel::RenderBvh => "render::render_bvh_cs",
@@ -103,7 +111,9 @@ impl Kernel {
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
-            Kernel::TreeletLevel => &[Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, Read],
+            Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
+            Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
+            Kernel::TreeletWide => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
         }

@@ -1,15 +1,17 @@
 //! Treelet restructuring of an LBVH on the device (Karras & Aila 2013),
 //! round by round: a bottom-up pass computes each node's primitive count,
-//! SAH cost and height, then one dispatch per height, from the leaves up,
-//! restructures every treelet whose root has at least `gamma` primitives.
+//! SAH cost and height; the roots of treelets (at least `gamma` primitives)
+//! are listed by height; then one dispatch per height, from the leaves up,
+//! restructures them, 32 lanes per treelet.
 //! Last, the SAH leaf collapse writes the tree anew in depth-first order
 //! with leaves of up to `max_leaf` primitives.
 //! Nodes of one height never contain each other, so each dispatch works on
 //! disjoint subtrees. (The paper instead restructures during one bottom-up
 //! climb with atomic counters; per-height dispatches trade some launches
 //! for visibility guarantees that need no device-scope atomics.)
-use anyhow::Result;
+use anyhow::{bail, Result};
 use treelet_core::layout::TreeletParams;
+use treelet_core::treelet::{MAX_LEVELS, TEAMS};
 use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
@@ -68,16 +70,44 @@ pub fn optimize<B: Backend>(
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
         init_pass(b, &bvh, &scratch, &base)?;
-        let root_height = b.read::<u32>(&scratch.heights, 1)?[0];
-        for level in 1..=root_height {
-            let lp = b.upload("treelet params", &[TreeletParams { gamma, level, ..base }])?;
+        // Treelet roots (at least gamma primitives) listed by height...
+        let p = b.upload("treelet params", &[TreeletParams { gamma, ..base }])?;
+        let level_counts = b.zeroed("treelet level counts", MAX_LEVELS as u64 * 4)?;
+        let (s, internal_groups) = (&scratch, groups_for(n - 1, WORKGROUP_SIZE));
+        b.dispatch(Kernel::TreeletHistogram, &[&p, &s.counts, &s.heights, &level_counts], internal_groups);
+        let per_level = b.read::<u32>(&level_counts, MAX_LEVELS)?;
+        if per_level[MAX_LEVELS - 1] > 0 {
+            bail!("the BVH is deeper than {} levels: treelet optimization refuses it", MAX_LEVELS - 2);
+        }
+        let offsets: Vec<u32> = per_level
+            .iter()
+            .scan(0u32, |sum, &c| {
+                *sum += c;
+                Some(*sum - c)
+            })
+            .collect();
+        let total: u32 = per_level.iter().sum();
+        gamma = gamma.saturating_mul(2);
+        if total == 0 {
+            continue;
+        }
+        let cursors = b.upload("treelet cursors", &offsets)?;
+        let roots = b.scratch("treelet roots", total as u64 * 4)?;
+        b.dispatch(Kernel::TreeletScatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
+        // ...then restructured height by height, bottom up: the treelets of
+        // one height are disjoint, and each sees its subtrees finished.
+        for (level, &count) in per_level.iter().enumerate().skip(1) {
+            if count == 0 {
+                continue;
+            }
+            let lp = TreeletParams { gamma: 0, level_offset: offsets[level], level_count: count, ..base };
+            let lp = b.upload("treelet params", &[lp])?;
             b.dispatch(
-                Kernel::TreeletLevel,
-                &[&lp, &bvh.nodes, &bvh.parents, &scratch.counts, &scratch.costs, &scratch.heights],
-                groups_for(n - 1, WORKGROUP_SIZE),
+                Kernel::TreeletWide,
+                &[&lp, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs],
+                groups_for(count, TEAMS as u32),
             );
         }
-        gamma = gamma.saturating_mul(2);
     }
     b.stage("collapse");
     let collapsed = collapse_pass(b, &bvh, &scratch, &base)?;

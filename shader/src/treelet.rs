@@ -2,8 +2,11 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
-use treelet_core::treelet::{treelet_init_kernel, treelet_level_kernel};
-use treelet_core::workgroup::linear_id;
+use treelet_core::treelet::{
+    treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel, treelet_wide_phase, TEAM_SLOTS,
+    TEAM_TABLE, WIDE_PHASES,
+};
+use treelet_core::workgroup::{barrier, linear_group, linear_id};
 
 /// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
 #[spirv(compute(threads(256)))]
@@ -41,20 +44,60 @@ pub fn treelet_init_relaxed_cs(
     treelet_init_kernel::<false>(id, params, nodes, parents, flags, counts, costs, heights, tree_leaves);
 }
 
-/// Restructures the treelets of one height.
+/// Counts treelet roots per height.
 #[spirv(compute(threads(256)))]
-pub fn treelet_level_cs(
+pub fn treelet_histogram_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &mut [Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] costs: &mut [f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] heights: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] level_counts: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_level_kernel(id, params, nodes, parents, counts, costs, heights);
+    treelet_histogram_kernel(id, params, counts, heights, level_counts);
+}
+
+/// Lists treelet roots by height.
+#[spirv(compute(threads(256)))]
+pub fn treelet_scatter_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] cursors: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] roots: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_scatter_kernel(id, params, counts, heights, cursors, roots);
+}
+
+/// Restructures the treelets of one height, 32 lanes per treelet.
+#[spirv(compute(threads(256)))]
+pub fn treelet_wide_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+    #[spirv(workgroup)] slots: &mut [u32; TEAM_SLOTS],
+    #[spirv(workgroup)] area: &mut [f32; TEAM_TABLE],
+    #[spirv(workgroup)] sub_count: &mut [u32; TEAM_TABLE],
+    #[spirv(workgroup)] cost: &mut [f32; TEAM_TABLE],
+    #[spirv(workgroup)] partition: &mut [u32; TEAM_TABLE],
+) {
+    let group = linear_group(group.x, group.y, groups.x);
+    for phase in 0..WIDE_PHASES {
+        treelet_wide_phase(
+            phase, lid, group, params, roots, nodes, parents, counts, costs, slots, area, sub_count, cost, partition,
+        );
+        barrier();
+    }
 }
 
 /// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
