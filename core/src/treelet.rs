@@ -100,51 +100,90 @@ impl TreeletCosts {
     }
 }
 
-/// A treelet: its root, its leaves and its internal nodes (root first).
+/// A treelet: its leaves (with their boxes, primitive counts and subtree
+/// costs, read once while forming it) and its internal nodes (root first).
 #[derive(Clone, Copy)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
 pub struct Treelet {
     pub leaves: [u32; TREELET_LEAVES],
     pub leaf_count: u32,
     pub internals: [u32; TREELET_INTERNALS],
+    pub boxes: [Aabb; TREELET_LEAVES],
+    pub counts: [u32; TREELET_LEAVES],
+    pub costs: [f32; TREELET_LEAVES],
 }
 
 /// Forms the treelet under internal node `root` (algorithm 2's first loop):
 /// expand, among the current leaves that are internal BVH nodes, the one of
-/// largest area, until seven leaves or no expandable leaf remain.
+/// largest area (the first on ties), until seven leaves or no expandable
+/// leaf remain. Each node is read once: an expansion loads only the two new
+/// children, so the chain of dependent loads is one per expansion.
 #[inline]
-pub fn form_treelet(root: u32, nodes: &[Node], costs: &TreeletCosts) -> Treelet {
-    let r = nodes[root as usize];
-    let mut t = Treelet { leaves: [0; TREELET_LEAVES], leaf_count: 2, internals: [0; TREELET_INTERNALS] };
+pub fn form_treelet(
+    root: u32,
+    nodes: &[Node],
+    counts: &[u32],
+    node_costs: &[f32],
+    costs: &TreeletCosts,
+) -> Treelet {
+    let mut t = Treelet {
+        leaves: [0; TREELET_LEAVES],
+        leaf_count: 2,
+        internals: [0; TREELET_INTERNALS],
+        boxes: [Aabb::EMPTY; TREELET_LEAVES],
+        counts: [0; TREELET_LEAVES],
+        costs: [0.0; TREELET_LEAVES],
+    };
+    // Per treelet leaf: its children (if internal) and area (-1 if a BVH leaf).
+    let mut lefts = [0u32; TREELET_LEAVES];
+    let mut rights = [0u32; TREELET_LEAVES];
+    let mut areas = [0.0f32; TREELET_LEAVES];
     t.internals[0] = root;
-    t.leaves[0] = r.left;
-    t.leaves[1] = r.right;
+    let r = nodes[root as usize];
+    let (first, second) = (r.left, r.right);
     let mut internal_count = 1usize;
-    while (t.leaf_count as usize) < TREELET_LEAVES {
-        let mut best = usize::MAX;
+    // Slot `best` takes the left child, a new slot the right one.
+    let mut best = 0usize;
+    let mut children = [first, second];
+    loop {
+        let mut side = 0;
+        while side < 2 {
+            let slot = if side == 0 { best } else { t.leaf_count as usize - 1 };
+            let id = children[side];
+            let node = nodes[id as usize];
+            t.leaves[slot] = id;
+            t.boxes[slot] = node.aabb();
+            lefts[slot] = node.left;
+            rights[slot] = node.right;
+            areas[slot] = if node.is_leaf() { -1.0 } else { costs.area(&t.boxes[slot]) };
+            side += 1;
+        }
+        if t.leaf_count as usize == TREELET_LEAVES {
+            break;
+        }
+        best = usize::MAX;
         let mut best_area = -1.0f32;
         let mut i = 0;
         while i < t.leaf_count as usize {
-            let n = nodes[t.leaves[i] as usize];
-            if !n.is_leaf() {
-                let a = costs.area(&n.aabb());
-                if a > best_area {
-                    best_area = a;
-                    best = i;
-                }
+            if areas[i] > best_area {
+                best_area = areas[i];
+                best = i;
             }
             i += 1;
         }
         if best == usize::MAX {
             break;
         }
-        let expanded = t.leaves[best];
-        let n = nodes[expanded as usize];
-        t.internals[internal_count] = expanded;
+        t.internals[internal_count] = t.leaves[best];
         internal_count += 1;
-        t.leaves[best] = n.left;
-        t.leaves[t.leaf_count as usize] = n.right;
+        children = [lefts[best], rights[best]];
         t.leaf_count += 1;
+    }
+    let mut i = 0;
+    while i < t.leaf_count as usize {
+        t.counts[i] = counts[t.leaves[i] as usize];
+        t.costs[i] = node_costs[t.leaves[i] as usize];
+        i += 1;
     }
     t
 }
@@ -222,22 +261,16 @@ pub fn solve_subset<const N: usize>(
     partition[base + s as usize] = best_p;
 }
 
-/// Algorithm 2's dynamic program over the subsets of `n` leaves with boxes
-/// `boxes`, subtree costs `leaf_costs` and primitive counts `leaf_counts`,
-/// in one invocation (the wide kernel spreads the same steps over a team).
+/// Algorithm 2's dynamic program over the subsets of the leaves of `t`, in
+/// one invocation (the wide kernel spreads the same steps over a team).
 #[inline]
-pub fn optimize(
-    n: u32,
-    boxes: &[Aabb; TREELET_LEAVES],
-    leaf_costs: &[f32; TREELET_LEAVES],
-    leaf_counts: &[u32; TREELET_LEAVES],
-    costs: &TreeletCosts,
-) -> TreeletSolution {
+pub fn optimize(t: &Treelet, costs: &TreeletCosts) -> TreeletSolution {
+    let n = t.leaf_count;
     let mut sol = TreeletSolution { partition: [0u32; SUBSETS], cost: [0.0; SUBSETS] };
     let full = (1u32 << n) - 1;
     let mut i = 0;
     while i < n {
-        sol.cost[1 << i] = leaf_costs[i as usize];
+        sol.cost[1 << i] = t.costs[i as usize];
         i += 1;
     }
     // Subsets by increasing size, so that every part is solved before.
@@ -246,8 +279,8 @@ pub fn optimize(
         let mut s = 1u32;
         while s <= full {
             if s.count_ones() == size {
-                let area = subset_area(s, n, boxes, costs);
-                let count = subset_count(s, n, leaf_counts);
+                let area = subset_area(s, n, &t.boxes, costs);
+                let count = subset_count(s, n, &t.counts);
                 solve_subset(s, 0, area, count, &mut sol.cost, &mut sol.partition, costs);
             }
             s += 1;
@@ -258,15 +291,21 @@ pub fn optimize(
 }
 
 /// Rewires the treelet's internal nodes into the tree that `partition`
-/// (a row at `base`) describes: children and parent links only. The root
-/// keeps its index; the other internal nodes are reused in order.
+/// (a row at `base`) describes, and sets each one's box, primitive count and
+/// cost from its subset: the union of its leaves' boxes and `cost[s]`, the
+/// values a refit from the children would give. The root keeps its index;
+/// the other internal nodes are reused in order.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn apply<const N: usize>(
     t: &Treelet,
     partition: &[u32; N],
+    cost: &[f32; N],
     base: usize,
     nodes: &mut [Node],
     parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
 ) {
     let n = t.leaf_count;
     let full = (1u32 << n) - 1;
@@ -281,6 +320,17 @@ pub fn apply<const N: usize>(
         top -= 1;
         let s = stack_s[top];
         let node = stack_n[top];
+        let mut b = Aabb::EMPTY;
+        let mut i = 0;
+        while i < n {
+            if s & (1 << i) != 0 {
+                b = b.union(&t.boxes[i as usize]);
+            }
+            i += 1;
+        }
+        nodes[node as usize].set_aabb(b);
+        counts[node as usize] = subset_count(s, n, &t.counts);
+        node_costs[node as usize] = cost[base + s as usize];
         let p = partition[base + s as usize];
         let mut side = 0;
         while side < 2 {
@@ -318,39 +368,29 @@ pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &Treel
     }
 }
 
-/// Rewires treelet `t` into the solved tree if its cost `best` is lower
-/// than the subtree's current cost, then refits the boxes, counts and costs
-/// of its internal nodes. Returns whether the treelet changed.
+/// Rewires treelet `t` into the solved tree (tables `partition` and `cost`,
+/// rows at `base`) if that is cheaper than the subtree's current cost
+/// `current`. Returns whether the treelet changed.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn commit<const N: usize>(
     t: &Treelet,
     partition: &[u32; N],
+    cost: &[f32; N],
     base: usize,
-    best: f32,
+    current: f32,
     nodes: &mut [Node],
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
-    costs: &TreeletCosts,
 ) -> bool {
+    let full = (1usize << t.leaf_count) - 1;
     // The current topology is one of the candidates: keep it unless the
     // optimum is strictly cheaper (avoids churn on ties and rounding).
-    if best >= node_costs[t.internals[0] as usize] * (1.0 - 1e-6) {
+    if cost[base + full] >= current * (1.0 - 1e-6) {
         return false;
     }
-    apply(t, partition, base, nodes, parents);
-    // Children are assigned after their parents, so refit in reverse.
-    let mut k = t.leaf_count as usize - 1;
-    while k > 0 {
-        k -= 1;
-        let id = t.internals[k] as usize;
-        let (l, r) = (nodes[id].left as usize, nodes[id].right as usize);
-        let b = nodes[l].aabb().union(&nodes[r].aabb());
-        nodes[id].set_aabb(b);
-        counts[id] = counts[l] + counts[r];
-        node_costs[id] = node_cost(&nodes[id], counts[id], (node_costs[l], node_costs[r]), costs);
-    }
+    apply(t, partition, cost, base, nodes, parents, counts, node_costs);
     true
 }
 
@@ -367,23 +407,13 @@ pub fn restructure(
     node_costs: &mut [f32],
     costs: &TreeletCosts,
 ) -> bool {
-    let t = form_treelet(root, nodes, costs);
+    let t = form_treelet(root, nodes, counts, node_costs, costs);
     if t.leaf_count < 3 {
         return false; // two leaves: only one tree
     }
-    let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
-    let mut leaf_costs = [0.0f32; TREELET_LEAVES];
-    let mut leaf_counts = [0u32; TREELET_LEAVES];
-    let mut i = 0;
-    while i < t.leaf_count as usize {
-        boxes[i] = nodes[t.leaves[i] as usize].aabb();
-        leaf_costs[i] = node_costs[t.leaves[i] as usize];
-        leaf_counts[i] = counts[t.leaves[i] as usize];
-        i += 1;
-    }
-    let sol = optimize(t.leaf_count, &boxes, &leaf_costs, &leaf_counts, costs);
-    let full = (1usize << t.leaf_count) - 1;
-    commit(&t, &sol.partition, 0, sol.cost[full], nodes, parents, counts, node_costs, costs)
+    let sol = optimize(&t, costs);
+    let current = node_costs[root as usize];
+    commit(&t, &sol.partition, &sol.cost, 0, current, nodes, parents, counts, node_costs)
 }
 
 /// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
@@ -491,10 +521,52 @@ pub const TEAM: u32 = 32;
 pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
 /// Shared DP tables: one row of [`SUBSETS`] per team.
 pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
-/// Shared treelet descriptions: per team, 7 leaves, the leaf count, 6 internals.
+/// Shared treelet nodes: per team, 7 leaves, the leaf count, 6 internals.
 pub const TEAM_SLOTS: usize = TEAMS * 16;
+/// Shared leaf boxes: per team, 7 boxes of 6 floats, then the root's cost.
+pub const TEAM_BOXES: usize = TEAMS * 48;
 /// Phases of [`treelet_wide_phase`]: form, areas, one per subset size 2..=7, commit.
 pub const WIDE_PHASES: u32 = 3 + TREELET_LEAVES as u32 - 1;
+
+/// The treelet a team formed, from workgroup memory: nodes and boxes from
+/// `slots` and `boxes`, leaf counts and costs from the singleton entries of
+/// the DP tables.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn shared_treelet(
+    team: usize,
+    n: u32,
+    slots: &[u32; TEAM_SLOTS],
+    boxes: &[f32; TEAM_BOXES],
+    sub_count: &[u32; TEAM_TABLE],
+    cost: &[f32; TEAM_TABLE],
+) -> Treelet {
+    let (sb, bb, tb) = (team * 16, team * 48, team * SUBSETS);
+    let mut t = Treelet {
+        leaves: [0; TREELET_LEAVES],
+        leaf_count: n,
+        internals: [0; TREELET_INTERNALS],
+        boxes: [Aabb::EMPTY; TREELET_LEAVES],
+        counts: [0; TREELET_LEAVES],
+        costs: [0.0; TREELET_LEAVES],
+    };
+    let mut i = 0;
+    while i < TREELET_LEAVES {
+        t.leaves[i] = slots[sb + i];
+        if i < TREELET_INTERNALS {
+            t.internals[i] = slots[sb + 8 + i];
+        }
+        let f = bb + 6 * i;
+        t.boxes[i] = Aabb::from_arrays(
+            [boxes[f], boxes[f + 1], boxes[f + 2]],
+            [boxes[f + 3], boxes[f + 4], boxes[f + 5]],
+        );
+        t.counts[i] = sub_count[tb + (1 << i)];
+        t.costs[i] = cost[tb + (1 << i)];
+        i += 1;
+    }
+    t
+}
 
 /// Kernel (workgroups of [`TEAMS`] teams of [`TEAM`] lanes; phase by phase):
 /// restructures the treelets rooted at `roots[level_offset..][..level_count]`,
@@ -514,6 +586,7 @@ pub fn treelet_wide_phase(
     counts: &mut [u32],
     node_costs: &mut [f32],
     slots: &mut [u32; TEAM_SLOTS],
+    boxes: &mut [f32; TEAM_BOXES],
     area: &mut [f32; TEAM_TABLE],
     sub_count: &mut [u32; TEAM_TABLE],
     cost: &mut [f32; TEAM_TABLE],
@@ -521,27 +594,36 @@ pub fn treelet_wide_phase(
 ) {
     let team = (lid / TEAM) as usize;
     let lane = lid % TEAM;
-    let sb = team * 16; // this team's slots
-    let tb = team * SUBSETS; // this team's table row
+    let (sb, bb, tb) = (team * 16, team * 48, team * SUBSETS);
     let costs = params.costs();
     if phase == 0 {
         if lane == 0 {
             let index = group * TEAMS as u32 + team as u32;
             let mut leaf_count = 0;
             if index < params.level_count {
-                let t = form_treelet(roots[(params.level_offset + index) as usize], nodes, &costs);
+                let root = roots[(params.level_offset + index) as usize];
+                let t = form_treelet(root, nodes, counts, node_costs, &costs);
                 if t.leaf_count >= 3 {
                     leaf_count = t.leaf_count;
                     let mut i = 0;
                     while i < TREELET_LEAVES {
                         slots[sb + i] = t.leaves[i];
+                        if i < TREELET_INTERNALS {
+                            slots[sb + 8 + i] = t.internals[i];
+                        }
+                        let f = bb + 6 * i;
+                        let (lo, hi) = (t.boxes[i].min, t.boxes[i].max);
+                        boxes[f] = lo[0];
+                        boxes[f + 1] = lo[1];
+                        boxes[f + 2] = lo[2];
+                        boxes[f + 3] = hi[0];
+                        boxes[f + 4] = hi[1];
+                        boxes[f + 5] = hi[2];
+                        sub_count[tb + (1 << i)] = t.counts[i];
+                        cost[tb + (1 << i)] = t.costs[i];
                         i += 1;
                     }
-                    let mut i = 0;
-                    while i < TREELET_INTERNALS {
-                        slots[sb + 8 + i] = t.internals[i];
-                        i += 1;
-                    }
+                    boxes[bb + 42] = node_costs[root as usize];
                 }
             }
             slots[sb + 7] = leaf_count;
@@ -554,22 +636,13 @@ pub fn treelet_wide_phase(
     }
     let full = (1u32 << n) - 1;
     if phase == 1 {
-        // Areas and counts of this lane's subsets; the leaves' own costs.
-        let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
-        let mut leaf_counts = [0u32; TREELET_LEAVES];
-        let mut i = 0;
-        while i < n as usize {
-            let leaf = slots[sb + i] as usize;
-            boxes[i] = nodes[leaf].aabb();
-            leaf_counts[i] = counts[leaf];
-            i += 1;
-        }
+        // Areas and counts of this lane's subsets of two or more leaves.
+        let t = shared_treelet(team, n, slots, boxes, sub_count, cost);
         let mut s = lane + 1;
         while s <= full {
-            area[tb + s as usize] = subset_area(s, n, &boxes, &costs);
-            sub_count[tb + s as usize] = subset_count(s, n, &leaf_counts);
-            if s.count_ones() == 1 {
-                cost[tb + s as usize] = node_costs[slots[sb + s.trailing_zeros() as usize] as usize];
+            if s.count_ones() > 1 {
+                area[tb + s as usize] = subset_area(s, n, &t.boxes, &costs);
+                sub_count[tb + s as usize] = subset_count(s, n, &t.counts);
             }
             s += TEAM;
         }
@@ -592,19 +665,9 @@ pub fn treelet_wide_phase(
             s += 1;
         }
     } else if lane == 0 {
-        let mut t = Treelet { leaves: [0; TREELET_LEAVES], leaf_count: n, internals: [0; TREELET_INTERNALS] };
-        let mut i = 0;
-        while i < TREELET_LEAVES {
-            t.leaves[i] = slots[sb + i];
-            i += 1;
-        }
-        let mut i = 0;
-        while i < TREELET_INTERNALS {
-            t.internals[i] = slots[sb + 8 + i];
-            i += 1;
-        }
-        let best = cost[tb + full as usize];
-        commit(&t, partition, tb, best, nodes, parents, counts, node_costs, &costs);
+        let t = shared_treelet(team, n, slots, boxes, sub_count, cost);
+        let current = boxes[bb + 42];
+        commit(&t, partition, cost, tb, current, nodes, parents, counts, node_costs);
     }
 }
 
@@ -668,7 +731,15 @@ mod tests {
             for n in 2..=TREELET_LEAVES as u32 {
                 for seed in 0..20 {
                     let l = random_leaves(seed * 31 + n, n);
-                    let sol = optimize(n, &l.boxes, &l.costs, &l.counts, &costs);
+                    let t = Treelet {
+                        leaves: [0; TREELET_LEAVES],
+                        leaf_count: n,
+                        internals: [0; TREELET_INTERNALS],
+                        boxes: l.boxes,
+                        counts: l.counts,
+                        costs: l.costs,
+                    };
+                    let sol = optimize(&t, &costs);
                     let full = (1u32 << n) - 1;
                     let expected = brute_force(full, &l, &costs);
                     let got = sol.cost[full as usize];

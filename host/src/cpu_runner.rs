@@ -273,6 +273,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
             let (counts, costs) = (view(counts), view(costs));
             let mut slots = [0u32; treelet::TEAM_SLOTS];
+            let mut boxes = [0f32; treelet::TEAM_BOXES];
             let mut area = [0f32; treelet::TEAM_TABLE];
             let mut sub_count = [0u32; treelet::TEAM_TABLE];
             let mut cost = [0f32; treelet::TEAM_TABLE];
@@ -289,6 +290,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                     counts,
                     costs,
                     &mut slots,
+                    &mut boxes,
                     &mut area,
                     &mut sub_count,
                     &mut cost,

@@ -3,8 +3,8 @@ use spirv_std::spirv;
 use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
 use treelet_core::treelet::{
-    treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel, treelet_wide_phase, TEAM_SLOTS,
-    TEAM_TABLE, WIDE_PHASES,
+    treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel, treelet_wide_phase, TEAM_BOXES,
+    TEAM_SLOTS, TEAM_TABLE, WIDE_PHASES,
 };
 use treelet_core::workgroup::{barrier, linear_group, linear_id};
 
@@ -86,6 +86,7 @@ pub fn treelet_wide_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
     #[spirv(workgroup)] slots: &mut [u32; TEAM_SLOTS],
+    #[spirv(workgroup)] boxes: &mut [f32; TEAM_BOXES],
     #[spirv(workgroup)] area: &mut [f32; TEAM_TABLE],
     #[spirv(workgroup)] sub_count: &mut [u32; TEAM_TABLE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_TABLE],
@@ -94,7 +95,8 @@ pub fn treelet_wide_cs(
     let group = linear_group(group.x, group.y, groups.x);
     for phase in 0..WIDE_PHASES {
         treelet_wide_phase(
-            phase, lid, group, params, roots, nodes, parents, counts, costs, slots, area, sub_count, cost, partition,
+            phase, lid, group, params, roots, nodes, parents, counts, costs, slots, boxes, area, sub_count, cost,
+            partition,
         );
         barrier();
     }
