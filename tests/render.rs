@@ -60,6 +60,8 @@ fn bvh_and_linear_scan_find_the_same_hits() {
     assert_eq!(mismatch_fraction(&none, &bvh, 1e-6), 0.0, "BVH traversal missed or invented hits");
     let trbvh = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Trbvh));
     assert_eq!(mismatch_fraction(&none, &trbvh, 1e-6), 0.0, "optimized BVH traversal missed or invented hits");
+    let sweep = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Sweep));
+    assert_eq!(mismatch_fraction(&none, &sweep, 1e-6), 0.0, "sweep BVH traversal missed or invented hits");
 }
 
 #[test]

@@ -27,6 +27,8 @@ pub enum Accel {
     Lbvh,
     /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
     Trbvh,
+    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
+    Sweep,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -126,6 +128,16 @@ pub fn render<B: Backend>(
             }
             (bvh.nodes, bvh.prim_indices, build_ms)
         }
+        Accel::Sweep => {
+            let build = Instant::now();
+            let bvh = crate::sweep::build_collapsed(&scene.spheres, TreeletConfig::default().max_leaf)?;
+            let build_ms = build.elapsed().as_secs_f64() * 1e3;
+            let depth = tree_depth(&bvh.nodes);
+            if depth + 1 > STACK_DEPTH {
+                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
+            }
+            (b.upload("sweep nodes", &bvh.nodes)?, b.upload("sweep primitive indices", &bvh.prim_indices)?, build_ms)
+        }
         Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
     };
     let spheres = b.upload("spheres", &scene.spheres)?;
@@ -134,7 +146,7 @@ pub fn render<B: Backend>(
     let camera = scene.camera.camera(width, height);
     let kernel = match accel {
         Accel::None => Kernel::RenderLinear,
-        Accel::Lbvh | Accel::Trbvh => Kernel::RenderBvh,
+        Accel::Lbvh | Accel::Trbvh | Accel::Sweep => Kernel::RenderBvh,
     };
     let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
 
