@@ -25,8 +25,9 @@
 //! paper, a subtree of at most `max_leaf` primitives costs the cheaper of its
 //! tree and one leaf holding all its primitives (`C_t·A·N`): the DP and the
 //! rounds optimize for the tree that [`crate::collapse`] finally produces.
-//! On the device, [`treelet_wide_phase`] spreads the DP of each treelet over
-//! 32 lanes as the paper does; [`restructure`] is the same steps in one
+//! On the device, [`treelet_solve_phase`] spreads the DP of each treelet over
+//! 32 lanes as the paper does, between [`treelet_form_kernel`] and
+//! [`treelet_commit_kernel`]; [`restructure`] is the same steps in one
 //! invocation (the CPU reference and tests).
 use crate::aabb::Aabb;
 use crate::atomics;
@@ -291,59 +292,54 @@ pub fn optimize(t: &Treelet, costs: &TreeletCosts) -> TreeletSolution {
 }
 
 /// Rewires the treelet's internal nodes into the tree that `partition`
-/// (a row at `base`) describes, and sets each one's box, primitive count and
-/// cost from its subset: the union of its leaves' boxes and `cost[s]`, the
-/// values a refit from the children would give. The root keeps its index;
-/// the other internal nodes are reused in order.
+/// (indexed by subset, from `base`) describes, and sets each one's box,
+/// primitive count and cost from its subset: the union of its leaves' boxes,
+/// and the cost the DP gave that subset, recomputed bottom-up with the DP's
+/// own operations (so it is the same number, and a refit from memory is not
+/// needed). The root keeps its index; the other internal nodes are reused in
+/// order.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn apply<const N: usize>(
+pub fn apply(
     t: &Treelet,
-    partition: &[u32; N],
-    cost: &[f32; N],
+    partition: &[u32],
     base: usize,
     nodes: &mut [Node],
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
+    costs: &TreeletCosts,
 ) {
     let n = t.leaf_count;
     let full = (1u32 << n) - 1;
-    // Stack of (subset, node index), depth at most the number of internals.
-    let mut stack_s = [0u32; TREELET_INTERNALS];
-    let mut stack_n = [0u32; TREELET_INTERNALS];
+    // Per internal slot: its subset and its children (a leaf index below
+    // 8, or 8 + the child's internal slot).
+    let mut sets = [0u32; TREELET_INTERNALS];
+    let mut kids = [0u32; 2 * TREELET_INTERNALS];
+    // Stack of internal slots still to split, depth at most the number of internals.
+    let mut stack = [0u32; TREELET_INTERNALS];
     let mut top = 1usize;
-    stack_s[0] = full;
-    stack_n[0] = t.internals[0];
+    sets[0] = full;
     let mut next_internal = 1usize;
     while top > 0 {
         top -= 1;
-        let s = stack_s[top];
-        let node = stack_n[top];
-        let mut b = Aabb::EMPTY;
-        let mut i = 0;
-        while i < n {
-            if s & (1 << i) != 0 {
-                b = b.union(&t.boxes[i as usize]);
-            }
-            i += 1;
-        }
-        nodes[node as usize].set_aabb(b);
-        counts[node as usize] = subset_count(s, n, &t.counts);
-        node_costs[node as usize] = cost[base + s as usize];
+        let k = stack[top] as usize;
+        let s = sets[k];
+        let node = t.internals[k];
         let p = partition[base + s as usize];
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
             let child = if part.count_ones() == 1 {
+                kids[2 * k + side] = part.trailing_zeros();
                 t.leaves[part.trailing_zeros() as usize]
             } else {
-                let c = t.internals[next_internal];
-                next_internal += 1;
-                stack_s[top] = part;
-                stack_n[top] = c;
+                kids[2 * k + side] = 8 + next_internal as u32;
+                sets[next_internal] = part;
+                stack[top] = next_internal as u32;
                 top += 1;
-                c
+                next_internal += 1;
+                t.internals[next_internal - 1]
             };
             if side == 0 {
                 nodes[node as usize].left = child;
@@ -353,6 +349,36 @@ pub fn apply<const N: usize>(
             parents[child as usize] = node;
             side += 1;
         }
+    }
+    // Children come after their parents: fill boxes and costs in reverse.
+    let mut internal_costs = [0.0f32; TREELET_INTERNALS];
+    let mut k = next_internal;
+    while k > 0 {
+        k -= 1;
+        let s = sets[k];
+        let mut children = 0.0f32;
+        let mut side = 0;
+        while side < 2 {
+            let kid = kids[2 * k + side];
+            let c = if kid < 8 { t.costs[kid as usize] } else { internal_costs[(kid - 8) as usize] };
+            children = if side == 0 { c } else { children + c };
+            side += 1;
+        }
+        let count = subset_count(s, n, &t.counts);
+        let cost = costs.subtree(subset_area(s, n, &t.boxes, costs), count, children);
+        internal_costs[k] = cost;
+        let node = t.internals[k] as usize;
+        let mut b = Aabb::EMPTY;
+        let mut i = 0;
+        while i < n {
+            if s & (1 << i) != 0 {
+                b = b.union(&t.boxes[i as usize]);
+            }
+            i += 1;
+        }
+        nodes[node].set_aabb(b);
+        counts[node] = count;
+        node_costs[node] = cost;
     }
 }
 
@@ -366,32 +392,6 @@ pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &Treel
     } else {
         costs.subtree(area, count, child_costs.0 + child_costs.1)
     }
-}
-
-/// Rewires treelet `t` into the solved tree (tables `partition` and `cost`,
-/// rows at `base`) if that is cheaper than the subtree's current cost
-/// `current`. Returns whether the treelet changed.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn commit<const N: usize>(
-    t: &Treelet,
-    partition: &[u32; N],
-    cost: &[f32; N],
-    base: usize,
-    current: f32,
-    nodes: &mut [Node],
-    parents: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-) -> bool {
-    let full = (1usize << t.leaf_count) - 1;
-    // The current topology is one of the candidates: keep it unless the
-    // optimum is strictly cheaper (avoids churn on ties and rounding).
-    if cost[base + full] >= current * (1.0 - 1e-6) {
-        return false;
-    }
-    apply(t, partition, cost, base, nodes, parents, counts, node_costs);
-    true
 }
 
 /// Restructures the treelet rooted at internal node `root` in place, in one
@@ -412,8 +412,20 @@ pub fn restructure(
         return false; // two leaves: only one tree
     }
     let sol = optimize(&t, costs);
-    let current = node_costs[root as usize];
-    commit(&t, &sol.partition, &sol.cost, 0, current, nodes, parents, counts, node_costs)
+    let full = (1usize << t.leaf_count) - 1;
+    if !improves(sol.cost[full], node_costs[root as usize]) {
+        return false;
+    }
+    apply(&t, &sol.partition, 0, nodes, parents, counts, node_costs, costs);
+    true
+}
+
+/// Whether an optimum of cost `best` replaces a subtree of cost `current`:
+/// the current topology is one of the candidates, so only a strictly lower
+/// cost counts (avoids churn on ties and rounding).
+#[inline]
+pub fn improves(best: f32, current: f32) -> bool {
+    best < current * (1.0 - 1e-6)
 }
 
 /// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
@@ -514,79 +526,119 @@ pub fn treelet_scatter_kernel(
     }
 }
 
-/// Lanes that solve one treelet together in the wide kernel (the paper's
-/// warp; a plain workgroup slice here, so no subgroup size is assumed).
-pub const TEAM: u32 = 32;
-/// Treelets per workgroup of the wide kernel.
-pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
-/// Shared DP tables: one row of [`SUBSETS`] per team.
-pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
-/// Shared treelet nodes: per team, 7 leaves, the leaf count, 6 internals.
-pub const TEAM_SLOTS: usize = TEAMS * 16;
-/// Shared leaf boxes: per team, 7 boxes of 6 floats, then the root's cost.
-pub const TEAM_BOXES: usize = TEAMS * 48;
-/// Phases of [`treelet_wide_phase`]: form, areas, one per subset size 2..=7, commit.
-pub const WIDE_PHASES: u32 = 3 + TREELET_LEAVES as u32 - 1;
+// The device restructures the treelets of one height in three dispatches:
+// form (one invocation per treelet, writing a record), solve (a team of 32
+// lanes per treelet, the DP as in the paper's warp-wide scheme, writing the
+// partitions), commit (one invocation per treelet). Splitting keeps the
+// one-lane steps from holding the registers of the wide one.
 
-/// The treelet a team formed, from workgroup memory: nodes and boxes from
-/// `slots` and `boxes`, leaf counts and costs from the singleton entries of
-/// the DP tables.
+/// Words of one treelet record: leaves (7) and leaf count, internal nodes
+/// (6), the root's current cost, leaf boxes (7 x 6), leaf primitive counts
+/// (7), leaf subtree costs (7). Floats are stored as bits.
+pub const RECORD_WORDS: usize = 72;
+const R_COUNT: usize = 7;
+const R_INTERNALS: usize = 8;
+const R_CURRENT: usize = 14;
+const R_BOXES: usize = 16;
+const R_COUNTS: usize = 58;
+const R_COSTS: usize = 65;
+/// Words of one solution row: `partition[s]` at `s`, and at 0 the optimum's cost bits.
+pub const SOLUTION_WORDS: usize = SUBSETS;
+
+/// Kernel (one invocation per treelet of this height): forms the treelet of
+/// `roots[level_offset + i]` and writes its record (leaf count 0 when it
+/// has fewer than three leaves: nothing to choose).
 #[allow(clippy::too_many_arguments)]
+pub fn treelet_form_kernel(
+    i: u32,
+    params: &TreeletParams,
+    roots: &[u32],
+    nodes: &[Node],
+    counts: &[u32],
+    node_costs: &[f32],
+    records: &mut [u32],
+) {
+    if i >= params.level_count {
+        return;
+    }
+    let root = roots[(params.level_offset + i) as usize];
+    let t = form_treelet(root, nodes, counts, node_costs, &params.costs());
+    let r = i as usize * RECORD_WORDS;
+    records[r + R_COUNT] = if t.leaf_count >= 3 { t.leaf_count } else { 0 };
+    let mut k = 0;
+    while k < TREELET_LEAVES {
+        records[r + k] = t.leaves[k];
+        if k < TREELET_INTERNALS {
+            records[r + R_INTERNALS + k] = t.internals[k];
+        }
+        let (lo, hi) = (t.boxes[k].min, t.boxes[k].max);
+        let f = r + R_BOXES + 6 * k;
+        records[f] = lo[0].to_bits();
+        records[f + 1] = lo[1].to_bits();
+        records[f + 2] = lo[2].to_bits();
+        records[f + 3] = hi[0].to_bits();
+        records[f + 4] = hi[1].to_bits();
+        records[f + 5] = hi[2].to_bits();
+        records[r + R_COUNTS + k] = t.counts[k];
+        records[r + R_COSTS + k] = t.costs[k].to_bits();
+        k += 1;
+    }
+    records[r + R_CURRENT] = node_costs[root as usize].to_bits();
+}
+
+/// The treelet of a record.
 #[inline]
-fn shared_treelet(
-    team: usize,
-    n: u32,
-    slots: &[u32; TEAM_SLOTS],
-    boxes: &[f32; TEAM_BOXES],
-    sub_count: &[u32; TEAM_TABLE],
-    cost: &[f32; TEAM_TABLE],
-) -> Treelet {
-    let (sb, bb, tb) = (team * 16, team * 48, team * SUBSETS);
+fn read_record(records: &[u32], r: usize) -> Treelet {
     let mut t = Treelet {
         leaves: [0; TREELET_LEAVES],
-        leaf_count: n,
+        leaf_count: records[r + R_COUNT],
         internals: [0; TREELET_INTERNALS],
         boxes: [Aabb::EMPTY; TREELET_LEAVES],
         counts: [0; TREELET_LEAVES],
         costs: [0.0; TREELET_LEAVES],
     };
-    let mut i = 0;
-    while i < TREELET_LEAVES {
-        t.leaves[i] = slots[sb + i];
-        if i < TREELET_INTERNALS {
-            t.internals[i] = slots[sb + 8 + i];
+    let mut k = 0;
+    while k < TREELET_LEAVES {
+        t.leaves[k] = records[r + k];
+        if k < TREELET_INTERNALS {
+            t.internals[k] = records[r + R_INTERNALS + k];
         }
-        let f = bb + 6 * i;
-        t.boxes[i] = Aabb::from_arrays(
-            [boxes[f], boxes[f + 1], boxes[f + 2]],
-            [boxes[f + 3], boxes[f + 4], boxes[f + 5]],
-        );
-        t.counts[i] = sub_count[tb + (1 << i)];
-        t.costs[i] = cost[tb + (1 << i)];
-        i += 1;
+        let f = r + R_BOXES + 6 * k;
+        let lo = [f32::from_bits(records[f]), f32::from_bits(records[f + 1]), f32::from_bits(records[f + 2])];
+        let hi = [f32::from_bits(records[f + 3]), f32::from_bits(records[f + 4]), f32::from_bits(records[f + 5])];
+        t.boxes[k] = Aabb::from_arrays(lo, hi);
+        t.counts[k] = records[r + R_COUNTS + k];
+        t.costs[k] = f32::from_bits(records[r + R_COSTS + k]);
+        k += 1;
     }
     t
 }
 
+/// Lanes that solve one treelet together (the paper's warp; a slice of a
+/// workgroup here, so no subgroup size is assumed).
+pub const TEAM: u32 = 32;
+/// Treelets per workgroup of the solve kernel.
+pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
+/// Shared DP tables: one row of [`SUBSETS`] per team.
+pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
+/// Shared leaf data: per team, the leaf count and 7 boxes of 6 floats.
+pub const TEAM_LEAVES: usize = TEAMS * 48;
+/// Phases of [`treelet_solve_phase`]: load, areas, one per subset size 2..=7, store.
+pub const SOLVE_PHASES: u32 = 3 + TREELET_LEAVES as u32 - 1;
+
 /// Kernel (workgroups of [`TEAMS`] teams of [`TEAM`] lanes; phase by phase):
-/// restructures the treelets rooted at `roots[level_offset..][..level_count]`,
-/// one per team, the DP spread over the team's lanes (Karras & Aila's
-/// warp-wide scheme): each lane takes every 32nd subset of each size, sizes
-/// in increasing order with a barrier between them. The steps are those of
-/// [`restructure`], so the result is the same tree.
+/// the DP of [`optimize`] for the treelets of `records`, one per team: each
+/// lane takes every 32nd subset of each size, sizes in increasing order with
+/// a barrier between them. Writes each treelet's partitions to `solutions`.
 #[allow(clippy::too_many_arguments)]
-pub fn treelet_wide_phase(
+pub fn treelet_solve_phase(
     phase: u32,
     lid: u32,
     group: u32,
     params: &TreeletParams,
-    roots: &[u32],
-    nodes: &mut [Node],
-    parents: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-    slots: &mut [u32; TEAM_SLOTS],
-    boxes: &mut [f32; TEAM_BOXES],
+    records: &[u32],
+    solutions: &mut [u32],
+    leaves: &mut [f32; TEAM_LEAVES],
     area: &mut [f32; TEAM_TABLE],
     sub_count: &mut [u32; TEAM_TABLE],
     cost: &mut [f32; TEAM_TABLE],
@@ -594,59 +646,62 @@ pub fn treelet_wide_phase(
 ) {
     let team = (lid / TEAM) as usize;
     let lane = lid % TEAM;
-    let (sb, bb, tb) = (team * 16, team * 48, team * SUBSETS);
-    let costs = params.costs();
+    let index = group * TEAMS as u32 + team as u32;
+    let (lb, tb) = (team * 48, team * SUBSETS);
+    let r = index as usize * RECORD_WORDS;
     if phase == 0 {
-        if lane == 0 {
-            let index = group * TEAMS as u32 + team as u32;
-            let mut leaf_count = 0;
-            if index < params.level_count {
-                let root = roots[(params.level_offset + index) as usize];
-                let t = form_treelet(root, nodes, counts, node_costs, &costs);
-                if t.leaf_count >= 3 {
-                    leaf_count = t.leaf_count;
-                    let mut i = 0;
-                    while i < TREELET_LEAVES {
-                        slots[sb + i] = t.leaves[i];
-                        if i < TREELET_INTERNALS {
-                            slots[sb + 8 + i] = t.internals[i];
-                        }
-                        let f = bb + 6 * i;
-                        let (lo, hi) = (t.boxes[i].min, t.boxes[i].max);
-                        boxes[f] = lo[0];
-                        boxes[f + 1] = lo[1];
-                        boxes[f + 2] = lo[2];
-                        boxes[f + 3] = hi[0];
-                        boxes[f + 4] = hi[1];
-                        boxes[f + 5] = hi[2];
-                        sub_count[tb + (1 << i)] = t.counts[i];
-                        cost[tb + (1 << i)] = t.costs[i];
-                        i += 1;
-                    }
-                    boxes[bb + 42] = node_costs[root as usize];
-                }
+        // The record into workgroup memory, the team's lanes side by side.
+        if index >= params.level_count {
+            if lane == 0 {
+                leaves[lb] = 0.0;
             }
-            slots[sb + 7] = leaf_count;
+            return;
+        }
+        let mut w = lane as usize;
+        while w < R_COSTS + TREELET_LEAVES {
+            let word = records[r + w];
+            if w == R_COUNT {
+                leaves[lb] = word as f32;
+            } else if (R_BOXES..R_COUNTS).contains(&w) {
+                leaves[lb + 1 + w - R_BOXES] = f32::from_bits(word);
+            } else if (R_COUNTS..R_COSTS).contains(&w) {
+                sub_count[tb + (1 << (w - R_COUNTS))] = word;
+            } else if w >= R_COSTS {
+                cost[tb + (1 << (w - R_COSTS))] = f32::from_bits(word);
+            }
+            w += TEAM as usize;
         }
         return;
     }
-    let n = slots[sb + 7];
+    let n = leaves[lb] as u32;
     if n == 0 {
         return;
     }
     let full = (1u32 << n) - 1;
+    let costs = params.costs();
     if phase == 1 {
         // Areas and counts of this lane's subsets of two or more leaves.
-        let t = shared_treelet(team, n, slots, boxes, sub_count, cost);
+        let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
+        let mut counts = [0u32; TREELET_LEAVES];
+        let mut k = 0;
+        while k < n as usize {
+            let f = lb + 1 + 6 * k;
+            boxes[k] = Aabb::from_arrays(
+                [leaves[f], leaves[f + 1], leaves[f + 2]],
+                [leaves[f + 3], leaves[f + 4], leaves[f + 5]],
+            );
+            counts[k] = sub_count[tb + (1 << k)];
+            k += 1;
+        }
         let mut s = lane + 1;
         while s <= full {
             if s.count_ones() > 1 {
-                area[tb + s as usize] = subset_area(s, n, &t.boxes, &costs);
-                sub_count[tb + s as usize] = subset_count(s, n, &t.counts);
+                area[tb + s as usize] = subset_area(s, n, &boxes, &costs);
+                sub_count[tb + s as usize] = subset_count(s, n, &counts);
             }
             s += TEAM;
         }
-    } else if phase < WIDE_PHASES - 1 {
+    } else if phase < SOLVE_PHASES - 1 {
         // Subsets of one size, dealt round-robin to the lanes.
         let size = phase;
         if size > n {
@@ -664,11 +719,43 @@ pub fn treelet_wide_phase(
             }
             s += 1;
         }
-    } else if lane == 0 {
-        let t = shared_treelet(team, n, slots, boxes, sub_count, cost);
-        let current = boxes[bb + 42];
-        commit(&t, partition, cost, tb, current, nodes, parents, counts, node_costs);
+    } else {
+        let row = index as usize * SOLUTION_WORDS;
+        let mut s = lane as usize;
+        while s <= full as usize {
+            solutions[row + s] = if s == 0 { cost[tb + full as usize].to_bits() } else { partition[tb + s] };
+            s += TEAM as usize;
+        }
     }
+}
+
+/// Kernel (one invocation per treelet of this height): rewires the treelet
+/// into its solved tree when that lowers its cost.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_commit_kernel(
+    i: u32,
+    params: &TreeletParams,
+    records: &[u32],
+    solutions: &[u32],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+) {
+    if i >= params.level_count {
+        return;
+    }
+    let r = i as usize * RECORD_WORDS;
+    if records[r + R_COUNT] == 0 {
+        return;
+    }
+    let row = i as usize * SOLUTION_WORDS;
+    let (best, current) = (f32::from_bits(solutions[row]), f32::from_bits(records[r + R_CURRENT]));
+    if !improves(best, current) {
+        return;
+    }
+    let t = read_record(records, r);
+    apply(&t, solutions, row, nodes, parents, counts, node_costs, &params.costs());
 }
 
 #[cfg(test)]

@@ -268,35 +268,45 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 treelet::treelet_scatter_kernel(id, &p, counts, heights, cursors, roots);
             }
         }
-        (Kernel::TreeletWide, [p, roots, nodes, parents, counts, costs]) => {
+        (Kernel::TreeletForm, [p, roots, nodes, counts, costs, records]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
-            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
-            let (counts, costs) = (view(counts), view(costs));
-            let mut slots = [0u32; treelet::TEAM_SLOTS];
-            let mut boxes = [0f32; treelet::TEAM_BOXES];
+            let (roots, nodes, counts, costs, records) =
+                (view(roots), view(nodes), view(counts), view(costs), view(records));
+            for id in ids(groups) {
+                treelet::treelet_form_kernel(id, &p, roots, nodes, counts, costs, records);
+            }
+        }
+        (Kernel::TreeletSolve, [p, records, solutions]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (records, solutions) = (view(records), view(solutions));
+            let mut leaves = [0f32; treelet::TEAM_LEAVES];
             let mut area = [0f32; treelet::TEAM_TABLE];
             let mut sub_count = [0u32; treelet::TEAM_TABLE];
             let mut cost = [0f32; treelet::TEAM_TABLE];
             let mut partition = [0u32; treelet::TEAM_TABLE];
-            workgroups(groups, treelet::WIDE_PHASES, |group, phase, lid| {
-                treelet::treelet_wide_phase(
+            workgroups(groups, treelet::SOLVE_PHASES, |group, phase, lid| {
+                treelet::treelet_solve_phase(
                     phase,
                     lid,
                     group,
                     &p,
-                    roots,
-                    nodes,
-                    parents,
-                    counts,
-                    costs,
-                    &mut slots,
-                    &mut boxes,
+                    records,
+                    solutions,
+                    &mut leaves,
                     &mut area,
                     &mut sub_count,
                     &mut cost,
                     &mut partition,
                 );
             });
+        }
+        (Kernel::TreeletCommit, [p, records, solutions, nodes, parents, counts, costs]) => {
+            let p: treelet_core::layout::TreeletParams = params(p);
+            let (records, solutions, nodes, parents) = (view(records), view(solutions), view(nodes), view(parents));
+            let (counts, costs) = (view(counts), view(costs));
+            for id in ids(groups) {
+                treelet::treelet_commit_kernel(id, &p, records, solutions, nodes, parents, counts, costs);
+            }
         }
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.

@@ -34,8 +34,12 @@ pub enum Kernel {
     TreeletHistogram,
     /// Treelet optimization: list treelet roots by height.
     TreeletScatter,
-    /// Treelet optimization: restructure the treelets of one height, a team of lanes each.
-    TreeletWide,
+    /// Treelet optimization: form the treelets of one height.
+    TreeletForm,
+    /// Treelet optimization: the DP of the treelets of one height, a team of lanes each.
+    TreeletSolve,
+    /// Treelet optimization: rewire the treelets of one height.
+    TreeletCommit,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
     /// Path tracing, closest hit by scanning every sphere.
@@ -45,7 +49,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 20] = [
+    pub const ALL: [Kernel; 22] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
         Kernel::ReduceBounds,
@@ -62,7 +66,9 @@ impl Kernel {
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,
-        Kernel::TreeletWide,
+        Kernel::TreeletForm,
+        Kernel::TreeletSolve,
+        Kernel::TreeletCommit,
         Kernel::Collapse,
         Kernel::RenderLinear,
         Kernel::RenderBvh,
@@ -87,7 +93,9 @@ impl Kernel {
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
-            Kernel::TreeletWide => "treelet::treelet_wide_cs",
+            Kernel::TreeletForm => "treelet::treelet_form_cs",
+            Kernel::TreeletSolve => "treelet::treelet_solve_cs",
+            Kernel::TreeletCommit => "treelet::treelet_commit_cs",
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::RenderLinear => "render::render_linear_cs",
             Kernel::RenderBvh => "render::render_bvh_cs",
@@ -113,7 +121,9 @@ impl Kernel {
             }
             Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::TreeletWide => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::TreeletForm => &[Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::TreeletSolve => &[Read, Read, ReadWrite],
+            Kernel::TreeletCommit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
         }

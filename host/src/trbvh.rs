@@ -2,7 +2,8 @@
 //! round by round: a bottom-up pass computes each node's primitive count,
 //! SAH cost and height; the roots of treelets (at least `gamma` primitives)
 //! are listed by height; then one dispatch per height, from the leaves up,
-//! restructures them, 32 lanes per treelet.
+//! restructures them: form each treelet (one invocation each), solve its
+//! DP (32 lanes each), rewire it (one invocation each).
 //! Last, the SAH leaf collapse writes the tree anew in depth-first order
 //! with leaves of up to `max_leaf` primitives.
 //! Nodes of one height never contain each other, so each dispatch works on
@@ -11,7 +12,7 @@
 //! for visibility guarantees that need no device-scope atomics.)
 use anyhow::{bail, Result};
 use treelet_core::layout::TreeletParams;
-use treelet_core::treelet::{MAX_LEVELS, TEAMS};
+use treelet_core::treelet::{MAX_LEVELS, RECORD_WORDS, SOLUTION_WORDS, TEAMS};
 use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
@@ -96,16 +97,22 @@ pub fn optimize<B: Backend>(
         b.dispatch(Kernel::TreeletScatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
         // ...then restructured height by height, bottom up: the treelets of
         // one height are disjoint, and each sees its subtrees finished.
+        let widest = per_level.iter().copied().max().unwrap_or(0) as u64;
+        let records = b.scratch("treelet records", widest * RECORD_WORDS as u64 * 4)?;
+        let solutions = b.scratch("treelet solutions", widest * SOLUTION_WORDS as u64 * 4)?;
         for (level, &count) in per_level.iter().enumerate().skip(1) {
             if count == 0 {
                 continue;
             }
             let lp = TreeletParams { gamma: 0, level_offset: offsets[level], level_count: count, ..base };
             let lp = b.upload("treelet params", &[lp])?;
+            let (one_each, teams) = (groups_for(count, WORKGROUP_SIZE), groups_for(count, TEAMS as u32));
+            b.dispatch(Kernel::TreeletForm, &[&lp, &roots, &bvh.nodes, &s.counts, &s.costs, &records], one_each);
+            b.dispatch(Kernel::TreeletSolve, &[&lp, &records, &solutions], teams);
             b.dispatch(
-                Kernel::TreeletWide,
-                &[&lp, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs],
-                groups_for(count, TEAMS as u32),
+                Kernel::TreeletCommit,
+                &[&lp, &records, &solutions, &bvh.nodes, &bvh.parents, &s.counts, &s.costs],
+                one_each,
             );
         }
     }

@@ -3,8 +3,8 @@ use spirv_std::spirv;
 use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
 use treelet_core::treelet::{
-    treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel, treelet_wide_phase, TEAM_BOXES,
-    TEAM_SLOTS, TEAM_TABLE, WIDE_PHASES,
+    treelet_commit_kernel, treelet_form_kernel, treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel,
+    treelet_solve_phase, SOLVE_PHASES, TEAM_LEAVES, TEAM_TABLE,
 };
 use treelet_core::workgroup::{barrier, linear_group, linear_id};
 
@@ -73,33 +73,59 @@ pub fn treelet_scatter_cs(
     treelet_scatter_kernel(id, params, counts, heights, cursors, roots);
 }
 
-/// Restructures the treelets of one height, 32 lanes per treelet.
+/// Forms the treelets of one height, one invocation each.
 #[spirv(compute(threads(256)))]
-pub fn treelet_wide_cs(
+pub fn treelet_form_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] costs: &[f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] records: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_form_kernel(id, params, roots, nodes, counts, costs, records);
+}
+
+/// The DP of the treelets of one height, 32 lanes per treelet.
+#[spirv(compute(threads(256)))]
+pub fn treelet_solve_cs(
     #[spirv(local_invocation_index)] lid: u32,
     #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-    #[spirv(workgroup)] slots: &mut [u32; TEAM_SLOTS],
-    #[spirv(workgroup)] boxes: &mut [f32; TEAM_BOXES],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] records: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] solutions: &mut [u32],
+    #[spirv(workgroup)] leaves: &mut [f32; TEAM_LEAVES],
     #[spirv(workgroup)] area: &mut [f32; TEAM_TABLE],
     #[spirv(workgroup)] sub_count: &mut [u32; TEAM_TABLE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_TABLE],
     #[spirv(workgroup)] partition: &mut [u32; TEAM_TABLE],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
-    for phase in 0..WIDE_PHASES {
-        treelet_wide_phase(
-            phase, lid, group, params, roots, nodes, parents, counts, costs, slots, boxes, area, sub_count, cost,
-            partition,
-        );
+    for phase in 0..SOLVE_PHASES {
+        treelet_solve_phase(phase, lid, group, params, records, solutions, leaves, area, sub_count, cost, partition);
         barrier();
     }
+}
+
+/// Rewires the treelets of one height into their solved trees, one invocation each.
+#[spirv(compute(threads(256)))]
+pub fn treelet_commit_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] records: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] solutions: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] costs: &mut [f32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_commit_kernel(id, params, records, solutions, nodes, parents, counts, costs);
 }
 
 /// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
