@@ -621,10 +621,44 @@ pub const TEAM: u32 = 32;
 pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
 /// Shared DP tables: one row of [`SUBSETS`] per team.
 pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
-/// Shared leaf data: per team, the leaf count and 7 boxes of 6 floats.
-pub const TEAM_LEAVES: usize = TEAMS * 48;
-/// Phases of [`treelet_solve_phase`]: load, areas, one per subset size 2..=7, store.
-pub const SOLVE_PHASES: u32 = 3 + TREELET_LEAVES as u32 - 1;
+/// Shared leaf data: per team, the leaf count, 7 boxes of 6 floats, 7 primitive counts.
+pub const TEAM_LEAVES: usize = TEAMS * 64;
+/// Phases of [`treelet_solve_phase`]: load, one per subset size 2..=7, store.
+pub const SOLVE_PHASES: u32 = 2 + TREELET_LEAVES as u32 - 1;
+
+/// Binomial coefficient C(n, k) for the small sizes of a treelet.
+#[inline]
+fn binomial(n: u32, k: u32) -> u32 {
+    if k > n {
+        return 0;
+    }
+    let mut c = 1u32;
+    let mut i = 0;
+    while i < k {
+        c = c * (n - i) / (i + 1);
+        i += 1;
+    }
+    c
+}
+
+/// The `rank`-th subset (in colex order) of `size` leaves among `n`: how a
+/// lane finds its subsets of one size without scanning all of them.
+#[inline]
+pub fn subset_of_rank(mut rank: u32, n: u32, size: u32) -> u32 {
+    let mut s = 0u32;
+    let mut k = size;
+    let mut pos = n;
+    while k > 0 && pos > 0 {
+        pos -= 1;
+        let below = binomial(pos, k);
+        if rank >= below {
+            s |= 1 << pos;
+            rank -= below;
+            k -= 1;
+        }
+    }
+    s
+}
 
 /// Kernel (workgroups of [`TEAMS`] teams of [`TEAM`] lanes; phase by phase):
 /// the DP of [`optimize`] for the treelets of `records`, one per team: each
@@ -639,18 +673,18 @@ pub fn treelet_solve_phase(
     records: &[u32],
     solutions: &mut [u32],
     leaves: &mut [f32; TEAM_LEAVES],
-    area: &mut [f32; TEAM_TABLE],
-    sub_count: &mut [u32; TEAM_TABLE],
     cost: &mut [f32; TEAM_TABLE],
     partition: &mut [u32; TEAM_TABLE],
 ) {
     let team = (lid / TEAM) as usize;
     let lane = lid % TEAM;
     let index = group * TEAMS as u32 + team as u32;
-    let (lb, tb) = (team * 48, team * SUBSETS);
+    let (lb, tb) = (team * 64, team * SUBSETS);
     let r = index as usize * RECORD_WORDS;
     if phase == 0 {
-        // The record into workgroup memory, the team's lanes side by side.
+        // The record into workgroup memory, the team's lanes side by side:
+        // leaf count at 0, boxes from 1, primitive counts from 43 (as f32,
+        // exact below 2^24), the leaves' costs into the DP's singleton entries.
         if index >= params.level_count {
             if lane == 0 {
                 leaves[lb] = 0.0;
@@ -665,7 +699,7 @@ pub fn treelet_solve_phase(
             } else if (R_BOXES..R_COUNTS).contains(&w) {
                 leaves[lb + 1 + w - R_BOXES] = f32::from_bits(word);
             } else if (R_COUNTS..R_COSTS).contains(&w) {
-                sub_count[tb + (1 << (w - R_COUNTS))] = word;
+                leaves[lb + 43 + w - R_COUNTS] = word as f32;
             } else if w >= R_COSTS {
                 cost[tb + (1 << (w - R_COSTS))] = f32::from_bits(word);
             }
@@ -678,46 +712,34 @@ pub fn treelet_solve_phase(
         return;
     }
     let full = (1u32 << n) - 1;
-    let costs = params.costs();
-    if phase == 1 {
-        // Areas and counts of this lane's subsets of two or more leaves.
-        let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
-        let mut counts = [0u32; TREELET_LEAVES];
-        let mut k = 0;
-        while k < n as usize {
-            let f = lb + 1 + 6 * k;
-            boxes[k] = Aabb::from_arrays(
-                [leaves[f], leaves[f + 1], leaves[f + 2]],
-                [leaves[f + 3], leaves[f + 4], leaves[f + 5]],
-            );
-            counts[k] = sub_count[tb + (1 << k)];
-            k += 1;
-        }
-        let mut s = lane + 1;
-        while s <= full {
-            if s.count_ones() > 1 {
-                area[tb + s as usize] = subset_area(s, n, &boxes, &costs);
-                sub_count[tb + s as usize] = subset_count(s, n, &counts);
-            }
-            s += TEAM;
-        }
-    } else if phase < SOLVE_PHASES - 1 {
+    if phase < SOLVE_PHASES - 1 {
         // Subsets of one size, dealt round-robin to the lanes.
-        let size = phase;
+        let size = phase + 1;
         if size > n {
             return;
         }
-        let mut rank = 0u32;
-        let mut s = 1u32;
-        while s <= full {
-            if s.count_ones() == size {
-                if rank % TEAM == lane {
-                    let (a, c) = (area[tb + s as usize], sub_count[tb + s as usize]);
-                    solve_subset(s, tb, a, c, cost, partition, &costs);
+        let costs = params.costs();
+        let total = binomial(n, size);
+        let mut rank = lane;
+        while rank < total {
+            let s = subset_of_rank(rank, n, size);
+            let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
+            let mut counts = [0u32; TREELET_LEAVES];
+            let mut k = 0;
+            while k < n as usize {
+                if s & (1 << k) != 0 {
+                    let f = lb + 1 + 6 * k;
+                    boxes[k] = Aabb::from_arrays(
+                        [leaves[f], leaves[f + 1], leaves[f + 2]],
+                        [leaves[f + 3], leaves[f + 4], leaves[f + 5]],
+                    );
+                    counts[k] = leaves[lb + 43 + k] as u32;
                 }
-                rank += 1;
+                k += 1;
             }
-            s += 1;
+            let (a, c) = (subset_area(s, n, &boxes, &costs), subset_count(s, n, &counts));
+            solve_subset(s, tb, a, c, cost, partition, &costs);
+            rank += TEAM;
         }
     } else {
         let row = index as usize * SOLUTION_WORDS;
@@ -835,6 +857,20 @@ mod tests {
                         "max_leaf {max_leaf} n {n} seed {seed}: dp {got} brute {expected}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn subsets_of_rank_cover_each_size_once() {
+        for n in 1..=TREELET_LEAVES as u32 {
+            for size in 1..=n {
+                let mut seen: Vec<u32> = (0..binomial(n, size)).map(|r| subset_of_rank(r, n, size)).collect();
+                assert!(seen.iter().all(|s| s.count_ones() == size && *s < (1 << n)), "n {n} size {size}");
+                seen.sort();
+                seen.dedup();
+                let expected = (1u32..1 << n).filter(|s| s.count_ones() == size).count();
+                assert_eq!(seen.len(), expected, "n {n} size {size}");
             }
         }
     }

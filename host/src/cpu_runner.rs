@@ -280,8 +280,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (records, solutions) = (view(records), view(solutions));
             let mut leaves = [0f32; treelet::TEAM_LEAVES];
-            let mut area = [0f32; treelet::TEAM_TABLE];
-            let mut sub_count = [0u32; treelet::TEAM_TABLE];
             let mut cost = [0f32; treelet::TEAM_TABLE];
             let mut partition = [0u32; treelet::TEAM_TABLE];
             workgroups(groups, treelet::SOLVE_PHASES, |group, phase, lid| {
@@ -293,8 +291,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                     records,
                     solutions,
                     &mut leaves,
-                    &mut area,
-                    &mut sub_count,
                     &mut cost,
                     &mut partition,
                 );

@@ -99,14 +99,12 @@ pub fn treelet_solve_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] records: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] solutions: &mut [u32],
     #[spirv(workgroup)] leaves: &mut [f32; TEAM_LEAVES],
-    #[spirv(workgroup)] area: &mut [f32; TEAM_TABLE],
-    #[spirv(workgroup)] sub_count: &mut [u32; TEAM_TABLE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_TABLE],
     #[spirv(workgroup)] partition: &mut [u32; TEAM_TABLE],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
     for phase in 0..SOLVE_PHASES {
-        treelet_solve_phase(phase, lid, group, params, records, solutions, leaves, area, sub_count, cost, partition);
+        treelet_solve_phase(phase, lid, group, params, records, solutions, leaves, cost, partition);
         barrier();
     }
 }
