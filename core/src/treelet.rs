@@ -723,22 +723,22 @@ pub fn treelet_solve_phase(
         let mut rank = lane;
         while rank < total {
             let s = subset_of_rank(rank, n, size);
-            let mut boxes = [Aabb::EMPTY; TREELET_LEAVES];
-            let mut counts = [0u32; TREELET_LEAVES];
+            // The subset's box and count straight from workgroup memory (a
+            // union is exact in any order, so this equals `subset_area`).
+            let (mut lo, mut hi) = ([f32::MAX; 3], [-f32::MAX; 3]);
+            let mut count = 0u32;
             let mut k = 0;
             while k < n as usize {
                 if s & (1 << k) != 0 {
                     let f = lb + 1 + 6 * k;
-                    boxes[k] = Aabb::from_arrays(
-                        [leaves[f], leaves[f + 1], leaves[f + 2]],
-                        [leaves[f + 3], leaves[f + 4], leaves[f + 5]],
-                    );
-                    counts[k] = leaves[lb + 43 + k] as u32;
+                    lo = [lo[0].min(leaves[f]), lo[1].min(leaves[f + 1]), lo[2].min(leaves[f + 2])];
+                    hi = [hi[0].max(leaves[f + 3]), hi[1].max(leaves[f + 4]), hi[2].max(leaves[f + 5])];
+                    count += leaves[lb + 43 + k] as u32;
                 }
                 k += 1;
             }
-            let (a, c) = (subset_area(s, n, &boxes, &costs), subset_count(s, n, &counts));
-            solve_subset(s, tb, a, c, cost, partition, &costs);
+            let a = costs.area(&Aabb::from_arrays(lo, hi));
+            solve_subset(s, tb, a, count, cost, partition, &costs);
             rank += TEAM;
         }
     } else {
