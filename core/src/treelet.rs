@@ -197,10 +197,9 @@ pub struct TreeletSolution {
     pub cost: [f32; SUBSETS],
 }
 
-/// Scaled area of the union of the leaves in subset `s` (in leaf order, so
-/// every caller rounds alike).
+/// Union of the boxes of the leaves in subset `s` (exact: min and max).
 #[inline]
-pub fn subset_area(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES], costs: &TreeletCosts) -> f32 {
+pub fn subset_box(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES]) -> Aabb {
     let mut b = Aabb::EMPTY;
     let mut i = 0;
     while i < n {
@@ -209,7 +208,13 @@ pub fn subset_area(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES], costs: &Treel
         }
         i += 1;
     }
-    costs.area(&b)
+    b
+}
+
+/// Scaled area of the union of the leaves in subset `s`.
+#[inline]
+pub fn subset_area(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES], costs: &TreeletCosts) -> f32 {
+    costs.area(&subset_box(s, n, boxes))
 }
 
 /// Primitives under the leaves in subset `s`.
@@ -365,17 +370,10 @@ pub fn apply(
             side += 1;
         }
         let count = subset_count(s, n, &t.counts);
-        let cost = costs.subtree(subset_area(s, n, &t.boxes, costs), count, children);
+        let b = subset_box(s, n, &t.boxes);
+        let cost = costs.subtree(costs.area(&b), count, children);
         internal_costs[k] = cost;
         let node = t.internals[k] as usize;
-        let mut b = Aabb::EMPTY;
-        let mut i = 0;
-        while i < n {
-            if s & (1 << i) != 0 {
-                b = b.union(&t.boxes[i as usize]);
-            }
-            i += 1;
-        }
         nodes[node].set_aabb(b);
         counts[node] = count;
         node_costs[node] = cost;
