@@ -21,11 +21,11 @@ pub enum BenchCommand {
         #[arg(long, value_enum, default_value = "lbvh")]
         builder: TreeBuilder,
         /// Treelet rounds, first gamma and largest collapsed leaf (trbvh).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = TreeletConfig::default().rounds)]
         rounds: u32,
-        #[arg(long, default_value_t = 7)]
+        #[arg(long, default_value_t = TreeletConfig::default().gamma)]
         gamma: u32,
-        #[arg(long, default_value_t = 8)]
+        #[arg(long, default_value_t = TreeletConfig::default().max_leaf)]
         max_leaf: u32,
         /// Primitive counts (the seed's table, then millions).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]

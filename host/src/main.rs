@@ -51,13 +51,13 @@ enum Command {
         #[arg(long, value_enum, default_value = "gpu")]
         device: Device,
         /// Treelet optimization rounds (trbvh).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = TreeletConfig::default().rounds)]
         rounds: u32,
         /// Smallest subtree restructured in the first round, doubled each round (trbvh).
-        #[arg(long, default_value_t = 7)]
+        #[arg(long, default_value_t = TreeletConfig::default().gamma)]
         gamma: u32,
         /// Largest leaf the final SAH collapse makes; 1 keeps one primitive per leaf (trbvh, sweep).
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1024))]
+        #[arg(long, default_value_t = TreeletConfig::default().max_leaf, value_parser = clap::value_parser!(u32).range(1..=1024))]
         max_leaf: u32,
         /// Print one JSON object instead of a summary.
         #[arg(long)]

@@ -27,7 +27,10 @@ pub struct TreeletConfig {
     /// Optimization rounds (the paper: 3).
     pub rounds: u32,
     /// Smallest subtree, in primitives, restructured in the first round;
-    /// doubled each round (the paper: 7, i.e. one full treelet).
+    /// doubled each round. The paper uses 7 (one full treelet); 3 also
+    /// restructures the small subtrees near the leaves, which brings the SAH
+    /// within 2% of the full-sweep builder's on random spheres (7: 3.5%)
+    /// for about twice the time.
     pub gamma: u32,
     /// Largest leaf the final SAH collapse makes (1: one primitive per leaf,
     /// no collapse). The paper sets no bound; a bound keeps the worst leaf
@@ -37,7 +40,7 @@ pub struct TreeletConfig {
 
 impl Default for TreeletConfig {
     fn default() -> Self {
-        Self { rounds: 3, gamma: 7, max_leaf: 8 }
+        Self { rounds: 3, gamma: 3, max_leaf: 8 }
     }
 }
 
