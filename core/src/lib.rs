@@ -56,6 +56,7 @@ pub mod scene;
 pub mod sort;
 pub mod traverse;
 pub mod treelet;
+pub mod triangle;
 pub mod workgroup;
 
 pub use aabb::Aabb;
