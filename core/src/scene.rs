@@ -3,6 +3,7 @@ use glam::Vec3;
 
 use crate::aabb::Aabb;
 use crate::layout::Sphere;
+use crate::triangle::Triangle;
 
 impl Sphere {
     #[inline]
@@ -22,5 +23,12 @@ impl Sphere {
 pub fn sphere_boxes_kernel(id: u32, n: u32, spheres: &[Sphere], boxes: &mut [Aabb]) {
     if id < n {
         boxes[id as usize] = spheres[id as usize].aabb();
+    }
+}
+
+/// Kernel: the box of triangle `id`.
+pub fn triangle_boxes_kernel(id: u32, n: u32, triangles: &[Triangle], boxes: &mut [Aabb]) {
+    if id < n {
+        boxes[id as usize] = triangles[id as usize].aabb();
     }
 }

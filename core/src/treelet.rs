@@ -76,7 +76,9 @@ impl TreeletCosts {
             return 0.0;
         }
         let e = b.extent() * self.inv_extent;
-        e.x * e.y + e.y * e.z + e.z * e.x
+        // Explicit fused multiply-adds: a GPU compiler may fuse `a * b + c`
+        // on its own, the CPU does not, and the tree must not depend on it.
+        libm::fmaf(e.x, e.y, libm::fmaf(e.y, e.z, e.z * e.x))
     }
 
     /// SAH cost of a subtree of `count` primitives whose root has area
@@ -84,7 +86,7 @@ impl TreeletCosts {
     /// an internal node and, when `count <= max_leaf`, one leaf.
     #[inline]
     pub fn subtree(&self, area: f32, count: u32, children: f32) -> f32 {
-        let internal = self.node * area + children;
+        let internal = libm::fmaf(self.node, area, children);
         if count <= self.max_leaf {
             let leaf = self.prim * area * count as f32;
             if leaf <= internal {
@@ -97,7 +99,7 @@ impl TreeletCosts {
     /// Whether a subtree collapses into one leaf (the choice of [`Self::subtree`]).
     #[inline]
     pub fn collapses(&self, area: f32, count: u32, children: f32) -> bool {
-        count <= self.max_leaf && self.prim * area * count as f32 <= self.node * area + children
+        count <= self.max_leaf && self.prim * area * count as f32 <= libm::fmaf(self.node, area, children)
     }
 }
 

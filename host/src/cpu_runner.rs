@@ -135,6 +135,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 scene::sphere_boxes_kernel(id, p.n, spheres, boxes);
             }
         }
+        (Kernel::TriangleBoxes, [p, triangles, boxes]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (triangles, boxes) = (view(triangles), view(boxes));
+            for id in ids(groups) {
+                scene::triangle_boxes_kernel(id, p.n, triangles, boxes);
+            }
+        }
         (Kernel::ReduceBounds, [p, input, output]) => {
             let p: treelet_core::BuildParams = params(p);
             let (input, output) = (view(input), view(output));

@@ -15,6 +15,7 @@ use Access::{Read, ReadWrite};
 pub enum Kernel {
     Fill,
     SphereBoxes,
+    TriangleBoxes,
     ReduceBounds,
     Morton,
     SortHistogram,
@@ -49,9 +50,10 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 22] = [
+    pub const ALL: [Kernel; 23] = [
         Kernel::Fill,
         Kernel::SphereBoxes,
+        Kernel::TriangleBoxes,
         Kernel::ReduceBounds,
         Kernel::Morton,
         Kernel::SortHistogram,
@@ -79,6 +81,7 @@ impl Kernel {
         match self {
             Kernel::Fill => "fill::fill_cs",
             Kernel::SphereBoxes => "scene::sphere_boxes_cs",
+            Kernel::TriangleBoxes => "scene::triangle_boxes_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
@@ -106,7 +109,7 @@ impl Kernel {
     pub fn bindings(self) -> &'static [Access] {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
-            Kernel::SphereBoxes => &[Read, Read, ReadWrite],
+            Kernel::SphereBoxes | Kernel::TriangleBoxes => &[Read, Read, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],

@@ -10,6 +10,7 @@ use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use crate::backend::{check_fits, Backend, StageTimes};
 use crate::kernels::Kernel;
+use crate::primitives::Primitives;
 
 /// The stages of a build, in order, as named in timings and reports.
 pub const STAGES: [&str; 5] = ["bounds", "morton", "sort", "tree", "fit"];
@@ -69,10 +70,18 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
 
 /// Builds the LBVH of `spheres` on `b` and leaves it there.
 pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(DeviceBvh<B>, StageTimes)> {
-    let n = u32::try_from(spheres.len())
+    build_primitives_on_device(b, Primitives::Spheres(spheres))
+}
+
+/// Builds the LBVH of spheres or triangles on `b` and leaves it there.
+pub fn build_primitives_on_device<B: Backend>(
+    b: &mut B,
+    prims: Primitives,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    let n = u32::try_from(prims.len())
         .ok()
         .filter(|&n| n <= MAX_PRIMITIVES)
-        .ok_or_else(|| anyhow::anyhow!("{} primitives: at most {MAX_PRIMITIVES} are supported", spheres.len()))?;
+        .ok_or_else(|| anyhow::anyhow!("{} primitives: at most {MAX_PRIMITIVES} are supported", prims.len()))?;
     b.begin_build();
     if n == 0 {
         let empty = b.scratch("empty", 0)?;
@@ -93,10 +102,13 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
 
     b.stage("bounds");
     let mut params = BuildParams { n, ..Default::default() };
-    let spheres_buf = b.upload("spheres", spheres)?;
+    let (kernel, input) = match prims {
+        Primitives::Spheres(s) => (Kernel::SphereBoxes, b.upload("spheres", s)?),
+        Primitives::Triangles(t) => (Kernel::TriangleBoxes, b.upload("triangles", t)?),
+    };
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
-    b.dispatch(Kernel::SphereBoxes, &[&p, &spheres_buf, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(kernel, &[&p, &input, &boxes], groups_for(n, WORKGROUP_SIZE));
     // Reduce centroids, then partial boxes, until one box remains.
     let (mut input, mut len, mut centroids) = (boxes.clone(), n, 1);
     let centroid_bounds = loop {

@@ -18,6 +18,8 @@ pub mod gpu;
 pub mod image_io;
 pub mod kernels;
 pub mod lbvh;
+pub mod mesh;
+pub mod primitives;
 pub mod plot;
 pub mod render;
 pub mod report;

@@ -108,6 +108,9 @@ pub fn render<B: Backend>(
             bail!("reference image is {}x{}, the render {width}x{height}", r.width, r.height);
         }
     }
+    if !scene.triangles.is_empty() {
+        bail!("{}: triangle meshes can be built (`treelet build`) but not rendered yet", scene.name);
+    }
     validate_spheres(&scene.spheres)?;
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;

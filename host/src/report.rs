@@ -9,14 +9,17 @@ use crate::backend::Backend;
 use treelet_core::{Aabb, Node};
 
 use crate::lbvh::{self, Bvh, STAGES};
-use crate::scene::{validate_spheres, Scene};
+use crate::scene::Scene;
 use crate::trbvh::{self, TreeletConfig};
-use crate::validate::validate;
+use crate::validate::validate_primitives;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct BuildReport {
     pub scene: String,
     pub primitives: usize,
+    /// Of which spheres and triangles.
+    pub spheres: usize,
+    pub triangles: usize,
     pub builder: &'static str,
     pub device: &'static str,
     pub adapter: String,
@@ -54,17 +57,19 @@ pub struct BuildReport {
 
 /// The full-sweep SAH reference build (CPU only), reported like the others.
 pub fn run_build_sweep(scene: &Scene, max_leaf: u32) -> Result<(Bvh, BuildReport)> {
-    let objects = scene.objects();
-    validate_spheres(objects)?;
+    let prims = scene.primitives();
+    prims.check()?;
     let start = Instant::now();
-    let bvh = crate::sweep::build_collapsed(objects, max_leaf)?;
+    let bvh = crate::sweep::build_collapsed_boxes(&prims.boxes(), max_leaf)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let mut ms = serde_json::Map::new();
     ms.insert("sweep".into(), serde_json::json!(wall_ms));
     let report = BuildReport {
         scene: scene.name.clone(),
-        primitives: objects.len(),
+        primitives: prims.len(),
+        spheres: prims.counts().0,
+        triangles: prims.counts().1,
         builder: "sweep",
         device: "cpu",
         adapter: "cpu".into(),
@@ -94,10 +99,10 @@ pub fn run_build<B: Backend>(
     scene: &Scene,
     treelets: Option<&TreeletConfig>,
 ) -> Result<(Bvh, BuildReport)> {
-    let objects = scene.objects();
-    validate_spheres(objects)?;
+    let prims = scene.primitives();
+    prims.check()?;
     let start = Instant::now();
-    let (mut device_bvh, times) = lbvh::build_on_device(backend, objects)?;
+    let (mut device_bvh, times) = lbvh::build_primitives_on_device(backend, prims)?;
     let mut bvh = device_bvh.read(backend)?;
     let mut ms: serde_json::Map<String, serde_json::Value> =
         STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
@@ -117,11 +122,13 @@ pub fn run_build<B: Backend>(
         bvh = device_bvh.read(backend)?;
     }
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-    let check = validate(objects, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let sah = sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA);
     let report = BuildReport {
         scene: scene.name.clone(),
-        primitives: objects.len(),
+        primitives: prims.len(),
+        spheres: prims.counts().0,
+        triangles: prims.counts().1,
         builder: if treelets.is_some() { "trbvh" } else { "lbvh" },
         device: backend.device_kind(),
         adapter: backend.adapter(),

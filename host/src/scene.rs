@@ -4,6 +4,9 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
 use treelet_core::render::SMALLPT_FOV;
+use treelet_core::triangle::Triangle;
+
+use crate::primitives::Primitives;
 
 /// Where random scenes place sphere centres: smallpt's room, short of the
 /// plane (z about 155) where its camera rays start, so that no sphere
@@ -23,6 +26,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub room: usize,
     pub camera: CameraSpec,
+    /// Triangles of a mesh scene (`treelet build` builds over them; they
+    /// are not rendered yet).
+    pub triangles: Vec<Triangle>,
 }
 
 /// Where the camera is; the image size comes from the render.
@@ -80,7 +86,7 @@ pub fn cornell() -> Scene {
             light,
         ])
         .unzip();
-    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT }
+    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
 }
 
 /// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
@@ -104,13 +110,35 @@ impl Scene {
         &self.spheres[..self.spheres.len() - self.room]
     }
 
-    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON scene file.
+    /// What `treelet build` builds over: a mesh's triangles, or the objects.
+    pub fn primitives(&self) -> Primitives<'_> {
+        if self.triangles.is_empty() {
+            Primitives::Spheres(self.objects())
+        } else {
+            Primitives::Triangles(&self.triangles)
+        }
+    }
+
+    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON
+    /// scene file or an `.obj` / `.ply` mesh.
     pub fn from_spec(spec: &str) -> Result<Scene> {
         if spec == "cornell" {
             return Ok(cornell());
         }
         if spec.ends_with(".json") {
             return crate::scene_file::load(std::path::Path::new(spec));
+        }
+        let lower = spec.to_ascii_lowercase();
+        if lower.ends_with(".obj") || lower.ends_with(".ply") {
+            let triangles = crate::mesh::load(std::path::Path::new(spec))?;
+            return Ok(Scene {
+                name: spec.into(),
+                spheres: Vec::new(),
+                materials: Vec::new(),
+                room: 0,
+                camera: CameraSpec::SMALLPT,
+                triangles,
+            });
         }
         let mut parts = spec.split(':');
         match parts.next() {
@@ -159,7 +187,7 @@ pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
         spheres.push(s);
         materials.push(m);
     }
-    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT }
+    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
 }
 
 /// `n` spheres with uniform random centres inside the Cornell box and random

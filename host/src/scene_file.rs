@@ -114,7 +114,14 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
     {
         bail!("scene file {name}: the camera needs a finite origin, a non-zero direction and a positive fov");
     }
-    Ok(Scene { name: name.into(), spheres, materials: sphere_materials, room: 0, camera: file.camera })
+    Ok(Scene {
+        name: name.into(),
+        spheres,
+        materials: sphere_materials,
+        room: 0,
+        camera: file.camera,
+        triangles: Vec::new(),
+    })
 }
 
 #[cfg(test)]

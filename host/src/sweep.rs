@@ -18,8 +18,14 @@ use crate::lbvh::{Bvh, DeviceBvh};
 /// The sweep tree with the SAH leaf collapse (leaves of up to `max_leaf`
 /// primitives), run by the CPU runner over the same kernels as the TRBVH's.
 pub fn build_collapsed(spheres: &[Sphere], max_leaf: u32) -> anyhow::Result<Bvh> {
-    let tree = build(spheres);
-    let n = spheres.len() as u32;
+    let boxes: Vec<Aabb> = spheres.iter().map(|s| s.aabb()).collect();
+    build_collapsed_boxes(&boxes, max_leaf)
+}
+
+/// [`build_collapsed`] over primitive boxes.
+pub fn build_collapsed_boxes(boxes: &[Aabb], max_leaf: u32) -> anyhow::Result<Bvh> {
+    let tree = build_boxes(boxes);
+    let n = boxes.len() as u32;
     if n < 2 {
         return Ok(tree);
     }
@@ -39,11 +45,16 @@ pub fn build_collapsed(spheres: &[Sphere], max_leaf: u32) -> anyhow::Result<Bvh>
 
 /// Builds the full-sweep SAH tree over `spheres`, one primitive per leaf.
 pub fn build(spheres: &[Sphere]) -> Bvh {
-    let n = spheres.len();
+    let boxes: Vec<Aabb> = spheres.iter().map(|s| s.aabb()).collect();
+    build_boxes(&boxes)
+}
+
+/// Builds the full-sweep SAH tree over primitives with these boxes.
+pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
+    let n = boxes.len();
     if n == 0 {
         return Bvh::default();
     }
-    let boxes: Vec<Aabb> = spheres.iter().map(|s| s.aabb()).collect();
     let centroids: Vec<[f32; 3]> = boxes.iter().map(|b| b.centroid().to_array()).collect();
     let mut order: [Vec<u32>; 3] = [0, 1, 2].map(|axis| {
         let mut v: Vec<u32> = (0..n as u32).collect();

@@ -2,6 +2,9 @@
 //! builders: it recomputes primitive boxes itself and walks the tree from the
 //! root with an explicit stack.
 use treelet_core::layout::{Node, Sphere};
+use treelet_core::triangle::Triangle;
+
+use crate::primitives::Primitives;
 
 /// The result of [`validate`]: empty `errors` means valid.
 #[derive(Clone, Debug, Default)]
@@ -26,6 +29,12 @@ fn sphere_box(s: &Sphere) -> ([f32; 3], [f32; 3]) {
     (lo, hi)
 }
 
+fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
+    let lo = [0, 1, 2].map(|k| t.v0[k].min(t.v1[k]).min(t.v2[k]));
+    let hi = [0, 1, 2].map(|k| t.v0[k].max(t.v1[k]).max(t.v2[k]));
+    (lo, hi)
+}
+
 fn encloses(outer_lo: &[f32; 3], outer_hi: &[f32; 3], lo: &[f32; 3], hi: &[f32; 3]) -> bool {
     (0..3).all(|k| outer_lo[k] <= lo[k] && outer_hi[k] >= hi[k])
 }
@@ -38,13 +47,22 @@ fn encloses(outer_lo: &[f32; 3], outer_hi: &[f32; 3], lo: &[f32; 3], hi: &[f32; 
 /// internal box contains its children's boxes; each leaf box contains its
 /// primitives; the root box contains the whole scene.
 pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    validate_primitives(Primitives::Spheres(spheres), nodes, parents, prim_indices)
+}
+
+/// [`validate`] for any primitives (boxes recomputed here, not by the builder's code).
+pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    let prim_box = |p: usize| match prims {
+        Primitives::Spheres(s) => sphere_box(&s[p]),
+        Primitives::Triangles(t) => triangle_box(&t[p]),
+    };
     let mut v = Validation::default();
     let mut err = |e: String| {
         if v.errors.len() < MAX_ERRORS {
             v.errors.push(e);
         }
     };
-    let n = spheres.len();
+    let n = prims.len();
     if n == 0 {
         if !nodes.is_empty() {
             err(format!("empty scene but {} nodes", nodes.len()));
@@ -91,7 +109,7 @@ pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indice
                     continue;
                 }
                 prim_seen[p] += 1;
-                let (lo, hi) = sphere_box(&spheres[p]);
+                let (lo, hi) = prim_box(p);
                 if !encloses(&node.min, &node.max, &lo, &hi) {
                     err(format!("leaf {i}: box {:?}..{:?} does not contain primitive {p}", node.min, node.max));
                 }
@@ -125,8 +143,8 @@ pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indice
         }
     }
     let root = &nodes[0];
-    for (p, s) in spheres.iter().enumerate() {
-        let (lo, hi) = sphere_box(s);
+    for p in 0..n {
+        let (lo, hi) = prim_box(p);
         if !encloses(&root.min, &root.max, &lo, &hi) {
             err(format!("root box does not contain primitive {p}"));
         }

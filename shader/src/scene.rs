@@ -2,6 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::layout::BuildParams;
 use treelet_core::workgroup::linear_id;
+use treelet_core::triangle::Triangle;
 use treelet_core::{Aabb, Sphere};
 
 #[spirv(compute(threads(256)))]
@@ -14,4 +15,16 @@ pub fn sphere_boxes_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     treelet_core::scene::sphere_boxes_kernel(id, params.n, spheres, boxes);
+}
+
+#[spirv(compute(threads(256)))]
+pub fn triangle_boxes_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] boxes: &mut [Aabb],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::scene::triangle_boxes_kernel(id, params.n, triangles, boxes);
 }

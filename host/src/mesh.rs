@@ -1,0 +1,188 @@
+//! Triangle meshes from OBJ (through `tobj`) and PLY, ASCII or binary
+//! (through `ply-rs-bw`). Loaders return an error naming the file and the
+//! element at fault, never panic, and never drop data silently: faces of
+//! more than three vertices are fanned into triangles, and a file without a
+//! single triangle is an error.
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use treelet_core::triangle::Triangle;
+
+use crate::primitives::Primitives;
+
+/// Loads the triangles of an `.obj` or `.ply` file and checks them
+/// (finite coordinates, at least one triangle).
+pub fn load(path: &Path) -> Result<Vec<Triangle>> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let triangles = match ext.as_deref() {
+        Some("obj") => load_obj(path)?,
+        Some("ply") => load_ply(path)?,
+        _ => bail!("{}: not a mesh file (expected .obj or .ply)", path.display()),
+    };
+    if triangles.is_empty() {
+        bail!("{}: the mesh has no triangles", path.display());
+    }
+    Primitives::Triangles(&triangles).check().with_context(|| format!("{}", path.display()))?;
+    Ok(triangles)
+}
+
+/// Wavefront OBJ: every object's faces, triangulated; materials are not read.
+pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
+    let mut reader = std::io::BufReader::new(file);
+    // Material libraries are ignored: Treelet assigns its own material.
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
+        .map_err(|e| anyhow!("{}: not a valid OBJ file: {e}", path.display()))?;
+    let mut triangles = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let vertex = |i: u32| -> Result<[f32; 3]> {
+            let i = i as usize;
+            mesh.positions
+                .get(3 * i..3 * i + 3)
+                .map(|p| [p[0], p[1], p[2]])
+                .ok_or_else(|| anyhow!("{}: object `{}`: vertex index {i} out of range", path.display(), model.name))
+        };
+        for (f, face) in mesh.indices.chunks(3).enumerate() {
+            if face.len() < 3 {
+                bail!("{}: object `{}`: face {f} has {} vertices", path.display(), model.name, face.len());
+            }
+            triangles.push(Triangle::new(vertex(face[0])?, vertex(face[1])?, vertex(face[2])?));
+        }
+    }
+    Ok(triangles)
+}
+
+/// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
+/// `face` elements with a `vertex_indices` (or `vertex_index`) list.
+pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Property};
+    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
+    let mut reader = std::io::BufReader::new(file);
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| anyhow!("{}: not a valid PLY file: {e}", path.display()))?;
+    let name = path.display();
+    let vertices = ply.payload.get("vertex").ok_or_else(|| anyhow!("{name}: no `vertex` element"))?;
+    let faces = ply.payload.get("face").ok_or_else(|| anyhow!("{name}: no `face` element"))?;
+    let mut positions = Vec::with_capacity(vertices.len());
+    for (i, v) in vertices.iter().enumerate() {
+        let coord = |axis: &str| {
+            v.get(axis)
+                .and_then(Property::to_f32_lossy)
+                .ok_or_else(|| anyhow!("{name}: vertex {i}: no numeric `{axis}` property"))
+        };
+        positions.push([coord("x")?, coord("y")?, coord("z")?]);
+    }
+    let mut triangles = Vec::with_capacity(faces.len());
+    for (f, face) in faces.iter().enumerate() {
+        let list = face
+            .get("vertex_indices")
+            .or_else(|| face.get("vertex_index"))
+            .ok_or_else(|| anyhow!("{name}: face {f}: no `vertex_indices` list"))?;
+        let indices: Vec<i64> = match list {
+            Property::ListChar(l) => l.iter().map(|&x| x as i64).collect(),
+            Property::ListUChar(l) => l.iter().map(|&x| x as i64).collect(),
+            Property::ListShort(l) => l.iter().map(|&x| x as i64).collect(),
+            Property::ListUShort(l) => l.iter().map(|&x| x as i64).collect(),
+            Property::ListInt(l) => l.iter().map(|&x| x as i64).collect(),
+            Property::ListUInt(l) => l.iter().map(|&x| x as i64).collect(),
+            _ => bail!("{name}: face {f}: `vertex_indices` is not a list of integers"),
+        };
+        if indices.len() < 3 {
+            bail!("{name}: face {f} has {} vertices (at least 3 needed)", indices.len());
+        }
+        let vertex = |k: usize| -> Result<[f32; 3]> {
+            let i = indices[k];
+            usize::try_from(i)
+                .ok()
+                .and_then(|i| positions.get(i).copied())
+                .ok_or_else(|| anyhow!("{name}: face {f}: vertex index {i} out of range 0..{}", positions.len()))
+        };
+        // A polygon becomes a fan of triangles around its first vertex.
+        for k in 1..indices.len() - 1 {
+            triangles.push(Triangle::new(vertex(0)?, vertex(k)?, vertex(k + 1)?));
+        }
+    }
+    Ok(triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, contents: &[u8]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("treelet-mesh-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, contents).unwrap();
+        path
+    }
+
+    const QUAD_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+
+    #[test]
+    fn obj_and_ply_load_the_same_quad() {
+        let obj = load(&write("quad.obj", QUAD_OBJ.as_bytes())).unwrap();
+        assert_eq!(obj.len(), 2);
+        let ply_text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                        element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+                        0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+        let ply = load(&write("quad.ply", ply_text.as_bytes())).unwrap();
+        assert_eq!(ply.len(), 2);
+        let area = |t: &Triangle| {
+            let (a, b, c) = (glam::Vec3::from(t.v0), glam::Vec3::from(t.v1), glam::Vec3::from(t.v2));
+            (b - a).cross(c - a).length() / 2.0
+        };
+        assert_eq!(obj.iter().map(area).sum::<f32>(), 1.0);
+        assert_eq!(ply.iter().map(area).sum::<f32>(), 1.0);
+    }
+
+    #[test]
+    fn binary_ply_loads() {
+        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                          property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+            .to_vec();
+        for v in [[0.0f32, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]] {
+            for x in v {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        bytes.push(3);
+        for i in [0u32, 1, 2] {
+            bytes.extend_from_slice(&i.to_le_bytes());
+        }
+        let t = load(&write("tri.ply", &bytes)).unwrap();
+        assert_eq!(t, vec![Triangle::new([0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0])]);
+    }
+
+    /// Each bad file gives an error naming the file and the problem; none panics.
+    #[test]
+    fn bad_files_are_clear_errors() {
+        let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+            ("empty.obj", b"".to_vec(), "no triangles"),
+            ("no_faces.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n".to_vec(), "no triangles"),
+            ("index.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 3\n".to_vec(), "index.obj"),
+            ("nan.obj", b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(), "not finite"),
+            ("inf.obj", b"v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(), "not finite"),
+            ("garbage.obj", b"v 0 0 zero\nf 1 2 3\n".to_vec(), "garbage.obj"),
+            ("text.ply", b"hello, not a mesh\n".to_vec(), "not a valid PLY"),
+            ("truncated.ply", format!("{header}0 0 0\n1 0 0\n").into_bytes(), "truncated.ply"),
+            ("range.ply", format!("{header}0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").into_bytes(), "out of range"),
+            ("twoverts.ply", format!("{header}0 0 0\n1 0 0\n0 1 0\n2 0 1\n").into_bytes(), "face 0 has 2 vertices"),
+            ("mesh.stl", b"solid x\n".to_vec(), "not a mesh file"),
+        ];
+        for (name, contents, needle) in cases {
+            let path = write(name, &contents);
+            let e = format!("{:#}", load(&path).expect_err(name));
+            assert!(e.contains(needle), "{name}: error `{e}` does not mention `{needle}`");
+            assert!(e.contains(name), "{name}: error `{e}` does not name the file");
+        }
+        let e = format!("{:#}", load(Path::new("/nonexistent/x.obj")).unwrap_err());
+        assert!(e.contains("cannot open"), "{e}");
+    }
+}
