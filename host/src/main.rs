@@ -166,7 +166,11 @@ fn run_render(args: RenderArgs) -> Result<()> {
                 result.rows.iter().filter_map(|r| Some((r.elapsed_s, r.mean_std_error?))).collect(),
             )
         };
-        let plot_path = path.with_extension("png");
+        // Never over the rendered image: `--out a.png --report a.json` puts the plot in `a.error.png`.
+        let mut plot_path = path.with_extension("png");
+        if plot_path == args.out {
+            plot_path = path.with_extension("error.png");
+        }
         let title = format!(
             "{}: {}x{}, {} spp, accel {:?}, {adapter}",
             scene.name, args.width, args.height, args.spp, args.accel

@@ -139,3 +139,17 @@ fn render_writes_image_report_and_plot() {
     let rmse: Vec<f64> = v["rows"].as_array().unwrap().iter().map(|r| r["rmse"].as_f64().unwrap()).collect();
     assert!(rmse.first() > rmse.last(), "{rmse:?}");
 }
+
+/// `--out x.png --report x.json`: the plot must not overwrite the image.
+#[test]
+fn report_plot_never_overwrites_the_image() {
+    let dir = std::env::temp_dir().join(format!("treelet-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (img, report) = (dir.join("same.png"), dir.join("same.json"));
+    let args = ["render", "--device", "cpu", "--width", "20", "--height", "16", "--spp", "16", "--out"];
+    let out = treelet(&[&args[..], &[img.to_str().unwrap(), "--report", report.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let image = image::image_dimensions(&img).unwrap();
+    assert_eq!(image, (20, 16), "the render was overwritten");
+    assert!(dir.join("same.error.png").exists(), "the plot goes to same.error.png");
+}
