@@ -85,3 +85,68 @@ fn mesh_trbvh_lowers_sah_on_both_devices() {
     eprintln!("GPU SAH {gpu:.6} vs CPU {trbvh:.6}; {differing} of {} nodes differ", c.nodes.len());
     assert!((gpu - trbvh).abs() <= 1e-4 * trbvh, "GPU SAH {gpu} vs CPU {trbvh}");
 }
+
+/// The loaders on mutated bytes of the small corpus in `tests/corpus`
+/// (OBJ, ASCII and binary PLY): every input gives triangles or an error that
+/// names the file, never a panic.
+mod fuzz {
+    use proptest::prelude::*;
+
+    fn corpus() -> Vec<(String, Vec<u8>)> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("corpus");
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
+            .collect();
+        files.sort();
+        assert!(files.len() >= 3, "the corpus is missing");
+        files
+    }
+
+    /// Applies `edits` (position, byte, kind) to `bytes`: overwrite, insert,
+    /// delete, or truncate there.
+    fn mutate(mut bytes: Vec<u8>, edits: &[(usize, u8, u8)]) -> Vec<u8> {
+        for &(at, byte, kind) in edits {
+            if bytes.is_empty() {
+                bytes.push(byte);
+                continue;
+            }
+            let at = at % bytes.len();
+            match kind % 4 {
+                0 => bytes[at] = byte,
+                1 => bytes.insert(at, byte),
+                2 => {
+                    bytes.remove(at);
+                }
+                _ => bytes.truncate(at),
+            }
+        }
+        bytes
+    }
+
+    proptest! {
+        // 600 cases in CI; PROPTEST_CASES=N for a longer run.
+        #![proptest_config(ProptestConfig {
+            cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(600),
+            ..ProptestConfig::default()
+        })]
+        #[test]
+        fn mutated_meshes_never_panic(
+            which in 0usize..16,
+            edits in proptest::collection::vec((any::<usize>(), any::<u8>(), any::<u8>()), 1..6),
+        ) {
+            let files = corpus();
+            let (name, bytes) = &files[which % files.len()];
+            let dir = std::env::temp_dir().join(format!("treelet-fuzz-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let path = dir.join(format!("m-{name}"));
+            std::fs::write(&path, mutate(bytes.clone(), &edits)).unwrap();
+            let result = std::panic::catch_unwind(|| treelet::mesh::load(&path));
+            prop_assert!(result.is_ok(), "the loader panicked on a mutation of {}", name);
+            if let Ok(Err(e)) = result {
+                prop_assert!(format!("{e:#}").contains(&format!("m-{name}")), "error `{e:#}` does not name the file");
+            }
+        }
+    }
+}
