@@ -29,7 +29,7 @@ fn terrain(n: usize, seed: u64) -> Vec<Triangle> {
 }
 
 fn build<B: Backend>(b: &mut B, tris: &[Triangle], treelets: Option<&TreeletConfig>) -> Bvh {
-    let (bvh, _) = build_primitives_on_device(b, Primitives::Triangles(tris)).unwrap();
+    let (bvh, _) = build_primitives_on_device(b, Primitives::triangles(tris)).unwrap();
     match treelets {
         None => bvh.read(b).unwrap(),
         Some(config) => {
@@ -45,7 +45,7 @@ fn mesh_lbvh_matches_cpu_and_is_valid() {
     for n in [1usize, 5, 60, 150] {
         let tris = terrain(n, seed);
         let c = build(&mut CpuBackend::new(), &tris, None);
-        let v = validate_primitives(Primitives::Triangles(&tris), &c.nodes, &c.parents, &c.prim_indices);
+        let v = validate_primitives(Primitives::triangles(&tris), &c.nodes, &c.parents, &c.prim_indices);
         assert!(v.is_valid(), "n = {n}: {:?}", v.errors);
         let Some(ctx) = treelet_tests::gpu() else { continue };
         let g = build(&mut GpuBackend::new(ctx), &tris, None);
@@ -64,7 +64,7 @@ fn mesh_lbvh_matches_cpu_and_is_valid() {
 fn mesh_trbvh_lowers_sah_on_both_devices() {
     let seed = treelet_tests::fresh_seed();
     let tris = terrain(120, seed);
-    let prims = Primitives::Triangles(&tris);
+    let prims = Primitives::triangles(&tris);
     let config = TreeletConfig::default();
     let lbvh = sah_cost(&build(&mut CpuBackend::new(), &tris, None).nodes, SahCosts::KARRAS_AILA);
     let c = build(&mut CpuBackend::new(), &tris, Some(&config));

@@ -4,8 +4,26 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
 use treelet::render::{render, Accel, RenderSettings};
-use treelet::scene::{cornell, random_scene, Scene};
+use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
+use treelet_core::triangle::Triangle;
 use treelet_tests::gpu;
+
+/// A small closed mesh (an octahedron with each face split into four),
+/// standing in smallpt's room.
+fn mesh() -> Scene {
+    let v = [[1.0f32, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let faces = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    let mid = |a: [f32; 3], b: [f32; 3]| [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5);
+    let mut tris = Vec::new();
+    for f in faces {
+        let (a, b, c) = (v[f[0]], v[f[1]], v[f[2]]);
+        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+        for t in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+            tris.push(Triangle::new(t[0], t[1], t[2]));
+        }
+    }
+    mesh_scene("octahedron", &tris)
+}
 
 fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> RenderSettings {
     RenderSettings { width, height, spp, seed, accel }
@@ -25,7 +43,11 @@ fn mismatch_fraction(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> f64 {
 fn gpu_render_matches_cpu() {
     let Some(ctx) = gpu() else { return };
     let seed = treelet_tests::fresh_seed() as u32;
-    for (scene, accel) in [(cornell(), Accel::None), (random_scene("random:300", 300, seed as u64), Accel::Lbvh)] {
+    for (scene, accel) in [
+        (cornell(), Accel::None),
+        (random_scene("random:300", 300, seed as u64), Accel::Lbvh),
+        (mesh(), Accel::Trbvh),
+    ] {
         let s = settings(48, 36, 16, seed, accel);
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
         let c = pixels(&mut CpuBackend::new(), &scene, &s);
@@ -62,6 +84,14 @@ fn bvh_and_linear_scan_find_the_same_hits() {
     assert_eq!(mismatch_fraction(&none, &trbvh, 1e-6), 0.0, "optimized BVH traversal missed or invented hits");
     let sweep = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Sweep));
     assert_eq!(mismatch_fraction(&none, &sweep, 1e-6), 0.0, "sweep BVH traversal missed or invented hits");
+    // Triangles and spheres in one tree.
+    let scene = mesh();
+    let none = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::None));
+    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+        let tree = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, accel));
+        assert_eq!(mismatch_fraction(&none, &tree, 1e-6), 0.0, "{accel:?} traversal of a mesh missed or invented hits");
+    }
+    assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "NaN or negative pixels in the mesh scene");
 }
 
 #[test]
@@ -92,8 +122,7 @@ fn cornell_has_no_nan_and_no_black_speckles() {
             o,
             d.normalize(),
             treelet_core::traverse::Origin::NONE,
-            &scene.spheres,
-            scene.spheres.len() as u32,
+            &treelet_core::traverse::Prims::spheres(&scene.spheres),
         );
         let kind = scene.materials[hit.prim as usize].kind;
         assert_ne!(kind, treelet_core::layout::DIFFUSE, "black pixel {i} on diffuse sphere {}", hit.prim);

@@ -81,7 +81,8 @@ pub struct BuildParams {
     pub reduce_len: u32,
     /// 1 when the reduction reads primitive boxes and reduces their centroids.
     pub reduce_centroids: u32,
-    pub _pad0: u32,
+    /// How many of the `n` primitives are spheres (the rest are triangles).
+    pub spheres: u32,
     /// Centroid bounds of the scene (Morton quantization frame).
     pub frame: Aabb,
 }
@@ -183,7 +184,9 @@ pub struct RenderParams {
     pub seed: u32,
     /// Number of spheres.
     pub prims: u32,
-    pub _pad0: [u32; 2],
+    /// Number of triangles (primitives `prims..prims + triangles`).
+    pub triangles: u32,
+    pub _pad0: u32,
     pub camera: Camera,
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);

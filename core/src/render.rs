@@ -20,9 +20,9 @@
 //! Random numbers are counter-based ([`crate::rng`]).
 use glam::Vec3;
 
-use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
+use crate::layout::{Camera, Material, Node, RenderParams, DIFFUSE, MIRROR};
 use crate::rng::BounceRng;
-use crate::traverse::{closest_hit_bvh, closest_hit_linear, Origin};
+use crate::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
@@ -113,7 +113,8 @@ pub const ACCEL_BVH: u32 = 1;
 
 /// Scene buffers of a render.
 pub struct SceneRefs<'a> {
-    pub spheres: &'a [Sphere],
+    /// Spheres then triangles; one material per primitive, in that order.
+    pub prims: Prims<'a>,
     pub materials: &'a [Material],
     pub nodes: &'a [Node],
     pub prim_indices: &'a [u32],
@@ -135,17 +136,23 @@ pub fn radiance<const ACCEL: u32>(
     let mut from = Origin::NONE;
     while depth < MAX_BOUNCES {
         let hit = if ACCEL == ACCEL_BVH {
-            closest_hit_bvh(o, d, from, scene.spheres, params.prims, scene.nodes, scene.prim_indices)
+            closest_hit_bvh(o, d, from, &scene.prims, scene.nodes, scene.prim_indices)
         } else {
-            closest_hit_linear(o, d, from, scene.spheres, params.prims)
+            closest_hit_linear(o, d, from, &scene.prims)
         };
         if !hit.is_hit() {
             break;
         }
-        let sphere = scene.spheres[hit.prim as usize];
         let m = scene.materials[hit.prim as usize];
         let x = o + d * hit.t;
-        let n = (x - Vec3::from_array(sphere.center)).normalize();
+        let n = if hit.prim < scene.prims.sphere_count {
+            (x - Vec3::from_array(scene.prims.spheres[hit.prim as usize].center)).normalize()
+        } else {
+            // A triangle's geometric normal; its winding decides "into" for glass.
+            let t = scene.prims.triangles[(hit.prim - scene.prims.sphere_count) as usize];
+            let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
+            (b - a).cross(c - a).normalize_or(-d)
+        };
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         result += throughput * Vec3::from_array(m.emission);
@@ -278,14 +285,14 @@ mod tests {
             let eye = Vec3::new(50.0, 40.0, 150.0);
             let aim = Vec3::new(1.0 + 98.0 * r.uniform(5), 81.6 * r.uniform(6), 170.0 * r.uniform(7));
             let d = (aim - eye).normalize();
-            let hit = closest_hit_linear(eye, d, Origin::NONE, &walls, walls.len() as u32);
+            let hit = closest_hit_linear(eye, d, Origin::NONE, &Prims::spheres(&walls));
             assert!(hit.is_hit());
             let x = eye + d * hit.t;
             let n = (x - Vec3::from_array(walls[hit.prim as usize].center)).normalize();
             let nl = if n.dot(d) < 0.0 { n } else { -n };
             let d2 = cosine_direction(nl, r.uniform(1), r.uniform(2));
             let from = Origin { prim: hit.prim, into: d2.dot(n) < 0.0 };
-            let next = closest_hit_linear(x + nl * surface_offset(x), d2, from, &walls, walls.len() as u32);
+            let next = closest_hit_linear(x + nl * surface_offset(x), d2, from, &Prims::spheres(&walls));
             // Hitting the same wall again is only possible at its far side.
             assert!(next.prim != hit.prim || next.t > 1e3, "bounce {i} hit its own wall {} away", next.t);
         }

@@ -19,16 +19,19 @@ impl Sphere {
     }
 }
 
-/// Kernel: the box of sphere `id`.
-pub fn sphere_boxes_kernel(id: u32, n: u32, spheres: &[Sphere], boxes: &mut [Aabb]) {
-    if id < n {
-        boxes[id as usize] = spheres[id as usize].aabb();
-    }
-}
-
-/// Kernel: the box of triangle `id`.
-pub fn triangle_boxes_kernel(id: u32, n: u32, triangles: &[Triangle], boxes: &mut [Aabb]) {
-    if id < n {
-        boxes[id as usize] = triangles[id as usize].aabb();
+/// Kernel: the box of primitive `id`: sphere `id` below `spheres`, else
+/// triangle `id - spheres`.
+pub fn primitive_boxes_kernel(
+    id: u32,
+    n: u32,
+    spheres: u32,
+    sphere_data: &[Sphere],
+    triangles: &[Triangle],
+    boxes: &mut [Aabb],
+) {
+    if id < spheres {
+        boxes[id as usize] = sphere_data[id as usize].aabb();
+    } else if id < n {
+        boxes[id as usize] = triangles[(id - spheres) as usize].aabb();
     }
 }

@@ -1,8 +1,45 @@
-//! Closest hit: by scanning every sphere, or through a BVH with a stack.
+//! Closest hit: by scanning every primitive, or through a BVH with a stack.
+//! Primitives are spheres then triangles: index `i < sphere_count` is
+//! sphere `i`, a larger one triangle `i - sphere_count`.
 use glam::Vec3;
 
 use crate::intersect::{ray_box, ray_sphere_mode, safe_inverse, MISS};
 use crate::layout::{Node, Sphere};
+use crate::triangle::{ray_triangle, Triangle, WatertightRay};
+
+/// The primitives rays are traced against (counts given apart from the
+/// slices, which on a GPU may be longer than their content).
+pub struct Prims<'a> {
+    pub spheres: &'a [Sphere],
+    pub sphere_count: u32,
+    pub triangles: &'a [Triangle],
+    pub triangle_count: u32,
+}
+
+impl<'a> Prims<'a> {
+    /// Spheres only.
+    #[cfg(not(target_arch = "spirv"))]
+    pub fn spheres(spheres: &'a [Sphere]) -> Self {
+        Prims { spheres, sphere_count: spheres.len() as u32, triangles: &[], triangle_count: 0 }
+    }
+
+    #[inline]
+    pub fn count(&self) -> u32 {
+        self.sphere_count + self.triangle_count
+    }
+
+    /// Distance along the ray to primitive `prim`, below `t_max`, honouring the start surface.
+    #[inline]
+    fn distance(&self, o: Vec3, d: Vec3, ray: &WatertightRay, from: Origin, prim: u32, t_max: f32) -> f32 {
+        if prim < self.sphere_count {
+            from.distance(o, d, &self.spheres[prim as usize], prim)
+        } else if prim == from.prim {
+            MISS // a flat triangle cannot be hit again by a ray leaving it
+        } else {
+            ray_triangle(ray, &self.triangles[(prim - self.sphere_count) as usize], t_max)
+        }
+    }
+}
 
 /// Depth of the traversal stack. A tree deeper than this (possible for a
 /// radix tree over pathological keys) would skip subtrees, so the host
@@ -49,23 +86,24 @@ impl Origin {
     }
 }
 
-/// Tests every sphere.
+/// Tests every primitive.
 ///
 /// ```
 /// use glam::Vec3;
-/// use treelet_core::traverse::{closest_hit_linear, Origin};
+/// use treelet_core::traverse::{closest_hit_linear, Origin, Prims};
 /// use treelet_core::Sphere;
 /// let spheres = [Sphere::new([5.0, 0.0, 0.0], 1.0), Sphere::new([3.0, 0.0, 0.0], 1.0)];
-/// let hit = closest_hit_linear(Vec3::ZERO, Vec3::X, Origin::NONE, &spheres, 2);
+/// let hit = closest_hit_linear(Vec3::ZERO, Vec3::X, Origin::NONE, &Prims::spheres(&spheres));
 /// assert_eq!((hit.prim, hit.t), (1, 2.0));
 /// ```
 #[inline]
-pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, spheres: &[Sphere], count: u32) -> Hit {
+pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
     let mut hit = Hit::NONE;
+    let ray = WatertightRay::new(o, d);
     let mut i = 0;
+    let count = prims.count();
     while i < count {
-        let s = spheres[i as usize];
-        let t = from.distance(o, d, &s, i);
+        let t = prims.distance(o, d, &ray, from, i, hit.t);
         if t < hit.t {
             hit = Hit { t, prim: i };
         }
@@ -77,20 +115,13 @@ pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, spheres: &[Sphere], co
 /// Walks the BVH rooted at node 0 (`2 * count - 1` nodes), nearest child
 /// first, pruning boxes beyond the closest hit so far.
 #[inline]
-pub fn closest_hit_bvh(
-    o: Vec3,
-    d: Vec3,
-    from: Origin,
-    spheres: &[Sphere],
-    count: u32,
-    nodes: &[Node],
-    prim_indices: &[u32],
-) -> Hit {
+pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
     let mut hit = Hit::NONE;
-    if count == 0 {
+    if prims.count() == 0 {
         return hit;
     }
     let inv_d = safe_inverse(d);
+    let ray = WatertightRay::new(o, d);
     let mut stack = [0u32; STACK_DEPTH];
     let mut top = 1usize; // stack[0] = root
     while top > 0 {
@@ -103,8 +134,7 @@ pub fn closest_hit_bvh(
             let mut k = 0;
             while k < node.prim_count() {
                 let prim = prim_indices[(node.left + k) as usize];
-                let s = spheres[prim as usize];
-                let t = from.distance(o, d, &s, prim);
+                let t = prims.distance(o, d, &ray, from, prim, hit.t);
                 if t < hit.t {
                     hit = Hit { t, prim };
                 }

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use treelet::cpu_runner::CpuBackend;
 use treelet::lbvh;
-use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Origin};
+use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
 use treelet_core::Sphere;
 
 fn main() -> anyhow::Result<()> {
@@ -26,9 +26,9 @@ fn main() -> anyhow::Result<()> {
     let origin = Vec3::new(-10.0, 28.5, 28.5);
     for k in 0..5 {
         let dir = Vec3::new(1.0, 0.05 * k as f32 - 0.1, 0.03 * k as f32).normalize();
-        let n = spheres.len() as u32;
-        let hit = closest_hit_bvh(origin, dir, Origin::NONE, &spheres, n, &bvh.nodes, &bvh.prim_indices);
-        let check = closest_hit_linear(origin, dir, Origin::NONE, &spheres, n);
+        let prims = Prims::spheres(&spheres);
+        let hit = closest_hit_bvh(origin, dir, Origin::NONE, &prims, &bvh.nodes, &bvh.prim_indices);
+        let check = closest_hit_linear(origin, dir, Origin::NONE, &prims);
         assert_eq!(hit.prim, check.prim);
         if hit.is_hit() {
             println!("ray {k}: sphere {} at distance {:.4}", hit.prim, hit.t);

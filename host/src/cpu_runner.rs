@@ -128,18 +128,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 fill::fill_kernel(id, &p, data);
             }
         }
-        (Kernel::SphereBoxes, [p, spheres, boxes]) => {
+        (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (spheres, boxes) = (view(spheres), view(boxes));
+            let (spheres, triangles, boxes) = (view(spheres), view(triangles), view(boxes));
             for id in ids(groups) {
-                scene::sphere_boxes_kernel(id, p.n, spheres, boxes);
-            }
-        }
-        (Kernel::TriangleBoxes, [p, triangles, boxes]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (triangles, boxes) = (view(triangles), view(boxes));
-            for id in ids(groups) {
-                scene::triangle_boxes_kernel(id, p.n, triangles, boxes);
+                scene::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
             }
         }
         (Kernel::ReduceBounds, [p, input, output]) => {
@@ -311,11 +304,16 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 treelet::treelet_commit_kernel(id, &p, records, solutions, nodes, parents, counts, costs);
             }
         }
-        (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum]) => {
+        (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum, triangles]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.
             let p: treelet_core::RenderParams = params(p);
             let scene = SceneRefs {
-                spheres: view(spheres),
+                prims: treelet_core::traverse::Prims {
+                    spheres: view(spheres),
+                    sphere_count: p.prims,
+                    triangles: view(triangles),
+                    triangle_count: p.triangles,
+                },
                 materials: view(materials),
                 nodes: view(nodes),
                 prim_indices: view(prims),

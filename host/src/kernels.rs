@@ -14,8 +14,7 @@ use Access::{Read, ReadWrite};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Kernel {
     Fill,
-    SphereBoxes,
-    TriangleBoxes,
+    PrimitiveBoxes,
     ReduceBounds,
     Morton,
     SortHistogram,
@@ -50,10 +49,9 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 23] = [
+    pub const ALL: [Kernel; 22] = [
         Kernel::Fill,
-        Kernel::SphereBoxes,
-        Kernel::TriangleBoxes,
+        Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
         Kernel::Morton,
         Kernel::SortHistogram,
@@ -80,8 +78,7 @@ impl Kernel {
     pub fn entry_point(self) -> &'static str {
         match self {
             Kernel::Fill => "fill::fill_cs",
-            Kernel::SphereBoxes => "scene::sphere_boxes_cs",
-            Kernel::TriangleBoxes => "scene::triangle_boxes_cs",
+            Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
@@ -109,7 +106,7 @@ impl Kernel {
     pub fn bindings(self) -> &'static [Access] {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
-            Kernel::SphereBoxes | Kernel::TriangleBoxes => &[Read, Read, ReadWrite],
+            Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
@@ -128,7 +125,7 @@ impl Kernel {
             Kernel::TreeletSolve => &[Read, Read, ReadWrite],
             Kernel::TreeletCommit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite, Read],
         }
     }
 }

@@ -70,7 +70,7 @@ pub fn build<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Bvh, StageTim
 
 /// Builds the LBVH of `spheres` on `b` and leaves it there.
 pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(DeviceBvh<B>, StageTimes)> {
-    build_primitives_on_device(b, Primitives::Spheres(spheres))
+    build_primitives_on_device(b, Primitives::spheres(spheres))
 }
 
 /// Builds the LBVH of spheres or triangles on `b` and leaves it there.
@@ -102,13 +102,12 @@ pub fn build_primitives_on_device<B: Backend>(
 
     b.stage("bounds");
     let mut params = BuildParams { n, ..Default::default() };
-    let (kernel, input) = match prims {
-        Primitives::Spheres(s) => (Kernel::SphereBoxes, b.upload("spheres", s)?),
-        Primitives::Triangles(t) => (Kernel::TriangleBoxes, b.upload("triangles", t)?),
-    };
+    params.spheres = prims.spheres.len() as u32;
+    let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
+    let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
-    b.dispatch(kernel, &[&p, &input, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &spheres, &triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
     // Reduce centroids, then partial boxes, until one box remains.
     let (mut input, mut len, mut centroids) = (boxes.clone(), n, 1);
     let centroid_bounds = loop {
@@ -146,6 +145,20 @@ pub fn build_primitives_on_device<B: Backend>(
     let times = b.take_times()?;
     let node_count = node_count as u32;
     Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
+}
+
+/// `data` on the device, or one zeroed element where it is empty (a
+/// binding needs a buffer; the kernels never read past their counts).
+pub fn upload_or_placeholder<B: Backend, T: bytemuck::Pod>(
+    b: &mut B,
+    label: &'static str,
+    data: &[T],
+) -> Result<B::Buffer> {
+    if data.is_empty() {
+        b.upload(label, &[T::zeroed()])
+    } else {
+        b.upload(label, data)
+    }
 }
 
 /// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.

@@ -22,7 +22,7 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
     if triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());
     }
-    Primitives::Triangles(&triangles).check().with_context(|| format!("{}", path.display()))?;
+    Primitives::triangles(&triangles).check().with_context(|| format!("{}", path.display()))?;
     Ok(triangles)
 }
 

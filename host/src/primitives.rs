@@ -1,21 +1,28 @@
-//! What a BVH is built over: spheres or triangles.
+//! What a BVH is built over: spheres and triangles, in one index space
+//! (spheres first, then triangles), as the kernels see them.
 use anyhow::{bail, Result};
 use treelet_core::triangle::Triangle;
 use treelet_core::{Aabb, Sphere};
 
-/// The primitives of one build (one kind per tree, for now).
+/// The primitives of one build: primitive `i` is sphere `i` below
+/// `spheres.len()`, else triangle `i - spheres.len()`.
 #[derive(Clone, Copy, Debug)]
-pub enum Primitives<'a> {
-    Spheres(&'a [Sphere]),
-    Triangles(&'a [Triangle]),
+pub struct Primitives<'a> {
+    pub spheres: &'a [Sphere],
+    pub triangles: &'a [Triangle],
 }
 
-impl Primitives<'_> {
+impl<'a> Primitives<'a> {
+    pub fn spheres(spheres: &'a [Sphere]) -> Self {
+        Primitives { spheres, triangles: &[] }
+    }
+
+    pub fn triangles(triangles: &'a [Triangle]) -> Self {
+        Primitives { spheres: &[], triangles }
+    }
+
     pub fn len(&self) -> usize {
-        match self {
-            Primitives::Spheres(s) => s.len(),
-            Primitives::Triangles(t) => t.len(),
-        }
+        self.spheres.len() + self.triangles.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -24,39 +31,29 @@ impl Primitives<'_> {
 
     /// (spheres, triangles): what a build report counts.
     pub fn counts(&self) -> (usize, usize) {
-        match self {
-            Primitives::Spheres(s) => (s.len(), 0),
-            Primitives::Triangles(t) => (0, t.len()),
-        }
+        (self.spheres.len(), self.triangles.len())
     }
 
     /// Each primitive's box, on the host (the CPU reference builder's input).
     pub fn boxes(&self) -> Vec<Aabb> {
-        match self {
-            Primitives::Spheres(s) => s.iter().map(|s| s.aabb()).collect(),
-            Primitives::Triangles(t) => t.iter().map(|t| t.aabb()).collect(),
-        }
+        self.spheres.iter().map(|s| s.aabb()).chain(self.triangles.iter().map(|t| t.aabb())).collect()
     }
 
     /// Rejects what no build can take: NaN or infinite coordinates, negative
     /// or overflowing radii, boxes whose extent overflows f32. Names the
     /// first bad primitive.
     pub fn check(&self) -> Result<()> {
-        match self {
-            Primitives::Spheres(s) => crate::scene::validate_spheres(s),
-            Primitives::Triangles(tris) => {
-                for (i, t) in tris.iter().enumerate() {
-                    for (k, v) in [t.v0, t.v1, t.v2].iter().enumerate() {
-                        if v.iter().any(|x| !x.is_finite()) {
-                            bail!("triangle {i}: vertex {k} {v:?} is not finite");
-                        }
-                    }
-                    if !t.aabb().extent().is_finite() {
-                        bail!("triangle {i}: its extent overflows f32");
-                    }
+        crate::scene::validate_spheres(self.spheres)?;
+        for (i, t) in self.triangles.iter().enumerate() {
+            for (k, v) in [t.v0, t.v1, t.v2].iter().enumerate() {
+                if v.iter().any(|x| !x.is_finite()) {
+                    bail!("triangle {i}: vertex {k} {v:?} is not finite");
                 }
-                Ok(())
+            }
+            if !t.aabb().extent().is_finite() {
+                bail!("triangle {i}: its extent overflows f32");
             }
         }
+        Ok(())
     }
 }

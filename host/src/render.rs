@@ -14,7 +14,8 @@ use crate::backend::Backend;
 use crate::image_io::HdrImage;
 use crate::kernels::Kernel;
 use crate::lbvh;
-use crate::scene::{validate_spheres, Scene};
+use crate::scene::Scene;
+use crate::primitives::Primitives;
 use crate::trbvh::{self, TreeletConfig};
 
 /// How closest hits are found.
@@ -108,16 +109,18 @@ pub fn render<B: Backend>(
             bail!("reference image is {}x{}, the render {width}x{height}", r.width, r.height);
         }
     }
-    if !scene.triangles.is_empty() {
-        bail!("{}: triangle meshes can be built (`treelet build`) but not rendered yet", scene.name);
+    // Everything the render traces: spheres (the room included), then triangles.
+    let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+    all.check()?;
+    if scene.materials.len() != all.len() {
+        bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
     }
-    validate_spheres(&scene.spheres)?;
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;
 
     let (nodes, prim_indices, build_ms) = match accel {
         Accel::Lbvh | Accel::Trbvh => {
-            let (mut bvh, times) = lbvh::build_on_device(b, &scene.spheres)?;
+            let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
             let mut build_ms = times.total();
             if accel == Accel::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
@@ -133,7 +136,7 @@ pub fn render<B: Backend>(
         }
         Accel::Sweep => {
             let build = Instant::now();
-            let bvh = crate::sweep::build_collapsed(&scene.spheres, TreeletConfig::default().max_leaf)?;
+            let bvh = crate::sweep::build_collapsed_boxes(&all.boxes(), TreeletConfig::default().max_leaf)?;
             let build_ms = build.elapsed().as_secs_f64() * 1e3;
             let depth = tree_depth(&bvh.nodes);
             if depth + 1 > STACK_DEPTH {
@@ -143,7 +146,8 @@ pub fn render<B: Backend>(
         }
         Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
     };
-    let spheres = b.upload("spheres", &scene.spheres)?;
+    let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
+    let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
     let materials = b.upload("materials", &scene.materials)?;
     let accum = b.zeroed("accumulation", pixels * 16)?;
     let camera = scene.camera.camera(width, height);
@@ -161,12 +165,22 @@ pub fn render<B: Backend>(
         b.stage("render");
         while done < target {
             let samples = (target - done).min(per_dispatch);
-            let params =
-                RenderParams { width, height, samples, first_sample: done, seed, prims, camera, ..Default::default() };
+            let triangles_n = scene.triangles.len() as u32;
+            let params = RenderParams {
+                width,
+                height,
+                samples,
+                first_sample: done,
+                seed,
+                prims,
+                triangles: triangles_n,
+                camera,
+                ..Default::default()
+            };
             let p = b.upload("render params", &[params])?;
             b.dispatch(
                 kernel,
-                &[&p, &spheres, &materials, &nodes, &prim_indices, &accum],
+                &[&p, &spheres, &materials, &nodes, &prim_indices, &accum, &triangles],
                 groups_for(pixels as u32, WORKGROUP_SIZE),
             );
             done += samples;

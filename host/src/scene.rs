@@ -89,6 +89,23 @@ pub fn cornell() -> Scene {
     Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
 }
 
+/// A mesh alone in smallpt's room, under its light and camera: scaled to fit
+/// a 60-unit cube, centred in the room and standing on the floor, in a
+/// light diffuse grey. (`treelet build` builds over the triangles alone.)
+pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
+    let bounds = mesh.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
+    let size = bounds.extent().max_element();
+    let scale = if size > 0.0 { 60.0 / size } else { 1.0 };
+    let (lo, hi) = (bounds.lo(), bounds.hi());
+    let shift = Vec3::new(50.0, 0.0, 80.0) - Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5) * scale;
+    let place = |v: [f32; 3]| (Vec3::from_array(v) * scale + shift).to_array();
+    let triangles: Vec<Triangle> = mesh.iter().map(|t| Triangle::new(place(t.v0), place(t.v1), place(t.v2))).collect();
+    let (spheres, mut materials): (Vec<_>, Vec<_>) = cornell_room().into_iter().unzip();
+    let room = spheres.len();
+    materials.extend(std::iter::repeat_n(diffuse([0.8, 0.78, 0.72]), triangles.len()));
+    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, triangles }
+}
+
 /// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
 /// the light last.
 pub fn cornell_room() -> Vec<(Sphere, Material)> {
@@ -113,9 +130,9 @@ impl Scene {
     /// What `treelet build` builds over: a mesh's triangles, or the objects.
     pub fn primitives(&self) -> Primitives<'_> {
         if self.triangles.is_empty() {
-            Primitives::Spheres(self.objects())
+            Primitives::spheres(self.objects())
         } else {
-            Primitives::Triangles(&self.triangles)
+            Primitives::triangles(&self.triangles)
         }
     }
 
@@ -131,14 +148,7 @@ impl Scene {
         let lower = spec.to_ascii_lowercase();
         if lower.ends_with(".obj") || lower.ends_with(".ply") {
             let triangles = crate::mesh::load(std::path::Path::new(spec))?;
-            return Ok(Scene {
-                name: spec.into(),
-                spheres: Vec::new(),
-                materials: Vec::new(),
-                room: 0,
-                camera: CameraSpec::SMALLPT,
-                triangles,
-            });
+            return Ok(mesh_scene(spec, &triangles));
         }
         let mut parts = spec.split(':');
         match parts.next() {

@@ -47,14 +47,14 @@ fn encloses(outer_lo: &[f32; 3], outer_hi: &[f32; 3], lo: &[f32; 3], hi: &[f32; 
 /// internal box contains its children's boxes; each leaf box contains its
 /// primitives; the root box contains the whole scene.
 pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
-    validate_primitives(Primitives::Spheres(spheres), nodes, parents, prim_indices)
+    validate_primitives(Primitives::spheres(spheres), nodes, parents, prim_indices)
 }
 
 /// [`validate`] for any primitives (boxes recomputed here, not by the builder's code).
 pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
-    let prim_box = |p: usize| match prims {
-        Primitives::Spheres(s) => sphere_box(&s[p]),
-        Primitives::Triangles(t) => triangle_box(&t[p]),
+    let prim_box = |p: usize| match p.checked_sub(prims.spheres.len()) {
+        None => sphere_box(&prims.spheres[p]),
+        Some(t) => triangle_box(&prims.triangles[t]),
     };
     let mut v = Validation::default();
     let mut err = |e: String| {

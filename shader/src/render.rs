@@ -2,9 +2,11 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::layout::{Material, Node, RenderParams, Sphere};
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
+use treelet_core::traverse::Prims;
+use treelet_core::triangle::Triangle;
 use treelet_core::workgroup::linear_id;
 
-/// Path tracing with a linear scan over all spheres.
+/// Path tracing with a linear scan over all primitives.
 #[spirv(compute(threads(256)))]
 pub fn render_linear_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -15,10 +17,13 @@ pub fn render_linear_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     if id < params.width * params.height {
-        let scene = SceneRefs { spheres, materials, nodes, prim_indices };
+        let prims =
+            Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
+        let scene = SceneRefs { prims, materials, nodes, prim_indices };
         accumulate(&mut accum[id as usize], render_pixel::<ACCEL_NONE>(id, params, &scene));
     }
 }
@@ -34,10 +39,13 @@ pub fn render_bvh_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     if id < params.width * params.height {
-        let scene = SceneRefs { spheres, materials, nodes, prim_indices };
+        let prims =
+            Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
+        let scene = SceneRefs { prims, materials, nodes, prim_indices };
         accumulate(&mut accum[id as usize], render_pixel::<ACCEL_BVH>(id, params, &scene));
     }
 }

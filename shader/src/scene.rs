@@ -6,25 +6,14 @@ use treelet_core::triangle::Triangle;
 use treelet_core::{Aabb, Sphere};
 
 #[spirv(compute(threads(256)))]
-pub fn sphere_boxes_cs(
+pub fn primitive_boxes_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] boxes: &mut [Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] boxes: &mut [Aabb],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::scene::sphere_boxes_kernel(id, params.n, spheres, boxes);
-}
-
-#[spirv(compute(threads(256)))]
-pub fn triangle_boxes_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] boxes: &mut [Aabb],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::scene::triangle_boxes_kernel(id, params.n, triangles, boxes);
+    treelet_core::scene::primitive_boxes_kernel(id, params.n, params.spheres, spheres, triangles, boxes);
 }
