@@ -127,13 +127,10 @@ impl Scene {
         &self.spheres[..self.spheres.len() - self.room]
     }
 
-    /// What `treelet build` builds over: a mesh's triangles, or the objects.
+    /// What `treelet build` builds over: the objects (spheres but the room)
+    /// and the triangles.
     pub fn primitives(&self) -> Primitives<'_> {
-        if self.triangles.is_empty() {
-            Primitives::spheres(self.objects())
-        } else {
-            Primitives::triangles(&self.triangles)
-        }
+        Primitives { spheres: self.objects(), triangles: &self.triangles }
     }
 
     /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON

@@ -1,4 +1,4 @@
-//! JSON scene files: spheres, named materials and a camera.
+//! JSON scene files: spheres, triangle meshes, named materials and a camera.
 //!
 //! ```json
 //! {
@@ -10,10 +10,17 @@
 //!   },
 //!   "spheres": [
 //!     { "center": [50, 1e5, 81.6], "radius": 1e5, "material": "white" }
+//!   ],
+//!   "meshes": [
+//!     { "path": "pyramid.obj", "material": "glass",
+//!       "scale": [20, 20, 20], "rotate": [0, 30, 0], "translate": [60, 0, 90] }
 //!   ]
 //! }
 //! ```
-//! `scenes/cornell.json` in the repository is smallpt's scene in this form.
+//! A mesh (`.obj` or `.ply`, its path relative to the scene file) is scaled,
+//! then rotated about x, y and z (degrees, in that order), then translated;
+//! all three are optional. `scenes/cornell.json` in the repository is
+//! smallpt's scene in this form, `scenes/cornell_mesh.json` adds a mesh.
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -28,7 +35,36 @@ use crate::scene::{CameraSpec, Scene};
 struct SceneFile {
     camera: CameraSpec,
     materials: BTreeMap<String, MaterialSpec>,
+    #[serde(default)]
     spheres: Vec<SphereSpec>,
+    #[serde(default)]
+    meshes: Vec<MeshSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshSpec {
+    path: String,
+    material: String,
+    #[serde(default = "unit_scale")]
+    scale: [f32; 3],
+    #[serde(default)]
+    rotate: [f32; 3],
+    #[serde(default)]
+    translate: [f32; 3],
+}
+
+fn unit_scale() -> [f32; 3] {
+    [1.0; 3]
+}
+
+impl MeshSpec {
+    /// Scale, rotate (x, then y, then z; degrees), translate.
+    fn transform(&self) -> glam::Affine3A {
+        let r = self.rotate.map(f32::to_radians);
+        let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, r[2], r[1], r[0]);
+        glam::Affine3A::from_scale_rotation_translation(self.scale.into(), rotation, self.translate.into())
+    }
 }
 
 #[derive(Deserialize)]
@@ -67,11 +103,17 @@ struct SphereSpec {
 /// sphere or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
-    parse(&text, &path.display().to_string())
+    parse_in(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 
-/// Parses scene-file text; `name` labels errors and the scene.
+/// Parses scene-file text; `name` labels errors and the scene; mesh paths
+/// are relative to the current directory.
 pub fn parse(text: &str, name: &str) -> Result<Scene> {
+    parse_in(text, name, Path::new("."))
+}
+
+/// Parses scene-file text whose mesh paths are relative to `dir`.
+pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
     let file: SceneFile = serde_json::from_str(text)
         .map_err(|e| anyhow::anyhow!("scene file {name}: line {}, column {}: {e}", e.line(), e.column()))?;
     let mut materials = BTreeMap::new();
@@ -94,8 +136,8 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
         let ior = if kind == GLASS { m.ior } else { 0.0 }; // meaningful for glass alone
         materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior });
     }
-    if file.spheres.is_empty() {
-        bail!("scene file {name}: no spheres");
+    if file.spheres.is_empty() && file.meshes.is_empty() {
+        bail!("scene file {name}: no spheres and no meshes");
     }
     let mut spheres = Vec::with_capacity(file.spheres.len());
     let mut sphere_materials = Vec::with_capacity(file.spheres.len());
@@ -107,6 +149,24 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
         sphere_materials.push(*m);
     }
     crate::scene::validate_spheres(&spheres).with_context(|| format!("scene file {name}"))?;
+    let mut triangles = Vec::new();
+    let mut triangle_materials = Vec::new();
+    for (i, mesh) in file.meshes.iter().enumerate() {
+        let m = materials
+            .get(&mesh.material)
+            .with_context(|| format!("scene file {name}: mesh {i} uses unknown material `{}`", mesh.material))?;
+        if mesh.scale.iter().chain(&mesh.rotate).chain(&mesh.translate).any(|v| !v.is_finite()) {
+            bail!("scene file {name}: mesh {i} has a non-finite transform");
+        }
+        let loaded = crate::mesh::load(&dir.join(&mesh.path)).with_context(|| format!("scene file {name}: mesh {i}"))?;
+        let xf = mesh.transform();
+        let place = |v: [f32; 3]| xf.transform_point3(v.into()).to_array();
+        triangle_materials.extend(std::iter::repeat_n(*m, loaded.len()));
+        triangles.extend(loaded.iter().map(|t| treelet_core::triangle::Triangle::new(place(t.v0), place(t.v1), place(t.v2))));
+    }
+    crate::primitives::Primitives::triangles(&triangles)
+        .check()
+        .with_context(|| format!("scene file {name}: after the mesh transforms"))?;
     let c = &file.camera;
     if c.origin.iter().chain(&c.direction).chain([&c.near, &c.fov]).any(|v| !v.is_finite())
         || c.direction.iter().all(|&v| v == 0.0)
@@ -114,14 +174,9 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
     {
         bail!("scene file {name}: the camera needs a finite origin, a non-zero direction and a positive fov");
     }
-    Ok(Scene {
-        name: name.into(),
-        spheres,
-        materials: sphere_materials,
-        room: 0,
-        camera: file.camera,
-        triangles: Vec::new(),
-    })
+    let mut materials = sphere_materials;
+    materials.extend(triangle_materials);
+    Ok(Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles })
 }
 
 #[cfg(test)]
@@ -148,6 +203,35 @@ mod tests {
             parse(r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {}, "spheres": []}"#, "z.json")
                 .unwrap_err()
                 .to_string();
-        assert!(e.contains("no spheres"), "{e}");
+        assert!(e.contains("no spheres and no meshes"), "{e}");
+    }
+
+    #[test]
+    fn meshes_are_loaded_relative_to_the_file_and_transformed() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell_mesh.json");
+        let scene = load(Path::new(path)).unwrap();
+        assert_eq!((scene.spheres.len(), scene.triangles.len()), (8, 6));
+        assert_eq!(scene.materials.len(), 14);
+        assert!(scene.materials[8..].iter().all(|m| m.kind == GLASS));
+        // The unit pyramid scaled by 30 and stood at (68, 0, 80): apex at y = 30.
+        let top = scene.triangles.iter().flat_map(|t| [t.v0, t.v1, t.v2]).fold(f32::MIN, |a, v| a.max(v[1]));
+        assert!((top - 30.0).abs() < 1e-4, "apex at {top}");
+        let bottom = scene.triangles.iter().flat_map(|t| [t.v0, t.v1, t.v2]).fold(f32::MAX, |a, v| a.min(v[1]));
+        assert!(bottom.abs() < 1e-4, "base at {bottom}");
+    }
+
+    #[test]
+    fn mesh_errors_name_the_mesh() {
+        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes"));
+        let base = r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "meshes": ["#;
+        let case = |mesh: &str| parse_in(&format!("{base}{mesh}]}}"), "m.json", dir).unwrap_err();
+        let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "gold"}"#));
+        assert!(e.contains("mesh 0 uses unknown material `gold`"), "{e}");
+        let e = format!("{:#}", case(r#"{"path": "missing.obj", "material": "w"}"#));
+        assert!(e.contains("mesh 0") && e.contains("missing.obj"), "{e}");
+        let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "w", "scale": [3e38, 3e38, 3e38], "translate": [3e38, 0, 0]}"#));
+        assert!(e.contains("after the mesh transforms"), "{e}");
+        let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "w", "spin": 3}"#));
+        assert!(e.contains("line 1") && e.contains("spin"), "{e}");
     }
 }
