@@ -143,3 +143,56 @@ fn render_rejects_bad_settings() {
     let e = render(&mut b, &scene, &settings(4, 4, 4, 0, Accel::None), Some(&reference), |_| {}).err().unwrap();
     assert!(e.to_string().contains("reference image is 3x3"), "{e}");
 }
+
+/// The ray-casting benchmark's kernel: primary and diffuse rays through the
+/// TRBVH of a mesh scene, GPU against the CPU run of the same kernel.
+#[test]
+fn cast_kernel_matches_cpu() {
+    use treelet::kernels::Kernel;
+    use treelet::lbvh::upload_or_placeholder;
+    use treelet::primitives::Primitives;
+    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
+    fn cast<B: Backend>(b: &mut B, scene: &Scene, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
+        let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+        let (nodes, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh).unwrap();
+        let spheres = upload_or_placeholder(b, "spheres", &scene.spheres).unwrap();
+        let triangles = upload_or_placeholder(b, "triangles", &scene.triangles).unwrap();
+        let materials = b.upload("materials", &scene.materials).unwrap();
+        let rays = b.zeroed("rays", (w * h) as u64 * 32).unwrap();
+        let base = treelet_core::RenderParams {
+            width: w,
+            height: h,
+            samples: 1,
+            seed: 3,
+            prims: scene.spheres.len() as u32,
+            triangles: scene.triangles.len() as u32,
+            camera: scene.camera.camera(w, h),
+            ..Default::default()
+        };
+        for mode in [CAST_PRIMARY, CAST_DIFFUSE] {
+            let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, ..base }]).unwrap();
+            let bindings = [&p, &spheres, &materials, &nodes, &prims, &rays, &triangles];
+            b.dispatch(Kernel::CastBvh, &bindings, (w * h).div_ceil(256));
+        }
+        b.read(&rays, (2 * w * h) as usize).unwrap()
+    }
+    let scene = mesh();
+    let c = cast(&mut CpuBackend::new(), &scene, (64, 48));
+    let hits = c.iter().step_by(2).filter(|r| r[3] > 0.0).count();
+    assert!(hits > 64 * 48 / 2, "only {hits} diffuse rays hit");
+    let Some(ctx) = gpu() else { return };
+    let g = cast(&mut GpuBackend::new(ctx), &scene, (64, 48));
+    // Lavapipe does not fuse its `Fma` (the wall intersection's error terms
+    // vanish), so hits on smallpt's 1e5-radius walls land up to ~0.02 units
+    // apart: positions and distances are compared with that allowance.
+    let near = |a: f32, b: f32, abs: f32, rel: f32| (a - b).abs() <= abs + rel * b.abs();
+    let same = |i: usize| {
+        let (go, co, gd, cd) = (g[i], c[i], g[i + 1], c[i + 1]);
+        (0..3).all(|k| near(go[k], co[k], 0.05, 1e-4) && near(gd[k], cd[k], 1e-3, 0.0))
+            && (go[3] > 0.0) == (co[3] > 0.0)
+            && near(go[3], co[3], 0.1, 1e-3)
+    };
+    let agree = (0..g.len()).step_by(2).filter(|&i| same(i)).count();
+    eprintln!("{agree} of {} pixels cast the same diffuse ray to the same hit", 64 * 48);
+    assert!(agree as f64 >= 0.95 * (64 * 48) as f64, "GPU and CPU casts differ: {agree} agree");
+}

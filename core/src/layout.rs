@@ -186,7 +186,8 @@ pub struct RenderParams {
     pub prims: u32,
     /// Number of triangles (primitives `prims..prims + triangles`).
     pub triangles: u32,
-    pub _pad0: u32,
+    /// Which rays [`crate::rays::cast_kernel`] casts (primary or diffuse).
+    pub cast_mode: u32,
     pub camera: Camera,
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);

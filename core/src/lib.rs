@@ -48,6 +48,7 @@ pub mod intersect;
 pub mod layout;
 pub mod morton;
 pub mod radix_tree;
+pub mod rays;
 pub mod render;
 pub mod rng;
 pub mod sah;

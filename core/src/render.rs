@@ -145,14 +145,7 @@ pub fn radiance<const ACCEL: u32>(
         }
         let m = scene.materials[hit.prim as usize];
         let x = o + d * hit.t;
-        let n = if hit.prim < scene.prims.sphere_count {
-            (x - Vec3::from_array(scene.prims.spheres[hit.prim as usize].center)).normalize()
-        } else {
-            // A triangle's geometric normal; its winding decides "into" for glass.
-            let t = scene.prims.triangles[(hit.prim - scene.prims.sphere_count) as usize];
-            let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
-            (b - a).cross(c - a).normalize_or(-d)
-        };
+        let n = hit_normal(&scene.prims, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         result += throughput * Vec3::from_array(m.emission);
@@ -217,6 +210,20 @@ pub fn radiance<const ACCEL: u32>(
 /// row), starting at sample `params.first_sample`. Returns the sum of their
 /// radiance (rgb) and the sum of their squared luminance (w), for
 /// [`accumulate`].
+/// The outward normal of primitive `prim` at its point `x` (hit along `d`):
+/// a sphere's radial direction, a triangle's geometric normal (its winding
+/// decides "into" for glass).
+#[inline]
+pub fn hit_normal(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
+    if prim < prims.sphere_count {
+        (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize()
+    } else {
+        let t = prims.triangles[(prim - prims.sphere_count) as usize];
+        let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
+        (b - a).cross(c - a).normalize_or(-d)
+    }
+}
+
 #[inline]
 pub fn render_pixel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &SceneRefs) -> [f32; 4] {
     let (w, h) = (params.width, params.height);

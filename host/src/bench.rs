@@ -42,6 +42,26 @@ pub enum BenchCommand {
         #[arg(long)]
         per_kernel: bool,
     },
+    /// Rays per second: one primary and one diffuse ray per pixel, cast alone
+    /// (no shading), through the chosen tree.
+    Rays {
+        /// Scene: cornell, random:N[:SEED], a .json scene, or an .obj/.ply mesh.
+        #[arg(long, default_value = "random:65536")]
+        scene: String,
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![Accel::Lbvh, Accel::Trbvh])]
+        accels: Vec<Accel>,
+        #[arg(long, default_value_t = 1024)]
+        width: u32,
+        #[arg(long, default_value_t = 768)]
+        height: u32,
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: Device,
+        /// Timed repeats (median reported), after one warm-up pass.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
     /// Render times at 1024x768 (--quick: 256x192): cornell against spp, and
     /// random:N at 4 spp with each closest-hit method.
     Render {
@@ -252,8 +272,128 @@ fn bench_sizes<B: Backend>(
     Ok(rows)
 }
 
+/// Primary and diffuse rays per second through one tree.
+#[derive(serde::Serialize)]
+struct RaysRow {
+    scene: String,
+    accel: Accel,
+    primitives: usize,
+    build_ms: f64,
+    primary_rays: u64,
+    diffuse_rays: u64,
+    primary_median_ms: f64,
+    diffuse_median_ms: f64,
+    primary_mrays_per_s: f64,
+    diffuse_mrays_per_s: f64,
+}
+
+fn bench_rays<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    accel: Accel,
+    (width, height): (u32, u32),
+    repeats: usize,
+) -> Result<RaysRow> {
+    use treelet::kernels::Kernel;
+    use treelet::primitives::Primitives;
+    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+    anyhow::ensure!(accel != Accel::None, "bench rays traces trees: pick lbvh, trbvh or sweep");
+    let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+    all.check()?;
+    let pixels = width as u64 * height as u64;
+    anyhow::ensure!(pixels > 0 && pixels <= u32::MAX as u64 / 4, "image size {width}x{height} out of range");
+    b.begin_build();
+    let (nodes, prim_indices, build_ms) = treelet::render::scene_tree(b, all, accel)?;
+    b.take_times()?;
+    let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
+    let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
+    let materials = b.upload("materials", &scene.materials)?;
+    let rays = b.zeroed("rays", pixels * 32)?;
+    let camera = scene.camera.camera(width, height);
+    let base = treelet_core::RenderParams {
+        width,
+        height,
+        samples: 1,
+        prims: scene.spheres.len() as u32,
+        triangles: scene.triangles.len() as u32,
+        camera,
+        ..Default::default()
+    };
+    let groups = groups_for(pixels as u32, WORKGROUP_SIZE);
+    let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
+    let mut diffuse_rays = 0;
+    for r in 0..=repeats {
+        for (stage, mode) in [("primary", CAST_PRIMARY), ("diffuse", CAST_DIFFUSE)] {
+            b.stage(stage);
+            let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
+            b.dispatch(Kernel::CastBvh, &[&p, &spheres, &materials, &nodes, &prim_indices, &rays, &triangles], groups);
+        }
+        let t = b.take_times()?;
+        if r == 0 {
+            // Warm-up; and count the diffuse rays (pixels whose camera ray hit).
+            let r: Vec<[f32; 4]> = b.read(&rays, 2 * pixels as usize)?;
+            diffuse_rays = r.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
+            continue;
+        }
+        primary.push(t.get("primary"));
+        diffuse.push(t.get("diffuse"));
+    }
+    let (p_ms, d_ms) = (median(primary), median(diffuse));
+    Ok(RaysRow {
+        scene: scene.name.clone(),
+        accel,
+        primitives: all.len(),
+        build_ms,
+        primary_rays: pixels,
+        diffuse_rays,
+        primary_median_ms: p_ms,
+        diffuse_median_ms: d_ms,
+        primary_mrays_per_s: pixels as f64 / p_ms / 1e3,
+        diffuse_mrays_per_s: diffuse_rays as f64 / d_ms / 1e3,
+    })
+}
+
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
+        BenchCommand::Rays { scene, accels, width, height, device, repeats, json } => {
+            let scene = Scene::from_spec(&scene)?;
+            let mut rows = Vec::new();
+            let adapter = match device {
+                Device::Gpu => {
+                    let mut b = GpuBackend::new(GpuContext::new()?);
+                    for &a in &accels {
+                        rows.push(bench_rays(&mut b, &scene, a, (width, height), repeats)?);
+                    }
+                    b.adapter()
+                }
+                Device::Cpu => {
+                    let mut b = CpuBackend::new();
+                    for &a in &accels {
+                        rows.push(bench_rays(&mut b, &scene, a, (width, height), repeats)?);
+                    }
+                    b.adapter()
+                }
+            };
+            println!("rays per second, {} ({} primitives), {width}x{height}, {adapter}, median of {repeats}", scene.name, rows.first().map_or(0, |r| r.primitives));
+            println!("{:>6}{:>12}{:>14}{:>14}{:>16}{:>16}", "accel", "build ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s");
+            for r in &rows {
+                println!(
+                    "{:>6}{:>12.3}{:>14.3}{:>14.3}{:>16.1}{:>16.1}",
+                    format!("{:?}", r.accel).to_lowercase(),
+                    r.build_ms,
+                    r.primary_median_ms,
+                    r.diffuse_median_ms,
+                    r.primary_mrays_per_s,
+                    r.diffuse_mrays_per_s
+                );
+            }
+            if let Some(path) = json {
+                let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
         BenchCommand::Render { device, quick, spp, sizes, accels, json } => {
             let sweep = RenderSweep {
                 quick,

@@ -304,6 +304,24 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 treelet::treelet_commit_kernel(id, &p, records, solutions, nodes, parents, counts, costs);
             }
         }
+        (Kernel::CastBvh, [p, spheres, materials, nodes, prims, rays, triangles]) => {
+            let p: treelet_core::RenderParams = params(p);
+            let scene = SceneRefs {
+                prims: treelet_core::traverse::Prims {
+                    spheres: view(spheres),
+                    sphere_count: p.prims,
+                    triangles: view(triangles),
+                    triangle_count: p.triangles,
+                },
+                materials: view(materials),
+                nodes: view(nodes),
+                prim_indices: view(prims),
+            };
+            let rays: &mut [[f32; 4]] = view(rays);
+            for id in ids(groups) {
+                treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, &p, &scene, rays);
+            }
+        }
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum, triangles]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.
             let p: treelet_core::RenderParams = params(p);

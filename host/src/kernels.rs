@@ -46,10 +46,12 @@ pub enum Kernel {
     RenderLinear,
     /// Path tracing, closest hit through the BVH.
     RenderBvh,
+    /// Ray-casting throughput through the BVH (primary or diffuse rays).
+    CastBvh,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 22] = [
+    pub const ALL: [Kernel; 23] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -72,6 +74,7 @@ impl Kernel {
         Kernel::Collapse,
         Kernel::RenderLinear,
         Kernel::RenderBvh,
+        Kernel::CastBvh,
     ];
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
@@ -99,6 +102,7 @@ impl Kernel {
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::RenderLinear => "render::render_linear_cs",
             Kernel::RenderBvh => "render::render_bvh_cs",
+            Kernel::CastBvh => "render::cast_bvh_cs",
         }
     }
 
@@ -125,7 +129,9 @@ impl Kernel {
             Kernel::TreeletSolve => &[Read, Read, ReadWrite],
             Kernel::TreeletCommit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RenderLinear | Kernel::RenderBvh => &[Read, Read, Read, Read, Read, ReadWrite, Read],
+            Kernel::RenderLinear | Kernel::RenderBvh | Kernel::CastBvh => {
+                &[Read, Read, Read, Read, Read, ReadWrite, Read]
+            }
         }
     }
 }

@@ -118,34 +118,7 @@ pub fn render<B: Backend>(
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;
 
-    let (nodes, prim_indices, build_ms) = match accel {
-        Accel::Lbvh | Accel::Trbvh => {
-            let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
-            let mut build_ms = times.total();
-            if accel == Accel::Trbvh {
-                let root = trbvh::root_box(b, &bvh)?;
-                let (optimized, times) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
-                bvh = optimized;
-                build_ms += times.total();
-            }
-            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?);
-            if depth + 1 > STACK_DEPTH {
-                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
-            }
-            (bvh.nodes, bvh.prim_indices, build_ms)
-        }
-        Accel::Sweep => {
-            let build = Instant::now();
-            let bvh = crate::sweep::build_collapsed_boxes(&all.boxes(), TreeletConfig::default().max_leaf)?;
-            let build_ms = build.elapsed().as_secs_f64() * 1e3;
-            let depth = tree_depth(&bvh.nodes);
-            if depth + 1 > STACK_DEPTH {
-                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
-            }
-            (b.upload("sweep nodes", &bvh.nodes)?, b.upload("sweep primitive indices", &bvh.prim_indices)?, build_ms)
-        }
-        Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
-    };
+    let (nodes, prim_indices, build_ms) = scene_tree(b, all, accel)?;
     let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
     let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
     let materials = b.upload("materials", &scene.materials)?;
@@ -254,4 +227,37 @@ mod tests {
         assert_eq!(pass_schedule(64), vec![4, 8, 16, 32, 64]);
         assert_eq!(pass_schedule(100), vec![4, 8, 16, 32, 64, 100]);
     }
+}
+
+/// The tree `accel` traces for these primitives, on the device: node and
+/// primitive-index buffers (placeholders for the scan) and the build time (ms).
+pub fn scene_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<(B::Buffer, B::Buffer, f64)> {
+    Ok(match accel {
+        Accel::Lbvh | Accel::Trbvh => {
+            let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
+            let mut build_ms = times.total();
+            if accel == Accel::Trbvh {
+                let root = trbvh::root_box(b, &bvh)?;
+                let (optimized, times) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
+                bvh = optimized;
+                build_ms += times.total();
+            }
+            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?);
+            if depth + 1 > STACK_DEPTH {
+                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
+            }
+            (bvh.nodes, bvh.prim_indices, build_ms)
+        }
+        Accel::Sweep => {
+            let build = Instant::now();
+            let bvh = crate::sweep::build_collapsed_boxes(&all.boxes(), TreeletConfig::default().max_leaf)?;
+            let build_ms = build.elapsed().as_secs_f64() * 1e3;
+            let depth = tree_depth(&bvh.nodes);
+            if depth + 1 > STACK_DEPTH {
+                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
+            }
+            (b.upload("sweep nodes", &bvh.nodes)?, b.upload("sweep primitive indices", &bvh.prim_indices)?, build_ms)
+        }
+        Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
+    })
 }

@@ -49,3 +49,22 @@ pub fn render_bvh_cs(
         accumulate(&mut accum[id as usize], render_pixel::<ACCEL_BVH>(id, params, &scene));
     }
 }
+
+/// Ray-casting throughput: one primary or one diffuse ray per pixel, through a BVH.
+#[spirv(compute(threads(256)))]
+pub fn cast_bvh_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    let prims = Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
+    let scene = SceneRefs { prims, materials, nodes, prim_indices };
+    treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, params, &scene, rays);
+}
