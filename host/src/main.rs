@@ -43,7 +43,7 @@ enum Builder {
 enum Command {
     /// Build a BVH over a scene, check it, and report its cost and stage times.
     Build {
-        /// Scene: random:N[:SEED] (N spheres), cornell, or a .json scene file.
+        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), cornell, a .json scene file, or an .obj/.ply mesh.
         #[arg(long, default_value = "random:100000")]
         scene: String,
         #[arg(long, value_enum, default_value = "lbvh")]
@@ -74,7 +74,7 @@ enum Command {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), or a .json scene file.
+    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
     #[arg(long, default_value_t = 512)]

@@ -89,6 +89,25 @@ pub fn cornell() -> Scene {
     Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
 }
 
+/// `terrain:N`: a height field of about N triangles (a square grid, two per
+/// cell) over 10 x 10 units, `y = sin 1.3x cos 0.7z + 0.2 sin(7.1x + 5.3z)`:
+/// a mesh of any size for benchmarks.
+pub fn terrain(n: usize) -> Vec<Triangle> {
+    let cells = ((n as f64 / 2.0).sqrt().round() as usize).max(1);
+    let p = |i: usize, j: usize| {
+        let (x, z) = (i as f32 / cells as f32 * 10.0, j as f32 / cells as f32 * 10.0);
+        [x, (x * 1.3).sin() * (z * 0.7).cos() + 0.2 * (x * 7.1 + z * 5.3).sin(), z]
+    };
+    let mut tris = Vec::with_capacity(2 * cells * cells);
+    for j in 0..cells {
+        for i in 0..cells {
+            tris.push(Triangle::new(p(i, j), p(i + 1, j), p(i + 1, j + 1)));
+            tris.push(Triangle::new(p(i, j), p(i + 1, j + 1), p(i, j + 1)));
+        }
+    }
+    tris
+}
+
 /// A mesh alone in smallpt's room, under its light and camera: scaled to fit
 /// a 60-unit cube, centred in the room and standing on the floor, in a
 /// light diffuse grey. (`treelet build` builds over the triangles alone.)
@@ -164,7 +183,20 @@ impl Scene {
                 }
                 Ok(random_scene(spec, n, seed))
             }
-            _ => bail!("unknown scene `{spec}`: expected cornell, random:N[:SEED] or a .json scene file"),
+            Some("terrain") => {
+                let n = parts.next().with_context(|| format!("scene `{spec}`: expected terrain:N"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a triangle count"))?;
+                if parts.next().is_some() || n == 0 {
+                    bail!("scene `{spec}`: expected terrain:N with N > 0 triangles");
+                }
+                if n > crate::lbvh::MAX_PRIMITIVES as usize {
+                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", crate::lbvh::MAX_PRIMITIVES);
+                }
+                Ok(mesh_scene(spec, &terrain(n)))
+            }
+            _ => bail!(
+                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file or an .obj/.ply mesh"
+            ),
         }
     }
 }

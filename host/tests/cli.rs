@@ -153,3 +153,17 @@ fn report_plot_never_overwrites_the_image() {
     assert_eq!(image, (20, 16), "the render was overwritten");
     assert!(dir.join("same.error.png").exists(), "the plot goes to same.error.png");
 }
+
+/// `terrain:N` builds and renders as a mesh scene; bad counts are clear errors.
+#[test]
+fn terrain_scenes() {
+    let out = treelet(&["build", "--device", "cpu", "--builder", "trbvh", "--scene", "terrain:2000", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((v["triangles"].as_u64(), v["spheres"].as_u64()), (Some(2048), Some(0)));
+    assert_eq!(v["valid"], true);
+    for (spec, needle) in [("terrain:0", "N > 0"), ("terrain:lots", "not a triangle count")] {
+        let e = stderr_of(&["build", "--device", "cpu", "--scene", spec]);
+        assert!(e.contains(needle), "{spec}: {e}");
+    }
+}
