@@ -59,6 +59,9 @@ pub enum BenchCommand {
         /// Timed repeats (median reported), after one warm-up pass.
         #[arg(long, default_value_t = 7)]
         repeats: usize,
+        /// Cast at the scene's triangles alone, framed by the camera (no room).
+        #[arg(long)]
+        mesh_only: bool,
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
@@ -356,8 +359,9 @@ fn bench_rays<B: Backend>(
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
-        BenchCommand::Rays { scene, accels, width, height, device, repeats, json } => {
+        BenchCommand::Rays { scene, accels, width, height, device, repeats, mesh_only, json } => {
             let scene = Scene::from_spec(&scene)?;
+            let scene = if mesh_only { scene.mesh_only()? } else { scene };
             let mut rows = Vec::new();
             let adapter = match device {
                 Device::Gpu => {

@@ -146,6 +146,32 @@ impl Scene {
         &self.spheres[..self.spheres.len() - self.room]
     }
 
+    /// The scene's triangles alone (no spheres, no room), seen from above and
+    /// in front so that they fill most of the view: what `bench rays
+    /// --mesh-only` casts at.
+    pub fn mesh_only(&self) -> Result<Scene> {
+        if self.triangles.is_empty() {
+            bail!("scene `{}` has no triangles", self.name);
+        }
+        let bounds = self.triangles.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
+        let (center, size) = (bounds.centroid(), bounds.extent().max_element().max(f32::MIN_POSITIVE));
+        let origin = center + Vec3::new(0.0, 0.6, 0.8) * size;
+        let camera = CameraSpec {
+            origin: origin.to_array(),
+            direction: (center - origin).to_array(),
+            near: 0.0,
+            fov: SMALLPT_FOV,
+        };
+        Ok(Scene {
+            name: format!("{} (mesh only)", self.name),
+            spheres: Vec::new(),
+            materials: self.materials[self.spheres.len()..].to_vec(),
+            room: 0,
+            camera,
+            triangles: self.triangles.clone(),
+        })
+    }
+
     /// What `treelet build` builds over: the objects (spheres but the room)
     /// and the triangles.
     pub fn primitives(&self) -> Primitives<'_> {

@@ -167,3 +167,14 @@ fn terrain_scenes() {
         assert!(e.contains(needle), "{spec}: {e}");
     }
 }
+
+/// `bench rays` casts at a mesh alone with `--mesh-only`, and refuses scenes without triangles.
+#[test]
+fn bench_rays_mesh_only() {
+    let args = ["bench", "rays", "--device", "cpu", "--width", "32", "--height", "24", "--repeats", "1", "--mesh-only"];
+    let out = treelet(&[&args[..], &["--scene", "terrain:500"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("primary Mray/s"));
+    let e = stderr_of(&[&args[..], &["--scene", "random:10"]].concat());
+    assert!(e.contains("has no triangles"), "{e}");
+}
