@@ -326,7 +326,14 @@ fn bench_rays<B: Backend>(
     let groups = groups_for(pixels as u32, WORKGROUP_SIZE);
     let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
-    for r in 0..=repeats {
+    // Warm-up passes for half a second first (pipelines, and GPU clocks,
+    // which drop while a CPU-built tree is being made), then the timed ones.
+    let warm = std::time::Instant::now();
+    let mut warm_passes = 0;
+    for r in 0.. {
+        if r > warm_passes + repeats {
+            break;
+        }
         for (stage, mode) in [("primary", CAST_PRIMARY), ("diffuse", CAST_DIFFUSE)] {
             b.stage(stage);
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
@@ -334,9 +341,14 @@ fn bench_rays<B: Backend>(
         }
         let t = b.take_times()?;
         if r == 0 {
-            // Warm-up; and count the diffuse rays (pixels whose camera ray hit).
+            // Count the diffuse rays (pixels whose camera ray hit).
             let r: Vec<[f32; 4]> = b.read(&rays, 2 * pixels as usize)?;
             diffuse_rays = r.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
+        }
+        if r == warm_passes {
+            if warm.elapsed().as_secs_f64() < 0.5 {
+                warm_passes += 1;
+            }
             continue;
         }
         primary.push(t.get("primary"));
