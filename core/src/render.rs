@@ -20,7 +20,8 @@
 //! Random numbers are counter-based ([`crate::rng`]).
 use glam::Vec3;
 
-use crate::layout::{Camera, Material, Node, RenderParams, DIFFUSE, MIRROR};
+use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
+use crate::triangle::Triangle;
 use crate::rng::BounceRng;
 use crate::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
 
@@ -118,6 +119,23 @@ pub struct SceneRefs<'a> {
     pub materials: &'a [Material],
     pub nodes: &'a [Node],
     pub prim_indices: &'a [u32],
+}
+
+impl<'a> SceneRefs<'a> {
+    /// The scene the render and cast kernels see: their bindings, with the
+    /// primitive counts from `params` (buffers may be longer than their content).
+    #[inline]
+    pub fn new(
+        params: &RenderParams,
+        spheres: &'a [Sphere],
+        triangles: &'a [Triangle],
+        materials: &'a [Material],
+        nodes: &'a [Node],
+        prim_indices: &'a [u32],
+    ) -> Self {
+        let prims = Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
+        SceneRefs { prims, materials, nodes, prim_indices }
+    }
 }
 
 /// Radiance along one path (smallpt's `radiance`, as a loop).

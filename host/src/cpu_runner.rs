@@ -306,17 +306,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
         }
         (Kernel::CastBvh, [p, spheres, materials, nodes, prims, rays, triangles]) => {
             let p: treelet_core::RenderParams = params(p);
-            let scene = SceneRefs {
-                prims: treelet_core::traverse::Prims {
-                    spheres: view(spheres),
-                    sphere_count: p.prims,
-                    triangles: view(triangles),
-                    triangle_count: p.triangles,
-                },
-                materials: view(materials),
-                nodes: view(nodes),
-                prim_indices: view(prims),
-            };
+            let scene = SceneRefs::new(&p, view(spheres), view(triangles), view(materials), view(nodes), view(prims));
             let rays: &mut [[f32; 4]] = view(rays);
             for id in ids(groups) {
                 treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, &p, &scene, rays);
@@ -325,17 +315,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
         (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum, triangles]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.
             let p: treelet_core::RenderParams = params(p);
-            let scene = SceneRefs {
-                prims: treelet_core::traverse::Prims {
-                    spheres: view(spheres),
-                    sphere_count: p.prims,
-                    triangles: view(triangles),
-                    triangle_count: p.triangles,
-                },
-                materials: view(materials),
-                nodes: view(nodes),
-                prim_indices: view(prims),
-            };
+            let scene = SceneRefs::new(&p, view(spheres), view(triangles), view(materials), view(nodes), view(prims));
             let accum: &mut [[f32; 4]] = view(accum);
             let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
             accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {

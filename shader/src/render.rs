@@ -2,7 +2,6 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::layout::{Material, Node, RenderParams, Sphere};
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
-use treelet_core::traverse::Prims;
 use treelet_core::triangle::Triangle;
 use treelet_core::workgroup::linear_id;
 
@@ -21,9 +20,7 @@ pub fn render_linear_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     if id < params.width * params.height {
-        let prims =
-            Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
-        let scene = SceneRefs { prims, materials, nodes, prim_indices };
+        let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
         accumulate(&mut accum[id as usize], render_pixel::<ACCEL_NONE>(id, params, &scene));
     }
 }
@@ -43,9 +40,7 @@ pub fn render_bvh_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     if id < params.width * params.height {
-        let prims =
-            Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
-        let scene = SceneRefs { prims, materials, nodes, prim_indices };
+        let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
         accumulate(&mut accum[id as usize], render_pixel::<ACCEL_BVH>(id, params, &scene));
     }
 }
@@ -64,7 +59,6 @@ pub fn cast_bvh_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    let prims = Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
-    let scene = SceneRefs { prims, materials, nodes, prim_indices };
+    let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
     treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, params, &scene, rays);
 }
