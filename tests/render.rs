@@ -4,6 +4,7 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
 use treelet::render::{render, Accel, RenderSettings};
+use treelet::variant::KernelChoice;
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet_core::triangle::Triangle;
 use treelet_tests::gpu;
@@ -26,7 +27,7 @@ fn mesh() -> Scene {
 }
 
 fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> RenderSettings {
-    RenderSettings { width, height, spp, seed, accel }
+    RenderSettings { width, height, spp, seed, accel, kernel: KernelChoice::Auto }
 }
 
 fn pixels<B: Backend>(b: &mut B, scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {

@@ -42,6 +42,7 @@ pub mod aabb;
 pub mod atomics;
 pub mod bounds;
 pub mod collapse;
+pub mod features;
 pub mod fill;
 pub mod fit;
 pub mod intersect;

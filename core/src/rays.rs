@@ -5,25 +5,15 @@
 use glam::Vec3;
 
 use crate::layout::RenderParams;
-use crate::render::{cosine_direction, hit_normal, surface_offset, SceneRefs, ACCEL_BVH};
+use crate::features;
+use crate::render::{closest_hit, cosine_direction, hit_normal, surface_offset, SceneRefs};
 use crate::rng::BounceRng;
-use crate::traverse::{closest_hit_bvh, closest_hit_linear, Hit, Origin};
+use crate::traverse::Origin;
 
 /// [`RenderParams::cast_mode`]: camera rays, which leave the diffuse rays.
 pub const CAST_PRIMARY: u32 = 0;
 /// [`RenderParams::cast_mode`]: the diffuse rays the primary pass left.
 pub const CAST_DIFFUSE: u32 = 1;
-
-/// The closest hit by the scan or the tree (no closure: rust-gpu cannot
-/// lower one that captures references).
-#[inline]
-fn closest<const ACCEL: u32>(o: Vec3, d: Vec3, from: Origin, scene: &SceneRefs) -> Hit {
-    if ACCEL == ACCEL_BVH {
-        closest_hit_bvh(o, d, from, &scene.prims, scene.nodes, scene.prim_indices)
-    } else {
-        closest_hit_linear(o, d, from, &scene.prims)
-    }
-}
 
 /// Kernel (one invocation per pixel): casts pixel `id`'s ray and writes
 /// `rays[2 id]` = (origin, 1 if a ray is to be cast, else 0) and
@@ -38,7 +28,7 @@ pub fn cast_kernel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &Sce
     if params.cast_mode == CAST_PRIMARY {
         let rng = BounceRng::new(params.seed, id, params.first_sample, 0);
         let (o, d) = params.camera.primary_ray(id % w, h - 1 - id / w, 0, w, h, &rng);
-        let hit = closest::<ACCEL>(o, d, Origin::NONE, scene);
+        let hit = closest_hit::<ACCEL, { features::ALL }>(o, d, Origin::NONE, scene);
         if !hit.is_hit() {
             rays[i] = [0.0; 4];
             return;
@@ -56,7 +46,7 @@ pub fn cast_kernel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &Sce
         let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
         let prim = rays[j][3].to_bits();
         // Leaving the surface outwards: it cannot be hit again.
-        let hit = closest::<ACCEL>(o, d, Origin { prim, into: false }, scene);
+        let hit = closest_hit::<ACCEL, { features::ALL }>(o, d, Origin { prim, into: false }, scene);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
 }

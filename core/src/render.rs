@@ -23,7 +23,8 @@ use glam::Vec3;
 use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
 use crate::triangle::Triangle;
 use crate::rng::BounceRng;
-use crate::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
+use crate::features::{self, has};
+use crate::traverse::{closest_hit_bvh_for, closest_hit_linear_for, Hit, Origin, Prims};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
@@ -138,9 +139,21 @@ impl<'a> SceneRefs<'a> {
     }
 }
 
-/// Radiance along one path (smallpt's `radiance`, as a loop).
+/// The closest hit by the scan (`ACCEL_NONE`) or the tree (`ACCEL_BVH`),
+/// testing the primitive kinds of `F` (see [`crate::features`]).
 #[inline]
-pub fn radiance<const ACCEL: u32>(
+pub fn closest_hit<const ACCEL: u32, const F: u32>(o: Vec3, d: Vec3, from: Origin, scene: &SceneRefs) -> Hit {
+    if ACCEL == ACCEL_BVH {
+        closest_hit_bvh_for::<F>(o, d, from, &scene.prims, scene.nodes, scene.prim_indices)
+    } else {
+        closest_hit_linear_for::<F>(o, d, from, &scene.prims)
+    }
+}
+
+/// Radiance along one path (smallpt's `radiance`, as a loop), with the
+/// code for the features `F` only (see [`crate::features`]).
+#[inline]
+pub fn radiance<const ACCEL: u32, const F: u32>(
     mut o: Vec3,
     mut d: Vec3,
     params: &RenderParams,
@@ -153,17 +166,13 @@ pub fn radiance<const ACCEL: u32>(
     let mut depth = 0u32;
     let mut from = Origin::NONE;
     while depth < MAX_BOUNCES {
-        let hit = if ACCEL == ACCEL_BVH {
-            closest_hit_bvh(o, d, from, &scene.prims, scene.nodes, scene.prim_indices)
-        } else {
-            closest_hit_linear(o, d, from, &scene.prims)
-        };
+        let hit = closest_hit::<ACCEL, F>(o, d, from, scene);
         if !hit.is_hit() {
             break;
         }
         let m = scene.materials[hit.prim as usize];
         let x = o + d * hit.t;
-        let n = hit_normal(&scene.prims, hit.prim, x, d);
+        let n = hit_normal_for::<F>(&scene.prims, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         result += throughput * Vec3::from_array(m.emission);
@@ -180,10 +189,12 @@ pub fn radiance<const ACCEL: u32>(
         }
         throughput *= f;
         let eps = surface_offset(x);
-        if m.kind == DIFFUSE {
+        // Branches for materials outside `F` are not compiled (the host
+        // never runs such a kernel on a scene that has them).
+        if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
             d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
             o = x + nl * eps;
-        } else if m.kind == MIRROR {
+        } else if !has(F, features::GLASS) || (has(F, features::MIRROR) && m.kind == MIRROR) {
             d = d - n * 2.0 * n.dot(d);
             o = x + nl * eps;
         } else {
@@ -233,7 +244,20 @@ pub fn radiance<const ACCEL: u32>(
 /// decides "into" for glass).
 #[inline]
 pub fn hit_normal(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
-    if prim < prims.sphere_count {
+    hit_normal_for::<{ features::ALL }>(prims, prim, x, d)
+}
+
+/// [`hit_normal`] compiled for the primitive kinds of `F`.
+#[inline]
+pub fn hit_normal_for<const F: u32>(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
+    let sphere = if !has(F, features::TRIANGLES) {
+        true
+    } else if !has(F, features::SPHERES) {
+        false
+    } else {
+        prim < prims.sphere_count
+    };
+    if sphere {
         (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize()
     } else {
         let t = prims.triangles[(prim - prims.sphere_count) as usize];
@@ -242,8 +266,12 @@ pub fn hit_normal(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
     }
 }
 
+/// Kernel body (one invocation per pixel): `params.samples` camera paths
+/// of pixel `id`, as sums of radiance and of squared luminance. `F`: the
+/// features compiled in (see [`crate::features`]); the scene's must be
+/// among them.
 #[inline]
-pub fn render_pixel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &SceneRefs) -> [f32; 4] {
+pub fn render_pixel<const ACCEL: u32, const F: u32>(id: u32, params: &RenderParams, scene: &SceneRefs) -> [f32; 4] {
     let (w, h) = (params.width, params.height);
     let (x, y) = (id % w, h - 1 - id / w);
     let mut sum = Vec3::ZERO;
@@ -253,7 +281,7 @@ pub fn render_pixel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &Sc
         let sample = params.first_sample + s;
         let rng = BounceRng::new(params.seed, id, sample, 0);
         let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
-        let l = radiance::<ACCEL>(o, d, params, id, sample, scene);
+        let l = radiance::<ACCEL, F>(o, d, params, id, sample, scene);
         sum += l;
         let lum = luminance(l);
         sum_sq += lum * lum;

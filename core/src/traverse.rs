@@ -3,6 +3,7 @@
 //! sphere `i`, a larger one triangle `i - sphere_count`.
 use glam::Vec3;
 
+use crate::features::{self, has};
 use crate::intersect::{ray_box, ray_sphere_mode, safe_inverse, MISS};
 use crate::layout::{Node, Sphere};
 use crate::triangle::{ray_triangle, Triangle, WatertightRay};
@@ -29,9 +30,26 @@ impl<'a> Prims<'a> {
     }
 
     /// Distance along the ray to primitive `prim`, below `t_max`, honouring the start surface.
+    /// Distance to primitive `prim` along the ray; `F` (see
+    /// [`crate::features`]) leaves out the test of a kind the scene lacks.
     #[inline]
-    fn distance(&self, o: Vec3, d: Vec3, ray: &WatertightRay, from: Origin, prim: u32, t_max: f32) -> f32 {
-        if prim < self.sphere_count {
+    fn distance<const F: u32>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        ray: &WatertightRay,
+        from: Origin,
+        prim: u32,
+        t_max: f32,
+    ) -> f32 {
+        let sphere = if !has(F, features::TRIANGLES) {
+            true
+        } else if !has(F, features::SPHERES) {
+            false
+        } else {
+            prim < self.sphere_count
+        };
+        if sphere {
             from.distance(o, d, &self.spheres[prim as usize], prim)
         } else if prim == from.prim {
             MISS // a flat triangle cannot be hit again by a ray leaving it
@@ -86,7 +104,8 @@ impl Origin {
     }
 }
 
-/// Tests every primitive.
+/// Tests every primitive; `F` (see [`crate::features`]) may leave out the
+/// test of a primitive kind the scene lacks.
 ///
 /// ```
 /// use glam::Vec3;
@@ -97,13 +116,13 @@ impl Origin {
 /// assert_eq!((hit.prim, hit.t), (1, 2.0));
 /// ```
 #[inline]
-pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
+pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
     let mut hit = Hit::NONE;
     let ray = WatertightRay::new(o, d);
     let mut i = 0;
     let count = prims.count();
     while i < count {
-        let t = prims.distance(o, d, &ray, from, i, hit.t);
+        let t = prims.distance::<F>(o, d, &ray, from, i, hit.t);
         if t < hit.t {
             hit = Hit { t, prim: i };
         }
@@ -113,9 +132,10 @@ pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit 
 }
 
 /// Walks the BVH rooted at node 0 (`2 * count - 1` nodes), nearest child
-/// first, pruning boxes beyond the closest hit so far.
+/// first, pruning boxes beyond the closest hit so far; `F` as for
+/// [`closest_hit_linear_for`].
 #[inline]
-pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
+pub fn closest_hit_bvh_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
     let mut hit = Hit::NONE;
     if prims.count() == 0 {
         return hit;
@@ -134,7 +154,7 @@ pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[N
             let mut k = 0;
             while k < node.prim_count() {
                 let prim = prim_indices[(node.left + k) as usize];
-                let t = prims.distance(o, d, &ray, from, prim, hit.t);
+                let t = prims.distance::<F>(o, d, &ray, from, prim, hit.t);
                 if t < hit.t {
                     hit = Hit { t, prim };
                 }
@@ -152,4 +172,16 @@ pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[N
         }
     }
     hit
+}
+
+/// [`closest_hit_linear_for`] with every primitive kind compiled in.
+#[inline]
+pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
+    closest_hit_linear_for::<{ features::ALL }>(o, d, from, prims)
+}
+
+/// [`closest_hit_bvh_for`] with every primitive kind compiled in.
+#[inline]
+pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
+    closest_hit_bvh_for::<{ features::ALL }>(o, d, from, prims, nodes, prim_indices)
 }

@@ -44,6 +44,9 @@ pub trait Backend {
     fn adapter(&self) -> String;
     /// "gpu" or "cpu".
     fn device_kind(&self) -> &'static str;
+    /// Whether the kernels run on CPU cores (the CPU runner, or a CPU
+    /// Vulkan adapter such as lavapipe): what is fastest differs there.
+    fn runs_on_cpu(&self) -> bool;
     /// False on devices that mis-execute ordered atomics in divergent control
     /// flow (lavapipe): they get the relaxed variants of such kernels.
     fn ordered_atomics_in_divergent_flow(&self) -> bool {

@@ -9,6 +9,7 @@ use treelet::lbvh;
 use treelet::render::{render, Accel, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::trbvh::{self, TreeletConfig};
+use treelet::variant::KernelChoice;
 use treelet_core::Sphere;
 
 use crate::Device;
@@ -65,6 +66,22 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+    /// Specialized render kernels against the general one (--kernel full):
+    /// render-kernel time per scene, and each kernel's SPIR-V size.
+    Variants {
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: Device,
+        /// 256x192 at 16 spp instead of 1024x768 at 64 (for a CPU or lavapipe).
+        #[arg(long)]
+        quick: bool,
+        #[arg(long, value_delimiter = ',', default_values_t = VARIANT_SCENES.map(String::from).to_vec())]
+        scenes: Vec<String>,
+        /// Timed renders per kernel (median reported), after one warm-up each.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
     /// Render times at 1024x768 (--quick: 256x192): cornell against spp, and
     /// random:N at 4 spp with each closest-hit method.
     Render {
@@ -87,6 +104,12 @@ pub enum BenchCommand {
         json: Option<std::path::PathBuf>,
     },
 }
+
+/// Scenes `bench variants` compares by default: each exercises a different
+/// specialized kernel (cornell: no triangles; diffuse and mirror-only
+/// variants; many spheres through a BVH; a mesh in smallpt's room).
+const VARIANT_SCENES: [&str; 5] =
+    ["cornell", "scenes/cornell_diffuse.json", "scenes/cornell_mirrors.json", "random:1000", "terrain:100000"];
 
 /// The device builders `bench build` times.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -113,6 +136,8 @@ fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&Treele
 struct RenderRow {
     scene: String,
     accel: Accel,
+    /// The render kernel variant that ran.
+    kernel: &'static str,
     width: u32,
     height: u32,
     spp: u32,
@@ -133,12 +158,25 @@ fn bench_render<B: Backend>(
     spp: u32,
     accel: Accel,
 ) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel };
+    bench_render_kernel(b, scene, width, height, spp, accel, KernelChoice::Auto)
+}
+
+fn bench_render_kernel<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    spp: u32,
+    accel: Accel,
+    kernel: KernelChoice,
+) -> Result<RenderRow> {
+    let settings = RenderSettings { width, height, spp, seed: 1, accel, kernel };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
     Ok(RenderRow {
         scene: scene.name.clone(),
-        accel,
+        accel: r.plan.accel,
+        kernel: r.plan.kernel,
         width,
         height,
         spp,
@@ -147,6 +185,71 @@ fn bench_render<B: Backend>(
         build_ms: r.build_ms,
         paths_per_s: width as f64 * height as f64 * spp as f64 / kernel_s,
     })
+}
+
+/// One scene of `bench variants`: the chosen variant against the general kernel.
+#[derive(serde::Serialize)]
+struct VariantRow {
+    scene: String,
+    accel: Accel,
+    kernel: &'static str,
+    /// SPIR-V words of the entry points that ran (None on the CPU runner).
+    kernel_words: Option<usize>,
+    full_words: Option<usize>,
+    /// Median render-kernel seconds.
+    kernel_s: f64,
+    full_s: f64,
+    speedup: f64,
+}
+
+fn bench_variants<B: Backend>(
+    b: &mut B,
+    scenes: &[String],
+    (width, height, spp): (u32, u32, u32),
+    repeats: usize,
+) -> Result<Vec<VariantRow>> {
+    let bar = ProgressBar::new((scenes.len() * 2 * (repeats + 1)) as u64);
+    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} renders {msg}").unwrap());
+    let mut rows = Vec::new();
+    for spec in scenes {
+        bar.set_message(spec.clone());
+        let scene = Scene::from_spec(spec)?;
+        let (mut auto, mut full) = (Vec::new(), Vec::new());
+        let (mut accel, mut kernel) = (Accel::Auto, "");
+        // Alternate the two so that clock drift hits both alike; the first
+        // of each warms pipelines and clocks.
+        for r in 0..=repeats {
+            for (choice, times) in [(KernelChoice::Auto, &mut auto), (KernelChoice::Full, &mut full)] {
+                let row = bench_render_kernel(b, &scene, width, height, spp, Accel::Auto, choice)?;
+                if choice == KernelChoice::Auto {
+                    (accel, kernel) = (row.accel, row.kernel);
+                }
+                if r > 0 {
+                    times.push(row.kernel_s);
+                }
+                bar.inc(1);
+            }
+        }
+        let entry = |name: &str| {
+            let method = if accel == Accel::None { "linear" } else { "bvh" };
+            (b.device_kind() == "gpu")
+                .then(|| treelet::gpu::context::entry_point_words(&format!("render::render_{method}_{name}_cs")))
+                .flatten()
+        };
+        let (kernel_s, full_s) = (median(auto), median(full));
+        rows.push(VariantRow {
+            scene: scene.name.clone(),
+            accel,
+            kernel,
+            kernel_words: entry(kernel),
+            full_words: entry("full"),
+            kernel_s,
+            full_s,
+            speedup: full_s / kernel_s,
+        });
+    }
+    bar.finish_and_clear();
+    Ok(rows)
 }
 
 fn print_render_rows(title: &str, rows: &[RenderRow]) {
@@ -406,6 +509,40 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             if let Some(path) = json {
                 let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Variants { device, quick, scenes, repeats, json } => {
+            let size = if quick { (256, 192, 16) } else { (1024, 768, 64) };
+            let (adapter, rows) = match device {
+                Device::Gpu => {
+                    let mut b = GpuBackend::new(GpuContext::new()?);
+                    (b.adapter(), bench_variants(&mut b, &scenes, size, repeats)?)
+                }
+                Device::Cpu => ("cpu".to_string(), bench_variants(&mut CpuBackend::new(), &scenes, size, repeats)?),
+            };
+            println!("Specialized kernel against the general one, {}x{} at {} spp, {adapter}, median of {repeats}", size.0, size.1, size.2);
+            println!(
+                "{:>30}{:>7}{:>18}{:>13}{:>12}{:>11}{:>11}{:>9}",
+                "scene", "accel", "kernel", "SPIR-V words", "full words", "kernel s", "full s", "speedup"
+            );
+            let words = |w: Option<usize>| w.map(|w| w.to_string()).unwrap_or_else(|| "-".into());
+            for r in &rows {
+                println!(
+                    "{:>30}{:>7}{:>18}{:>13}{:>12}{:>11.4}{:>11.4}{:>9.3}",
+                    r.scene,
+                    format!("{:?}", r.accel).to_lowercase(),
+                    r.kernel,
+                    words(r.kernel_words),
+                    words(r.full_words),
+                    r.kernel_s,
+                    r.full_s,
+                    r.speedup
+                );
+            }
+            if let Some(path) = json {
+                let doc = serde_json::json!({ "adapter": adapter, "width": size.0, "height": size.1, "spp": size.2, "repeats": repeats, "rows": rows });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())

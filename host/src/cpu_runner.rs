@@ -12,6 +12,7 @@ use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::aabb::Aabb;
+use treelet_core::features::VARIANTS;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet};
@@ -64,6 +65,19 @@ fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
     }
 }
 
+/// `render_pixel` compiled for `VARIANTS[v]`, as the shader's entry points are.
+fn render_variant<const ACCEL: u32>(v: u8, id: u32, p: &treelet_core::RenderParams, scene: &SceneRefs) -> [f32; 4] {
+    const _: () = assert!(VARIANTS.len() == 6, "one arm per variant");
+    match v {
+        0 => render_pixel::<ACCEL, { VARIANTS[0].0 }>(id, p, scene),
+        1 => render_pixel::<ACCEL, { VARIANTS[1].0 }>(id, p, scene),
+        2 => render_pixel::<ACCEL, { VARIANTS[2].0 }>(id, p, scene),
+        3 => render_pixel::<ACCEL, { VARIANTS[3].0 }>(id, p, scene),
+        4 => render_pixel::<ACCEL, { VARIANTS[4].0 }>(id, p, scene),
+        _ => render_pixel::<ACCEL, { VARIANTS[5].0 }>(id, p, scene),
+    }
+}
+
 /// Invocation ids of a dispatch of `groups` workgroups.
 fn ids(groups: u32) -> std::ops::Range<u32> {
     0..groups * WORKGROUP_SIZE
@@ -77,6 +91,9 @@ impl Backend for CpuBackend {
     }
     fn device_kind(&self) -> &'static str {
         "cpu"
+    }
+    fn runs_on_cpu(&self) -> bool {
+        true
     }
     fn max_buffer_bytes(&self) -> u64 {
         u64::MAX
@@ -312,17 +329,18 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, &p, &scene, rays);
             }
         }
-        (Kernel::RenderLinear | Kernel::RenderBvh, [p, spheres, materials, nodes, prims, accum, triangles]) => {
+        (Kernel::RenderLinear(v) | Kernel::RenderBvh(v), [p, spheres, materials, nodes, prims, accum, triangles]) => {
             // Pixels are independent: the one kernel the CPU runs in parallel.
             let p: treelet_core::RenderParams = params(p);
             let scene = SceneRefs::new(&p, view(spheres), view(triangles), view(materials), view(nodes), view(prims));
             let accum: &mut [[f32; 4]] = view(accum);
             let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
+            let bvh = matches!(kernel, Kernel::RenderBvh(_));
             accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
-                let add = if kernel == Kernel::RenderBvh {
-                    render_pixel::<ACCEL_BVH>(id as u32, &p, &scene)
+                let add = if bvh {
+                    render_variant::<ACCEL_BVH>(v, id as u32, &p, &scene)
                 } else {
-                    render_pixel::<ACCEL_NONE>(id as u32, &p, &scene)
+                    render_variant::<ACCEL_NONE>(v, id as u32, &p, &scene)
                 };
                 accumulate(acc, add);
             });

@@ -8,7 +8,19 @@ pub enum Access {
     Read,
     ReadWrite,
 }
+use treelet_core::features::VARIANTS;
 use Access::{Read, ReadWrite};
+
+/// Entry points of the render variants (linear, BVH), in the order of
+/// `VARIANTS`: the shader crate's `render_kernel!` lines.
+const RENDER_ENTRY_POINTS: [[&str; 2]; VARIANTS.len()] = [
+    ["render::render_linear_spheres_diffuse_cs", "render::render_bvh_spheres_diffuse_cs"],
+    ["render::render_linear_spheres_mirror_cs", "render::render_bvh_spheres_mirror_cs"],
+    ["render::render_linear_spheres_cs", "render::render_bvh_spheres_cs"],
+    ["render::render_linear_triangles_diffuse_cs", "render::render_bvh_triangles_diffuse_cs"],
+    ["render::render_linear_mixed_diffuse_cs", "render::render_bvh_mixed_diffuse_cs"],
+    ["render::render_linear_full_cs", "render::render_bvh_full_cs"],
+];
 
 /// Every compute kernel of Treelet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -42,16 +54,17 @@ pub enum Kernel {
     TreeletCommit,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
-    /// Path tracing, closest hit by scanning every sphere.
-    RenderLinear,
-    /// Path tracing, closest hit through the BVH.
-    RenderBvh,
+    /// Path tracing, closest hit by scanning every primitive, compiled for
+    /// the feature set `treelet_core::features::VARIANTS[i]`.
+    RenderLinear(u8),
+    /// Path tracing, closest hit through the BVH, for `VARIANTS[i]`.
+    RenderBvh(u8),
     /// Ray-casting throughput through the BVH (primary or diffuse rays).
     CastBvh,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 23] = [
+    const FIXED: [Kernel; 21] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -72,10 +85,18 @@ impl Kernel {
         Kernel::TreeletSolve,
         Kernel::TreeletCommit,
         Kernel::Collapse,
-        Kernel::RenderLinear,
-        Kernel::RenderBvh,
         Kernel::CastBvh,
     ];
+
+    /// Every kernel: the fixed ones and each render variant.
+    pub fn all() -> Vec<Kernel> {
+        let variants = 0..VARIANTS.len() as u8;
+        Self::FIXED
+            .into_iter()
+            .chain(variants.clone().map(Kernel::RenderLinear))
+            .chain(variants.map(Kernel::RenderBvh))
+            .collect()
+    }
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
     pub fn entry_point(self) -> &'static str {
@@ -100,8 +121,8 @@ impl Kernel {
             Kernel::TreeletSolve => "treelet::treelet_solve_cs",
             Kernel::TreeletCommit => "treelet::treelet_commit_cs",
             Kernel::Collapse => "treelet::collapse_cs",
-            Kernel::RenderLinear => "render::render_linear_cs",
-            Kernel::RenderBvh => "render::render_bvh_cs",
+            Kernel::RenderLinear(i) => RENDER_ENTRY_POINTS[i as usize][0],
+            Kernel::RenderBvh(i) => RENDER_ENTRY_POINTS[i as usize][1],
             Kernel::CastBvh => "render::cast_bvh_cs",
         }
     }
@@ -129,7 +150,7 @@ impl Kernel {
             Kernel::TreeletSolve => &[Read, Read, ReadWrite],
             Kernel::TreeletCommit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RenderLinear | Kernel::RenderBvh | Kernel::CastBvh => {
+            Kernel::RenderLinear(_) | Kernel::RenderBvh(_) | Kernel::CastBvh => {
                 &[Read, Read, Read, Read, Read, ReadWrite, Read]
             }
         }

@@ -29,3 +29,4 @@ pub mod sort;
 pub mod sweep;
 pub mod trbvh;
 pub mod validate;
+pub mod variant;

@@ -13,6 +13,7 @@ use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::trbvh::TreeletConfig;
+use treelet::variant::{self, KernelChoice};
 
 mod bench;
 
@@ -84,8 +85,17 @@ struct RenderArgs {
     /// Samples per pixel (taken in turn by the 2x2 subpixels).
     #[arg(long, default_value_t = 64)]
     spp: u32,
-    #[arg(long, value_enum, default_value = "none")]
+    /// How closest hits are found; auto: a linear scan below the measured
+    /// crossover in primitive count, else the treelet-optimized BVH.
+    #[arg(long, value_enum, default_value = "auto")]
     accel: Accel,
+    /// Render kernel: auto, the variant compiled for the scene's features
+    /// only; full, the general one (for comparison).
+    #[arg(long, value_enum, default_value = "auto")]
+    kernel: KernelChoice,
+    /// Print the scene's features and the accel and kernel chosen, and why.
+    #[arg(long)]
+    explain: bool,
     #[arg(long, value_enum, default_value = "gpu")]
     device: Device,
     #[arg(long, default_value_t = 0)]
@@ -104,8 +114,14 @@ struct RenderArgs {
 fn run_render(args: RenderArgs) -> Result<()> {
     let scene = Scene::from_spec(&args.scene)?;
     let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
-    let settings =
-        RenderSettings { width: args.width, height: args.height, spp: args.spp, seed: args.seed, accel: args.accel };
+    let settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        seed: args.seed,
+        accel: args.accel,
+        kernel: args.kernel,
+    };
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -117,25 +133,35 @@ fn run_render(args: RenderArgs) -> Result<()> {
         };
         bar.set_message(err);
     };
+    let explain = |b: &dyn Fn() -> bool| {
+        if args.explain {
+            bar.suspend(|| eprintln!("{}", variant::plan(&scene, args.accel, args.kernel, b()).explain()));
+        }
+    };
     let (result, device, adapter) = match args.device {
         Device::Gpu => {
             let mut b = GpuBackend::new(GpuContext::new()?);
+            explain(&|| b.runs_on_cpu());
             let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
             (r, "gpu", b.adapter())
         }
         Device::Cpu => {
-            (render(&mut CpuBackend::new(), &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into())
+            let mut b = CpuBackend::new();
+            explain(&|| b.runs_on_cpu());
+            (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into())
         }
     };
     bar.finish_and_clear();
     image_io::write(&args.out, &result.image)?;
     let paths = args.width as f64 * args.height as f64 * args.spp as f64;
     eprintln!(
-        "{}: {}x{} at {} spp on {adapter}, {:.3} s ({:.1} M camera paths/s), wrote {}",
+        "{}: {}x{} at {} spp on {adapter} (accel {:?}, kernel {}), {:.3} s ({:.1} M camera paths/s), wrote {}",
         scene.name,
         args.width,
         args.height,
         args.spp,
+        result.plan.accel,
+        result.plan.kernel,
         result.total_s,
         paths / result.total_s / 1e6,
         args.out.display()
@@ -147,7 +173,8 @@ fn run_render(args: RenderArgs) -> Result<()> {
             "height": args.height,
             "spp": args.spp,
             "seed": args.seed,
-            "accel": args.accel,
+            "accel": result.plan.accel,
+            "plan": result.plan,
             "device": device,
             "adapter": adapter,
             "build_ms": result.build_ms,
@@ -173,7 +200,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         }
         let title = format!(
             "{}: {}x{}, {} spp, accel {:?}, {adapter}",
-            scene.name, args.width, args.height, args.spp, args.accel
+            scene.name, args.width, args.height, args.spp, result.plan.accel
         );
         let series = [Series { label: format!("{device} ({adapter})"), points }];
         match treelet::plot::error_vs_time(&plot_path, &title, label, &series) {

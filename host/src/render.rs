@@ -17,12 +17,16 @@ use crate::lbvh;
 use crate::scene::Scene;
 use crate::primitives::Primitives;
 use crate::trbvh::{self, TreeletConfig};
+use crate::variant::{self, KernelChoice, Plan};
 
 /// How closest hits are found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Accel {
-    /// Test every sphere.
+    /// A linear scan for scenes below the measured crossover, else trbvh
+    /// (see `treelet::variant`).
+    Auto,
+    /// Test every primitive.
     None,
     /// Traverse the LBVH (Karras 2012).
     Lbvh,
@@ -40,6 +44,8 @@ pub struct RenderSettings {
     pub spp: u32,
     pub seed: u32,
     pub accel: Accel,
+    /// The render kernel: the smallest variant for the scene, or the general one.
+    pub kernel: KernelChoice,
 }
 
 /// Camera paths per dispatch at most, so that no dispatch runs long enough
@@ -74,6 +80,8 @@ pub struct RenderResult {
     /// Render-kernel time, summed (ms; GPU timestamps where available).
     pub render_ms: f64,
     pub total_s: f64,
+    /// What ran (acceleration structure, kernel variant) and why.
+    pub plan: Plan,
 }
 
 /// Cumulative sample counts after each pass: 4, 8, 16, ... then `spp`.
@@ -96,7 +104,7 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel } = *settings;
+    let RenderSettings { width, height, spp, seed, accel, kernel } = *settings;
     if width == 0 || height == 0 || spp == 0 {
         bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
     }
@@ -115,19 +123,18 @@ pub fn render<B: Backend>(
     if scene.materials.len() != all.len() {
         bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
     }
+    let plan = variant::plan(scene, accel, kernel, b.runs_on_cpu());
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;
 
-    let (nodes, prim_indices, build_ms) = scene_tree(b, all, accel)?;
+    let (nodes, prim_indices, build_ms) = scene_tree(b, all, plan.accel)?;
     let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
     let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
     let materials = b.upload("materials", &scene.materials)?;
     let accum = b.zeroed("accumulation", pixels * 16)?;
     let camera = scene.camera.camera(width, height);
-    let kernel = match accel {
-        Accel::None => Kernel::RenderLinear,
-        Accel::Lbvh | Accel::Trbvh | Accel::Sweep => Kernel::RenderBvh,
-    };
+    let variant = plan.variant as u8;
+    let kernel = if plan.accel == Accel::None { Kernel::RenderLinear(variant) } else { Kernel::RenderBvh(variant) };
     let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
 
     let mut rows = Vec::new();
@@ -166,7 +173,7 @@ pub fn render<B: Backend>(
     }
     let image =
         HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
-    Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64() })
+    Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
 }
 
 /// Longest root-to-leaf path (edges) of a tree rooted at node 0.
@@ -230,9 +237,11 @@ mod tests {
 }
 
 /// The tree `accel` traces for these primitives, on the device: node and
-/// primitive-index buffers (placeholders for the scan) and the build time (ms).
+/// primitive-index buffers (placeholders for the scan) and the build time
+/// (ms). `Accel::Auto` must have been resolved (see [`variant::plan`]).
 pub fn scene_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<(B::Buffer, B::Buffer, f64)> {
     Ok(match accel {
+        Accel::Auto => bail!("internal: --accel auto reached the tree builder unresolved"),
         Accel::Lbvh | Accel::Trbvh => {
             let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
             let mut build_ms = times.total();

@@ -1,49 +1,49 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
+use treelet_core::features::{ALL, GLASS, MIRROR, SPHERES, TRIANGLES};
 use treelet_core::layout::{Material, Node, RenderParams, Sphere};
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::triangle::Triangle;
 use treelet_core::workgroup::linear_id;
 
-/// Path tracing with a linear scan over all primitives.
-#[spirv(compute(threads(256)))]
-pub fn render_linear_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    if id < params.width * params.height {
-        let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
-        accumulate(&mut accum[id as usize], render_pixel::<ACCEL_NONE>(id, params, &scene));
-    }
+/// One path-tracing entry point: `render_pixel` for one closest-hit method
+/// and one feature set (see `treelet_core::features::VARIANTS`, whose names
+/// these must match).
+macro_rules! render_kernel {
+    ($name:ident, $accel:expr, $features:expr) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            if id < params.width * params.height {
+                let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
+                accumulate(&mut accum[id as usize], render_pixel::<{ $accel }, { $features }>(id, params, &scene));
+            }
+        }
+    };
 }
 
-/// Path tracing through a BVH.
-#[spirv(compute(threads(256)))]
-pub fn render_bvh_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    if id < params.width * params.height {
-        let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
-        accumulate(&mut accum[id as usize], render_pixel::<ACCEL_BVH>(id, params, &scene));
-    }
-}
+render_kernel!(render_linear_spheres_diffuse_cs, ACCEL_NONE, SPHERES);
+render_kernel!(render_bvh_spheres_diffuse_cs, ACCEL_BVH, SPHERES);
+render_kernel!(render_linear_spheres_mirror_cs, ACCEL_NONE, SPHERES | MIRROR);
+render_kernel!(render_bvh_spheres_mirror_cs, ACCEL_BVH, SPHERES | MIRROR);
+render_kernel!(render_linear_spheres_cs, ACCEL_NONE, SPHERES | MIRROR | GLASS);
+render_kernel!(render_bvh_spheres_cs, ACCEL_BVH, SPHERES | MIRROR | GLASS);
+render_kernel!(render_linear_triangles_diffuse_cs, ACCEL_NONE, TRIANGLES);
+render_kernel!(render_bvh_triangles_diffuse_cs, ACCEL_BVH, TRIANGLES);
+render_kernel!(render_linear_mixed_diffuse_cs, ACCEL_NONE, SPHERES | TRIANGLES);
+render_kernel!(render_bvh_mixed_diffuse_cs, ACCEL_BVH, SPHERES | TRIANGLES);
+render_kernel!(render_linear_full_cs, ACCEL_NONE, ALL);
+render_kernel!(render_bvh_full_cs, ACCEL_BVH, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel, through a BVH.
 #[spirv(compute(threads(256)))]

@@ -184,6 +184,9 @@ impl Backend for GpuBackend {
     fn device_kind(&self) -> &'static str {
         "gpu"
     }
+    fn runs_on_cpu(&self) -> bool {
+        self.ctx.info.device_type == wgpu::DeviceType::Cpu
+    }
     fn ordered_atomics_in_divergent_flow(&self) -> bool {
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
     }

@@ -1,10 +1,12 @@
-//! Adapter, device, and one compute pipeline per [`Kernel`], built once.
+//! Adapter, device, and one compute pipeline per [`Kernel`], built on first
+//! use (a run needs a few of the render variants, and compiling a path
+//! tracer takes seconds on lavapipe).
 //!
 //! Treelet's kernels are SPIR-V from rust-gpu, loaded through wgpu's
 //! passthrough (naga cannot read the Vulkan memory model capability the
 //! device-scope atomics need), so Treelet runs on Vulkan adapters only.
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use anyhow::{bail, Context as _, Result};
 
@@ -26,12 +28,13 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     /// Whether compute passes can be timed with timestamp queries.
     pub timestamps: bool,
-    pipelines: HashMap<Kernel, Pipeline>,
+    module: wgpu::ShaderModule,
+    pipelines: Mutex<HashMap<Kernel, Arc<Pipeline>>>,
 }
 
 impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred) and
-    /// builds all pipelines. Fails with a clear message when there is none.
+    /// loads the shader module. Fails with a clear message when there is none.
     pub fn new() -> Result<Arc<Self>> {
         pollster::block_on(Self::new_async())
     }
@@ -72,12 +75,14 @@ impl GpuContext {
             })
             .await
             .with_context(|| format!("could not open adapter `{}`", info.name))?;
-        let pipelines = build_pipelines(&device);
-        Ok(Arc::new(Self { device, queue, info, limits, timestamps, pipelines }))
+        let module = shader_module(&device);
+        Ok(Arc::new(Self { device, queue, info, limits, timestamps, module, pipelines: Mutex::default() }))
     }
 
-    pub fn pipeline(&self, kernel: Kernel) -> &Pipeline {
-        &self.pipelines[&kernel]
+    /// The pipeline of `kernel`, built the first time it is asked for.
+    pub fn pipeline(&self, kernel: Kernel) -> Arc<Pipeline> {
+        let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        pipelines.entry(kernel).or_insert_with(|| Arc::new(build_pipeline(&self.device, &self.module, kernel))).clone()
     }
 
     /// Largest buffer usable as one storage binding.
@@ -86,24 +91,24 @@ impl GpuContext {
     }
 }
 
-fn build_pipelines(device: &wgpu::Device) -> HashMap<Kernel, Pipeline> {
+fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {
     let words = wgpu::util::make_spirv_raw(SHADER_SPV);
-    let entry_points: Vec<_> = Kernel::ALL
+    let entry_points: Vec<_> = Kernel::all()
         .iter()
         .map(|k| wgpu::PassthroughShaderEntryPoint { name: k.entry_point().into(), workgroup_size: (256, 1, 1) })
         .collect();
     // SAFETY: the module is rust-gpu output validated by spirv-val at build time.
-    let module = unsafe {
+    unsafe {
         device.create_shader_module_passthrough(wgpu::ShaderModuleDescriptorPassthrough {
             label: Some("treelet_shader"),
             entry_points: entry_points.into(),
             spirv: Some(words),
             ..Default::default()
         })
-    };
-    Kernel::ALL
-        .iter()
-        .map(|&kernel| {
+    }
+}
+
+fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Kernel) -> Pipeline {
             let entries: Vec<_> = kernel
                 .bindings()
                 .iter()
@@ -131,12 +136,43 @@ fn build_pipelines(device: &wgpu::Device) -> HashMap<Kernel, Pipeline> {
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(kernel.entry_point()),
                 layout: Some(&pipeline_layout),
-                module: &module,
+                module,
                 entry_point: Some(kernel.entry_point()),
                 compilation_options: Default::default(),
                 cache: None,
             });
-            (kernel, Pipeline { pipeline, layout })
-        })
-        .collect()
+            Pipeline { pipeline, layout }
+}
+
+/// Size in 32-bit words of an entry point's function in the shader module
+/// (rust-gpu inlines everything a kernel calls into it), or None if the
+/// module has no such entry point: the code size of one kernel variant.
+pub fn entry_point_words(name: &str) -> Option<usize> {
+    const OP_ENTRY_POINT: u32 = 15;
+    const OP_FUNCTION: u32 = 54;
+    const OP_FUNCTION_END: u32 = 56;
+    let words: Vec<u32> = SHADER_SPV.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    let mut target = None;
+    let (mut i, mut start) = (5, None);
+    while i < words.len() {
+        let (count, op) = ((words[i] >> 16) as usize, words[i] & 0xffff);
+        if count == 0 {
+            return None;
+        }
+        let operands = &words[i + 1..(i + count).min(words.len())];
+        match op {
+            OP_ENTRY_POINT if operands.len() > 2 => {
+                let bytes: Vec<u8> = operands[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
+                let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+                if &bytes[..end] == name.as_bytes() {
+                    target = Some(operands[1]);
+                }
+            }
+            OP_FUNCTION if operands.len() > 1 && Some(operands[1]) == target => start = Some(i),
+            OP_FUNCTION_END if start.is_some() => return start.map(|s| i + count - s),
+            _ => {}
+        }
+        i += count;
+    }
+    None
 }

@@ -1,0 +1,227 @@
+//! Leaving out what a scene does not need: from the scene's features, the
+//! render kernel compiled without the rest (`treelet_core::features`), and
+//! whether a BVH pays at all. The same choice on every backend, recorded
+//! with its reasons for `treelet render --explain` and the report.
+use serde::Serialize;
+use treelet_core::features::{self, VARIANTS};
+use treelet_core::layout::{DIFFUSE, GLASS, MIRROR};
+
+use crate::render::Accel;
+use crate::scene::Scene;
+
+/// What a scene contains.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SceneFeatures {
+    pub spheres: usize,
+    pub triangles: usize,
+    /// Primitives by material kind.
+    pub diffuse: usize,
+    pub mirror: usize,
+    pub glass: usize,
+    /// Primitives that emit light (of any kind).
+    pub emissive: usize,
+}
+
+impl SceneFeatures {
+    pub fn of(scene: &Scene) -> Self {
+        let mut f = SceneFeatures { spheres: scene.spheres.len(), triangles: scene.triangles.len(), ..Default::default() };
+        for m in &scene.materials {
+            match m.kind {
+                DIFFUSE => f.diffuse += 1,
+                MIRROR => f.mirror += 1,
+                GLASS => f.glass += 1,
+                _ => {}
+            }
+            if m.emission.iter().any(|&e| e > 0.0) {
+                f.emissive += 1;
+            }
+        }
+        f
+    }
+
+    pub fn primitives(&self) -> usize {
+        self.spheres + self.triangles
+    }
+
+    /// The kernel features (`treelet_core::features`) these need.
+    pub fn bits(&self) -> u32 {
+        let mut bits = 0;
+        for (count, bit) in [
+            (self.spheres, features::SPHERES),
+            (self.triangles, features::TRIANGLES),
+            (self.mirror, features::MIRROR),
+            (self.glass, features::GLASS),
+        ] {
+            if count > 0 {
+                bits |= bit;
+            }
+        }
+        bits
+    }
+}
+
+/// Names of feature bits, for messages.
+pub fn describe(bits: u32) -> String {
+    let names: Vec<&str> = [
+        (features::SPHERES, "spheres"),
+        (features::TRIANGLES, "triangles"),
+        (features::MIRROR, "mirror"),
+        (features::GLASS, "glass"),
+    ]
+    .iter()
+    .filter(|(bit, _)| bits & bit != 0)
+    .map(|&(_, name)| name)
+    .collect();
+    let mut s = String::from("diffuse, emission");
+    for n in names {
+        s.push_str(", ");
+        s.push_str(n);
+    }
+    s
+}
+
+/// Which render kernel to run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum KernelChoice {
+    /// The smallest variant compiled for the scene's features.
+    #[default]
+    Auto,
+    /// The general kernel (every feature compiled in), for comparison.
+    Full,
+}
+
+/// The smallest compiled variant (index into `VARIANTS`) whose features
+/// include `bits`; the general kernel always does.
+pub fn smallest_variant(bits: u32) -> usize {
+    VARIANTS
+        .iter()
+        .enumerate()
+        .filter(|(_, (v, _))| v & bits == bits)
+        .min_by_key(|(i, (v, _))| (v.count_ones(), *i))
+        .map(|(i, _)| i)
+        .expect("the general variant contains every feature")
+}
+
+/// Index of the general kernel in `VARIANTS`.
+pub fn full_variant() -> usize {
+    VARIANTS.iter().position(|(v, _)| *v == features::ALL).expect("VARIANTS has the general kernel")
+}
+
+/// Up to this many primitives a linear scan beats building and traversing
+/// a BVH (per path, at a few spp). Measured with `treelet bench render
+/// --sizes 0,1,4,8,16,32,64 --accels none,lbvh` on random:N (N spheres in
+/// smallpt's 9-sphere room): see issue 6's note for the numbers.
+pub const LINEAR_MAX_GPU: usize = 16;
+/// As [`LINEAR_MAX_GPU`] on CPU devices (lavapipe, the CPU runner).
+pub const LINEAR_MAX_CPU: usize = 16;
+
+/// What the render will run, and why.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    pub features: SceneFeatures,
+    pub accel: Accel,
+    pub accel_reason: String,
+    /// Index into `VARIANTS`.
+    #[serde(skip)]
+    pub variant: usize,
+    /// Entry-point name of the variant (`render_{linear,bvh}_<name>_cs`).
+    pub kernel: &'static str,
+    pub kernel_features: String,
+    pub kernel_reason: String,
+}
+
+/// Chooses the acceleration structure and kernel variant for `scene` on a
+/// device that `runs_on_cpu` or not. `Accel::Auto` picks the linear scan up
+/// to the measured crossover, else the treelet-optimized BVH.
+pub fn plan(scene: &Scene, accel: Accel, kernel: KernelChoice, runs_on_cpu: bool) -> Plan {
+    let features = SceneFeatures::of(scene);
+    let n = features.primitives();
+    let (linear_max, device) = if runs_on_cpu { (LINEAR_MAX_CPU, "a CPU device") } else { (LINEAR_MAX_GPU, "a GPU") };
+    let (accel, accel_reason) = match accel {
+        Accel::Auto if n <= linear_max => (
+            Accel::None,
+            format!("{n} primitives: a linear scan is faster than a BVH up to {linear_max} on {device}"),
+        ),
+        Accel::Auto => (
+            Accel::Trbvh,
+            format!("{n} primitives: above {linear_max} a BVH is faster on {device}; treelet-optimized"),
+        ),
+        other => (other, "as asked (--accel)".to_string()),
+    };
+    let bits = features.bits();
+    let (variant, kernel_reason) = match kernel {
+        KernelChoice::Full => (full_variant(), "as asked (--kernel full)".to_string()),
+        KernelChoice::Auto => {
+            let v = smallest_variant(bits);
+            let left_out = features::ALL & !VARIANTS[v].0;
+            let reason = if left_out == 0 {
+                "no smaller variant covers the scene".to_string()
+            } else {
+                format!("the scene needs {}; left out: {}", describe(bits), describe(left_out).replace("diffuse, emission, ", ""))
+            };
+            (v, reason)
+        }
+    };
+    let name = VARIANTS[variant].1;
+    Plan {
+        features,
+        accel,
+        accel_reason,
+        variant,
+        kernel: name,
+        kernel_features: describe(VARIANTS[variant].0),
+        kernel_reason,
+    }
+}
+
+impl Plan {
+    /// The lines `--explain` prints.
+    pub fn explain(&self) -> String {
+        let f = &self.features;
+        format!(
+            "features   {} spheres, {} triangles; materials: {} diffuse, {} mirror, {} glass, {} emissive\n\
+             accel      {:?}: {}\n\
+             kernel     {} ({}): {}",
+            f.spheres,
+            f.triangles,
+            f.diffuse,
+            f.mirror,
+            f.glass,
+            f.emissive,
+            self.accel,
+            self.accel_reason,
+            self.kernel,
+            self.kernel_features,
+            self.kernel_reason
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_feature_set_gets_a_variant_that_contains_it() {
+        for bits in 0..=features::ALL {
+            let v = smallest_variant(bits);
+            assert_eq!(VARIANTS[v].0 & bits, bits, "features {bits:#b} got {}", VARIANTS[v].1);
+            // And no variant that contains them is smaller.
+            for (other, _) in VARIANTS {
+                if other & bits == bits {
+                    assert!(other.count_ones() >= VARIANTS[v].0.count_ones());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn glass_never_runs_without_refraction() {
+        for bits in 0..=features::ALL {
+            if bits & features::GLASS != 0 {
+                assert!(VARIANTS[smallest_variant(bits)].0 & features::GLASS != 0);
+            }
+        }
+    }
+}

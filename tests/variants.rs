@@ -1,0 +1,115 @@
+//! Per-scene kernel variants: each specialized kernel renders the same image
+//! as the general one (same seed) on a scene that selects it, on the CPU
+//! runner and on the GPU; the choice never drops a feature the scene has.
+use std::collections::BTreeSet;
+
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::GpuBackend;
+use treelet::render::{render, Accel, RenderResult, RenderSettings};
+use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
+use treelet::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU};
+use treelet_core::features::{self, VARIANTS};
+use treelet_core::triangle::Triangle;
+use treelet_tests::gpu;
+
+/// A tetrahedron-studded patch of triangles.
+fn triangles(n: usize, seed: u64) -> Vec<Triangle> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let c = [rng.random_range(-1.0..1.0f32), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+            let v = |rng: &mut rand_pcg::Pcg64| c.map(|x| x + rng.random_range(-0.3..0.3f32));
+            Triangle::new(v(&mut rng), v(&mut rng), v(&mut rng))
+        })
+        .collect()
+}
+
+/// Scenes that select each specialized variant: (scene, variant name).
+fn scenes(seed: u64) -> Vec<(Scene, &'static str)> {
+    let mut diffuse = Scene::from_spec("scenes/cornell_diffuse.json")
+        .or_else(|_| Scene::from_spec("../scenes/cornell_diffuse.json"))
+        .unwrap();
+    diffuse.name = "cornell diffuse".into();
+    let mirrors = Scene::from_spec("scenes/cornell_mirrors.json")
+        .or_else(|_| Scene::from_spec("../scenes/cornell_mirrors.json"))
+        .unwrap();
+    let mixed = mesh_scene("triangles in the room", &triangles(150, seed));
+    // Triangles alone, half of them lights.
+    let mut only = mixed.mesh_only().unwrap();
+    for (i, m) in only.materials.iter_mut().enumerate() {
+        if i % 2 == 0 {
+            m.emission = [2.0, 2.0, 2.0];
+        }
+    }
+    vec![
+        (cornell(), "spheres"),
+        (diffuse, "spheres_diffuse"),
+        (mirrors, "spheres_mirror"),
+        (random_scene("random:60", 60, seed), "spheres"),
+        (mixed, "mixed_diffuse"),
+        (only, "triangles_diffuse"),
+    ]
+}
+
+fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel, seed: u32) -> RenderResult {
+    let s = RenderSettings { width: 40, height: 30, spp: 8, seed, accel, kernel };
+    render(b, scene, &s, None, |_| {}).unwrap()
+}
+
+/// Fraction of pixels whose channels differ by more than `tol` (relative to 1 + value).
+fn mismatch_fraction(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> f64 {
+    let bad = a.iter().zip(b).filter(|(x, y)| (0..3).any(|k| (x[k] - y[k]).abs() > tol * (1.0 + y[k].abs()))).count();
+    bad as f64 / a.len() as f64
+}
+
+#[test]
+fn every_variant_renders_what_the_full_kernel_renders() {
+    let seed = treelet_tests::fresh_seed();
+    let ctx = gpu();
+    let mut exercised = BTreeSet::new();
+    for (scene, expected) in scenes(seed) {
+        for accel in [Accel::None, Accel::Lbvh] {
+            let auto = run(&mut CpuBackend::new(), &scene, KernelChoice::Auto, accel, seed as u32);
+            assert_eq!(auto.plan.kernel, expected, "{}: chose {}", scene.name, auto.plan.kernel);
+            exercised.insert(auto.plan.kernel);
+            let full = run(&mut CpuBackend::new(), &scene, KernelChoice::Full, accel, seed as u32);
+            assert_eq!(full.plan.kernel, "full");
+            // The same operations in the same order: the same image, bit for bit.
+            assert!(auto.image.pixels == full.image.pixels, "{} ({accel:?}): CPU variant differs from full", scene.name);
+            let lit = auto.image.pixels.iter().filter(|p| p.iter().any(|&c| c > 0.0)).count();
+            assert!(lit > auto.image.pixels.len() / 4, "{}: only {lit} lit pixels, a weak test", scene.name);
+            let Some(ctx) = &ctx else { continue };
+            let g = run(&mut GpuBackend::new(ctx.clone()), &scene, KernelChoice::Auto, accel, seed as u32);
+            let gf = run(&mut GpuBackend::new(ctx.clone()), &scene, KernelChoice::Full, accel, seed as u32);
+            // Separately compiled code may round a few paths differently (see
+            // tests/render.rs); nearly all pixels agree to 1e-4.
+            let off = mismatch_fraction(&g.image.pixels, &gf.image.pixels, 1e-4);
+            assert!(off < 0.02, "{} ({accel:?}): {:.1}% of GPU pixels differ from the full kernel", scene.name, off * 100.0);
+            eprintln!("{} ({accel:?}, {}): {:.2}% of GPU pixels differ from the full kernel", scene.name, g.plan.kernel, off * 100.0);
+        }
+    }
+    let specialized: BTreeSet<&str> = VARIANTS.iter().map(|v| v.1).filter(|&n| n != "full").collect();
+    assert_eq!(exercised, specialized, "every specialized variant is exercised");
+}
+
+#[test]
+fn choices_keep_every_feature_and_follow_the_crossover() {
+    let seed = treelet_tests::fresh_seed();
+    for (scene, _) in scenes(seed) {
+        let bits = SceneFeatures::of(&scene).bits();
+        for kernel in [KernelChoice::Auto, KernelChoice::Full] {
+            let p = plan(&scene, Accel::Auto, kernel, true);
+            let compiled = VARIANTS[p.variant].0;
+            assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
+            if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
+                assert!(compiled & features::GLASS != 0, "{}: glass without refraction", scene.name);
+            }
+            let n = scene.spheres.len() + scene.triangles.len();
+            assert_eq!(p.accel == Accel::None, n <= LINEAR_MAX_CPU, "{}: {n} primitives, {:?}", scene.name, p.accel);
+        }
+        // Forced choices stay as asked.
+        assert_eq!(plan(&scene, Accel::Sweep, KernelChoice::Auto, false).accel, Accel::Sweep);
+    }
+}
