@@ -108,13 +108,17 @@ pub fn full_variant() -> usize {
     VARIANTS.iter().position(|(v, _)| *v == features::ALL).expect("VARIANTS has the general kernel")
 }
 
-/// Up to this many primitives a linear scan beats building and traversing
-/// a BVH (per path, at a few spp). Measured with `treelet bench render
-/// --sizes 0,1,4,8,16,32,64 --accels none,lbvh` on random:N (N spheres in
-/// smallpt's 9-sphere room): see issue 6's note for the numbers.
-pub const LINEAR_MAX_GPU: usize = 16;
-/// As [`LINEAR_MAX_GPU`] on CPU devices (lavapipe, the CPU runner).
-pub const LINEAR_MAX_CPU: usize = 16;
+/// Up to this many primitives a linear scan beats traversing a BVH on a
+/// GPU. Measured with `treelet bench render --spp 4 --sizes
+/// 0,8,16,32,64,128,256,1000 --accels none,lbvh,trbvh` (random:N: N spheres
+/// in smallpt's 9-sphere room, 1024x768) on an H100: render-kernel time of
+/// the scan 40.4 ms against 45.5 ms for the treelet-optimized BVH at 265
+/// primitives, 158 ms against 66 ms at 1009.
+pub const LINEAR_MAX_GPU: usize = 256;
+/// As [`LINEAR_MAX_GPU`] on CPU devices (lavapipe, 256x192): the scan wins
+/// at 521 primitives (5.0 s against 7.5 s), loses at 1009 (11.7 s against
+/// 4.5 s). The CPU runner uses it too (not measured separately).
+pub const LINEAR_MAX_CPU: usize = 512;
 
 /// What the render will run, and why.
 #[derive(Clone, Debug, Serialize)]
