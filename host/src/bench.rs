@@ -404,7 +404,10 @@ fn bench_rays<B: Backend>(
     use treelet::primitives::Primitives;
     use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
     use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
-    anyhow::ensure!(accel != Accel::None, "bench rays traces trees: pick lbvh, trbvh or sweep");
+    anyhow::ensure!(
+        !matches!(accel, Accel::None | Accel::Auto),
+        "bench rays traces trees: pick lbvh, trbvh or sweep (not {accel:?})"
+    );
     let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
     all.check()?;
     let pixels = width as u64 * height as u64;
