@@ -12,10 +12,59 @@ use treelet::trbvh::{self, TreeletConfig};
 use treelet::variant::KernelChoice;
 use treelet_core::Sphere;
 
+use crate::suite::{Figure, Suite};
 use crate::Device;
+
+/// Options of every figure command.
+#[derive(clap::Args, Clone)]
+pub struct FigureArgs {
+    #[arg(long, value_enum, default_value = "gpu")]
+    device: Device,
+    /// Small sizes: minutes on lavapipe or a CPU (default: the seed's sizes and beyond).
+    #[arg(long)]
+    quick: bool,
+    /// Where the JSON and PNG of each figure (and RESULTS.md for `all`) go.
+    #[arg(long)]
+    out: std::path::PathBuf,
+    /// Timed repeats per measurement (median, min and max are recorded).
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+}
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
+    /// Figure: cornell render time against samples per pixel, GPU and CPU runner (the seed's Graph 1).
+    #[command(name = "graph1")]
+    Graph1(FigureArgs),
+    /// Figure: render time against scene size, linear scan against BVHs (Graph 2).
+    #[command(name = "graph2")]
+    Graph2(FigureArgs),
+    /// Figure: BVH build time against size, with CPU builders and peers (Graph 2.5).
+    #[command(name = "graph2.5")]
+    Graph25(FigureArgs),
+    /// Figure: render time against size, LBVH against optimized BVHs (Graph 3).
+    #[command(name = "graph3")]
+    Graph3(FigureArgs),
+    /// Figure: treelet-optimization time against size (Graph 3.5).
+    #[command(name = "graph3.5")]
+    Graph35(FigureArgs),
+    /// Figure: error against time for each closest-hit method.
+    Error(FigureArgs),
+    /// Figure: SAH cost against build time for every builder and peer.
+    Pareto(FigureArgs),
+    /// Figure: primary and diffuse rays per second through each tree.
+    #[command(name = "rays-figure")]
+    RaysFigure(FigureArgs),
+    /// Every figure, then RESULTS.md in --out.
+    All(FigureArgs),
+    /// One RESULTS.md from the figure files of several `bench all` runs (how docs/RESULTS.md is made).
+    Results {
+        /// Run directories, each written by `treelet bench all --out DIR`.
+        #[arg(long, value_delimiter = ',', required = true)]
+        runs: Vec<std::path::PathBuf>,
+        #[arg(long, default_value = "docs/RESULTS.md")]
+        out: std::path::PathBuf,
+    },
     /// LBVH (and treelet-optimization) build times over random:N scenes.
     Build {
         /// lbvh: the Karras 2012 build; trbvh: the build plus treelet restructuring (stage times of both).
@@ -105,6 +154,11 @@ pub enum BenchCommand {
     },
 }
 
+fn figure(f: Figure, a: FigureArgs) -> Result<()> {
+    let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats: a.repeats.max(1) };
+    crate::suite::run(f, &suite)
+}
+
 /// Scenes `bench variants` compares by default: each exercises a different
 /// specialized kernel (cornell: no triangles; diffuse and mirror-only
 /// variants; many spheres through a BVH; a mesh in smallpt's room).
@@ -133,24 +187,24 @@ fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&Treele
 
 /// Paths per second of a render, by wall clock and by render-kernel time.
 #[derive(serde::Serialize)]
-struct RenderRow {
-    scene: String,
-    accel: Accel,
+pub(crate) struct RenderRow {
+    pub(crate) scene: String,
+    pub(crate) accel: Accel,
     /// The render kernel variant that ran.
-    kernel: &'static str,
-    width: u32,
-    height: u32,
-    spp: u32,
+    pub(crate) kernel: &'static str,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) spp: u32,
     /// Whole render, BVH build and readbacks included (s).
-    total_s: f64,
+    pub(crate) total_s: f64,
     /// Render kernels alone (GPU timestamps on a GPU) (s).
-    kernel_s: f64,
-    build_ms: f64,
+    pub(crate) kernel_s: f64,
+    pub(crate) build_ms: f64,
     /// Camera paths per second of kernel time.
-    paths_per_s: f64,
+    pub(crate) paths_per_s: f64,
 }
 
-fn bench_render<B: Backend>(
+pub(crate) fn bench_render<B: Backend>(
     b: &mut B,
     scene: &Scene,
     width: u32,
@@ -161,7 +215,7 @@ fn bench_render<B: Backend>(
     bench_render_kernel(b, scene, width, height, spp, accel, KernelChoice::Auto)
 }
 
-fn bench_render_kernel<B: Backend>(
+pub(crate) fn bench_render_kernel<B: Backend>(
     b: &mut B,
     scene: &Scene,
     width: u32,
@@ -311,17 +365,17 @@ fn render_sweeps<B: Backend>(b: &mut B, sweep: &RenderSweep) -> Result<(Vec<Rend
 }
 
 #[derive(serde::Serialize)]
-struct Row {
-    primitives: usize,
+pub(crate) struct Row {
+    pub(crate) primitives: usize,
     /// Median per stage (or per kernel, with --per-kernel), in the order run.
-    median_ms: Vec<(&'static str, f64)>,
-    total_median_ms: f64,
-    total_min_ms: f64,
-    total_max_ms: f64,
-    mprims_per_s: f64,
+    pub(crate) median_ms: Vec<(&'static str, f64)>,
+    pub(crate) total_median_ms: f64,
+    pub(crate) total_min_ms: f64,
+    pub(crate) total_max_ms: f64,
+    pub(crate) mprims_per_s: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let m = v.len() / 2;
     if v.len() % 2 == 1 {
@@ -331,7 +385,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-fn bench_sizes<B: Backend>(
+pub(crate) fn bench_sizes<B: Backend>(
     b: &mut B,
     sizes: &[usize],
     repeats: usize,
@@ -380,20 +434,20 @@ fn bench_sizes<B: Backend>(
 
 /// Primary and diffuse rays per second through one tree.
 #[derive(serde::Serialize)]
-struct RaysRow {
-    scene: String,
-    accel: Accel,
-    primitives: usize,
-    build_ms: f64,
-    primary_rays: u64,
-    diffuse_rays: u64,
-    primary_median_ms: f64,
-    diffuse_median_ms: f64,
-    primary_mrays_per_s: f64,
-    diffuse_mrays_per_s: f64,
+pub(crate) struct RaysRow {
+    pub(crate) scene: String,
+    pub(crate) accel: Accel,
+    pub(crate) primitives: usize,
+    pub(crate) build_ms: f64,
+    pub(crate) primary_rays: u64,
+    pub(crate) diffuse_rays: u64,
+    pub(crate) primary_median_ms: f64,
+    pub(crate) diffuse_median_ms: f64,
+    pub(crate) primary_mrays_per_s: f64,
+    pub(crate) diffuse_mrays_per_s: f64,
 }
 
-fn bench_rays<B: Backend>(
+pub(crate) fn bench_rays<B: Backend>(
     b: &mut B,
     scene: &Scene,
     accel: Accel,
@@ -514,6 +568,20 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
+            Ok(())
+        }
+        BenchCommand::Graph1(a) => figure(Figure::Graph1, a),
+        BenchCommand::Graph2(a) => figure(Figure::Graph2, a),
+        BenchCommand::Graph25(a) => figure(Figure::Graph25, a),
+        BenchCommand::Graph3(a) => figure(Figure::Graph3, a),
+        BenchCommand::Graph35(a) => figure(Figure::Graph35, a),
+        BenchCommand::Error(a) => figure(Figure::Error, a),
+        BenchCommand::Pareto(a) => figure(Figure::Pareto, a),
+        BenchCommand::RaysFigure(a) => figure(Figure::Rays, a),
+        BenchCommand::All(a) => figure(Figure::All, a),
+        BenchCommand::Results { runs, out } => {
+            crate::results::collect(&runs, &out)?;
+            eprintln!("wrote {}", out.display());
             Ok(())
         }
         BenchCommand::Variants { device, quick, scenes, repeats, json } => {

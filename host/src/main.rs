@@ -16,6 +16,8 @@ use treelet::trbvh::TreeletConfig;
 use treelet::variant::{self, KernelChoice};
 
 mod bench;
+mod results;
+mod suite;
 
 #[derive(Parser)]
 #[command(name = "treelet", version, about = "GPU BVH construction (Karras 2012) and a smallpt path tracer, in Rust")]

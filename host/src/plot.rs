@@ -89,3 +89,106 @@ pub fn error_vs_time(path: &Path, title: &str, y_label: &str, series: &[Series])
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
+
+/// How [`chart`] draws a figure.
+pub struct Chart<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub log_x: bool,
+    pub log_y: bool,
+    /// Points only, each labelled with its series (a Pareto plot), instead of lines.
+    pub scatter: bool,
+}
+
+/// Writes a plot of `series` (x, y) to `path` (PNG): lines with markers, or
+/// labelled points; log axes where asked (non-positive values are dropped there).
+pub fn chart(path: &Path, c: &Chart, series: &[Series]) -> Result<()> {
+    register_font();
+    let keep = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && (!c.log_x || x > 0.0) && (!c.log_y || y > 0.0);
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().copied()).filter(keep).collect();
+    if all.is_empty() {
+        bail!("nothing to plot in {}", path.display());
+    }
+    let (x0, x1) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let range = |lo: f64, hi: f64, log: bool| {
+        if log {
+            (lo / 1.5, hi * 1.5)
+        } else {
+            let pad = ((hi - lo) * 0.08).max(hi.abs() * 0.02).max(1e-9);
+            (lo - pad, hi + pad)
+        }
+    };
+    let ((mut xa, mut xb), (ya, yb)) = (range(x0, x1, c.log_x), range(y0, y1, c.log_y));
+    if c.scatter {
+        // Room on the right for the points' labels.
+        (xa, xb) = if c.log_x { (xa, xb * 4.0) } else { (xa, xb + (xb - xa) * 0.3) };
+    }
+    let root = BitMapBackend::new(path, (1000, 650)).into_drawing_area();
+    let err = |e: &dyn std::fmt::Display| anyhow!("plotting {}: {e}", path.display());
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let colors = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0), RGBColor(120, 60, 180)];
+    // The four axis combinations are four chart types in plotters.
+    macro_rules! draw {
+        ($x:expr, $y:expr) => {{
+            let mut chart = ChartBuilder::on(&root)
+                .caption(c.title, ("sans-serif", 22))
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d($x, $y)
+                .map_err(|e| err(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc(c.x_label)
+                .y_desc(c.y_label)
+                .x_label_formatter(&|v| short(*v))
+                .y_label_formatter(&|v| short(*v))
+                .label_style(("sans-serif", 15))
+                .draw()
+                .map_err(|e| err(&e))?;
+            for (i, s) in series.iter().enumerate() {
+                let color = colors[i % colors.len()];
+                let pts: Vec<_> = s.points.iter().copied().filter(keep).collect();
+                if c.scatter {
+                    // Each point carries its label: no legend to cover them.
+                    let label = s.label.clone();
+                    chart.draw_series(pts.iter().map(|&p| Circle::new(p, 6, color.filled()))).map_err(|e| err(&e))?;
+                    chart
+                        .draw_series(pts.iter().map(|&p| {
+                            EmptyElement::at(p)
+                                + Text::new(label.clone(), (8, -6), ("sans-serif", 13).into_font().color(&color))
+                        }))
+                        .map_err(|e| err(&e))?;
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+                        .map_err(|e| err(&e))?
+                        .label(&s.label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                    chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(|e| err(&e))?;
+                }
+            }
+            if c.scatter {
+                return Ok(root.present().map_err(|e| err(&e))?);
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 15))
+                .draw()
+                .map_err(|e| err(&e))?;
+        }};
+    }
+    match (c.log_x, c.log_y) {
+        (true, true) => draw!((xa..xb).log_scale(), (ya..yb).log_scale()),
+        (true, false) => draw!((xa..xb).log_scale(), ya..yb),
+        (false, true) => draw!(xa..xb, (ya..yb).log_scale()),
+        (false, false) => draw!(xa..xb, ya..yb),
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}

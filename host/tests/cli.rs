@@ -178,3 +178,35 @@ fn bench_rays_mesh_only() {
     let e = stderr_of(&[&args[..], &["--scene", "random:10"]].concat());
     assert!(e.contains("has no triangles"), "{e}");
 }
+
+#[test]
+fn figure_writes_json_png_and_results() {
+    let dir = std::env::temp_dir().join(format!("treelet-figure-{}", std::process::id()));
+    let out = treelet(&["bench", "graph2.5", "--quick", "--device", "cpu", "--repeats", "1", "--out", dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("graph2.5.json")).unwrap()).unwrap();
+    assert_eq!(doc["figure"], "graph2.5");
+    assert_eq!(doc["adapter"], "cpu");
+    let points = doc["points"].as_array().unwrap();
+    // The device LBVH and the CPU sweep at each quick size, and the seed's two points.
+    for series in ["LBVH (CPU runner)", "full-sweep SAH (Treelet, CPU)", "seed report (GRID K520)"] {
+        let mine: Vec<_> = points.iter().filter(|p| p["series"] == series).collect();
+        assert!(mine.len() >= 2, "{series}: {} points", mine.len());
+        for p in mine {
+            let (lo, med, hi) = (p["min"].as_f64().unwrap(), p["median"].as_f64().unwrap(), p["max"].as_f64().unwrap());
+            assert!(lo > 0.0 && lo <= med && med <= hi, "{series}: {lo} {med} {hi}");
+        }
+    }
+    assert!(std::fs::metadata(dir.join("graph2.5.png")).unwrap().len() > 10_000, "the plot is missing or empty");
+    let md = dir.join("R.md");
+    let out = treelet(&["bench", "results", "--runs", dir.to_str().unwrap(), "--out", md.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&md).unwrap();
+    assert!(text.contains("### graph2.5") && text.contains("graph2.5.png") && text.contains("| primitives |"), "{text}");
+    // A run directory without figures is an error that names it.
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = treelet(&["bench", "results", "--runs", empty.to_str().unwrap(), "--out", md.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no figure files"));
+}

@@ -1,0 +1,590 @@
+//! `treelet bench <figure>|all --out DIR`: the seed report's figures and a
+//! few more, each measured on this machine and written as `DIR/<figure>.json`
+//! (every measurement: series, x, median, min, max, repeats), `DIR/<figure>.png`
+//! and a printed table; `all` also writes `DIR/RESULTS.md` (see `docs/RESULTS.md`).
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize};
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::{GpuBackend, GpuContext};
+use treelet::plot::{chart, Chart, Series};
+use treelet::render::{render, Accel, RenderSettings};
+use treelet::scene::{random_spheres, Scene};
+use treelet::trbvh::TreeletConfig;
+use treelet::variant::KernelChoice;
+
+use crate::bench::{bench_rays, bench_render_kernel, bench_sizes, median};
+use crate::Device;
+
+/// The figures: the seed's five, then three it lacks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Figure {
+    /// Graph 1: render time against samples per pixel, GPU and CPU runner (cornell).
+    #[value(name = "graph1")]
+    Graph1,
+    /// Graph 2: render time against scene size, linear scan against BVHs.
+    #[value(name = "graph2")]
+    Graph2,
+    /// Graph 2.5: BVH build time against size (LBVH on the device; CPU builders, peers).
+    #[value(name = "graph2.5")]
+    Graph25,
+    /// Graph 3: render time against size, LBVH against the optimized BVHs.
+    #[value(name = "graph3")]
+    Graph3,
+    /// Graph 3.5: treelet-optimization time against size.
+    #[value(name = "graph3.5")]
+    Graph35,
+    /// Error against time for each closest-hit method.
+    #[value(name = "error")]
+    Error,
+    /// SAH cost against build time for every builder (Pareto plot).
+    #[value(name = "pareto")]
+    Pareto,
+    /// Primary and diffuse rays per second through each tree.
+    #[value(name = "rays")]
+    Rays,
+    /// Every figure, then RESULTS.md.
+    #[value(name = "all")]
+    All,
+}
+
+impl Figure {
+    const EACH: [Figure; 8] = [
+        Figure::Graph1,
+        Figure::Graph2,
+        Figure::Graph25,
+        Figure::Graph3,
+        Figure::Graph35,
+        Figure::Error,
+        Figure::Pareto,
+        Figure::Rays,
+    ];
+
+    /// File names of the figures, in order.
+    pub fn names() -> impl Iterator<Item = &'static str> {
+        Self::EACH.into_iter().map(Figure::name)
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Figure::Graph1 => "graph1",
+            Figure::Graph2 => "graph2",
+            Figure::Graph25 => "graph2.5",
+            Figure::Graph3 => "graph3",
+            Figure::Graph35 => "graph3.5",
+            Figure::Error => "error",
+            Figure::Pareto => "pareto",
+            Figure::Rays => "rays",
+            Figure::All => "all",
+        }
+    }
+}
+
+/// One measurement: a point of one series.
+#[derive(Clone, Serialize, Deserialize)]
+pub struct Point {
+    pub series: String,
+    pub x: f64,
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    pub repeats: usize,
+}
+
+impl Point {
+    fn of(series: impl Into<String>, x: f64, samples: &[f64]) -> Point {
+        Point {
+            series: series.into(),
+            x,
+            median: median(samples.to_vec()),
+            min: samples.iter().copied().fold(f64::MAX, f64::min),
+            max: samples.iter().copied().fold(f64::MIN, f64::max),
+            repeats: samples.len(),
+        }
+    }
+
+    fn once(series: impl Into<String>, x: f64, y: f64) -> Point {
+        Point::of(series, x, &[y])
+    }
+}
+
+/// Everything a figure's JSON holds.
+#[derive(Serialize, Deserialize)]
+pub struct FigureDoc {
+    pub figure: String,
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub log_x: bool,
+    pub log_y: bool,
+    pub scatter: bool,
+    pub device: String,
+    pub adapter: String,
+    pub date: String,
+    pub command: String,
+    pub quick: bool,
+    pub parameters: serde_json::Value,
+    pub notes: Vec<String>,
+    pub points: Vec<Point>,
+}
+
+/// What every figure runs on.
+pub struct Suite {
+    pub device: Device,
+    pub quick: bool,
+    pub out: PathBuf,
+    pub repeats: usize,
+}
+
+/// A backend for the suite's device (the GPU context is made once).
+enum Runner {
+    Gpu(std::sync::Arc<GpuContext>),
+    Cpu,
+}
+
+macro_rules! with_backend {
+    ($runner:expr, |$b:ident| $body:expr) => {
+        match $runner {
+            Runner::Gpu(ctx) => {
+                let $b = &mut GpuBackend::new(ctx.clone());
+                $body
+            }
+            Runner::Cpu => {
+                let $b = &mut CpuBackend::new();
+                $body
+            }
+        }
+    };
+}
+
+pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
+    std::fs::create_dir_all(&suite.out).with_context(|| format!("creating {}", suite.out.display()))?;
+    let runner = match suite.device {
+        Device::Gpu => Runner::Gpu(GpuContext::new()?),
+        Device::Cpu => Runner::Cpu,
+    };
+    let adapter = match &runner {
+        Runner::Gpu(ctx) => ctx.info.name.clone(),
+        Runner::Cpu => "cpu".to_string(),
+    };
+    let figures: Vec<Figure> = if figure == Figure::All { Figure::EACH.to_vec() } else { vec![figure] };
+    let mut docs = Vec::new();
+    for f in figures {
+        eprintln!("== {} ({adapter})", f.name());
+        let start = std::time::Instant::now();
+        let mut doc = measure(f, suite, &runner)?;
+        doc.adapter = adapter.clone();
+        doc.device = format!("{:?}", suite.device).to_lowercase();
+        doc.date = chrono::Utc::now().format("%Y-%m-%d").to_string();
+        doc.quick = suite.quick;
+        doc.command = format!(
+            "treelet bench {}{} --device {} --out DIR",
+            if f == Figure::Rays { "rays-figure" } else { f.name() },
+            if suite.quick { " --quick" } else { "" },
+            doc.device
+        );
+        write_figure(&suite.out, &doc)?;
+        print_table(&doc);
+        eprintln!("   {:.1} s", start.elapsed().as_secs_f64());
+        docs.push(doc);
+    }
+    if figure == Figure::All {
+        let md = crate::results::markdown(&docs, "");
+        let path = suite.out.join("RESULTS.md");
+        std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn write_figure(dir: &Path, doc: &FigureDoc) -> Result<()> {
+    let json = dir.join(format!("{}.json", doc.figure));
+    std::fs::write(&json, serde_json::to_string_pretty(doc)?).with_context(|| format!("writing {}", json.display()))?;
+    let mut names: Vec<&str> = Vec::new();
+    for p in &doc.points {
+        if !names.contains(&p.series.as_str()) {
+            names.push(&p.series);
+        }
+    }
+    let series: Vec<Series> = names
+        .iter()
+        .map(|n| Series {
+            label: n.to_string(),
+            points: doc.points.iter().filter(|p| p.series == *n).map(|p| (p.x, p.median)).collect(),
+        })
+        .collect();
+    let c = Chart {
+        title: &doc.title,
+        x_label: &doc.x_label,
+        y_label: &doc.y_label,
+        log_x: doc.log_x,
+        log_y: doc.log_y,
+        scatter: doc.scatter,
+    };
+    chart(&dir.join(format!("{}.png", doc.figure)), &c, &series)
+}
+
+/// The figure as a table: header and rows. Rows are x values and columns
+/// series (medians) where the series share their x values; otherwise (a
+/// Pareto plot, error against time) one row per point.
+pub fn table(doc: &FigureDoc) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut names: Vec<String> = Vec::new();
+    let mut xs: Vec<f64> = Vec::new();
+    for p in &doc.points {
+        if !names.contains(&p.series) {
+            names.push(p.series.clone());
+        }
+        if !xs.contains(&p.x) {
+            xs.push(p.x);
+        }
+    }
+    let x_name = doc.x_label.clone();
+    if doc.scatter || xs.len() * 2 > doc.points.len() + 1 {
+        let header = vec!["series".to_string(), x_name, doc.y_label.clone()];
+        let rows = doc.points.iter().map(|p| vec![p.series.clone(), fmt(p.x), fmt(p.median)]).collect();
+        return (header, rows);
+    }
+    xs.sort_by(f64::total_cmp);
+    let mut header = vec![x_name];
+    header.extend(names.iter().cloned());
+    let rows = xs
+        .iter()
+        .map(|&x| {
+            let mut row = vec![fmt(x)];
+            for n in &names {
+                row.push(match doc.points.iter().find(|p| p.series == *n && p.x == x) {
+                    Some(p) => fmt(p.median),
+                    None => String::new(),
+                });
+            }
+            row
+        })
+        .collect();
+    (header, rows)
+}
+
+pub fn fmt(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v.abs() >= 1e5 || v.abs() < 1e-3 {
+        format!("{v:.3e}")
+    } else if v.abs() >= 100.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+fn print_table(doc: &FigureDoc) {
+    println!("{} — {} ({})", doc.figure, doc.title, doc.adapter);
+    println!("y: {}", doc.y_label);
+    let (header, rows) = table(doc);
+    let widths: Vec<usize> = (0..header.len())
+        .map(|i| rows.iter().map(|r| r[i].len()).chain([header[i].len()]).max().unwrap_or(0) + 2)
+        .collect();
+    for (h, w) in header.iter().zip(&widths) {
+        print!("{h:>w$}");
+    }
+    println!();
+    for r in rows {
+        for (c, w) in r.iter().zip(&widths) {
+            print!("{c:>w$}");
+        }
+        println!();
+    }
+    for n in &doc.notes {
+        println!("note: {n}");
+    }
+}
+
+fn bar(len: usize, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
+    bar.set_style(ProgressStyle::with_template(&format!("{{bar:40}} {{pos}}/{{len}} {what} {{msg}}")).unwrap());
+    bar
+}
+
+fn doc(figure: Figure, title: &str, x: &str, y: &str, (log_x, log_y): (bool, bool)) -> FigureDoc {
+    FigureDoc {
+        figure: figure.name().into(),
+        title: title.into(),
+        x_label: x.into(),
+        y_label: y.into(),
+        log_x,
+        log_y,
+        scatter: false,
+        device: String::new(),
+        adapter: String::new(),
+        date: String::new(),
+        command: String::new(),
+        quick: false,
+        parameters: serde_json::Value::Null,
+        notes: Vec::new(),
+        points: Vec::new(),
+    }
+}
+
+/// Render-kernel seconds of `repeats` renders (after one warm-up).
+fn render_times<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    (w, h, spp): (u32, u32, u32),
+    accel: Accel,
+    repeats: usize,
+) -> Result<Vec<f64>> {
+    bench_render_kernel(b, scene, w, h, spp.min(4), accel, KernelChoice::Auto)?;
+    let mut v = Vec::new();
+    for _ in 0..repeats {
+        v.push(bench_render_kernel(b, scene, w, h, spp, accel, KernelChoice::Auto)?.kernel_s);
+        // One run of several seconds is enough: its noise is small.
+        if v[0] > 5.0 {
+            break;
+        }
+    }
+    Ok(v)
+}
+
+fn accel_name(a: Accel) -> &'static str {
+    match a {
+        Accel::Auto => "auto",
+        Accel::None => "linear scan",
+        Accel::Lbvh => "LBVH",
+        Accel::Trbvh => "TRBVH",
+        Accel::Sweep => "full-sweep SAH",
+    }
+}
+
+fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
+    let q = s.quick;
+    let r = s.repeats;
+    match figure {
+        Figure::Graph1 => {
+            let size = if q { (128, 96) } else { (1024, 768) };
+            let gpu_spp: Vec<u32> = if q { vec![4, 16, 64] } else { vec![4, 16, 64, 256, 1024] };
+            let cpu_spp: Vec<u32> = if q { vec![4, 16] } else { vec![4, 16, 64] };
+            let mut d = doc(figure, "cornell: render time against samples per pixel", "samples per pixel", "render-kernel time (s)", (true, true));
+            d.parameters = serde_json::json!({ "scene": "cornell", "width": size.0, "height": size.1, "gpu_spp": gpu_spp, "cpu_spp": cpu_spp });
+            let cornell = Scene::from_spec("cornell")?;
+            let pb = bar(gpu_spp.len() + cpu_spp.len(), "renders");
+            if let Runner::Gpu(ctx) = runner {
+                let b = &mut GpuBackend::new(ctx.clone());
+                for &spp in &gpu_spp {
+                    d.points.push(Point::of(format!("GPU ({})", ctx.info.name), spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), Accel::Auto, r)?));
+                    pb.inc(1);
+                }
+            }
+            let b = &mut CpuBackend::new();
+            for &spp in &cpu_spp {
+                d.points.push(Point::of("CPU runner (rayon)", spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), Accel::Auto, r.min(2))?));
+                pb.inc(1);
+            }
+            pb.finish_and_clear();
+            d.notes.push(format!("{}x{}; GPU time from timestamp queries, CPU runner by wall clock of its kernels", size.0, size.1));
+            Ok(d)
+        }
+        Figure::Graph2 | Figure::Graph3 => {
+            let (size, sizes, accels, title) = if figure == Figure::Graph2 {
+                let sizes: Vec<usize> = if q { vec![10, 100, 1000] } else { vec![100, 1000, 4000, 16000, 65536] };
+                ((128, 96, 4), sizes, vec![Accel::None, Accel::Lbvh, Accel::Trbvh], "random:N at 4 spp: linear scan against BVHs")
+            } else {
+                let sizes: Vec<usize> = if q { vec![1000, 10000] } else { vec![1000, 10000, 100000, 1000000] };
+                ((128, 96, 4), sizes, vec![Accel::Lbvh, Accel::Trbvh, Accel::Sweep], "random:N at 4 spp: LBVH against optimized BVHs")
+            };
+            let size = if q { size } else { (1024, 768, 4) };
+            let mut d = doc(figure, title, "spheres (N, plus the 9 of the room)", "render-kernel time (s)", (true, true));
+            d.parameters = serde_json::json!({ "width": size.0, "height": size.1, "spp": size.2, "sizes": sizes });
+            let pb = bar(sizes.len() * accels.len(), "renders");
+            with_backend!(runner, |b| {
+                for &n in &sizes {
+                    let scene = Scene::from_spec(&format!("random:{n}"))?;
+                    for &a in &accels {
+                        pb.set_message(format!("random:{n} {}", accel_name(a)));
+                        d.points.push(Point::of(accel_name(a), n as f64, &render_times(b, &scene, size, a, r)?));
+                        pb.inc(1);
+                    }
+                }
+            });
+            pb.finish_and_clear();
+            if figure == Figure::Graph3 {
+                d.notes.push("the full-sweep tree is built on the CPU (its build time is not in these numbers)".into());
+            }
+            Ok(d)
+        }
+        Figure::Graph25 | Figure::Graph35 => {
+            let device_sizes: Vec<usize> =
+                if q { vec![1000, 10000, 65000] } else { vec![1000, 10000, 65000, 1_000_000, 4_000_000, 16_000_000] };
+            let mut d = if figure == Figure::Graph25 {
+                doc(figure, "BVH build time against size (random:N spheres)", "primitives", "build time (ms)", (true, true))
+            } else {
+                doc(figure, "treelet optimization time against size (random:N spheres)", "primitives", "optimization time (ms)", (true, true))
+            };
+            d.parameters = serde_json::json!({ "sizes": device_sizes, "treelets": TreeletConfig::default() });
+            let device = if matches!(runner, Runner::Gpu(_)) { "device" } else { "CPU runner" };
+            with_backend!(runner, |b| {
+                let configs: Vec<(String, Option<TreeletConfig>)> = if figure == Figure::Graph25 {
+                    vec![(format!("LBVH ({device})"), None)]
+                } else {
+                    vec![
+                        (format!("TRBVH, gamma 3 ({device})"), Some(TreeletConfig::default())),
+                        (format!("TRBVH, gamma 7 ({device})"), Some(TreeletConfig { gamma: 7, ..Default::default() })),
+                    ]
+                };
+                for (name, config) in configs {
+                    for row in bench_sizes(b, &device_sizes, r.max(3), config.as_ref())? {
+                        let total = if figure == Figure::Graph25 {
+                            [row.total_min_ms, row.total_median_ms, row.total_max_ms]
+                        } else {
+                            // The optimization alone: rounds and collapse.
+                            let opt: f64 = row.median_ms.iter().filter(|(s, _)| s.starts_with("round") || *s == "collapse").map(|(_, v)| v).sum();
+                            [opt, opt, opt]
+                        };
+                        d.points.push(Point { series: name.clone(), x: row.primitives as f64, median: total[1], min: total[0], max: total[2], repeats: r.max(3) });
+                    }
+                }
+            });
+            if figure == Figure::Graph25 {
+                // CPU builders over the same boxes, wall clock.
+                let cpu_sizes: Vec<usize> = device_sizes.iter().copied().filter(|&n| n <= if q { 65000 } else { 1_000_000 }).collect();
+                for &n in &cpu_sizes {
+                    for (name, ms) in cpu_builds(&random_boxes(n))? {
+                        d.points.push(Point::once(name, n as f64, ms));
+                    }
+                }
+                // The seed's published endpoints (GRID K520; intermediate values not known here).
+                d.points.push(Point::once("seed report (GRID K520)", 1000.0, 1.2));
+                d.points.push(Point::once("seed report (GRID K520)", 65000.0, 4.0));
+                d.notes.push("seed report row: its table's endpoints, 1.2 ms at 1 000 and 4.0 ms at 65 000 primitives, on a GRID K520".into());
+                d.notes.push("CPU builders: one thread, wall clock, one run each".into());
+            } else {
+                d.notes.push("rounds + SAH leaf collapse, without the LBVH build".into());
+            }
+            Ok(d)
+        }
+        Figure::Error => {
+            let (w, h, spp) = if q { (128, 96, 64) } else { (1024, 768, 128) };
+            let spec = if q { "random:300" } else { "random:4000" };
+            let mut d = doc(figure, &format!("{spec}: error against time for each closest-hit method"), "time (s)", "mean standard error of pixel luminance", (true, true));
+            d.parameters = serde_json::json!({ "scene": spec, "width": w, "height": h, "spp": spp });
+            let scene = Scene::from_spec(spec)?;
+            with_backend!(runner, |b| {
+                for a in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
+                    let settings = RenderSettings { width: w, height: h, spp, seed: 1, accel: a, kernel: KernelChoice::Auto };
+                    let res = render(b, &scene, &settings, None, |_| {})?;
+                    for row in &res.rows {
+                        if let Some(e) = row.mean_std_error {
+                            d.points.push(Point::once(accel_name(a), row.elapsed_s, e));
+                        }
+                    }
+                }
+            });
+            d.notes.push("time is wall clock since the render began, BVH build included; error from per-pixel sample variance".into());
+            Ok(d)
+        }
+        Figure::Pareto => {
+            let specs: Vec<&str> = if q { vec!["random:10000", "terrain:10000"] } else { vec!["random:1000000", "terrain:1002528"] };
+            let mut d = doc(figure, &format!("SAH cost against build time ({})", specs.join(", ")), "build time (ms)", "SAH cost (C_i 1.2, C_t 1)", (true, false));
+            d.scatter = true;
+            d.parameters = serde_json::json!({ "scenes": specs });
+            for spec in &specs {
+                let scene = Scene::from_spec(spec)?;
+                let tag = spec.split(':').next().unwrap_or(spec);
+                with_backend!(runner, |b| {
+                    for (name, config) in [
+                        ("LBVH", None),
+                        ("TRBVH g1", Some(TreeletConfig { gamma: 1, ..Default::default() })),
+                        ("TRBVH g3", Some(TreeletConfig::default())),
+                        ("TRBVH g7", Some(TreeletConfig { gamma: 7, ..Default::default() })),
+                    ] {
+                        let (sah, ms) = device_build(b, &scene, config.as_ref())?;
+                        d.points.push(Point::once(format!("{name} {tag}"), ms, sah));
+                    }
+                });
+                let boxes = scene.primitives().boxes();
+                for (name, ms, sah) in cpu_builds_scored(&boxes)? {
+                    d.points.push(Point::once(format!("{name} {tag}"), ms, sah));
+                }
+            }
+            d.notes.push("device builds: GPU timestamps (median of 3 after a warm-up); CPU builders: one thread, wall clock".into());
+            Ok(d)
+        }
+        Figure::Rays => {
+            let (w, h) = if q { (256, 192) } else { (1920, 1080) };
+            let sizes: Vec<usize> = if q { vec![1000, 10000] } else { vec![10000, 100000, 1000000] };
+            let mut d = doc(figure, "rays per second through each tree (terrain:N, mesh alone)", "triangles", "M rays/s", (true, false));
+            d.parameters = serde_json::json!({ "width": w, "height": h, "sizes": sizes });
+            let pb = bar(sizes.len() * 3, "trees");
+            with_backend!(runner, |b| {
+                for &n in &sizes {
+                    let scene = Scene::from_spec(&format!("terrain:{n}"))?.mesh_only()?;
+                    for a in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+                        let row = bench_rays(b, &scene, a, (w, h), r.max(3))?;
+                        let x = row.primitives as f64;
+                        d.points.push(Point::once(format!("{} primary", accel_name(a)), x, row.primary_mrays_per_s));
+                        d.points.push(Point::once(format!("{} diffuse", accel_name(a)), x, row.diffuse_mrays_per_s));
+                        pb.inc(1);
+                    }
+                }
+            });
+            pb.finish_and_clear();
+            d.notes.push(format!("{w}x{h}, one camera ray and one cosine bounce per pixel, no shading; medians of {} passes", r.max(3)));
+            Ok(d)
+        }
+        Figure::All => unreachable!("all is expanded by run"),
+    }
+}
+
+fn random_boxes(n: usize) -> Vec<treelet_core::Aabb> {
+    random_spheres(n, 1).iter().map(|s| s.aabb()).collect()
+}
+
+/// SAH and build time (ms, GPU timestamps: median of 3 after a warm-up) of a device build.
+fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
+    use treelet::{lbvh, trbvh};
+    use treelet_core::sah::{sah_cost, SahCosts};
+    let all = scene.primitives();
+    let mut times = Vec::new();
+    let mut sah = 0.0;
+    for i in 0..4 {
+        b.begin_build();
+        let (bvh, t) = lbvh::build_primitives_on_device(b, all)?;
+        let mut ms = t.total();
+        let bvh = match config {
+            Some(c) => {
+                let root = trbvh::root_box(b, &bvh)?;
+                let (o, t) = trbvh::optimize(b, bvh, &root, c)?;
+                ms += t.total();
+                o
+            }
+            None => bvh,
+        };
+        if i > 0 {
+            times.push(ms);
+        }
+        if i == 3 {
+            let nodes = b.read::<treelet_core::Node>(&bvh.nodes, bvh.node_count as usize)?;
+            sah = sah_cost(&nodes, SahCosts::KARRAS_AILA);
+        }
+    }
+    Ok((sah, median(times)))
+}
+
+/// The CPU builders over `boxes`: (name, build ms).
+fn cpu_builds(boxes: &[treelet_core::Aabb]) -> Result<Vec<(String, f64)>> {
+    Ok(cpu_builds_scored(boxes)?.into_iter().map(|(n, ms, _)| (n, ms)).collect())
+}
+
+/// The CPU builders over `boxes`: (name, build ms, SAH with Treelet's function).
+fn cpu_builds_scored(boxes: &[treelet_core::Aabb]) -> Result<Vec<(String, f64, f64)>> {
+    use treelet_core::sah::{sah_cost, SahCosts};
+    let mut out = Vec::new();
+    let start = std::time::Instant::now();
+    let sweep = treelet::sweep::build_collapsed_boxes(boxes, TreeletConfig::default().max_leaf)?;
+    out.push(("full-sweep SAH (Treelet, CPU)".to_string(), start.elapsed().as_secs_f64() * 1e3, sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA)));
+    #[cfg(feature = "peers")]
+    for t in [treelet_peers::bvh_crate(boxes), treelet_peers::obvhs_ploc(boxes)] {
+        out.push((format!("peer: {} (CPU)", t.name), t.build_ms, sah_cost(&t.nodes, SahCosts::KARRAS_AILA)));
+    }
+    Ok(out)
+}
