@@ -173,9 +173,12 @@ pub fn chart(path: &Path, c: &Chart, series: &[Series]) -> Result<()> {
             if c.scatter {
                 return Ok(root.present().map_err(|e| err(&e))?);
             }
+            // The legend goes to the upper corner the curves leave free.
+            let (left, right) = first_and_last_mean(series);
+            let corner = if left < right { SeriesLabelPosition::UpperLeft } else { SeriesLabelPosition::UpperRight };
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(corner)
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 15))
@@ -191,4 +194,22 @@ pub fn chart(path: &Path, c: &Chart, series: &[Series]) -> Result<()> {
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// Mean y of the points at the smallest and at the largest x of each series
+/// (of their first and last points): which side of a chart the curves rise on.
+fn first_and_last_mean(series: &[Series]) -> (f64, f64) {
+    let (mut a, mut b, mut n) = (0.0, 0.0, 0.0);
+    for s in series {
+        if let (Some(f), Some(l)) = (s.points.first(), s.points.last()) {
+            a += f.1;
+            b += l.1;
+            n += 1.0;
+        }
+    }
+    if n > 0.0 {
+        (a / n, b / n)
+    } else {
+        (0.0, 0.0)
+    }
 }

@@ -203,6 +203,11 @@ pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
 fn write_figure(dir: &Path, doc: &FigureDoc) -> Result<()> {
     let json = dir.join(format!("{}.json", doc.figure));
     std::fs::write(&json, serde_json::to_string_pretty(doc)?).with_context(|| format!("writing {}", json.display()))?;
+    plot_figure(dir, doc)
+}
+
+/// `dir/<figure>.png` from the figure's points (medians).
+pub fn plot_figure(dir: &Path, doc: &FigureDoc) -> Result<()> {
     let mut names: Vec<&str> = Vec::new();
     for p in &doc.points {
         if !names.contains(&p.series.as_str()) {
@@ -269,6 +274,8 @@ pub fn table(doc: &FigureDoc) -> (Vec<String>, Vec<Vec<String>>) {
 pub fn fmt(v: f64) -> String {
     if v == 0.0 {
         "0".into()
+    } else if v.fract() == 0.0 && v.abs() < 1e9 {
+        format!("{v:.0}")
     } else if v.abs() >= 1e5 || v.abs() < 1e-3 {
         format!("{v:.3e}")
     } else if v.abs() >= 100.0 {
@@ -408,7 +415,12 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             });
             pb.finish_and_clear();
             if figure == Figure::Graph3 {
-                d.notes.push("the full-sweep tree is built on the CPU (its build time is not in these numbers)".into());
+                d.notes.push(
+                    "the full-sweep tree is built on the CPU before each of its renders (not counted here); at 1M that \
+                     takes seconds, the GPU idles meanwhile and its clocks drop, which slows the render that follows: \
+                     `treelet bench rays`, which warms up first, compares the trees' traversal fairly"
+                        .into(),
+                );
             }
             Ok(d)
         }
@@ -484,12 +496,19 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
         }
         Figure::Pareto => {
             let specs: Vec<&str> = if q { vec!["random:10000", "terrain:10000"] } else { vec!["random:1000000", "terrain:1002528"] };
-            let mut d = doc(figure, &format!("SAH cost against build time ({})", specs.join(", ")), "build time (ms)", "SAH cost (C_i 1.2, C_t 1)", (true, false));
+            let mut d = doc(
+                figure,
+                &format!("SAH cost against build time ({})", specs.join(", ")),
+                "build time (ms)",
+                "SAH cost / full-sweep SAH cost of the same scene",
+                (true, false),
+            );
             d.scatter = true;
             d.parameters = serde_json::json!({ "scenes": specs });
             for spec in &specs {
                 let scene = Scene::from_spec(spec)?;
                 let tag = spec.split(':').next().unwrap_or(spec);
+                let mut found: Vec<(String, f64, f64)> = Vec::new();
                 with_backend!(runner, |b| {
                     for (name, config) in [
                         ("LBVH", None),
@@ -498,15 +517,20 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                         ("TRBVH g7", Some(TreeletConfig { gamma: 7, ..Default::default() })),
                     ] {
                         let (sah, ms) = device_build(b, &scene, config.as_ref())?;
-                        d.points.push(Point::once(format!("{name} {tag}"), ms, sah));
+                        found.push((name.to_string(), ms, sah));
                     }
                 });
-                let boxes = scene.primitives().boxes();
-                for (name, ms, sah) in cpu_builds_scored(&boxes)? {
-                    d.points.push(Point::once(format!("{name} {tag}"), ms, sah));
+                found.extend(cpu_builds_scored(&scene.primitives().boxes())?);
+                // Relative to the full-sweep tree, so that scenes share an axis.
+                let sweep = found.iter().find(|f| f.0.starts_with("full-sweep")).map(|f| f.2).unwrap_or(1.0);
+                let mut absolute = Vec::new();
+                for (name, ms, sah) in found {
+                    d.points.push(Point::once(format!("{name} {tag}"), ms, sah / sweep));
+                    absolute.push(format!("{name} {sah:.2}"));
                 }
+                d.notes.push(format!("{spec}, absolute SAH: {}", absolute.join(", ")));
             }
-            d.notes.push("device builds: GPU timestamps (median of 3 after a warm-up); CPU builders: one thread, wall clock".into());
+            d.notes.push("device builds: GPU timestamps (median of 3 after 0.5 s of warm-up); CPU builders: one thread, wall clock".into());
             Ok(d)
         }
         Figure::Rays => {
@@ -539,14 +563,13 @@ fn random_boxes(n: usize) -> Vec<treelet_core::Aabb> {
     random_spheres(n, 1).iter().map(|s| s.aabb()).collect()
 }
 
-/// SAH and build time (ms, GPU timestamps: median of 3 after a warm-up) of a device build.
+/// SAH and build time (ms, GPU timestamps: median of 3 after half a second
+/// of warm-up builds, as `bench build`) of a device build.
 fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
     use treelet::{lbvh, trbvh};
     use treelet_core::sah::{sah_cost, SahCosts};
     let all = scene.primitives();
-    let mut times = Vec::new();
-    let mut sah = 0.0;
-    for i in 0..4 {
+    let once = |b: &mut B| -> Result<(lbvh::DeviceBvh<B>, f64)> {
         b.begin_build();
         let (bvh, t) = lbvh::build_primitives_on_device(b, all)?;
         let mut ms = t.total();
@@ -559,10 +582,18 @@ fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletCon
             }
             None => bvh,
         };
-        if i > 0 {
-            times.push(ms);
-        }
-        if i == 3 {
+        Ok((bvh, ms))
+    };
+    let warm = std::time::Instant::now();
+    while warm.elapsed().as_secs_f64() < 0.5 {
+        once(b)?;
+    }
+    let mut times = Vec::new();
+    let mut sah = 0.0;
+    for i in 0..3 {
+        let (bvh, ms) = once(b)?;
+        times.push(ms);
+        if i == 2 {
             let nodes = b.read::<treelet_core::Node>(&bvh.nodes, bvh.node_count as usize)?;
             sah = sah_cost(&nodes, SahCosts::KARRAS_AILA);
         }
