@@ -250,14 +250,7 @@ pub fn hit_normal(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
 /// [`hit_normal`] compiled for the primitive kinds of `F`.
 #[inline]
 pub fn hit_normal_for<const F: u32>(prims: &Prims, prim: u32, x: Vec3, d: Vec3) -> Vec3 {
-    let sphere = if !has(F, features::TRIANGLES) {
-        true
-    } else if !has(F, features::SPHERES) {
-        false
-    } else {
-        prim < prims.sphere_count
-    };
-    if sphere {
+    if prims.is_sphere::<F>(prim) {
         (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize()
     } else {
         let t = prims.triangles[(prim - prims.sphere_count) as usize];

@@ -30,6 +30,19 @@ impl<'a> Prims<'a> {
     }
 
     /// Distance along the ray to primitive `prim`, below `t_max`, honouring the start surface.
+    /// Whether primitive `prim` is a sphere, decided at compile time when
+    /// `F` (see [`crate::features`]) has only one primitive kind.
+    #[inline]
+    pub fn is_sphere<const F: u32>(&self, prim: u32) -> bool {
+        if !has(F, features::TRIANGLES) {
+            true
+        } else if !has(F, features::SPHERES) {
+            false
+        } else {
+            prim < self.sphere_count
+        }
+    }
+
     /// Distance to primitive `prim` along the ray; `F` (see
     /// [`crate::features`]) leaves out the test of a kind the scene lacks.
     #[inline]
@@ -42,14 +55,7 @@ impl<'a> Prims<'a> {
         prim: u32,
         t_max: f32,
     ) -> f32 {
-        let sphere = if !has(F, features::TRIANGLES) {
-            true
-        } else if !has(F, features::SPHERES) {
-            false
-        } else {
-            prim < self.sphere_count
-        };
-        if sphere {
+        if self.is_sphere::<F>(prim) {
             from.distance(o, d, &self.spheres[prim as usize], prim)
         } else if prim == from.prim {
             MISS // a flat triangle cannot be hit again by a ray leaving it

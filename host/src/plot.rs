@@ -30,64 +30,21 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// Writes a log-log plot of error against time to `path` (PNG).
+/// Writes a log-log plot of error against time to `path` (PNG), with the
+/// Monte Carlo slope (error ∝ time^-1/2) drawn through the first point.
 pub fn error_vs_time(path: &Path, title: &str, y_label: &str, series: &[Series]) -> Result<()> {
-    register_font();
-    let all: Vec<(f64, f64)> =
-        series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| x > 0.0 && y > 0.0).collect();
-    if all.len() < 2 {
-        bail!("not enough positive points to plot ({})", all.len());
+    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0;
+    let count = series.iter().flat_map(|s| s.points.iter()).filter(positive).count();
+    if count < 2 {
+        bail!("not enough positive points to plot ({count})");
     }
-    let (x0, x1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (y0, y1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| anyhow!("plotting {}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x0 / 1.5..x1 * 1.5).log_scale(), (y0 / 1.5..y1 * 1.5).log_scale())
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc(y_label)
-        .x_label_formatter(&|v| short(*v))
-        .y_label_formatter(&|v| short(*v))
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(|e| err(&e))?;
-    let colors = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
-    for (i, s) in series.iter().enumerate() {
-        let color = colors[i % colors.len()];
-        let pts: Vec<_> = s.points.iter().copied().filter(|&(x, y)| x > 0.0 && y > 0.0).collect();
-        chart
-            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
-            .map_err(|e| err(&e))?
-            .label(&s.label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
-        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(|e| err(&e))?;
+    let x1 = series.iter().flat_map(|s| s.points.iter()).filter(positive).fold(0.0f64, |a, p| a.max(p.0));
+    let mut all: Vec<Series> = series.iter().map(|s| Series { label: s.label.clone(), points: s.points.clone() }).collect();
+    if let Some(&(tx, ty)) = series.first().and_then(|s| s.points.iter().find(positive)) {
+        all.push(Series { label: "slope -1/2".into(), points: vec![(tx, ty), (x1, ty * (x1 / tx).powf(-0.5))] });
     }
-    // Monte Carlo: error ∝ time^(-1/2), through the first point of the first series.
-    if let Some(&(tx, ty)) = series.first().and_then(|s| s.points.iter().find(|p| p.0 > 0.0 && p.1 > 0.0)) {
-        let line = [(tx, ty), (x1, ty * (x1 / tx).powf(-0.5))];
-        chart
-            .draw_series(LineSeries::new(line, BLACK.mix(0.4).stroke_width(1)))
-            .map_err(|e| err(&e))?
-            .label("slope -1/2")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.4)));
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+    let c = Chart { title, x_label: "time (s)", y_label, log_x: true, log_y: true, scatter: false };
+    chart(path, &c, &all)
 }
 
 /// How [`chart`] draws a figure.
