@@ -120,14 +120,21 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
                 assert!(x.is_leaf() || x.left as usize == i + 1, "n = {n}: node {i} is not in depth-first order");
             }
             let Some(ctx) = treelet_tests::gpu() else { continue };
-            let (g, _) = run(&mut GpuBackend::new(ctx), &spheres, &config);
+            // Costs use fused multiply-adds (`libm::fmaf`, which rust-gpu emits
+            // as GLSL `Fma`). A device may execute `Fma` unfused: lavapipe does,
+            // and a near-tie between two treelet topologies can then go the
+            // other way. Where `Fma` is fused (the H100) the tree must be the
+            // CPU's bit for bit; on a CPU adapter its SAH must agree within 1e-4.
+            let mut gpu = GpuBackend::new(ctx);
+            let fused = !gpu.runs_on_cpu();
+            let (g, _) = run(&mut gpu, &spheres, &config);
             let v = validate(&spheres, &g.nodes, &g.parents, &g.prim_indices);
             assert!(v.is_valid(), "gpu n = {n}: {:?}", v.errors);
             let differing = (0..c.nodes.len().min(g.nodes.len())).filter(|&i| g.nodes[i] != c.nodes[i]).count();
             if differing > 0 || g.nodes.len() != c.nodes.len() {
                 let i = (0..c.nodes.len()).find(|&i| g.nodes.get(i) != Some(&c.nodes[i])).unwrap_or(0);
                 let gs = sah_cost(&g.nodes, SahCosts::KARRAS_AILA);
-                panic!(
+                let what = format!(
                     "max_leaf {max_leaf}, n = {n}: {differing} of {} nodes differ ({} on the GPU), SAH gpu {gs} cpu \
                      {after}; first at {i}: gpu {:?} cpu {:?}",
                     c.nodes.len(),
@@ -135,6 +142,10 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
                     g.nodes.get(i),
                     c.nodes[i]
                 );
+                assert!(!fused, "{what}");
+                assert!((gs - after).abs() <= 1e-4 * after, "{what}");
+                eprintln!("unfused Fma on this adapter: {what}");
+                continue;
             }
             assert_eq!(g.parents, c.parents, "n = {n}");
             assert_eq!(g.prim_indices, c.prim_indices, "n = {n}");
