@@ -11,16 +11,15 @@ pub enum Access {
 use treelet_core::features::VARIANTS;
 use Access::{Read, ReadWrite};
 
-/// Entry points of the render variants (linear, BVH), in the order of
-/// `VARIANTS`: the shader crate's `render_kernel!` lines.
-const RENDER_ENTRY_POINTS: [[&str; 2]; VARIANTS.len()] = [
-    ["render::render_linear_spheres_diffuse_cs", "render::render_bvh_spheres_diffuse_cs"],
-    ["render::render_linear_spheres_mirror_cs", "render::render_bvh_spheres_mirror_cs"],
-    ["render::render_linear_spheres_cs", "render::render_bvh_spheres_cs"],
-    ["render::render_linear_triangles_diffuse_cs", "render::render_bvh_triangles_diffuse_cs"],
-    ["render::render_linear_mixed_diffuse_cs", "render::render_bvh_mixed_diffuse_cs"],
-    ["render::render_linear_full_cs", "render::render_bvh_full_cs"],
-];
+/// Entry points of the render variants, `[linear, BVH]` per entry of
+/// `VARIANTS`, named from its names as the shader crate's `render_kernel!`
+/// lines are (`render::render_{linear,bvh}_<name>_cs`).
+fn render_entry_points() -> &'static [[String; 2]] {
+    static NAMES: std::sync::OnceLock<Vec<[String; 2]>> = std::sync::OnceLock::new();
+    NAMES.get_or_init(|| {
+        VARIANTS.iter().map(|(_, n)| [format!("render::render_linear_{n}_cs"), format!("render::render_bvh_{n}_cs")]).collect()
+    })
+}
 
 /// Every compute kernel of Treelet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -121,8 +120,8 @@ impl Kernel {
             Kernel::TreeletSolve => "treelet::treelet_solve_cs",
             Kernel::TreeletCommit => "treelet::treelet_commit_cs",
             Kernel::Collapse => "treelet::collapse_cs",
-            Kernel::RenderLinear(i) => RENDER_ENTRY_POINTS[i as usize][0],
-            Kernel::RenderBvh(i) => RENDER_ENTRY_POINTS[i as usize][1],
+            Kernel::RenderLinear(i) => &render_entry_points()[i as usize][0],
+            Kernel::RenderBvh(i) => &render_entry_points()[i as usize][1],
             Kernel::CastBvh => "render::cast_bvh_cs",
         }
     }

@@ -60,8 +60,8 @@ impl SceneFeatures {
     }
 }
 
-/// Names of feature bits, for messages.
-pub fn describe(bits: u32) -> String {
+/// Names of the optional features in `bits`, for messages.
+fn optional(bits: u32) -> String {
     let names: Vec<&str> = [
         (features::SPHERES, "spheres"),
         (features::TRIANGLES, "triangles"),
@@ -72,12 +72,15 @@ pub fn describe(bits: u32) -> String {
     .filter(|(bit, _)| bits & bit != 0)
     .map(|&(_, name)| name)
     .collect();
-    let mut s = String::from("diffuse, emission");
-    for n in names {
-        s.push_str(", ");
-        s.push_str(n);
+    names.join(", ")
+}
+
+/// Names of everything `bits` compiles in (diffuse and emission always).
+pub fn describe(bits: u32) -> String {
+    match optional(bits) {
+        o if o.is_empty() => "diffuse, emission".to_string(),
+        o => format!("diffuse, emission, {o}"),
     }
-    s
 }
 
 /// Which render kernel to run.
@@ -162,7 +165,7 @@ pub fn plan(scene: &Scene, accel: Accel, kernel: KernelChoice, runs_on_cpu: bool
             let reason = if left_out == 0 {
                 "no smaller variant covers the scene".to_string()
             } else {
-                format!("the scene needs {}; left out: {}", describe(bits), describe(left_out).replace("diffuse, emission, ", ""))
+                format!("the scene needs {}; left out: {}", describe(bits), optional(left_out))
             };
             (v, reason)
         }

@@ -1,6 +1,6 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::features::{ALL, GLASS, MIRROR, SPHERES, TRIANGLES};
+use treelet_core::features::VARIANTS;
 use treelet_core::layout::{Material, Node, RenderParams, Sphere};
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::triangle::Triangle;
@@ -8,7 +8,7 @@ use treelet_core::workgroup::linear_id;
 
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// and one feature set (see `treelet_core::features::VARIANTS`, whose names
-/// these must match).
+/// these must match: the feature sets come from it by index).
 macro_rules! render_kernel {
     ($name:ident, $accel:expr, $features:expr) => {
         #[spirv(compute(threads(256)))]
@@ -32,18 +32,20 @@ macro_rules! render_kernel {
     };
 }
 
-render_kernel!(render_linear_spheres_diffuse_cs, ACCEL_NONE, SPHERES);
-render_kernel!(render_bvh_spheres_diffuse_cs, ACCEL_BVH, SPHERES);
-render_kernel!(render_linear_spheres_mirror_cs, ACCEL_NONE, SPHERES | MIRROR);
-render_kernel!(render_bvh_spheres_mirror_cs, ACCEL_BVH, SPHERES | MIRROR);
-render_kernel!(render_linear_spheres_cs, ACCEL_NONE, SPHERES | MIRROR | GLASS);
-render_kernel!(render_bvh_spheres_cs, ACCEL_BVH, SPHERES | MIRROR | GLASS);
-render_kernel!(render_linear_triangles_diffuse_cs, ACCEL_NONE, TRIANGLES);
-render_kernel!(render_bvh_triangles_diffuse_cs, ACCEL_BVH, TRIANGLES);
-render_kernel!(render_linear_mixed_diffuse_cs, ACCEL_NONE, SPHERES | TRIANGLES);
-render_kernel!(render_bvh_mixed_diffuse_cs, ACCEL_BVH, SPHERES | TRIANGLES);
-render_kernel!(render_linear_full_cs, ACCEL_NONE, ALL);
-render_kernel!(render_bvh_full_cs, ACCEL_BVH, ALL);
+const _: () = assert!(VARIANTS.len() == 6, "one pair of lines per variant");
+
+render_kernel!(render_linear_spheres_diffuse_cs, ACCEL_NONE, VARIANTS[0].0);
+render_kernel!(render_bvh_spheres_diffuse_cs, ACCEL_BVH, VARIANTS[0].0);
+render_kernel!(render_linear_spheres_mirror_cs, ACCEL_NONE, VARIANTS[1].0);
+render_kernel!(render_bvh_spheres_mirror_cs, ACCEL_BVH, VARIANTS[1].0);
+render_kernel!(render_linear_spheres_cs, ACCEL_NONE, VARIANTS[2].0);
+render_kernel!(render_bvh_spheres_cs, ACCEL_BVH, VARIANTS[2].0);
+render_kernel!(render_linear_triangles_diffuse_cs, ACCEL_NONE, VARIANTS[3].0);
+render_kernel!(render_bvh_triangles_diffuse_cs, ACCEL_BVH, VARIANTS[3].0);
+render_kernel!(render_linear_mixed_diffuse_cs, ACCEL_NONE, VARIANTS[4].0);
+render_kernel!(render_bvh_mixed_diffuse_cs, ACCEL_BVH, VARIANTS[4].0);
+render_kernel!(render_linear_full_cs, ACCEL_NONE, VARIANTS[5].0);
+render_kernel!(render_bvh_full_cs, ACCEL_BVH, VARIANTS[5].0);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel, through a BVH.
 #[spirv(compute(threads(256)))]
