@@ -26,10 +26,11 @@ fn post_order(nodes: &[Node]) -> Vec<u32> {
     out
 }
 
-/// Every node's subtree cost and primitive count.
-fn subtree_costs(nodes: &[Node], costs: &TreeletCosts) -> (Vec<f32>, Vec<u32>) {
+/// Every node's subtree cost, primitive count and height.
+fn subtree_costs(nodes: &[Node], costs: &TreeletCosts) -> (Vec<f32>, Vec<u32>, Vec<u32>) {
     let mut c = vec![0.0f32; nodes.len()];
     let mut counts = vec![0u32; nodes.len()];
+    let mut heights = vec![0u32; nodes.len()];
     for (i, n) in nodes.iter().enumerate() {
         if n.is_leaf() {
             counts[i] = n.prim_count();
@@ -40,8 +41,9 @@ fn subtree_costs(nodes: &[Node], costs: &TreeletCosts) -> (Vec<f32>, Vec<u32>) {
         let n = nodes[i as usize];
         counts[i as usize] = counts[n.left as usize] + counts[n.right as usize];
         c[i as usize] = node_cost(&n, counts[i as usize], (c[n.left as usize], c[n.right as usize]), costs);
+        heights[i as usize] = 1 + heights[n.left as usize].max(heights[n.right as usize]);
     }
-    (c, counts)
+    (c, counts, heights)
 }
 
 #[test]
@@ -54,12 +56,20 @@ fn one_round_keeps_invariants_and_lowers_sah() {
         let extent = root_box.extent().max_element().max(f32::MIN_POSITIVE);
         let costs = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 1.0 / extent, max_leaf: 1 };
         let before = sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA);
-        let (mut node_costs, mut counts) = subtree_costs(&bvh.nodes, &costs);
+        let (mut node_costs, mut counts, mut heights) = subtree_costs(&bvh.nodes, &costs);
         let mut changed = 0;
         for root in post_order(&bvh.nodes) {
-            if restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut counts, &mut node_costs, &costs) {
+            let h = &mut heights;
+            if restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut counts, &mut node_costs, h, &costs) {
                 changed += 1;
             }
+        }
+        // Restructuring kept every count, cost and height current.
+        let (fresh_costs, fresh_counts, fresh_heights) = subtree_costs(&bvh.nodes, &costs);
+        assert_eq!(counts, fresh_counts, "n = {n}: counts went stale");
+        assert_eq!(heights, fresh_heights, "n = {n}: heights went stale");
+        for (i, (&kept, &fresh)) in node_costs.iter().zip(&fresh_costs).enumerate() {
+            assert!((kept - fresh).abs() <= 1e-4 * fresh.abs().max(1e-30), "n = {n}: node {i} cost {kept} != {fresh}");
         }
         assert_eq!(bvh.parents[0], INVALID);
         let v = validate(&spheres, &bvh.nodes, &bvh.parents, &bvh.prim_indices);

@@ -69,6 +69,21 @@ pub fn add_workgroup(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
+/// Ors `value` into a workgroup-memory word (relaxed: a barrier follows).
+#[inline]
+pub fn or_workgroup(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_or::<u32, WORKGROUP, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        let old = *slot;
+        *slot = old | value;
+        old
+    }
+}
+
 /// Device-scope relaxed store of an `f32`, for data another invocation reads
 /// after synchronizing through [`add_device`].
 #[inline]

@@ -58,7 +58,9 @@ pub mod scene;
 pub mod sort;
 pub mod traverse;
 pub mod treelet;
+pub mod treelet_kernels;
 pub mod triangle;
+pub mod unchecked;
 pub mod workgroup;
 
 pub use aabb::Aabb;

@@ -25,14 +25,12 @@
 //! paper, a subtree of at most `max_leaf` primitives costs the cheaper of its
 //! tree and one leaf holding all its primitives (`C_t·A·N`): the DP and the
 //! rounds optimize for the tree that [`crate::collapse`] finally produces.
-//! On the device, [`treelet_solve_phase`] spreads the DP of each treelet over
-//! 32 lanes as the paper does, between [`treelet_form_kernel`] and
-//! [`treelet_commit_kernel`]; [`restructure`] is the same steps in one
-//! invocation (the CPU reference and tests).
+//! [`restructure`] is the steps in one invocation (the reference the tests
+//! use); [`crate::treelet_kernels`] runs them on the device, the DP of each
+//! treelet spread over a team of lanes.
 use crate::aabb::Aabb;
-use crate::atomics;
-use crate::fit::second_arrival;
 use crate::layout::{Node, TreeletParams};
+use crate::unchecked::{get, set};
 
 /// Leaves of a treelet (the paper's 7).
 pub const TREELET_LEAVES: usize = 7;
@@ -103,73 +101,110 @@ impl TreeletCosts {
     }
 }
 
-/// A treelet: its leaves (with their boxes, primitive counts and subtree
-/// costs, read once while forming it) and its internal nodes (root first).
-#[derive(Clone, Copy)]
-#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
-pub struct Treelet {
-    pub leaves: [u32; TREELET_LEAVES],
-    pub leaf_count: u32,
-    pub internals: [u32; TREELET_INTERNALS],
-    pub boxes: [Aabb; TREELET_LEAVES],
-    pub counts: [u32; TREELET_LEAVES],
-    pub costs: [f32; TREELET_LEAVES],
+// A treelet is staged in an array of words (floats as bits) from some base:
+// in a private array for the one-invocation reference, in workgroup memory
+// in the kernel, where a team of lanes reads it. Words, from the base:
+/// Leaf node ids (7).
+pub const T_LEAVES: usize = 0;
+/// Leaf count (2 to 7).
+pub const T_COUNT: usize = 7;
+/// Internal node ids, root first (up to 6).
+pub const T_INTERNALS: usize = 8;
+/// The root's current cost (bits) and height, for the kernel.
+pub const T_CURRENT: usize = 14;
+pub const T_HEIGHT: usize = 15;
+/// Leaf primitive counts, subtree heights and subtree costs (bits), 7 each.
+pub const T_PRIMS: usize = 16;
+pub const T_HEIGHTS: usize = 23;
+pub const T_COSTS: usize = 30;
+/// Leaf boxes, 6 floats each (min xyz, max xyz).
+pub const T_BOXES: usize = 37;
+/// Scratch of [`form_treelet`] (areas, left and right children per slot)
+/// and of [`apply`] (subsets, children, costs, heights per internal node, a stack).
+const T_SCRATCH: usize = T_BOXES + 6 * TREELET_LEAVES;
+const F_AREAS: usize = T_SCRATCH;
+const F_LEFTS: usize = T_SCRATCH + TREELET_LEAVES;
+const F_RIGHTS: usize = T_SCRATCH + 2 * TREELET_LEAVES;
+const A_SETS: usize = T_SCRATCH;
+const A_KIDS: usize = A_SETS + TREELET_INTERNALS;
+const A_COSTS: usize = A_KIDS + 2 * TREELET_INTERNALS;
+const A_HEIGHTS: usize = A_COSTS + TREELET_INTERNALS;
+const A_STACK: usize = A_HEIGHTS + TREELET_INTERNALS;
+/// Words of one staged treelet (odd, so that treelets staged side by side
+/// in workgroup memory start on different banks).
+pub const TREELET_WORDS: usize = A_STACK + TREELET_INTERNALS + 1;
+
+/// The box of leaf `k` of the treelet staged at `b`.
+#[inline]
+pub fn staged_box<const N: usize>(stage: &[u32; N], b: usize, k: usize) -> Aabb {
+    let f = b + T_BOXES + 6 * k;
+    let w = |j: usize| f32::from_bits(get(stage, f + j));
+    Aabb::from_arrays([w(0), w(1), w(2)], [w(3), w(4), w(5)])
 }
 
-/// Forms the treelet under internal node `root` (algorithm 2's first loop):
-/// expand, among the current leaves that are internal BVH nodes, the one of
-/// largest area (the first on ties), until seven leaves or no expandable
-/// leaf remain. Each node is read once: an expansion loads only the two new
-/// children, so the chain of dependent loads is one per expansion.
+/// Stages box `x` as the box of leaf `k`.
 #[inline]
-pub fn form_treelet(
+pub fn stage_box<const N: usize>(stage: &mut [u32; N], b: usize, k: usize, x: &Aabb) {
+    let f = b + T_BOXES + 6 * k;
+    let (lo, hi) = (x.min, x.max);
+    stage[f] = lo[0].to_bits();
+    stage[f + 1] = lo[1].to_bits();
+    stage[f + 2] = lo[2].to_bits();
+    stage[f + 3] = hi[0].to_bits();
+    stage[f + 4] = hi[1].to_bits();
+    stage[f + 5] = hi[2].to_bits();
+}
+
+/// Forms the treelet under internal node `root` (algorithm 2's first loop)
+/// into `stage` at `b`: expand, among the current leaves that are internal
+/// BVH nodes, the one of largest area (the first on ties), until seven
+/// leaves or no expandable leaf remain; then read the leaves' primitive
+/// counts, costs and heights. Each node is read once: an expansion loads
+/// only the two new children, so the chain of dependent loads is one per
+/// expansion. Returns the leaf count.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn form_treelet<const N: usize>(
     root: u32,
     nodes: &[Node],
     counts: &[u32],
     node_costs: &[f32],
+    heights: &[u32],
     costs: &TreeletCosts,
-) -> Treelet {
-    let mut t = Treelet {
-        leaves: [0; TREELET_LEAVES],
-        leaf_count: 2,
-        internals: [0; TREELET_INTERNALS],
-        boxes: [Aabb::EMPTY; TREELET_LEAVES],
-        counts: [0; TREELET_LEAVES],
-        costs: [0.0; TREELET_LEAVES],
-    };
-    // Per treelet leaf: its children (if internal) and area (-1 if a BVH leaf).
-    let mut lefts = [0u32; TREELET_LEAVES];
-    let mut rights = [0u32; TREELET_LEAVES];
-    let mut areas = [0.0f32; TREELET_LEAVES];
-    t.internals[0] = root;
+    stage: &mut [u32; N],
+    b: usize,
+) -> u32 {
+    stage[b + T_INTERNALS] = root;
     let r = nodes[root as usize];
-    let (first, second) = (r.left, r.right);
     let mut internal_count = 1usize;
+    let mut leaf_count = 2usize;
     // Slot `best` takes the left child, a new slot the right one.
     let mut best = 0usize;
-    let mut children = [first, second];
+    let (mut left, mut right) = (r.left, r.right);
     loop {
         let mut side = 0;
         while side < 2 {
-            let slot = if side == 0 { best } else { t.leaf_count as usize - 1 };
-            let id = children[side];
+            let (slot, id) = if side == 0 { (best, left) } else { (leaf_count - 1, right) };
             let node = nodes[id as usize];
-            t.leaves[slot] = id;
-            t.boxes[slot] = node.aabb();
-            lefts[slot] = node.left;
-            rights[slot] = node.right;
-            areas[slot] = if node.is_leaf() { -1.0 } else { costs.area(&t.boxes[slot]) };
+            let x = node.aabb();
+            stage[b + T_LEAVES + slot] = id;
+            stage_box(stage, b, slot, &x);
+            stage[b + F_LEFTS + slot] = node.left;
+            stage[b + F_RIGHTS + slot] = node.right;
+            let area = if node.is_leaf() { -1.0 } else { costs.area(&x) };
+            stage[b + F_AREAS + slot] = area.to_bits();
             side += 1;
         }
-        if t.leaf_count as usize == TREELET_LEAVES {
+        if leaf_count == TREELET_LEAVES {
             break;
         }
         best = usize::MAX;
         let mut best_area = -1.0f32;
         let mut i = 0;
-        while i < t.leaf_count as usize {
-            if areas[i] > best_area {
-                best_area = areas[i];
+        while i < leaf_count {
+            let a = f32::from_bits(stage[b + F_AREAS + i]);
+            if a > best_area {
+                best_area = a;
                 best = i;
             }
             i += 1;
@@ -177,56 +212,63 @@ pub fn form_treelet(
         if best == usize::MAX {
             break;
         }
-        t.internals[internal_count] = t.leaves[best];
+        stage[b + T_INTERNALS + internal_count] = stage[b + T_LEAVES + best];
         internal_count += 1;
-        children = [lefts[best], rights[best]];
-        t.leaf_count += 1;
+        left = stage[b + F_LEFTS + best];
+        right = stage[b + F_RIGHTS + best];
+        leaf_count += 1;
     }
     let mut i = 0;
-    while i < t.leaf_count as usize {
-        t.counts[i] = counts[t.leaves[i] as usize];
-        t.costs[i] = node_costs[t.leaves[i] as usize];
+    while i < leaf_count {
+        let leaf = stage[b + T_LEAVES + i] as usize;
+        stage[b + T_PRIMS + i] = counts[leaf];
+        stage[b + T_COSTS + i] = node_costs[leaf].to_bits();
+        stage[b + T_HEIGHTS + i] = heights[leaf];
         i += 1;
     }
-    t
+    stage[b + T_COUNT] = leaf_count as u32;
+    leaf_count as u32
 }
 
-/// The optimal tree over a treelet's leaves: `partition[s]` is the subset of
-/// `s` that forms one child of the node covering `s` (the other is `s ^ p`),
-/// `cost[s]` the cost of that best subtree.
-pub struct TreeletSolution {
-    pub partition: [u32; SUBSETS],
-    pub cost: [f32; SUBSETS],
-}
+/// Words of a packed partition table: the partition of subset `s` is byte
+/// `s % 4` of word `s / 4` (a subset of seven leaves fits in a byte).
+pub const PACKED_WORDS: usize = SUBSETS / 4;
 
-/// Union of the boxes of the leaves in subset `s` (exact: min and max).
+/// The partition of subset `s` in a packed table whose words start at `base`.
 #[inline]
-pub fn subset_box(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES]) -> Aabb {
-    let mut b = Aabb::EMPTY;
+pub fn packed_partition<const M: usize>(parts: &[u32; M], base: usize, s: u32) -> u32 {
+    (parts[base + (s / 4) as usize] >> (8 * (s % 4))) & 0xff
+}
+
+/// `p` placed where [`packed_partition`] finds the partition of subset `s`
+/// (to be or-ed into word `s / 4`).
+#[inline]
+pub fn packed_bits(s: u32, p: u32) -> u32 {
+    p << (8 * (s % 4))
+}
+
+/// Union of the boxes of the leaves in subset `s` of the treelet staged at `b`.
+#[inline]
+pub fn subset_box<const N: usize>(s: u32, n: u32, stage: &[u32; N], b: usize) -> Aabb {
+    let mut x = Aabb::EMPTY;
     let mut i = 0;
     while i < n {
         if s & (1 << i) != 0 {
-            b = b.union(&boxes[i as usize]);
+            x = x.union(&staged_box(stage, b, i as usize));
         }
         i += 1;
     }
-    b
+    x
 }
 
-/// Scaled area of the union of the leaves in subset `s`.
+/// Primitives under the leaves in subset `s` of the treelet staged at `b`.
 #[inline]
-pub fn subset_area(s: u32, n: u32, boxes: &[Aabb; TREELET_LEAVES], costs: &TreeletCosts) -> f32 {
-    costs.area(&subset_box(s, n, boxes))
-}
-
-/// Primitives under the leaves in subset `s`.
-#[inline]
-pub fn subset_count(s: u32, n: u32, leaf_counts: &[u32; TREELET_LEAVES]) -> u32 {
+pub fn subset_count<const N: usize>(s: u32, n: u32, stage: &[u32; N], b: usize) -> u32 {
     let mut c = 0;
     let mut i = 0;
     while i < n {
         if s & (1 << i) != 0 {
-            c += leaf_counts[i as usize];
+            c += get(stage, b + T_PRIMS + i as usize);
         }
         i += 1;
     }
@@ -234,12 +276,13 @@ pub fn subset_count(s: u32, n: u32, leaf_counts: &[u32; TREELET_LEAVES]) -> u32 
 }
 
 /// One step of the DP: the best partition of subset `s` (of at least two
-/// leaves) from the solved costs of its parts. Tables are rows of
-/// [`SUBSETS`] entries starting at `base` (several treelets share one table
-/// in the wide kernel).
+/// leaves) from the solved costs of its parts. Writes the cost of `s` (at
+/// `base + s`, several treelets share one table in the kernel) and returns
+/// the partition.
 ///
 /// Algorithm 3: partitions `(p, s ^ p)` with `p` inside `s` minus its lowest
-/// bit, each unordered pair once.
+/// bit, each unordered pair once, the first of equal costs kept: whoever
+/// solves `s`, the result is the same.
 #[inline]
 pub fn solve_subset<const N: usize>(
     s: u32,
@@ -247,15 +290,14 @@ pub fn solve_subset<const N: usize>(
     area: f32,
     count: u32,
     cost: &mut [f32; N],
-    partition: &mut [u32; N],
     costs: &TreeletCosts,
-) {
+) -> u32 {
     let delta = (s - 1) & s;
     let mut p = delta.wrapping_neg() & s;
     let mut best = f32::MAX;
     let mut best_p = 0u32;
     loop {
-        let c = cost[base + p as usize] + cost[base + (s ^ p) as usize];
+        let c = get(cost, base + p as usize) + get(cost, base + (s ^ p) as usize);
         if c < best {
             best = c;
             best_p = p;
@@ -265,88 +307,92 @@ pub fn solve_subset<const N: usize>(
             break;
         }
     }
-    cost[base + s as usize] = costs.subtree(area, count, best);
-    partition[base + s as usize] = best_p;
+    set(cost, base + s as usize, costs.subtree(area, count, best));
+    best_p
 }
 
-/// Algorithm 2's dynamic program over the subsets of the leaves of `t`, in
-/// one invocation (the wide kernel spreads the same steps over a team).
+/// The optimal tree over a treelet's leaves: `cost[s]` is the cost of the
+/// best subtree over subset `s`; its root splits `s` into `p` and `s ^ p`,
+/// `p` = [`packed_partition`]`(&parts, 0, s)`.
+pub struct TreeletSolution {
+    pub cost: [f32; SUBSETS],
+    pub parts: [u32; PACKED_WORDS],
+}
+
+/// Algorithm 2's dynamic program over the subsets of the leaves of the
+/// treelet staged at `b`, in one invocation (the kernel deals the same
+/// steps to a team of lanes). Subsets go in increasing order: every proper
+/// subset of `s` is smaller than `s`, so its parts are solved before it.
 #[inline]
-pub fn optimize(t: &Treelet, costs: &TreeletCosts) -> TreeletSolution {
-    let n = t.leaf_count;
-    let mut sol = TreeletSolution { partition: [0u32; SUBSETS], cost: [0.0; SUBSETS] };
-    let full = (1u32 << n) - 1;
+pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts) -> TreeletSolution {
+    let mut sol = TreeletSolution { cost: [0.0; SUBSETS], parts: [0u32; PACKED_WORDS] };
+    let n = stage[b + T_COUNT];
     let mut i = 0;
-    while i < n {
-        sol.cost[1 << i] = t.costs[i as usize];
+    while i < n as usize {
+        sol.cost[1 << i] = f32::from_bits(stage[b + T_COSTS + i]);
         i += 1;
     }
-    // Subsets by increasing size, so that every part is solved before.
-    let mut size = 2;
-    while size <= n {
-        let mut s = 1u32;
-        while s <= full {
-            if s.count_ones() == size {
-                let area = subset_area(s, n, &t.boxes, costs);
-                let count = subset_count(s, n, &t.counts);
-                solve_subset(s, 0, area, count, &mut sol.cost, &mut sol.partition, costs);
-            }
-            s += 1;
+    let full = (1u32 << n) - 1;
+    let mut s = 3u32;
+    while s <= full {
+        if s & (s - 1) != 0 {
+            let area = costs.area(&subset_box(s, n, stage, b));
+            let p = solve_subset(s, 0, area, subset_count(s, n, stage, b), &mut sol.cost, costs);
+            sol.parts[(s / 4) as usize] |= packed_bits(s, p);
         }
-        size += 1;
+        s += 1;
     }
     sol
 }
 
-/// Rewires the treelet's internal nodes into the tree that `partition`
-/// (indexed by subset, from `base`) describes, and sets each one's box,
-/// primitive count and cost from its subset: the union of its leaves' boxes,
-/// and the cost the DP gave that subset, recomputed bottom-up with the DP's
-/// own operations (so it is the same number, and a refit from memory is not
-/// needed). The root keeps its index; the other internal nodes are reused in
-/// order.
+/// Rewires the internal nodes of the treelet staged at `b` into the tree
+/// that the packed partitions `parts` (from `base`) describe, and sets each
+/// one's box, primitive count, cost and height from its subset: the union
+/// of its leaves' boxes, and the cost the DP gave that subset, recomputed
+/// bottom-up with the DP's own operations (so it is the same number, and a
+/// refit from memory is not needed). The root keeps its index; the other
+/// internal nodes are reused in order. Uses the stage's scratch words.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn apply(
-    t: &Treelet,
-    partition: &[u32],
+pub fn apply<const N: usize, const M: usize>(
+    stage: &mut [u32; N],
+    b: usize,
+    parts: &[u32; M],
     base: usize,
     nodes: &mut [Node],
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
+    heights: &mut [u32],
     costs: &TreeletCosts,
 ) {
-    let n = t.leaf_count;
-    let full = (1u32 << n) - 1;
+    let n = stage[b + T_COUNT];
     // Per internal slot: its subset and its children (a leaf index below
-    // 8, or 8 + the child's internal slot).
-    let mut sets = [0u32; TREELET_INTERNALS];
-    let mut kids = [0u32; 2 * TREELET_INTERNALS];
-    // Stack of internal slots still to split, depth at most the number of internals.
-    let mut stack = [0u32; TREELET_INTERNALS];
+    // 8, or 8 + the child's internal slot). A stack of internal slots still
+    // to split, at most as deep as there are internal nodes.
+    stage[b + A_SETS] = (1u32 << n) - 1;
+    stage[b + A_STACK] = 0;
     let mut top = 1usize;
-    sets[0] = full;
     let mut next_internal = 1usize;
     while top > 0 {
         top -= 1;
-        let k = stack[top] as usize;
-        let s = sets[k];
-        let node = t.internals[k];
-        let p = partition[base + s as usize];
+        let k = stage[b + A_STACK + top] as usize;
+        let s = stage[b + A_SETS + k];
+        let node = stage[b + T_INTERNALS + k];
+        let p = packed_partition(parts, base, s);
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
             let child = if part.count_ones() == 1 {
-                kids[2 * k + side] = part.trailing_zeros();
-                t.leaves[part.trailing_zeros() as usize]
+                stage[b + A_KIDS + 2 * k + side] = part.trailing_zeros();
+                stage[b + T_LEAVES + part.trailing_zeros() as usize]
             } else {
-                kids[2 * k + side] = 8 + next_internal as u32;
-                sets[next_internal] = part;
-                stack[top] = next_internal as u32;
+                stage[b + A_KIDS + 2 * k + side] = 8 + next_internal as u32;
+                stage[b + A_SETS + next_internal] = part;
+                stage[b + A_STACK + top] = next_internal as u32;
                 top += 1;
                 next_internal += 1;
-                t.internals[next_internal - 1]
+                stage[b + T_INTERNALS + next_internal - 1]
             };
             if side == 0 {
                 nodes[node as usize].left = child;
@@ -358,27 +404,35 @@ pub fn apply(
         }
     }
     // Children come after their parents: fill boxes and costs in reverse.
-    let mut internal_costs = [0.0f32; TREELET_INTERNALS];
     let mut k = next_internal;
     while k > 0 {
         k -= 1;
-        let s = sets[k];
+        let s = stage[b + A_SETS + k];
         let mut children = 0.0f32;
+        let mut height = 0u32;
         let mut side = 0;
         while side < 2 {
-            let kid = kids[2 * k + side];
-            let c = if kid < 8 { t.costs[kid as usize] } else { internal_costs[(kid - 8) as usize] };
+            let kid = stage[b + A_KIDS + 2 * k + side] as usize;
+            let (c, h) = if kid < 8 {
+                (stage[b + T_COSTS + kid], stage[b + T_HEIGHTS + kid])
+            } else {
+                (stage[b + A_COSTS + kid - 8], stage[b + A_HEIGHTS + kid - 8])
+            };
+            let c = f32::from_bits(c);
             children = if side == 0 { c } else { children + c };
+            height = height.max(h + 1);
             side += 1;
         }
-        let count = subset_count(s, n, &t.counts);
-        let b = subset_box(s, n, &t.boxes);
-        let cost = costs.subtree(costs.area(&b), count, children);
-        internal_costs[k] = cost;
-        let node = t.internals[k] as usize;
-        nodes[node].set_aabb(b);
+        let count = subset_count(s, n, stage, b);
+        let x = subset_box(s, n, stage, b);
+        let cost = costs.subtree(costs.area(&x), count, children);
+        stage[b + A_COSTS + k] = cost.to_bits();
+        stage[b + A_HEIGHTS + k] = height;
+        let node = stage[b + T_INTERNALS + k] as usize;
+        nodes[node].set_aabb(x);
         counts[node] = count;
         node_costs[node] = cost;
+        heights[node] = height;
     }
 }
 
@@ -394,10 +448,31 @@ pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &Treel
     }
 }
 
+/// The subtree cost and height of internal node `root` from its children's,
+/// which must be current. A root keeps its treelet when nothing cheaper
+/// exists, yet the subtrees under it may have changed: storing these lets
+/// the changes reach the nodes above, and later rounds, without a new climb.
+#[inline]
+pub fn current_root(
+    root: u32,
+    nodes: &[Node],
+    counts: &[u32],
+    node_costs: &[f32],
+    heights: &[u32],
+    costs: &TreeletCosts,
+) -> (f32, u32) {
+    let r = nodes[root as usize];
+    let (l, rr) = (r.left as usize, r.right as usize);
+    let cost = costs.subtree(costs.area(&r.aabb()), counts[root as usize], node_costs[l] + node_costs[rr]);
+    (cost, 1 + heights[l].max(heights[rr]))
+}
+
 /// Restructures the treelet rooted at internal node `root` in place, in one
 /// invocation: forms it, solves the DP, and commits the result if cheaper.
 /// `node_costs` holds every node's subtree cost (as [`node_cost`] defines
-/// it) and `counts` its primitive count. Returns whether the treelet changed.
+/// it), `counts` its primitive count and `heights` its height (leaves 0),
+/// current below `root`; they are current at `root` afterwards.
+/// Returns whether the treelet changed.
 #[inline]
 pub fn restructure(
     root: u32,
@@ -405,18 +480,25 @@ pub fn restructure(
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
+    heights: &mut [u32],
     costs: &TreeletCosts,
 ) -> bool {
-    let t = form_treelet(root, nodes, counts, node_costs, costs);
-    if t.leaf_count < 3 {
-        return false; // two leaves: only one tree
+    let mut stage = [0u32; TREELET_WORDS];
+    let n = form_treelet(root, nodes, counts, node_costs, heights, costs, &mut stage, 0);
+    let (current, height) = current_root(root, nodes, counts, node_costs, heights, costs);
+    let keep = |node_costs: &mut [f32], heights: &mut [u32]| {
+        node_costs[root as usize] = current;
+        heights[root as usize] = height;
+        false
+    };
+    if n < 3 {
+        return keep(node_costs, heights); // two leaves: only one tree
     }
-    let sol = optimize(&t, costs);
-    let full = (1usize << t.leaf_count) - 1;
-    if !improves(sol.cost[full], node_costs[root as usize]) {
-        return false;
+    let sol = optimize(&stage, 0, costs);
+    if !improves(sol.cost[(1usize << n) - 1], current) {
+        return keep(node_costs, heights);
     }
-    apply(&t, &sol.partition, 0, nodes, parents, counts, node_costs, costs);
+    apply(&mut stage, 0, &sol.parts, 0, nodes, parents, counts, node_costs, heights, costs);
     true
 }
 
@@ -426,364 +508,6 @@ pub fn restructure(
 #[inline]
 pub fn improves(best: f32, current: f32) -> bool {
     best < current * (1.0 - 1e-6)
-}
-
-/// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
-/// every node's primitive count, subtree SAH cost and height (leaves 0), and
-/// its number of leaves after the final collapse (1 where it collapses), an
-/// internal node once both children are done. `flags` are zeroed counters.
-#[allow(clippy::too_many_arguments)]
-pub fn treelet_init_kernel<const ORDERED: bool>(
-    i: u32,
-    params: &TreeletParams,
-    nodes: &[Node],
-    parents: &[u32],
-    flags: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-    heights: &mut [u32],
-    tree_leaves: &mut [u32],
-) {
-    let n = params.n;
-    if i >= n {
-        return;
-    }
-    let costs = params.costs();
-    // Leaves are found through the tree, not by index: restructuring moves
-    // internal nodes but never leaves, and leaf `i` stays at `n - 1 + i`.
-    let leaf = n - 1 + i;
-    let node = nodes[leaf as usize];
-    atomics::store_u32(&mut counts[leaf as usize], node.prim_count());
-    atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, node.prim_count(), (0.0, 0.0), &costs));
-    atomics::store_u32(&mut heights[leaf as usize], 0);
-    atomics::store_u32(&mut tree_leaves[leaf as usize], 1);
-    let mut current = leaf;
-    while current != 0 {
-        let parent = parents[current as usize];
-        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
-            return;
-        }
-        let p = nodes[parent as usize];
-        let (l, r) = (p.left as usize, p.right as usize);
-        let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
-        let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);
-        let area = costs.area(&p.aabb());
-        let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
-        let leaves = if costs.collapses(area, count, children) {
-            1
-        } else {
-            atomics::load_u32(&tree_leaves[l]) + atomics::load_u32(&tree_leaves[r])
-        };
-        atomics::store_u32(&mut counts[parent as usize], count);
-        atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
-        atomics::store_u32(&mut heights[parent as usize], height);
-        atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
-        current = parent;
-    }
-}
-
-/// Heights the level lists hold; the last slot counts deeper nodes (an
-/// error for the host: traversal refuses such trees anyway).
-pub const MAX_LEVELS: usize = 256;
-
-/// Whether internal node `i` roots a treelet this round, and at which height.
-#[inline]
-fn treelet_root(i: u32, params: &TreeletParams, counts: &[u32], heights: &[u32]) -> Option<usize> {
-    if params.n < 2 || i >= params.n - 1 || counts[i as usize] < params.gamma {
-        return None;
-    }
-    Some((heights[i as usize] as usize).min(MAX_LEVELS - 1))
-}
-
-/// Kernel (one invocation per internal node): counts the treelet roots of
-/// each height into `level_counts` (zeroed, [`MAX_LEVELS`] entries).
-pub fn treelet_histogram_kernel(
-    i: u32,
-    params: &TreeletParams,
-    counts: &[u32],
-    heights: &[u32],
-    level_counts: &mut [u32],
-) {
-    if let Some(h) = treelet_root(i, params, counts, heights) {
-        atomics::add_device(&mut level_counts[h], 1);
-    }
-}
-
-/// Kernel (one invocation per internal node): appends each treelet root to
-/// its height's list; `cursors` start at each list's offset. Order within a
-/// list does not matter: the treelets of one height are disjoint.
-pub fn treelet_scatter_kernel(
-    i: u32,
-    params: &TreeletParams,
-    counts: &[u32],
-    heights: &[u32],
-    cursors: &mut [u32],
-    roots: &mut [u32],
-) {
-    if let Some(h) = treelet_root(i, params, counts, heights) {
-        let slot = atomics::add_device(&mut cursors[h], 1);
-        roots[slot as usize] = i;
-    }
-}
-
-// The device restructures the treelets of one height in three dispatches:
-// form (one invocation per treelet, writing a record), solve (a team of 32
-// lanes per treelet, the DP as in the paper's warp-wide scheme, writing the
-// partitions), commit (one invocation per treelet). Splitting keeps the
-// one-lane steps from holding the registers of the wide one.
-
-/// Words of one treelet record: leaves (7) and leaf count, internal nodes
-/// (6), the root's current cost, leaf boxes (7 x 6), leaf primitive counts
-/// (7), leaf subtree costs (7). Floats are stored as bits.
-pub const RECORD_WORDS: usize = 72;
-const R_COUNT: usize = 7;
-const R_INTERNALS: usize = 8;
-const R_CURRENT: usize = 14;
-const R_BOXES: usize = 16;
-const R_COUNTS: usize = 58;
-const R_COSTS: usize = 65;
-/// Words of one solution row: `partition[s]` at `s`, and at 0 the optimum's cost bits.
-pub const SOLUTION_WORDS: usize = SUBSETS;
-
-/// Kernel (one invocation per treelet of this height): forms the treelet of
-/// `roots[level_offset + i]` and writes its record (leaf count 0 when it
-/// has fewer than three leaves: nothing to choose).
-#[allow(clippy::too_many_arguments)]
-pub fn treelet_form_kernel(
-    i: u32,
-    params: &TreeletParams,
-    roots: &[u32],
-    nodes: &[Node],
-    counts: &[u32],
-    node_costs: &[f32],
-    records: &mut [u32],
-) {
-    if i >= params.level_count {
-        return;
-    }
-    let root = roots[(params.level_offset + i) as usize];
-    let t = form_treelet(root, nodes, counts, node_costs, &params.costs());
-    let r = i as usize * RECORD_WORDS;
-    records[r + R_COUNT] = if t.leaf_count >= 3 { t.leaf_count } else { 0 };
-    let mut k = 0;
-    while k < TREELET_LEAVES {
-        records[r + k] = t.leaves[k];
-        if k < TREELET_INTERNALS {
-            records[r + R_INTERNALS + k] = t.internals[k];
-        }
-        let (lo, hi) = (t.boxes[k].min, t.boxes[k].max);
-        let f = r + R_BOXES + 6 * k;
-        records[f] = lo[0].to_bits();
-        records[f + 1] = lo[1].to_bits();
-        records[f + 2] = lo[2].to_bits();
-        records[f + 3] = hi[0].to_bits();
-        records[f + 4] = hi[1].to_bits();
-        records[f + 5] = hi[2].to_bits();
-        records[r + R_COUNTS + k] = t.counts[k];
-        records[r + R_COSTS + k] = t.costs[k].to_bits();
-        k += 1;
-    }
-    records[r + R_CURRENT] = node_costs[root as usize].to_bits();
-}
-
-/// The treelet of a record.
-#[inline]
-fn read_record(records: &[u32], r: usize) -> Treelet {
-    let mut t = Treelet {
-        leaves: [0; TREELET_LEAVES],
-        leaf_count: records[r + R_COUNT],
-        internals: [0; TREELET_INTERNALS],
-        boxes: [Aabb::EMPTY; TREELET_LEAVES],
-        counts: [0; TREELET_LEAVES],
-        costs: [0.0; TREELET_LEAVES],
-    };
-    let mut k = 0;
-    while k < TREELET_LEAVES {
-        t.leaves[k] = records[r + k];
-        if k < TREELET_INTERNALS {
-            t.internals[k] = records[r + R_INTERNALS + k];
-        }
-        let f = r + R_BOXES + 6 * k;
-        let lo = [f32::from_bits(records[f]), f32::from_bits(records[f + 1]), f32::from_bits(records[f + 2])];
-        let hi = [f32::from_bits(records[f + 3]), f32::from_bits(records[f + 4]), f32::from_bits(records[f + 5])];
-        t.boxes[k] = Aabb::from_arrays(lo, hi);
-        t.counts[k] = records[r + R_COUNTS + k];
-        t.costs[k] = f32::from_bits(records[r + R_COSTS + k]);
-        k += 1;
-    }
-    t
-}
-
-/// Lanes that solve one treelet together (the paper's warp; a slice of a
-/// workgroup here, so no subgroup size is assumed).
-pub const TEAM: u32 = 32;
-/// Treelets per workgroup of the solve kernel.
-pub const TEAMS: usize = crate::workgroup::WG / TEAM as usize;
-/// Shared DP tables: one row of [`SUBSETS`] per team.
-pub const TEAM_TABLE: usize = TEAMS * SUBSETS;
-/// Shared leaf data: per team, the leaf count, 7 boxes of 6 floats, 7 primitive counts.
-pub const TEAM_LEAVES: usize = TEAMS * 64;
-/// Phases of [`treelet_solve_phase`]: load, one per subset size 2..=7, store.
-pub const SOLVE_PHASES: u32 = 2 + TREELET_LEAVES as u32 - 1;
-
-/// Binomial coefficient C(n, k) for n, k <= 7, from Pascal's triangle
-/// packed six bits per entry (no division: GPUs do it slowly).
-#[inline]
-pub fn binomial(n: u32, k: u32) -> u32 {
-    let row: u64 = match n {
-        0 => 1,
-        1 => 1 | 1 << 6,
-        2 => 1 | 2 << 6 | 1 << 12,
-        3 => 1 | 3 << 6 | 3 << 12 | 1 << 18,
-        4 => 1 | 4 << 6 | 6 << 12 | 4 << 18 | 1 << 24,
-        5 => 1 | 5 << 6 | 10 << 12 | 10 << 18 | 5 << 24 | 1 << 30,
-        6 => 1 | 6 << 6 | 15 << 12 | 20 << 18 | 15 << 24 | 6 << 30 | 1 << 36,
-        7 => 1 | 7 << 6 | 21 << 12 | 35 << 18 | 35 << 24 | 21 << 30 | 7 << 36 | 1 << 42,
-        _ => 0,
-    };
-    if k > 7 {
-        return 0;
-    }
-    ((row >> (6 * k)) & 63) as u32
-}
-
-/// The `rank`-th subset (in colex order) of `size` leaves among `n`: how a
-/// lane finds its subsets of one size without scanning all of them.
-#[inline]
-pub fn subset_of_rank(mut rank: u32, n: u32, size: u32) -> u32 {
-    let mut s = 0u32;
-    let mut k = size;
-    let mut pos = n;
-    while k > 0 && pos > 0 {
-        pos -= 1;
-        let below = binomial(pos, k);
-        if rank >= below {
-            s |= 1 << pos;
-            rank -= below;
-            k -= 1;
-        }
-    }
-    s
-}
-
-/// Kernel (workgroups of [`TEAMS`] teams of [`TEAM`] lanes; phase by phase):
-/// the DP of [`optimize`] for the treelets of `records`, one per team: each
-/// lane takes every 32nd subset of each size, sizes in increasing order with
-/// a barrier between them. Writes each treelet's partitions to `solutions`.
-#[allow(clippy::too_many_arguments)]
-pub fn treelet_solve_phase(
-    phase: u32,
-    lid: u32,
-    group: u32,
-    params: &TreeletParams,
-    records: &[u32],
-    solutions: &mut [u32],
-    leaves: &mut [f32; TEAM_LEAVES],
-    cost: &mut [f32; TEAM_TABLE],
-    partition: &mut [u32; TEAM_TABLE],
-) {
-    let team = (lid / TEAM) as usize;
-    let lane = lid % TEAM;
-    let index = group * TEAMS as u32 + team as u32;
-    let (lb, tb) = (team * 64, team * SUBSETS);
-    let r = index as usize * RECORD_WORDS;
-    if phase == 0 {
-        // The record into workgroup memory, the team's lanes side by side:
-        // leaf count at 0, boxes from 1, primitive counts from 43 (as f32,
-        // exact below 2^24), the leaves' costs into the DP's singleton entries.
-        if index >= params.level_count {
-            if lane == 0 {
-                leaves[lb] = 0.0;
-            }
-            return;
-        }
-        let mut w = lane as usize;
-        while w < R_COSTS + TREELET_LEAVES {
-            let word = records[r + w];
-            if w == R_COUNT {
-                leaves[lb] = word as f32;
-            } else if (R_BOXES..R_COUNTS).contains(&w) {
-                leaves[lb + 1 + w - R_BOXES] = f32::from_bits(word);
-            } else if (R_COUNTS..R_COSTS).contains(&w) {
-                leaves[lb + 43 + w - R_COUNTS] = word as f32;
-            } else if w >= R_COSTS {
-                cost[tb + (1 << (w - R_COSTS))] = f32::from_bits(word);
-            }
-            w += TEAM as usize;
-        }
-        return;
-    }
-    let n = leaves[lb] as u32;
-    if n == 0 {
-        return;
-    }
-    let full = (1u32 << n) - 1;
-    if phase < SOLVE_PHASES - 1 {
-        // Subsets of one size, dealt round-robin to the lanes.
-        let size = phase + 1;
-        if size > n {
-            return;
-        }
-        let costs = params.costs();
-        let total = binomial(n, size);
-        let mut rank = lane;
-        while rank < total {
-            let s = subset_of_rank(rank, n, size);
-            // The subset's box and count straight from workgroup memory (a
-            // union is exact in any order, so this equals `subset_area`).
-            let (mut lo, mut hi) = ([f32::MAX; 3], [-f32::MAX; 3]);
-            let mut count = 0u32;
-            let mut k = 0;
-            while k < n as usize {
-                if s & (1 << k) != 0 {
-                    let f = lb + 1 + 6 * k;
-                    lo = [lo[0].min(leaves[f]), lo[1].min(leaves[f + 1]), lo[2].min(leaves[f + 2])];
-                    hi = [hi[0].max(leaves[f + 3]), hi[1].max(leaves[f + 4]), hi[2].max(leaves[f + 5])];
-                    count += leaves[lb + 43 + k] as u32;
-                }
-                k += 1;
-            }
-            let a = costs.area(&Aabb::from_arrays(lo, hi));
-            solve_subset(s, tb, a, count, cost, partition, &costs);
-            rank += TEAM;
-        }
-    } else {
-        let row = index as usize * SOLUTION_WORDS;
-        let mut s = lane as usize;
-        while s <= full as usize {
-            solutions[row + s] = if s == 0 { cost[tb + full as usize].to_bits() } else { partition[tb + s] };
-            s += TEAM as usize;
-        }
-    }
-}
-
-/// Kernel (one invocation per treelet of this height): rewires the treelet
-/// into its solved tree when that lowers its cost.
-#[allow(clippy::too_many_arguments)]
-pub fn treelet_commit_kernel(
-    i: u32,
-    params: &TreeletParams,
-    records: &[u32],
-    solutions: &[u32],
-    nodes: &mut [Node],
-    parents: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-) {
-    if i >= params.level_count {
-        return;
-    }
-    let r = i as usize * RECORD_WORDS;
-    if records[r + R_COUNT] == 0 {
-        return;
-    }
-    let row = i as usize * SOLUTION_WORDS;
-    let (best, current) = (f32::from_bits(solutions[row]), f32::from_bits(records[r + R_CURRENT]));
-    if !improves(best, current) {
-        return;
-    }
-    let t = read_record(records, r);
-    apply(&t, solutions, row, nodes, parents, counts, node_costs, &params.costs());
 }
 
 #[cfg(test)]
@@ -846,15 +570,14 @@ mod tests {
             for n in 2..=TREELET_LEAVES as u32 {
                 for seed in 0..20 {
                     let l = random_leaves(seed * 31 + n, n);
-                    let t = Treelet {
-                        leaves: [0; TREELET_LEAVES],
-                        leaf_count: n,
-                        internals: [0; TREELET_INTERNALS],
-                        boxes: l.boxes,
-                        counts: l.counts,
-                        costs: l.costs,
-                    };
-                    let sol = optimize(&t, &costs);
+                    let mut stage = [0u32; TREELET_WORDS];
+                    stage[T_COUNT] = n;
+                    for k in 0..n as usize {
+                        stage_box(&mut stage, 0, k, &l.boxes[k]);
+                        stage[T_PRIMS + k] = l.counts[k];
+                        stage[T_COSTS + k] = l.costs[k].to_bits();
+                    }
+                    let sol = optimize(&stage, 0, &costs);
                     let full = (1u32 << n) - 1;
                     let expected = brute_force(full, &l, &costs);
                     let got = sol.cost[full as usize];
@@ -863,30 +586,6 @@ mod tests {
                         "max_leaf {max_leaf} n {n} seed {seed}: dp {got} brute {expected}"
                     );
                 }
-            }
-        }
-    }
-
-    #[test]
-    fn binomials_match_pascal() {
-        for n in 0..=7u32 {
-            for k in 0..=8u32 {
-                let expected = if k > n { 0 } else { (0..k).fold(1u32, |c, i| c * (n - i) / (i + 1)) };
-                assert_eq!(binomial(n, k), expected, "C({n}, {k})");
-            }
-        }
-    }
-
-    #[test]
-    fn subsets_of_rank_cover_each_size_once() {
-        for n in 1..=TREELET_LEAVES as u32 {
-            for size in 1..=n {
-                let mut seen: Vec<u32> = (0..binomial(n, size)).map(|r| subset_of_rank(r, n, size)).collect();
-                assert!(seen.iter().all(|s| s.count_ones() == size && *s < (1 << n)), "n {n} size {size}");
-                seen.sort();
-                seen.dedup();
-                let expected = (1u32..1 << n).filter(|s| s.count_ones() == size).count();
-                assert_eq!(seen.len(), expected, "n {n} size {size}");
             }
         }
     }

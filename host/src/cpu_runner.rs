@@ -15,7 +15,7 @@ use treelet_core::aabb::Aabb;
 use treelet_core::features::VARIANTS;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet};
+use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
 
 use crate::backend::{Backend, StageTimes};
 use crate::kernels::Kernel;
@@ -63,6 +63,27 @@ fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
             }
         }
     }
+}
+
+/// The restructuring kernel for teams of `TEAM` lanes, as its entry point
+/// runs it, with workgroup arrays of `S`, `C` and `P` entries.
+#[allow(clippy::too_many_arguments)]
+fn restructure<const TEAM: u32, const S: usize, const C: usize, const P: usize>(
+    groups: u32,
+    p: &treelet_core::layout::TreeletParams,
+    roots: &[u32],
+    nodes: &mut [treelet_core::Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    costs: &mut [f32],
+    heights: &mut [u32],
+) {
+    let (mut stage, mut cost, mut parts) = ([0u32; S], [0f32; C], [0u32; P]);
+    workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
+        treelet_kernels::treelet_restructure_phase::<TEAM, S, C, P>(
+            phase, lid, group, p, roots, nodes, parents, counts, costs, heights, &mut stage, &mut cost, &mut parts,
+        );
+    });
 }
 
 /// `render_pixel` compiled for `VARIANTS[v]`, as the shader's entry points are.
@@ -248,7 +269,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
             let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
             for id in ids(groups) {
-                treelet::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights, tree_leaves);
+                treelet_kernels::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights, tree_leaves);
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
@@ -274,51 +295,38 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
         (Kernel::TreeletHistogram, [p, counts, heights, level_counts]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (counts, heights, level_counts) = (view(counts), view(heights), view(level_counts));
-            for id in ids(groups) {
-                treelet::treelet_histogram_kernel(id, &p, counts, heights, level_counts);
-            }
+            let mut local = [0u32; WG];
+            workgroups(groups, treelet_kernels::HISTOGRAM_PHASES, |group, phase, lid| {
+                treelet_kernels::treelet_histogram_phase(phase, lid, group, &p, counts, heights, level_counts, &mut local);
+            });
         }
         (Kernel::TreeletScatter, [p, counts, heights, cursors, roots]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (counts, heights, cursors, roots) = (view(counts), view(heights), view(cursors), view(roots));
-            for id in ids(groups) {
-                treelet::treelet_scatter_kernel(id, &p, counts, heights, cursors, roots);
-            }
-        }
-        (Kernel::TreeletForm, [p, roots, nodes, counts, costs, records]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
-            let (roots, nodes, counts, costs, records) =
-                (view(roots), view(nodes), view(counts), view(costs), view(records));
-            for id in ids(groups) {
-                treelet::treelet_form_kernel(id, &p, roots, nodes, counts, costs, records);
-            }
-        }
-        (Kernel::TreeletSolve, [p, records, solutions]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
-            let (records, solutions) = (view(records), view(solutions));
-            let mut leaves = [0f32; treelet::TEAM_LEAVES];
-            let mut cost = [0f32; treelet::TEAM_TABLE];
-            let mut partition = [0u32; treelet::TEAM_TABLE];
-            workgroups(groups, treelet::SOLVE_PHASES, |group, phase, lid| {
-                treelet::treelet_solve_phase(
-                    phase,
-                    lid,
-                    group,
-                    &p,
-                    records,
-                    solutions,
-                    &mut leaves,
-                    &mut cost,
-                    &mut partition,
+            let (mut local, mut ranks) = ([0u32; WG], [0u32; WG]);
+            workgroups(groups, treelet_kernels::SCATTER_PHASES, |group, phase, lid| {
+                treelet_kernels::treelet_scatter_phase(
+                    phase, lid, group, &p, counts, heights, cursors, roots, &mut local, &mut ranks,
                 );
             });
         }
-        (Kernel::TreeletCommit, [p, records, solutions, nodes, parents, counts, costs]) => {
+        (Kernel::TreeletRestructure(i), [p, roots, nodes, parents, counts, costs, heights]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
-            let (records, solutions, nodes, parents) = (view(records), view(solutions), view(nodes), view(parents));
-            let (counts, costs) = (view(counts), view(costs));
-            for id in ids(groups) {
-                treelet::treelet_commit_kernel(id, &p, records, solutions, nodes, parents, counts, costs);
+            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
+            let (counts, costs, heights) = (view(counts), view(costs), view(heights));
+            use treelet_kernels::{team_costs as tc, team_parts as tp, team_stage as ts, TEAM_SIZES as T};
+            const _: () = assert!(T.len() == 3, "one arm per team size");
+            let (g, r) = (groups, roots);
+            match i {
+                0 => restructure::<{ T[0] }, { ts(T[0]) }, { tc(T[0]) }, { tp(T[0]) }>(
+                    g, &p, r, nodes, parents, counts, costs, heights,
+                ),
+                1 => restructure::<{ T[1] }, { ts(T[1]) }, { tc(T[1]) }, { tp(T[1]) }>(
+                    g, &p, r, nodes, parents, counts, costs, heights,
+                ),
+                _ => restructure::<{ T[2] }, { ts(T[2]) }, { tc(T[2]) }, { tp(T[2]) }>(
+                    g, &p, r, nodes, parents, counts, costs, heights,
+                ),
             }
         }
         (Kernel::CastBvh, [p, spheres, materials, nodes, prims, rays, triangles]) => {

@@ -1,9 +1,10 @@
 //! Treelet restructuring of an LBVH on the device (Karras & Aila 2013),
-//! round by round: a bottom-up pass computes each node's primitive count,
-//! SAH cost and height; the roots of treelets (at least `gamma` primitives)
-//! are listed by height; then one dispatch per height, from the leaves up,
-//! restructures them: form each treelet (one invocation each), solve its
-//! DP (32 lanes each), rewire it (one invocation each).
+//! round by round (the kernels: `treelet_core::treelet_kernels`): a
+//! bottom-up pass computes each node's primitive count, SAH cost and height
+//! once; each round lists the roots of its treelets (at least `gamma`
+//! primitives) by height, then restructures them with one dispatch per
+//! height, from the leaves up, a team of lanes per treelet: wide teams
+//! where a height has few treelets, narrow ones where it has many.
 //! Last, the SAH leaf collapse writes the tree anew in depth-first order
 //! with leaves of up to `max_leaf` primitives.
 //! Nodes of one height never contain each other, so each dispatch works on
@@ -12,7 +13,7 @@
 //! for visibility guarantees that need no device-scope atomics.)
 use anyhow::{bail, Result};
 use treelet_core::layout::TreeletParams;
-use treelet_core::treelet::{MAX_LEVELS, RECORD_WORDS, SOLUTION_WORDS, TEAMS};
+use treelet_core::treelet_kernels::{teams, MAX_LEVELS, TEAM_SIZES};
 use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
@@ -73,7 +74,10 @@ pub fn optimize<B: Backend>(
     let mut gamma = config.gamma;
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
-        init_pass(b, &bvh, &scratch, &base)?;
+        if round == 0 {
+            // Later rounds find counts, costs and heights kept current.
+            init_pass(b, &bvh, &scratch, &base)?;
+        }
         // Treelet roots (at least gamma primitives) listed by height...
         let p = b.upload("treelet params", &[TreeletParams { gamma, ..base }])?;
         let level_counts = b.zeroed("treelet level counts", MAX_LEVELS as u64 * 4)?;
@@ -100,22 +104,22 @@ pub fn optimize<B: Backend>(
         b.dispatch(Kernel::TreeletScatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
         // ...then restructured height by height, bottom up: the treelets of
         // one height are disjoint, and each sees its subtrees finished.
-        let widest = per_level.iter().copied().max().unwrap_or(0) as u64;
-        let records = b.scratch("treelet records", widest * RECORD_WORDS as u64 * 4)?;
-        let solutions = b.scratch("treelet solutions", widest * SOLUTION_WORDS as u64 * 4)?;
         for (level, &count) in per_level.iter().enumerate().skip(1) {
             if count == 0 {
                 continue;
             }
-            let lp = TreeletParams { gamma: 0, level_offset: offsets[level], level_count: count, ..base };
+            let mode = std::env::var("TREELET_MODE").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
+            let lp = TreeletParams { gamma: mode, level_offset: offsets[level], level_count: count, ..base };
             let lp = b.upload("treelet params", &[lp])?;
-            let (one_each, teams) = (groups_for(count, WORKGROUP_SIZE), groups_for(count, TEAMS as u32));
-            b.dispatch(Kernel::TreeletForm, &[&lp, &roots, &bvh.nodes, &s.counts, &s.costs, &records], one_each);
-            b.dispatch(Kernel::TreeletSolve, &[&lp, &records, &solutions], teams);
+            let team = std::env::var("TREELET_TEAM").ok().and_then(|v| v.parse().ok()).unwrap_or(0u8);
+            let kernel = Kernel::TreeletRestructure(team);
+            if std::env::var_os("TREELET_LEVELS").is_some() {
+                b.stage(Box::leak(format!("r{round} h{level:02} n{count} {kernel:?}").into_boxed_str()));
+            }
             b.dispatch(
-                Kernel::TreeletCommit,
-                &[&lp, &records, &solutions, &bvh.nodes, &bvh.parents, &s.counts, &s.costs],
-                one_each,
+                kernel,
+                &[&lp, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights],
+                count.div_ceil(teams(TEAM_SIZES[team as usize])),
             );
         }
     }

@@ -2,11 +2,11 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
-use treelet_core::treelet::{
-    treelet_commit_kernel, treelet_form_kernel, treelet_histogram_kernel, treelet_init_kernel, treelet_scatter_kernel,
-    treelet_solve_phase, SOLVE_PHASES, TEAM_LEAVES, TEAM_TABLE,
+use treelet_core::treelet_kernels::{
+    treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase, HISTOGRAM_PHASES,
+    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_SIZES, team_costs, team_parts, team_stage,
 };
-use treelet_core::workgroup::{barrier, linear_group, linear_id};
+use treelet_core::workgroup::{barrier, linear_group, linear_id, WG};
 
 /// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
 #[spirv(compute(threads(256)))]
@@ -44,87 +44,81 @@ pub fn treelet_init_relaxed_cs(
     treelet_init_kernel::<false>(id, params, nodes, parents, flags, counts, costs, heights, tree_leaves);
 }
 
-/// Counts treelet roots per height.
+/// Counts treelet roots per height (a local histogram per workgroup first).
 #[spirv(compute(threads(256)))]
 pub fn treelet_histogram_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] level_counts: &mut [u32],
+    #[spirv(workgroup)] local: &mut [u32; WG],
 ) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_histogram_kernel(id, params, counts, heights, level_counts);
+    let group = linear_group(group.x, group.y, groups.x);
+    for phase in 0..HISTOGRAM_PHASES {
+        treelet_histogram_phase(phase, lid, group, params, counts, heights, level_counts, local);
+        barrier();
+    }
 }
 
-/// Lists treelet roots by height.
+/// Lists treelet roots by height (a range per workgroup and height).
 #[spirv(compute(threads(256)))]
 pub fn treelet_scatter_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] cursors: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] roots: &mut [u32],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_scatter_kernel(id, params, counts, heights, cursors, roots);
-}
-
-/// Forms the treelets of one height, one invocation each.
-#[spirv(compute(threads(256)))]
-pub fn treelet_form_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] costs: &[f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] records: &mut [u32],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_form_kernel(id, params, roots, nodes, counts, costs, records);
-}
-
-/// The DP of the treelets of one height, 32 lanes per treelet.
-#[spirv(compute(threads(256)))]
-pub fn treelet_solve_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] records: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] solutions: &mut [u32],
-    #[spirv(workgroup)] leaves: &mut [f32; TEAM_LEAVES],
-    #[spirv(workgroup)] cost: &mut [f32; TEAM_TABLE],
-    #[spirv(workgroup)] partition: &mut [u32; TEAM_TABLE],
+    #[spirv(workgroup)] local: &mut [u32; WG],
+    #[spirv(workgroup)] ranks: &mut [u32; WG],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
-    for phase in 0..SOLVE_PHASES {
-        treelet_solve_phase(phase, lid, group, params, records, solutions, leaves, cost, partition);
+    for phase in 0..SCATTER_PHASES {
+        treelet_scatter_phase(phase, lid, group, params, counts, heights, cursors, roots, local, ranks);
         barrier();
     }
 }
 
-/// Rewires the treelets of one height into their solved trees, one invocation each.
-#[spirv(compute(threads(256)))]
-pub fn treelet_commit_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] records: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] solutions: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] costs: &mut [f32],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_commit_kernel(id, params, records, solutions, nodes, parents, counts, costs);
+/// Restructures the treelets of one height, a team of `$team` lanes each
+/// (one entry point per entry of `TEAM_SIZES`).
+macro_rules! restructure_kernel {
+    ($name:ident, $team:expr) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(local_invocation_index)] lid: u32,
+            #[spirv(workgroup_id)] group: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+            #[spirv(workgroup)] stage: &mut [u32; team_stage($team)],
+            #[spirv(workgroup)] cost: &mut [f32; team_costs($team)],
+            #[spirv(workgroup)] parts: &mut [u32; team_parts($team)],
+        ) {
+            let group = linear_group(group.x, group.y, groups.x);
+            for phase in 0..RESTRUCTURE_PHASES {
+                treelet_restructure_phase::<{ $team }, _, _, _>(
+                    phase, lid, group, params, roots, nodes, parents, counts, costs, heights, stage, cost, parts,
+                );
+                barrier();
+            }
+        }
+    };
 }
+
+const _: () = assert!(TEAM_SIZES.len() == 3, "one line per team size");
+restructure_kernel!(treelet_restructure_32_cs, TEAM_SIZES[0]);
+restructure_kernel!(treelet_restructure_16_cs, TEAM_SIZES[1]);
+restructure_kernel!(treelet_restructure_8_cs, TEAM_SIZES[2]);
 
 /// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
 #[spirv(compute(threads(256)))]

@@ -1,0 +1,365 @@
+//! The device schedule of treelet restructuring ([`crate::treelet`]).
+//!
+//! A round: [`treelet_init_kernel`] climbs from the leaves once and writes
+//! every node's primitive count, SAH cost and height; the roots of this
+//! round's treelets (subtrees of at least `gamma` primitives) are counted and
+//! listed by height ([`treelet_histogram_phase`], [`treelet_scatter_phase`]);
+//! then one dispatch per height, bottom up, restructures them
+//! ([`treelet_restructure_phase`]). Nodes of one height never contain each
+//! other, so one dispatch works on disjoint subtrees, and each sees the
+//! subtrees below it finished. Restructuring keeps counts, costs and heights
+//! up to date, so later rounds need no new climb.
+//!
+//! Restructuring is a team of 32 lanes per treelet (a slice of a workgroup,
+//! so no subgroup size is assumed), as in the paper's warp-wide scheme, the
+//! treelet and its DP tables in workgroup memory throughout: nothing of it
+//! lives in per-invocation arrays, which GPUs keep in slow local memory
+//! when indexed at run time. The result does not depend on which lane
+//! solves which subset: every subset's cost is the same minimum over the
+//! same partitions in the same order.
+use crate::atomics;
+use crate::fit::second_arrival;
+use crate::layout::{Node, TreeletParams};
+use crate::treelet::{
+    apply, current_root, form_treelet, improves, node_cost, packed_bits, solve_subset, subset_box, subset_count,
+    PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS,
+};
+use crate::workgroup::{WG, WORKGROUP_SIZE};
+
+/// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
+/// every node's primitive count, subtree SAH cost and height (leaves 0), and
+/// its number of leaves after the final collapse (1 where it collapses), an
+/// internal node once both children are done. `flags` are zeroed counters.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_init_kernel<const ORDERED: bool>(
+    i: u32,
+    params: &TreeletParams,
+    nodes: &[Node],
+    parents: &[u32],
+    flags: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+    tree_leaves: &mut [u32],
+) {
+    let n = params.n;
+    if i >= n {
+        return;
+    }
+    let costs = params.costs();
+    // Leaves are found through the tree, not by index: restructuring moves
+    // internal nodes but never leaves, and leaf `i` stays at `n - 1 + i`.
+    let leaf = n - 1 + i;
+    let node = nodes[leaf as usize];
+    atomics::store_u32(&mut counts[leaf as usize], node.prim_count());
+    atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, node.prim_count(), (0.0, 0.0), &costs));
+    atomics::store_u32(&mut heights[leaf as usize], 0);
+    atomics::store_u32(&mut tree_leaves[leaf as usize], 1);
+    let mut current = leaf;
+    while current != 0 {
+        let parent = parents[current as usize];
+        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
+            return;
+        }
+        let p = nodes[parent as usize];
+        let (l, r) = (p.left as usize, p.right as usize);
+        let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
+        let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);
+        let area = costs.area(&p.aabb());
+        let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
+        let leaves = if costs.collapses(area, count, children) {
+            1
+        } else {
+            atomics::load_u32(&tree_leaves[l]) + atomics::load_u32(&tree_leaves[r])
+        };
+        atomics::store_u32(&mut counts[parent as usize], count);
+        atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
+        atomics::store_u32(&mut heights[parent as usize], height);
+        atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
+        current = parent;
+    }
+}
+
+/// Heights the level lists hold; the last slot counts deeper nodes (an
+/// error for the host: traversal refuses such trees anyway). One per lane
+/// of a workgroup, so that a workgroup's local histogram has a lane per bin.
+pub const MAX_LEVELS: usize = WG;
+
+/// Whether internal node `i` roots a treelet this round, and at which height.
+#[inline]
+fn treelet_root(i: u32, params: &TreeletParams, counts: &[u32], heights: &[u32]) -> Option<usize> {
+    if params.n < 2 || i >= params.n - 1 || counts[i as usize] < params.gamma {
+        return None;
+    }
+    Some((heights[i as usize] as usize).min(MAX_LEVELS - 1))
+}
+
+/// Phases of [`treelet_histogram_phase`].
+pub const HISTOGRAM_PHASES: u32 = 3;
+
+/// Kernel (one invocation per internal node, phase by phase): counts the
+/// treelet roots of each height into `level_counts` (zeroed, [`MAX_LEVELS`]
+/// entries), first within the workgroup, so that the device-wide counters
+/// take one atomic per workgroup and height rather than one per root.
+pub fn treelet_histogram_phase(
+    phase: u32,
+    lid: u32,
+    group: u32,
+    params: &TreeletParams,
+    counts: &[u32],
+    heights: &[u32],
+    level_counts: &mut [u32],
+    local: &mut [u32; WG],
+) {
+    let i = group * WORKGROUP_SIZE + lid;
+    match phase {
+        0 => local[lid as usize] = 0,
+        1 => {
+            if let Some(h) = treelet_root(i, params, counts, heights) {
+                atomics::add_workgroup(&mut local[h], 1);
+            }
+        }
+        _ => {
+            let c = local[lid as usize];
+            if c > 0 {
+                atomics::add_device(&mut level_counts[lid as usize], c);
+            }
+        }
+    }
+}
+
+/// Phases of [`treelet_scatter_phase`].
+pub const SCATTER_PHASES: u32 = 4;
+
+/// Kernel (one invocation per internal node, phase by phase): appends each
+/// treelet root to its height's list; `cursors` start at each list's
+/// offset. A workgroup reserves one range per height and fills it. Order
+/// within a list does not matter: the treelets of one height are disjoint.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_scatter_phase(
+    phase: u32,
+    lid: u32,
+    group: u32,
+    params: &TreeletParams,
+    counts: &[u32],
+    heights: &[u32],
+    cursors: &mut [u32],
+    roots: &mut [u32],
+    local: &mut [u32; WG],
+    ranks: &mut [u32; WG],
+) {
+    let i = group * WORKGROUP_SIZE + lid;
+    let l = lid as usize;
+    match phase {
+        0 => local[l] = 0,
+        1 => {
+            if let Some(h) = treelet_root(i, params, counts, heights) {
+                ranks[l] = atomics::add_workgroup(&mut local[h], 1);
+            }
+        }
+        2 => {
+            let c = local[l];
+            if c > 0 {
+                local[l] = atomics::add_device(&mut cursors[l], c);
+            }
+        }
+        _ => {
+            if let Some(h) = treelet_root(i, params, counts, heights) {
+                roots[(local[h] + ranks[l]) as usize] = i;
+            }
+        }
+    }
+}
+
+/// Binomial coefficient C(n, k) for n, k <= 7, from Pascal's triangle
+/// packed six bits per entry, rows picked by selects (no division, no
+/// branch: GPUs do both slowly).
+#[inline]
+pub fn binomial(n: u32, k: u32) -> u32 {
+    let pick = |row: u64, i: u32, r: u64| if n == i { r } else { row };
+    let mut row = 1u64;
+    row = pick(row, 1, 1 | 1 << 6);
+    row = pick(row, 2, 1 | 2 << 6 | 1 << 12);
+    row = pick(row, 3, 1 | 3 << 6 | 3 << 12 | 1 << 18);
+    row = pick(row, 4, 1 | 4 << 6 | 6 << 12 | 4 << 18 | 1 << 24);
+    row = pick(row, 5, 1 | 5 << 6 | 10 << 12 | 10 << 18 | 5 << 24 | 1 << 30);
+    row = pick(row, 6, 1 | 6 << 6 | 15 << 12 | 20 << 18 | 15 << 24 | 6 << 30 | 1 << 36);
+    row = pick(row, 7, 1 | 7 << 6 | 21 << 12 | 35 << 18 | 35 << 24 | 21 << 30 | 7 << 36 | 1 << 42);
+    if n > 7 {
+        return 0;
+    }
+    if k > 7 {
+        return 0;
+    }
+    ((row >> (6 * k)) & 63) as u32
+}
+
+/// The `rank`-th subset (in colex order) of `size` leaves among `n`: how a
+/// lane finds its subsets of one size without scanning all of them.
+#[inline]
+pub fn subset_of_rank(mut rank: u32, n: u32, size: u32) -> u32 {
+    let mut s = 0u32;
+    let mut k = size;
+    let mut pos = n;
+    while k > 0 && pos > 0 {
+        pos -= 1;
+        let below = binomial(pos, k);
+        if rank >= below {
+            s |= 1 << pos;
+            rank -= below;
+            k -= 1;
+        }
+    }
+    s
+}
+
+/// Team sizes (lanes per treelet) with an entry point each: 32 is the
+/// paper's warp; smaller teams put more treelets in a workgroup.
+pub const TEAM_SIZES: [u32; 3] = [32, 16, 8];
+/// Treelets per workgroup for teams of `team` lanes.
+pub const fn teams(team: u32) -> u32 {
+    WORKGROUP_SIZE / team
+}
+/// Workgroup memory for teams of `team` lanes: the staged treelets (see
+/// [`crate::treelet`]'s `T_*` words), their DP costs and their packed
+/// partitions, one row per team (odd strides, so that the teams' rows start
+/// on different banks).
+pub const fn team_stage(team: u32) -> usize {
+    teams(team) as usize * TREELET_WORDS
+}
+pub const COST_ROW: usize = SUBSETS + 1;
+pub const fn team_costs(team: u32) -> usize {
+    teams(team) as usize * COST_ROW
+}
+pub const PARTS_ROW: usize = PACKED_WORDS + 1;
+pub const fn team_parts(team: u32) -> usize {
+    teams(team) as usize * PARTS_ROW
+}
+/// Phases of [`treelet_restructure_phase`]: form, one per subset size 2..=7, commit.
+pub const RESTRUCTURE_PHASES: u32 = 2 + TREELET_LEAVES as u32 - 1;
+
+/// Kernel (workgroups of [`teams`]`(TEAM)` teams of `TEAM` lanes, phase by
+/// phase, with workgroup arrays of [`team_stage`], [`team_costs`] and
+/// [`team_parts`] entries):
+/// restructures the treelets of `roots[level_offset..][..level_count]`, one
+/// per team. One lane forms the treelet into workgroup memory; the team
+/// solves the subsets of one size per phase, dealt round-robin to its
+/// lanes; one lane rewires the treelet if that lowers its cost, or else
+/// stores the root's current cost and height.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_restructure_phase<const TEAM: u32, const S: usize, const C: usize, const P: usize>(
+    phase: u32,
+    lid: u32,
+    group: u32,
+    params: &TreeletParams,
+    roots: &[u32],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+    stage: &mut [u32; S],
+    cost: &mut [f32; C],
+    parts: &mut [u32; P],
+) {
+    let team = lid / TEAM;
+    let lane = lid % TEAM;
+    let index = group * teams(TEAM) + team;
+    let (b, cb, pb) = (team as usize * TREELET_WORDS, team as usize * COST_ROW, team as usize * PARTS_ROW);
+    let costs = params.costs();
+    if phase == 0 {
+        let mut w = lane as usize;
+        while w < PACKED_WORDS {
+            parts[pb + w] = 0;
+            w += TEAM as usize;
+        }
+        if lane != 0 {
+            return;
+        }
+        stage[b + T_COUNT] = 0;
+        if index >= params.level_count {
+            return;
+        }
+        let root = roots[(params.level_offset + index) as usize];
+        let n = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
+        let (current, height) = current_root(root, nodes, counts, node_costs, heights, &costs);
+        if n < 3 {
+            // Two leaves: only one tree.
+            node_costs[root as usize] = current;
+            heights[root as usize] = height;
+            stage[b + T_COUNT] = 0;
+            return;
+        }
+        stage[b + T_CURRENT] = current.to_bits();
+        stage[b + T_HEIGHT] = height;
+        let mut k = 0;
+        while k < n as usize {
+            cost[cb + (1 << k)] = f32::from_bits(stage[b + T_COSTS + k]);
+            k += 1;
+        }
+        return;
+    }
+    let n = stage[b + T_COUNT];
+    if n == 0 || params.gamma == 1 {
+        return;
+    }
+    if phase < RESTRUCTURE_PHASES - 1 {
+        let size = phase + 1;
+        if size > n {
+            return;
+        }
+        let total = binomial(n, size);
+        let mut rank = lane;
+        while rank < total {
+            let s = subset_of_rank(rank, n, size);
+            let area = costs.area(&subset_box(s, n, stage, b));
+            let p = solve_subset(s, cb, area, subset_count(s, n, stage, b), cost, &costs);
+            atomics::or_workgroup(&mut parts[pb + (s / 4) as usize], packed_bits(s, p));
+            rank += TEAM;
+        }
+        return;
+    }
+    if lane != 0 || params.gamma == 2 {
+        return;
+    }
+    let current = f32::from_bits(stage[b + T_CURRENT]);
+    if improves(cost[cb + (1usize << n) - 1], current) {
+        apply(stage, b, parts, pb, nodes, parents, counts, node_costs, heights, &costs);
+    } else {
+        let root = stage[b + T_INTERNALS] as usize;
+        node_costs[root] = current;
+        heights[root] = stage[b + T_HEIGHT];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    #[test]
+    fn binomials_match_pascal() {
+        for n in 0..=7u32 {
+            for k in 0..=8u32 {
+                let expected = if k > n { 0 } else { (0..k).fold(1u32, |c, i| c * (n - i) / (i + 1)) };
+                assert_eq!(binomial(n, k), expected, "C({n}, {k})");
+            }
+        }
+    }
+
+    #[test]
+    fn subsets_of_rank_cover_each_size_once() {
+        for n in 1..=TREELET_LEAVES as u32 {
+            for size in 1..=n {
+                let mut seen: Vec<u32> = (0..binomial(n, size)).map(|r| subset_of_rank(r, n, size)).collect();
+                assert!(seen.iter().all(|s| s.count_ones() == size && *s < (1 << n)), "n {n} size {size}");
+                seen.sort();
+                seen.dedup();
+                let expected = (1u32..1 << n).filter(|s| s.count_ones() == size).count();
+                assert_eq!(seen.len(), expected, "n {n} size {size}");
+            }
+        }
+    }
+
+}

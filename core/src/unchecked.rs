@@ -1,0 +1,36 @@
+//! Array reads and writes without bounds checks on the GPU.
+//!
+//! rust-gpu keeps every bounds check as a branch, and in the treelet DP's
+//! inner loops those branches cost more than the work. The CPU build, which
+//! runs the same kernels in the tests, keeps the checks: an index out of
+//! range there fails a test instead of passing silently.
+
+/// `a[i]`, unchecked on the GPU.
+#[inline]
+pub fn get<T: Copy, const N: usize>(a: &[T; N], i: usize) -> T {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::arch::IndexUnchecked;
+        // SAFETY: callers index within the arrays they size; the CPU build checks it.
+        unsafe { *a.index_unchecked(i) }
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        a[i]
+    }
+}
+
+/// `a[i] = v`, unchecked on the GPU.
+#[inline]
+pub fn set<T: Copy, const N: usize>(a: &mut [T; N], i: usize, v: T) {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::arch::IndexUnchecked;
+        // SAFETY: as in `get`.
+        unsafe { *a.index_unchecked_mut(i) = v }
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        a[i] = v;
+    }
+}
