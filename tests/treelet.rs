@@ -104,7 +104,8 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
 
     let seed = treelet_tests::fresh_seed();
     for max_leaf in [1, 8] {
-        let config = TreeletConfig { max_leaf, ..Default::default() };
+        // `verify`: the counts, costs and heights the rounds keep current equal a fresh climb's.
+        let config = TreeletConfig { max_leaf, verify: true, ..Default::default() };
         for n in [2usize, 3, 7, 64, 1000, 30_000] {
             let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
             let (c, before) = run(&mut CpuBackend::new(), &spheres, &config);

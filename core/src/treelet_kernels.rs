@@ -213,41 +213,31 @@ pub fn subset_of_rank(mut rank: u32, n: u32, size: u32) -> u32 {
     s
 }
 
-/// Team sizes (lanes per treelet) with an entry point each: 32 is the
-/// paper's warp; smaller teams put more treelets in a workgroup.
-pub const TEAM_SIZES: [u32; 3] = [32, 16, 8];
-/// Treelets per workgroup for teams of `team` lanes.
-pub const fn teams(team: u32) -> u32 {
-    WORKGROUP_SIZE / team
-}
-/// Workgroup memory for teams of `team` lanes: the staged treelets (see
-/// [`crate::treelet`]'s `T_*` words), their DP costs and their packed
-/// partitions, one row per team (odd strides, so that the teams' rows start
-/// on different banks).
-pub const fn team_stage(team: u32) -> usize {
-    teams(team) as usize * TREELET_WORDS
-}
+/// Lanes per treelet (the paper's warp). On the H100, teams of 16 or 8
+/// lanes (more treelets per workgroup) were slower: the latency of one
+/// treelet, not idle lanes, bounds this kernel.
+pub const TEAM: u32 = 32;
+/// Treelets per workgroup.
+pub const TEAMS: u32 = WORKGROUP_SIZE / TEAM;
+/// Workgroup memory: the staged treelets (see [`crate::treelet`]'s `T_*`
+/// words), their DP costs and their packed partitions, one row per team
+/// (odd strides, so that the teams' rows start on different banks).
+pub const TEAM_STAGE: usize = TEAMS as usize * TREELET_WORDS;
 pub const COST_ROW: usize = SUBSETS + 1;
-pub const fn team_costs(team: u32) -> usize {
-    teams(team) as usize * COST_ROW
-}
+pub const TEAM_COSTS: usize = TEAMS as usize * COST_ROW;
 pub const PARTS_ROW: usize = PACKED_WORDS + 1;
-pub const fn team_parts(team: u32) -> usize {
-    teams(team) as usize * PARTS_ROW
-}
+pub const TEAM_PARTS: usize = TEAMS as usize * PARTS_ROW;
 /// Phases of [`treelet_restructure_phase`]: form, one per subset size 2..=7, commit.
 pub const RESTRUCTURE_PHASES: u32 = 2 + TREELET_LEAVES as u32 - 1;
 
-/// Kernel (workgroups of [`teams`]`(TEAM)` teams of `TEAM` lanes, phase by
-/// phase, with workgroup arrays of [`team_stage`], [`team_costs`] and
-/// [`team_parts`] entries):
-/// restructures the treelets of `roots[level_offset..][..level_count]`, one
+/// Kernel ([`TEAMS`] teams of [`TEAM`] lanes per workgroup, phase by
+/// phase): restructures the treelets of `roots[level_offset..][..level_count]`, one
 /// per team. One lane forms the treelet into workgroup memory; the team
 /// solves the subsets of one size per phase, dealt round-robin to its
 /// lanes; one lane rewires the treelet if that lowers its cost, or else
 /// stores the root's current cost and height.
 #[allow(clippy::too_many_arguments)]
-pub fn treelet_restructure_phase<const TEAM: u32, const S: usize, const C: usize, const P: usize>(
+pub fn treelet_restructure_phase(
     phase: u32,
     lid: u32,
     group: u32,
@@ -258,13 +248,13 @@ pub fn treelet_restructure_phase<const TEAM: u32, const S: usize, const C: usize
     counts: &mut [u32],
     node_costs: &mut [f32],
     heights: &mut [u32],
-    stage: &mut [u32; S],
-    cost: &mut [f32; C],
-    parts: &mut [u32; P],
+    stage: &mut [u32; TEAM_STAGE],
+    cost: &mut [f32; TEAM_COSTS],
+    parts: &mut [u32; TEAM_PARTS],
 ) {
     let team = lid / TEAM;
     let lane = lid % TEAM;
-    let index = group * teams(TEAM) + team;
+    let index = group * TEAMS + team;
     let (b, cb, pb) = (team as usize * TREELET_WORDS, team as usize * COST_ROW, team as usize * PARTS_ROW);
     let costs = params.costs();
     if phase == 0 {
@@ -300,7 +290,7 @@ pub fn treelet_restructure_phase<const TEAM: u32, const S: usize, const C: usize
         return;
     }
     let n = stage[b + T_COUNT];
-    if n == 0 || params.gamma == 1 {
+    if n == 0 {
         return;
     }
     if phase < RESTRUCTURE_PHASES - 1 {
@@ -319,7 +309,7 @@ pub fn treelet_restructure_phase<const TEAM: u32, const S: usize, const C: usize
         }
         return;
     }
-    if lane != 0 || params.gamma == 2 {
+    if lane != 0 {
         return;
     }
     let current = f32::from_bits(stage[b + T_CURRENT]);

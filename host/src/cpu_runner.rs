@@ -65,27 +65,6 @@ fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
     }
 }
 
-/// The restructuring kernel for teams of `TEAM` lanes, as its entry point
-/// runs it, with workgroup arrays of `S`, `C` and `P` entries.
-#[allow(clippy::too_many_arguments)]
-fn restructure<const TEAM: u32, const S: usize, const C: usize, const P: usize>(
-    groups: u32,
-    p: &treelet_core::layout::TreeletParams,
-    roots: &[u32],
-    nodes: &mut [treelet_core::Node],
-    parents: &mut [u32],
-    counts: &mut [u32],
-    costs: &mut [f32],
-    heights: &mut [u32],
-) {
-    let (mut stage, mut cost, mut parts) = ([0u32; S], [0f32; C], [0u32; P]);
-    workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
-        treelet_kernels::treelet_restructure_phase::<TEAM, S, C, P>(
-            phase, lid, group, p, roots, nodes, parents, counts, costs, heights, &mut stage, &mut cost, &mut parts,
-        );
-    });
-}
-
 /// `render_pixel` compiled for `VARIANTS[v]`, as the shader's entry points are.
 fn render_variant<const ACCEL: u32>(v: u8, id: u32, p: &treelet_core::RenderParams, scene: &SceneRefs) -> [f32; 4] {
     const _: () = assert!(VARIANTS.len() == 6, "one arm per variant");
@@ -310,24 +289,19 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             });
         }
-        (Kernel::TreeletRestructure(i), [p, roots, nodes, parents, counts, costs, heights]) => {
+        (Kernel::TreeletRestructure, [p, roots, nodes, parents, counts, costs, heights]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
             let (counts, costs, heights) = (view(counts), view(costs), view(heights));
-            use treelet_kernels::{team_costs as tc, team_parts as tp, team_stage as ts, TEAM_SIZES as T};
-            const _: () = assert!(T.len() == 3, "one arm per team size");
-            let (g, r) = (groups, roots);
-            match i {
-                0 => restructure::<{ T[0] }, { ts(T[0]) }, { tc(T[0]) }, { tp(T[0]) }>(
-                    g, &p, r, nodes, parents, counts, costs, heights,
-                ),
-                1 => restructure::<{ T[1] }, { ts(T[1]) }, { tc(T[1]) }, { tp(T[1]) }>(
-                    g, &p, r, nodes, parents, counts, costs, heights,
-                ),
-                _ => restructure::<{ T[2] }, { ts(T[2]) }, { tc(T[2]) }, { tp(T[2]) }>(
-                    g, &p, r, nodes, parents, counts, costs, heights,
-                ),
-            }
+            let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
+            let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
+            let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
+            workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
+                treelet_kernels::treelet_restructure_phase(
+                    phase, lid, group, &p, roots, nodes, parents, counts, costs, heights, &mut stage, &mut cost,
+                    &mut parts,
+                );
+            });
         }
         (Kernel::CastBvh, [p, spheres, materials, nodes, prims, rays, triangles]) => {
             let p: treelet_core::RenderParams = params(p);

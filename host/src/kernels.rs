@@ -9,7 +9,6 @@ pub enum Access {
     ReadWrite,
 }
 use treelet_core::features::VARIANTS;
-use treelet_core::treelet_kernels::TEAM_SIZES;
 use Access::{Read, ReadWrite};
 
 /// Entry points of the render variants, `[linear, BVH]` per entry of
@@ -20,13 +19,6 @@ fn render_entry_points() -> &'static [[String; 2]] {
     NAMES.get_or_init(|| {
         VARIANTS.iter().map(|(_, n)| [format!("render::render_linear_{n}_cs"), format!("render::render_bvh_{n}_cs")]).collect()
     })
-}
-
-/// Entry points of the restructuring kernels, one per entry of `TEAM_SIZES`
-/// (`treelet::treelet_restructure_<lanes>_cs`).
-fn restructure_entry_points() -> &'static [String] {
-    static NAMES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
-    NAMES.get_or_init(|| TEAM_SIZES.iter().map(|t| format!("treelet::treelet_restructure_{t}_cs")).collect())
 }
 
 /// Every compute kernel of Treelet.
@@ -53,9 +45,8 @@ pub enum Kernel {
     TreeletHistogram,
     /// Treelet optimization: list treelet roots by height.
     TreeletScatter,
-    /// Treelet optimization: restructure the treelets of one height, a team
-    /// of lanes each, of `treelet_kernels::TEAM_SIZES[i]` lanes.
-    TreeletRestructure(u8),
+    /// Treelet optimization: restructure the treelets of one height, a team of lanes each.
+    TreeletRestructure,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
     /// Path tracing, closest hit by scanning every primitive, compiled for
@@ -68,7 +59,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 18] = [
+    const FIXED: [Kernel; 19] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -85,6 +76,7 @@ impl Kernel {
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,
+        Kernel::TreeletRestructure,
         Kernel::Collapse,
         Kernel::CastBvh,
     ];
@@ -96,7 +88,6 @@ impl Kernel {
             .into_iter()
             .chain(variants.clone().map(Kernel::RenderLinear))
             .chain(variants.map(Kernel::RenderBvh))
-            .chain((0..TEAM_SIZES.len() as u8).map(Kernel::TreeletRestructure))
             .collect()
     }
 
@@ -119,7 +110,7 @@ impl Kernel {
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
-            Kernel::TreeletRestructure(i) => &restructure_entry_points()[i as usize],
+            Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::RenderLinear(i) => &render_entry_points()[i as usize][0],
             Kernel::RenderBvh(i) => &render_entry_points()[i as usize][1],
@@ -146,7 +137,7 @@ impl Kernel {
             }
             Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::TreeletRestructure(_) => {
+            Kernel::TreeletRestructure => {
                 &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],

@@ -13,7 +13,7 @@
 //! for visibility guarantees that need no device-scope atomics.)
 use anyhow::{bail, Result};
 use treelet_core::layout::TreeletParams;
-use treelet_core::treelet_kernels::{teams, MAX_LEVELS, TEAM_SIZES};
+use treelet_core::treelet_kernels::{MAX_LEVELS, TEAMS};
 use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
@@ -37,11 +37,16 @@ pub struct TreeletConfig {
     /// no collapse). The paper sets no bound; a bound keeps the worst leaf
     /// a ray must test small.
     pub max_leaf: u32,
+    /// After the rounds, climb the tree afresh and check that the counts,
+    /// costs and heights the rounds kept current (instead of climbing each
+    /// round) match; an error if not. For tests.
+    #[serde(skip)]
+    pub verify: bool,
 }
 
 impl Default for TreeletConfig {
     fn default() -> Self {
-        Self { rounds: 3, gamma: 3, max_leaf: 8 }
+        Self { rounds: 3, gamma: 3, max_leaf: 8, verify: false }
     }
 }
 
@@ -72,6 +77,8 @@ pub fn optimize<B: Backend>(
     const ROUND_NAMES: [&str; 8] =
         ["round 1", "round 2", "round 3", "round 4", "round 5", "round 6", "round 7", "round 8"];
     let mut gamma = config.gamma;
+    // Developers' profiling switch: time each height as its own stage.
+    let profile_levels = std::env::var_os("TREELET_PROFILE_LEVELS").is_some();
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
         if round == 0 {
@@ -108,20 +115,22 @@ pub fn optimize<B: Backend>(
             if count == 0 {
                 continue;
             }
-            let mode = std::env::var("TREELET_MODE").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
-            let lp = TreeletParams { gamma: mode, level_offset: offsets[level], level_count: count, ..base };
+            let lp = TreeletParams { gamma: 0, level_offset: offsets[level], level_count: count, ..base };
             let lp = b.upload("treelet params", &[lp])?;
-            let team = std::env::var("TREELET_TEAM").ok().and_then(|v| v.parse().ok()).unwrap_or(0u8);
-            let kernel = Kernel::TreeletRestructure(team);
-            if std::env::var_os("TREELET_LEVELS").is_some() {
-                b.stage(Box::leak(format!("r{round} h{level:02} n{count} {kernel:?}").into_boxed_str()));
+            if profile_levels {
+                // A stage per height (`round r h<height> n<treelets>`), for
+                // `bench build`: what a height costs against its treelets.
+                b.stage(Box::leak(format!("r{round} h{level:02} n{count}").into_boxed_str()));
             }
             b.dispatch(
-                kernel,
+                Kernel::TreeletRestructure,
                 &[&lp, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights],
-                count.div_ceil(teams(TEAM_SIZES[team as usize])),
+                count.div_ceil(TEAMS),
             );
         }
+    }
+    if config.verify {
+        verify_current(b, &bvh, &scratch, &base)?;
     }
     b.stage("collapse");
     let collapsed = collapse_pass(b, &bvh, &scratch, &base)?;
@@ -176,6 +185,26 @@ fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &T
         &[&p, &bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves],
         groups_for(n, WORKGROUP_SIZE),
     );
+    Ok(())
+}
+
+/// Checks the counts, costs and heights in `s` against a fresh climb.
+fn verify_current<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &TreeletParams) -> Result<()> {
+    let node_count = 2 * bvh.n as usize - 1;
+    let kept = (b.read::<u32>(&s.counts, node_count)?, b.read::<f32>(&s.costs, node_count)?, b.read::<u32>(&s.heights, node_count)?);
+    let fresh = scratch(b, bvh.n)?;
+    init_pass(b, bvh, &fresh, base)?;
+    let (counts, costs, heights) =
+        (b.read::<u32>(&fresh.counts, node_count)?, b.read::<f32>(&fresh.costs, node_count)?, b.read::<u32>(&fresh.heights, node_count)?);
+    for i in 0..node_count {
+        if kept.0[i] != counts[i] || kept.2[i] != heights[i] {
+            bail!("node {i}: kept count {} height {}, fresh {} {}", kept.0[i], kept.2[i], counts[i], heights[i]);
+        }
+        // Kept costs come from the DP's operations, fresh ones from the climb's.
+        if (kept.1[i] - costs[i]).abs() > 1e-4 * costs[i].abs().max(f32::MIN_POSITIVE) {
+            bail!("node {i}: kept cost {} fresh {}", kept.1[i], costs[i]);
+        }
+    }
     Ok(())
 }
 

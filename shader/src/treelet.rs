@@ -4,7 +4,7 @@ use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
 use treelet_core::treelet_kernels::{
     treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase, HISTOGRAM_PHASES,
-    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_SIZES, team_costs, team_parts, team_stage,
+    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE,
 };
 use treelet_core::workgroup::{barrier, linear_group, linear_id, WG};
 
@@ -84,41 +84,31 @@ pub fn treelet_scatter_cs(
     }
 }
 
-/// Restructures the treelets of one height, a team of `$team` lanes each
-/// (one entry point per entry of `TEAM_SIZES`).
-macro_rules! restructure_kernel {
-    ($name:ident, $team:expr) => {
-        #[spirv(compute(threads(256)))]
-        pub fn $name(
-            #[spirv(local_invocation_index)] lid: u32,
-            #[spirv(workgroup_id)] group: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-            #[spirv(workgroup)] stage: &mut [u32; team_stage($team)],
-            #[spirv(workgroup)] cost: &mut [f32; team_costs($team)],
-            #[spirv(workgroup)] parts: &mut [u32; team_parts($team)],
-        ) {
-            let group = linear_group(group.x, group.y, groups.x);
-            for phase in 0..RESTRUCTURE_PHASES {
-                treelet_restructure_phase::<{ $team }, _, _, _>(
-                    phase, lid, group, params, roots, nodes, parents, counts, costs, heights, stage, cost, parts,
-                );
-                barrier();
-            }
-        }
-    };
+/// Restructures the treelets of one height, a team of 32 lanes each.
+#[spirv(compute(threads(256)))]
+pub fn treelet_restructure_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+    #[spirv(workgroup)] stage: &mut [u32; TEAM_STAGE],
+    #[spirv(workgroup)] cost: &mut [f32; TEAM_COSTS],
+    #[spirv(workgroup)] parts: &mut [u32; TEAM_PARTS],
+) {
+    let group = linear_group(group.x, group.y, groups.x);
+    for phase in 0..RESTRUCTURE_PHASES {
+        treelet_restructure_phase(
+            phase, lid, group, params, roots, nodes, parents, counts, costs, heights, stage, cost, parts,
+        );
+        barrier();
+    }
 }
-
-const _: () = assert!(TEAM_SIZES.len() == 3, "one line per team size");
-restructure_kernel!(treelet_restructure_32_cs, TEAM_SIZES[0]);
-restructure_kernel!(treelet_restructure_16_cs, TEAM_SIZES[1]);
-restructure_kernel!(treelet_restructure_8_cs, TEAM_SIZES[2]);
 
 /// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
 #[spirv(compute(threads(256)))]
