@@ -120,15 +120,14 @@ pub const T_COSTS: usize = 30;
 /// Leaf boxes, 6 floats each (min xyz, max xyz).
 pub const T_BOXES: usize = 37;
 /// Scratch of [`form_treelet`] (areas, left and right children per slot)
-/// and of [`apply`] (subsets, children, costs, heights per internal node, a stack).
+/// and of [`plan_rewire`] (subsets, children, heights per internal node, a stack).
 const T_SCRATCH: usize = T_BOXES + 6 * TREELET_LEAVES;
 const F_AREAS: usize = T_SCRATCH;
 const F_LEFTS: usize = T_SCRATCH + TREELET_LEAVES;
 const F_RIGHTS: usize = T_SCRATCH + 2 * TREELET_LEAVES;
 const A_SETS: usize = T_SCRATCH;
 const A_KIDS: usize = A_SETS + TREELET_INTERNALS;
-const A_COSTS: usize = A_KIDS + 2 * TREELET_INTERNALS;
-const A_HEIGHTS: usize = A_COSTS + TREELET_INTERNALS;
+const A_HEIGHTS: usize = A_KIDS + 2 * TREELET_INTERNALS;
 const A_STACK: usize = A_HEIGHTS + TREELET_INTERNALS;
 /// Words of one staged treelet (odd, so that treelets staged side by side
 /// in workgroup memory start on different banks).
@@ -155,13 +154,25 @@ pub fn stage_box<const N: usize>(stage: &mut [u32; N], b: usize, k: usize, x: &A
     stage[f + 5] = hi[2].to_bits();
 }
 
+/// What [`form_treelet`] finds besides the staged treelet.
+#[derive(Clone, Copy)]
+pub struct Formed {
+    /// Leaves of the treelet (2 to 7).
+    pub leaf_count: u32,
+    /// The root's subtree cost and height from its children's, which must
+    /// be current. A root keeps its treelet when nothing cheaper exists, yet
+    /// the subtrees under it may have changed: storing these lets the
+    /// changes reach the nodes above, and later rounds, without a new climb.
+    pub current: f32,
+    pub height: u32,
+}
+
 /// Forms the treelet under internal node `root` (algorithm 2's first loop)
 /// into `stage` at `b`: expand, among the current leaves that are internal
 /// BVH nodes, the one of largest area (the first on ties), until seven
-/// leaves or no expandable leaf remain; then read the leaves' primitive
-/// counts, costs and heights. Each node is read once: an expansion loads
-/// only the two new children, so the chain of dependent loads is one per
-/// expansion. Returns the leaf count.
+/// leaves or no expandable leaf remain. Each node is read once, and with it
+/// its primitive count, cost and height, whether it stays a leaf or not:
+/// the chain of dependent loads is one per expansion and no longer.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn form_treelet<const N: usize>(
@@ -173,9 +184,10 @@ pub fn form_treelet<const N: usize>(
     costs: &TreeletCosts,
     stage: &mut [u32; N],
     b: usize,
-) -> u32 {
+) -> Formed {
     stage[b + T_INTERNALS] = root;
     let r = nodes[root as usize];
+    let root_count = counts[root as usize];
     let mut internal_count = 1usize;
     let mut leaf_count = 2usize;
     // Slot `best` takes the left child, a new slot the right one.
@@ -193,7 +205,16 @@ pub fn form_treelet<const N: usize>(
             stage[b + F_RIGHTS + slot] = node.right;
             let area = if node.is_leaf() { -1.0 } else { costs.area(&x) };
             stage[b + F_AREAS + slot] = area.to_bits();
+            stage[b + T_PRIMS + slot] = counts[id as usize];
+            stage[b + T_COSTS + slot] = node_costs[id as usize].to_bits();
+            stage[b + T_HEIGHTS + slot] = heights[id as usize];
             side += 1;
+        }
+        if leaf_count == 2 {
+            // The root's children, before either is expanded.
+            let (c0, c1) = (f32::from_bits(stage[b + T_COSTS]), f32::from_bits(stage[b + T_COSTS + 1]));
+            stage[b + T_CURRENT] = costs.subtree(costs.area(&r.aabb()), root_count, c0 + c1).to_bits();
+            stage[b + T_HEIGHT] = 1 + stage[b + T_HEIGHTS].max(stage[b + T_HEIGHTS + 1]);
         }
         if leaf_count == TREELET_LEAVES {
             break;
@@ -218,16 +239,12 @@ pub fn form_treelet<const N: usize>(
         right = stage[b + F_RIGHTS + best];
         leaf_count += 1;
     }
-    let mut i = 0;
-    while i < leaf_count {
-        let leaf = stage[b + T_LEAVES + i] as usize;
-        stage[b + T_PRIMS + i] = counts[leaf];
-        stage[b + T_COSTS + i] = node_costs[leaf].to_bits();
-        stage[b + T_HEIGHTS + i] = heights[leaf];
-        i += 1;
-    }
     stage[b + T_COUNT] = leaf_count as u32;
-    leaf_count as u32
+    Formed {
+        leaf_count: leaf_count as u32,
+        current: f32::from_bits(stage[b + T_CURRENT]),
+        height: stage[b + T_HEIGHT],
+    }
 }
 
 /// Words of a packed partition table: the partition of subset `s` is byte
@@ -345,31 +362,17 @@ pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts
     sol
 }
 
-/// Rewires the internal nodes of the treelet staged at `b` into the tree
-/// that the packed partitions `parts` (from `base`) describe, and sets each
-/// one's box, primitive count, cost and height from its subset: the union
-/// of its leaves' boxes, and the cost the DP gave that subset, recomputed
-/// bottom-up with the DP's own operations (so it is the same number, and a
-/// refit from memory is not needed). The root keeps its index; the other
-/// internal nodes are reused in order. Uses the stage's scratch words.
-#[allow(clippy::too_many_arguments)]
+/// First step of rewiring the treelet staged at `b` into the tree that the
+/// packed partitions `parts` (from `base`) describe: which subset each of
+/// its `leaf_count - 1` internal nodes covers (the root keeps its index and
+/// covers all; the others are reused in order), their children and their
+/// heights, into the stage's scratch for [`rewire_internal`].
 #[inline]
-pub fn apply<const N: usize, const M: usize>(
-    stage: &mut [u32; N],
-    b: usize,
-    parts: &[u32; M],
-    base: usize,
-    nodes: &mut [Node],
-    parents: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-    heights: &mut [u32],
-    costs: &TreeletCosts,
-) {
+pub fn plan_rewire<const N: usize, const M: usize>(stage: &mut [u32; N], b: usize, parts: &[u32; M], base: usize) {
     let n = stage[b + T_COUNT];
-    // Per internal slot: its subset and its children (a leaf index below
-    // 8, or 8 + the child's internal slot). A stack of internal slots still
-    // to split, at most as deep as there are internal nodes.
+    // Children: a leaf index below 8, or 8 + the child's internal slot. A
+    // stack of internal slots still to split, at most as deep as there
+    // are internal nodes.
     stage[b + A_SETS] = (1u32 << n) - 1;
     stage[b + A_STACK] = 0;
     let mut top = 1usize;
@@ -378,62 +381,77 @@ pub fn apply<const N: usize, const M: usize>(
         top -= 1;
         let k = stage[b + A_STACK + top] as usize;
         let s = stage[b + A_SETS + k];
-        let node = stage[b + T_INTERNALS + k];
         let p = packed_partition(parts, base, s);
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
-            let child = if part.count_ones() == 1 {
+            if part.count_ones() == 1 {
                 stage[b + A_KIDS + 2 * k + side] = part.trailing_zeros();
-                stage[b + T_LEAVES + part.trailing_zeros() as usize]
             } else {
                 stage[b + A_KIDS + 2 * k + side] = 8 + next_internal as u32;
                 stage[b + A_SETS + next_internal] = part;
                 stage[b + A_STACK + top] = next_internal as u32;
                 top += 1;
                 next_internal += 1;
-                stage[b + T_INTERNALS + next_internal - 1]
-            };
-            if side == 0 {
-                nodes[node as usize].left = child;
-            } else {
-                nodes[node as usize].right = child;
             }
-            parents[child as usize] = node;
             side += 1;
         }
     }
-    // Children come after their parents: fill boxes and costs in reverse.
+    // Children come after their parents: heights in reverse.
     let mut k = next_internal;
     while k > 0 {
         k -= 1;
-        let s = stage[b + A_SETS + k];
-        let mut children = 0.0f32;
         let mut height = 0u32;
         let mut side = 0;
         while side < 2 {
             let kid = stage[b + A_KIDS + 2 * k + side] as usize;
-            let (c, h) = if kid < 8 {
-                (stage[b + T_COSTS + kid], stage[b + T_HEIGHTS + kid])
-            } else {
-                (stage[b + A_COSTS + kid - 8], stage[b + A_HEIGHTS + kid - 8])
-            };
-            let c = f32::from_bits(c);
-            children = if side == 0 { c } else { children + c };
+            let h = if kid < 8 { stage[b + T_HEIGHTS + kid] } else { stage[b + A_HEIGHTS + kid - 8] };
             height = height.max(h + 1);
             side += 1;
         }
-        let count = subset_count(s, n, stage, b);
-        let x = subset_box(s, n, stage, b);
-        let cost = costs.subtree(costs.area(&x), count, children);
-        stage[b + A_COSTS + k] = cost.to_bits();
         stage[b + A_HEIGHTS + k] = height;
-        let node = stage[b + T_INTERNALS + k] as usize;
-        nodes[node].set_aabb(x);
-        counts[node] = count;
-        node_costs[node] = cost;
-        heights[node] = height;
     }
+}
+
+/// Second step of rewiring (after [`plan_rewire`]), for internal node `k`
+/// of the treelet staged at `b`: its children, their parent links, and its
+/// box, primitive count, cost and height from its subset (the union of its
+/// leaves' boxes; the cost the DP found for the subset, in `cost` from
+/// `cb`). Internal nodes are independent here: lanes may take one each.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn rewire_internal<const N: usize, const C: usize>(
+    k: usize,
+    stage: &[u32; N],
+    b: usize,
+    cost: &[f32; C],
+    cb: usize,
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+) {
+    let n = stage[b + T_COUNT];
+    let s = stage[b + A_SETS + k];
+    let node = stage[b + T_INTERNALS + k];
+    let mut side = 0;
+    while side < 2 {
+        let kid = stage[b + A_KIDS + 2 * k + side] as usize;
+        let child = if kid < 8 { stage[b + T_LEAVES + kid] } else { stage[b + T_INTERNALS + kid - 8] };
+        if side == 0 {
+            nodes[node as usize].left = child;
+        } else {
+            nodes[node as usize].right = child;
+        }
+        parents[child as usize] = node;
+        side += 1;
+    }
+    let node = node as usize;
+    nodes[node].set_aabb(subset_box(s, n, stage, b));
+    counts[node] = subset_count(s, n, stage, b);
+    node_costs[node] = cost[cb + s as usize];
+    heights[node] = stage[b + A_HEIGHTS + k];
 }
 
 /// SAH cost of the subtree under `node` with `count` primitives, given its
@@ -446,25 +464,6 @@ pub fn node_cost(node: &Node, count: u32, child_costs: (f32, f32), costs: &Treel
     } else {
         costs.subtree(area, count, child_costs.0 + child_costs.1)
     }
-}
-
-/// The subtree cost and height of internal node `root` from its children's,
-/// which must be current. A root keeps its treelet when nothing cheaper
-/// exists, yet the subtrees under it may have changed: storing these lets
-/// the changes reach the nodes above, and later rounds, without a new climb.
-#[inline]
-pub fn current_root(
-    root: u32,
-    nodes: &[Node],
-    counts: &[u32],
-    node_costs: &[f32],
-    heights: &[u32],
-    costs: &TreeletCosts,
-) -> (f32, u32) {
-    let r = nodes[root as usize];
-    let (l, rr) = (r.left as usize, r.right as usize);
-    let cost = costs.subtree(costs.area(&r.aabb()), counts[root as usize], node_costs[l] + node_costs[rr]);
-    (cost, 1 + heights[l].max(heights[rr]))
 }
 
 /// Restructures the treelet rooted at internal node `root` in place, in one
@@ -484,22 +483,23 @@ pub fn restructure(
     costs: &TreeletCosts,
 ) -> bool {
     let mut stage = [0u32; TREELET_WORDS];
-    let n = form_treelet(root, nodes, counts, node_costs, heights, costs, &mut stage, 0);
-    let (current, height) = current_root(root, nodes, counts, node_costs, heights, costs);
-    let keep = |node_costs: &mut [f32], heights: &mut [u32]| {
-        node_costs[root as usize] = current;
-        heights[root as usize] = height;
-        false
-    };
-    if n < 3 {
-        return keep(node_costs, heights); // two leaves: only one tree
+    let f = form_treelet(root, nodes, counts, node_costs, heights, costs, &mut stage, 0);
+    let sol = if f.leaf_count >= 3 { Some(optimize(&stage, 0, costs)) } else { None };
+    match sol {
+        Some(sol) if improves(sol.cost[(1usize << f.leaf_count) - 1], f.current) => {
+            plan_rewire(&mut stage, 0, &sol.parts, 0);
+            for k in 0..f.leaf_count as usize - 1 {
+                rewire_internal(k, &stage, 0, &sol.cost, 0, nodes, parents, counts, node_costs, heights);
+            }
+            true
+        }
+        // Two leaves (only one tree), or nothing cheaper.
+        _ => {
+            node_costs[root as usize] = f.current;
+            heights[root as usize] = f.height;
+            false
+        }
     }
-    let sol = optimize(&stage, 0, costs);
-    if !improves(sol.cost[(1usize << n) - 1], current) {
-        return keep(node_costs, heights);
-    }
-    apply(&mut stage, 0, &sol.parts, 0, nodes, parents, counts, node_costs, heights, costs);
-    true
 }
 
 /// Whether an optimum of cost `best` replaces a subtree of cost `current`:

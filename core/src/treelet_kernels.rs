@@ -21,8 +21,9 @@ use crate::atomics;
 use crate::fit::second_arrival;
 use crate::layout::{Node, TreeletParams};
 use crate::treelet::{
-    apply, current_root, form_treelet, improves, node_cost, packed_bits, solve_subset, subset_box, subset_count,
-    PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS,
+    form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
+    subset_count, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
+    T_INTERNALS,
 };
 use crate::workgroup::{WG, WORKGROUP_SIZE};
 
@@ -227,15 +228,48 @@ pub const COST_ROW: usize = SUBSETS + 1;
 pub const TEAM_COSTS: usize = TEAMS as usize * COST_ROW;
 pub const PARTS_ROW: usize = PACKED_WORDS + 1;
 pub const TEAM_PARTS: usize = TEAMS as usize * PARTS_ROW;
-/// Phases of [`treelet_restructure_phase`]: form, one per subset size 2..=7, commit.
-pub const RESTRUCTURE_PHASES: u32 = 2 + TREELET_LEAVES as u32 - 1;
+/// Every subset of seven leaves, by size, and within a size in colex
+/// order: the subsets of `size` leaves among the first `n` are the first
+/// `binomial(n, size)` of their size (colex order lists the subsets of a
+/// set before any subset with a larger element). The kernel reads a
+/// subset per lane from this table rather than unranking it.
+pub fn subset_order() -> [u32; SUBSETS] {
+    let mut out = [0u32; SUBSETS];
+    let mut i = 0;
+    let mut size = 0;
+    while size <= TREELET_LEAVES as u32 {
+        let mut rank = 0;
+        while rank < binomial(TREELET_LEAVES as u32, size) {
+            out[i] = subset_of_rank(rank, TREELET_LEAVES as u32, size);
+            i += 1;
+            rank += 1;
+        }
+        size += 1;
+    }
+    out
+}
+
+/// Where the subsets of `size` leaves start in [`subset_order`].
+#[inline]
+pub fn subset_order_start(size: u32) -> usize {
+    // Partial sums of the binomials C(7, k), a byte each.
+    const STARTS: u64 = 1 << 8 | 8 << 16 | 29 << 24 | 64 << 32 | 99 << 40 | 120 << 48 | 127 << 56;
+    ((STARTS >> (8 * size)) & 0xff) as usize
+}
+
+// Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7;
+// plan the rewiring; rewire.
+const P_PLAN: u32 = 7;
+const P_REWIRE: u32 = 8;
+pub const RESTRUCTURE_PHASES: u32 = P_REWIRE + 1;
 
 /// Kernel ([`TEAMS`] teams of [`TEAM`] lanes per workgroup, phase by
-/// phase): restructures the treelets of `roots[level_offset..][..level_count]`, one
-/// per team. One lane forms the treelet into workgroup memory; the team
-/// solves the subsets of one size per phase, dealt round-robin to its
-/// lanes; one lane rewires the treelet if that lowers its cost, or else
-/// stores the root's current cost and height.
+/// phase): restructures the treelets of `roots[level_offset..][..level_count]`,
+/// one per team. One lane forms the treelet into workgroup memory; the team
+/// solves the subsets of one size per phase, dealt round-robin to its lanes
+/// (`subsets` is [`subset_order`]); if that lowers the treelet's cost, one
+/// lane plans the new topology and a lane per internal node rewires it, or
+/// else one lane stores the root's current cost and height.
 #[allow(clippy::too_many_arguments)]
 pub fn treelet_restructure_phase(
     phase: u32,
@@ -243,6 +277,7 @@ pub fn treelet_restructure_phase(
     group: u32,
     params: &TreeletParams,
     roots: &[u32],
+    subsets: &[u32],
     nodes: &mut [Node],
     parents: &mut [u32],
     counts: &mut [u32],
@@ -258,10 +293,8 @@ pub fn treelet_restructure_phase(
     let (b, cb, pb) = (team as usize * TREELET_WORDS, team as usize * COST_ROW, team as usize * PARTS_ROW);
     let costs = params.costs();
     if phase == 0 {
-        let mut w = lane as usize;
-        while w < PACKED_WORDS {
-            parts[pb + w] = 0;
-            w += TEAM as usize;
+        if (lane as usize) < PACKED_WORDS {
+            parts[pb + lane as usize] = 0;
         }
         if lane != 0 {
             return;
@@ -271,19 +304,16 @@ pub fn treelet_restructure_phase(
             return;
         }
         let root = roots[(params.level_offset + index) as usize];
-        let n = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
-        let (current, height) = current_root(root, nodes, counts, node_costs, heights, &costs);
-        if n < 3 {
+        let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
+        if f.leaf_count < 3 {
             // Two leaves: only one tree.
-            node_costs[root as usize] = current;
-            heights[root as usize] = height;
+            node_costs[root as usize] = f.current;
+            heights[root as usize] = f.height;
             stage[b + T_COUNT] = 0;
             return;
         }
-        stage[b + T_CURRENT] = current.to_bits();
-        stage[b + T_HEIGHT] = height;
         let mut k = 0;
-        while k < n as usize {
+        while k < f.leaf_count as usize {
             cost[cb + (1 << k)] = f32::from_bits(stage[b + T_COSTS + k]);
             k += 1;
         }
@@ -293,15 +323,16 @@ pub fn treelet_restructure_phase(
     if n == 0 {
         return;
     }
-    if phase < RESTRUCTURE_PHASES - 1 {
+    if phase < P_PLAN {
+        // Subsets of one size, dealt round-robin to the lanes.
         let size = phase + 1;
         if size > n {
             return;
         }
-        let total = binomial(n, size);
+        let (start, total) = (subset_order_start(size), binomial(n, size));
         let mut rank = lane;
         while rank < total {
-            let s = subset_of_rank(rank, n, size);
+            let s = subsets[start + rank as usize];
             let area = costs.area(&subset_box(s, n, stage, b));
             let p = solve_subset(s, cb, area, subset_count(s, n, stage, b), cost, &costs);
             atomics::or_workgroup(&mut parts[pb + (s / 4) as usize], packed_bits(s, p));
@@ -309,16 +340,23 @@ pub fn treelet_restructure_phase(
         }
         return;
     }
-    if lane != 0 {
+    if phase == P_PLAN {
+        if lane != 0 {
+            return;
+        }
+        let current = f32::from_bits(stage[b + T_CURRENT]);
+        if improves(cost[cb + (1usize << n) - 1], current) {
+            plan_rewire(stage, b, parts, pb);
+        } else {
+            let root = stage[b + T_INTERNALS] as usize;
+            node_costs[root] = current;
+            heights[root] = stage[b + T_HEIGHT];
+            stage[b + T_COUNT] = 0;
+        }
         return;
     }
-    let current = f32::from_bits(stage[b + T_CURRENT]);
-    if improves(cost[cb + (1usize << n) - 1], current) {
-        apply(stage, b, parts, pb, nodes, parents, counts, node_costs, heights, &costs);
-    } else {
-        let root = stage[b + T_INTERNALS] as usize;
-        node_costs[root] = current;
-        heights[root] = stage[b + T_HEIGHT];
+    if lane < n - 1 {
+        rewire_internal(lane as usize, stage, b, cost, cb, nodes, parents, counts, node_costs, heights);
     }
 }
 
@@ -336,6 +374,22 @@ mod tests {
                 assert_eq!(binomial(n, k), expected, "C({n}, {k})");
             }
         }
+    }
+
+    #[test]
+    fn subset_order_lists_each_size_from_its_start() {
+        let order = subset_order();
+        for n in 1..=TREELET_LEAVES as u32 {
+            for size in 1..=n {
+                let start = subset_order_start(size);
+                let mut got: Vec<u32> = order[start..start + binomial(n, size) as usize].to_vec();
+                assert!(got.iter().all(|s| s.count_ones() == size && *s < (1 << n)), "n {n} size {size}");
+                got.sort();
+                got.dedup();
+                assert_eq!(got.len() as u32, binomial(n, size), "n {n} size {size}");
+            }
+        }
+        assert_eq!(subset_order_start(TREELET_LEAVES as u32), SUBSETS - 1);
     }
 
     #[test]

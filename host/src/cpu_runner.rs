@@ -289,17 +289,17 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             });
         }
-        (Kernel::TreeletRestructure, [p, roots, nodes, parents, counts, costs, heights]) => {
+        (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
-            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
+            let (roots, subsets, nodes, parents) = (view(roots), view(subsets), view(nodes), view(parents));
             let (counts, costs, heights) = (view(counts), view(costs), view(heights));
             let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
             let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
             let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
             workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
-                    phase, lid, group, &p, roots, nodes, parents, counts, costs, heights, &mut stage, &mut cost,
-                    &mut parts,
+                    phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, &mut stage,
+                    &mut cost, &mut parts,
                 );
             });
         }

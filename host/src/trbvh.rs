@@ -13,7 +13,7 @@
 //! for visibility guarantees that need no device-scope atomics.)
 use anyhow::{bail, Result};
 use treelet_core::layout::TreeletParams;
-use treelet_core::treelet_kernels::{MAX_LEVELS, TEAMS};
+use treelet_core::treelet_kernels::{subset_order, MAX_LEVELS, TEAMS};
 use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
@@ -74,6 +74,7 @@ pub fn optimize<B: Backend>(
     }
     let base = base_params(n, root_box, config);
     let scratch = scratch(b, n)?;
+    let subsets = b.upload("treelet subset order", &subset_order())?;
     const ROUND_NAMES: [&str; 8] =
         ["round 1", "round 2", "round 3", "round 4", "round 5", "round 6", "round 7", "round 8"];
     let mut gamma = config.gamma;
@@ -124,7 +125,7 @@ pub fn optimize<B: Backend>(
             }
             b.dispatch(
                 Kernel::TreeletRestructure,
-                &[&lp, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights],
+                &[&lp, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights],
                 count.div_ceil(TEAMS),
             );
         }

@@ -92,11 +92,12 @@ pub fn treelet_restructure_cs(
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] subsets: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] heights: &mut [u32],
     #[spirv(workgroup)] stage: &mut [u32; TEAM_STAGE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_COSTS],
     #[spirv(workgroup)] parts: &mut [u32; TEAM_PARTS],
@@ -104,7 +105,7 @@ pub fn treelet_restructure_cs(
     let group = linear_group(group.x, group.y, groups.x);
     for phase in 0..RESTRUCTURE_PHASES {
         treelet_restructure_phase(
-            phase, lid, group, params, roots, nodes, parents, counts, costs, heights, stage, cost, parts,
+            phase, lid, group, params, roots, subsets, nodes, parents, counts, costs, heights, stage, cost, parts,
         );
         barrier();
     }
