@@ -129,9 +129,12 @@ const A_SETS: usize = T_SCRATCH;
 const A_KIDS: usize = A_SETS + TREELET_INTERNALS;
 const A_HEIGHTS: usize = A_KIDS + 2 * TREELET_INTERNALS;
 const A_STACK: usize = A_HEIGHTS + TREELET_INTERNALS;
-/// Words of one staged treelet (odd, so that treelets staged side by side
-/// in workgroup memory start on different banks).
-pub const TREELET_WORDS: usize = A_STACK + TREELET_INTERNALS + 1;
+/// Whether the kernel rewires the treelet (1) or keeps it (0).
+pub const T_REWIRE: usize = A_STACK + TREELET_INTERNALS;
+/// Words of one staged treelet, rounded up to odd so that treelets staged
+/// side by side in workgroup memory start on different banks.
+pub const TREELET_WORDS: usize = (T_REWIRE + 1) | 1;
+const _: () = assert!(TREELET_WORDS % 2 == 1);
 
 /// The box of leaf `k` of the treelet staged at `b`.
 #[inline]

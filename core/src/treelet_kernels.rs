@@ -23,7 +23,7 @@ use crate::layout::{Node, TreeletParams};
 use crate::treelet::{
     form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
     subset_count, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
-    T_INTERNALS,
+    T_INTERNALS, T_REWIRE,
 };
 use crate::workgroup::{WG, WORKGROUP_SIZE};
 
@@ -257,10 +257,10 @@ pub fn subset_order_start(size: u32) -> usize {
     ((STARTS >> (8 * size)) & 0xff) as usize
 }
 
-// Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7;
-// plan the rewiring; rewire.
-const P_PLAN: u32 = 7;
-const P_REWIRE: u32 = 8;
+// Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7
+// (the lane that solves the whole treelet plans the rewiring right away);
+// rewire.
+const P_REWIRE: u32 = 7;
 pub const RESTRUCTURE_PHASES: u32 = P_REWIRE + 1;
 
 /// Kernel ([`TEAMS`] teams of [`TEAM`] lanes per workgroup, phase by
@@ -323,7 +323,7 @@ pub fn treelet_restructure_phase(
     if n == 0 {
         return;
     }
-    if phase < P_PLAN {
+    if phase < P_REWIRE {
         // Subsets of one size, dealt round-robin to the lanes.
         let size = phase + 1;
         if size > n {
@@ -338,24 +338,23 @@ pub fn treelet_restructure_phase(
             atomics::or_workgroup(&mut parts[pb + (s / 4) as usize], packed_bits(s, p));
             rank += TEAM;
         }
+        if size == n && lane == 0 {
+            // The whole treelet, solved by this lane after every smaller
+            // subset (earlier phases): rewire it if that lowers its cost.
+            let current = f32::from_bits(stage[b + T_CURRENT]);
+            let rewire = improves(cost[cb + (1usize << n) - 1], current);
+            if rewire {
+                plan_rewire(stage, b, parts, pb);
+            } else {
+                let root = stage[b + T_INTERNALS] as usize;
+                node_costs[root] = current;
+                heights[root] = stage[b + T_HEIGHT];
+            }
+            stage[b + T_REWIRE] = rewire as u32;
+        }
         return;
     }
-    if phase == P_PLAN {
-        if lane != 0 {
-            return;
-        }
-        let current = f32::from_bits(stage[b + T_CURRENT]);
-        if improves(cost[cb + (1usize << n) - 1], current) {
-            plan_rewire(stage, b, parts, pb);
-        } else {
-            let root = stage[b + T_INTERNALS] as usize;
-            node_costs[root] = current;
-            heights[root] = stage[b + T_HEIGHT];
-            stage[b + T_COUNT] = 0;
-        }
-        return;
-    }
-    if lane < n - 1 {
+    if lane < n - 1 && stage[b + T_REWIRE] == 1 {
         rewire_internal(lane as usize, stage, b, cost, cb, nodes, parents, counts, node_costs, heights);
     }
 }
