@@ -192,7 +192,7 @@ pub struct RenderParams {
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);
 
-/// Parameters of the treelet kernels. repr(C), Pod, 32 bytes.
+/// Parameters of the treelet kernels. repr(C), Pod, 48 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
@@ -212,5 +212,11 @@ pub struct TreeletParams {
     pub inv_extent: f32,
     /// How many treelet roots this dispatch restructures.
     pub level_count: u32,
+    /// The restructuring round, from 1.
+    pub round: u32,
+    /// 1: skip treelets kept last round whose subtrees have not changed since
+    /// (their DP would keep them again); 0: solve every treelet.
+    pub skip_kept: u32,
+    pub _pad: [u32; 2],
 }
-const _: () = assert!(core::mem::size_of::<TreeletParams>() == 32);
+const _: () = assert!(core::mem::size_of::<TreeletParams>() == 48);

@@ -131,9 +131,11 @@ const A_HEIGHTS: usize = A_KIDS + 2 * TREELET_INTERNALS;
 const A_STACK: usize = A_HEIGHTS + TREELET_INTERNALS;
 /// Whether the kernel rewires the treelet (1) or keeps it (0).
 pub const T_REWIRE: usize = A_STACK + TREELET_INTERNALS;
+/// The round in which the root's subtree last changed, for the kernel's marks.
+pub const T_CHANGED: usize = T_REWIRE + 1;
 /// Words of one staged treelet, rounded up to odd so that treelets staged
 /// side by side in workgroup memory start on different banks.
-pub const TREELET_WORDS: usize = (T_REWIRE + 1) | 1;
+pub const TREELET_WORDS: usize = (T_CHANGED + 1) | 1;
 const _: () = assert!(TREELET_WORDS % 2 == 1);
 
 /// The box of leaf `k` of the treelet staged at `b`.

@@ -23,7 +23,7 @@ use crate::layout::{Node, TreeletParams};
 use crate::treelet::{
     form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
     subset_count, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
-    T_INTERNALS, T_REWIRE,
+    T_CHANGED, T_INTERNALS, T_REWIRE,
 };
 use crate::workgroup::{WG, WORKGROUP_SIZE};
 
@@ -257,6 +257,15 @@ pub fn subset_order_start(size: u32) -> usize {
     ((STARTS >> (8 * size)) & 0xff) as usize
 }
 
+/// A node's mark: the round in which its subtree last changed (shifted
+/// left by one; 0 before the first), and in bit 0 whether the treelet
+/// rooted at it was solved and kept since (nothing cheaper): such a treelet
+/// is skipped while no subtree under it changes.
+#[inline]
+fn mark(changed_round: u32, kept: bool) -> u32 {
+    (changed_round << 1) | kept as u32
+}
+
 // Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7
 // (the lane that solves the whole treelet plans the rewiring right away);
 // rewire.
@@ -269,7 +278,14 @@ pub const RESTRUCTURE_PHASES: u32 = P_REWIRE + 1;
 /// solves the subsets of one size per phase, dealt round-robin to its lanes
 /// (`subsets` is [`subset_order`]); if that lowers the treelet's cost, one
 /// lane plans the new topology and a lane per internal node rewires it, or
-/// else one lane stores the root's current cost and height.
+/// else one lane stores the root's current cost and height. `marks` (see
+/// [`mark`]; zeroed before the first round) let later rounds skip treelets
+/// that were kept and under which nothing changed: every node whose
+/// subtree changes this round is a treelet root or inside a rewired
+/// treelet (changes only come from treelets, whose roots have at least
+/// `gamma` primitives, as have all their ancestors), so a change reaches
+/// the marks of the children of every root above it before that root is
+/// processed.
 #[allow(clippy::too_many_arguments)]
 pub fn treelet_restructure_phase(
     phase: u32,
@@ -283,10 +299,12 @@ pub fn treelet_restructure_phase(
     counts: &mut [u32],
     node_costs: &mut [f32],
     heights: &mut [u32],
+    marks: &mut [u32],
     stage: &mut [u32; TEAM_STAGE],
     cost: &mut [f32; TEAM_COSTS],
     parts: &mut [u32; TEAM_PARTS],
 ) {
+    let round = params.round;
     let team = lid / TEAM;
     let lane = lid % TEAM;
     let index = group * TEAMS + team;
@@ -304,12 +322,21 @@ pub fn treelet_restructure_phase(
             return;
         }
         let root = roots[(params.level_offset + index) as usize];
+        let r = nodes[root as usize];
+        let below = marks[r.left as usize] >> 1 == round || marks[r.right as usize] >> 1 == round;
+        let old = marks[root as usize];
+        if params.skip_kept == 1 && old & 1 == 1 && !below {
+            return; // kept, and nothing under it changed: it would be kept again
+        }
+        // Changed this round if anything under it did; kept (so far).
+        let changed = if below { round } else { old >> 1 };
+        stage[b + T_CHANGED] = changed;
         let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
         if f.leaf_count < 3 {
             // Two leaves: only one tree.
             node_costs[root as usize] = f.current;
             heights[root as usize] = f.height;
-            stage[b + T_COUNT] = 0;
+            marks[root as usize] = mark(changed, true);
             return;
         }
         let mut k = 0;
@@ -349,6 +376,7 @@ pub fn treelet_restructure_phase(
                 let root = stage[b + T_INTERNALS] as usize;
                 node_costs[root] = current;
                 heights[root] = stage[b + T_HEIGHT];
+                marks[root] = mark(stage[b + T_CHANGED], true);
             }
             stage[b + T_REWIRE] = rewire as u32;
         }
@@ -356,6 +384,8 @@ pub fn treelet_restructure_phase(
     }
     if lane < n - 1 && stage[b + T_REWIRE] == 1 {
         rewire_internal(lane as usize, stage, b, cost, cb, nodes, parents, counts, node_costs, heights);
+        // A new subtree, not solved as a treelet root yet.
+        marks[stage[b + T_INTERNALS + lane as usize] as usize] = mark(round, false);
     }
 }
 

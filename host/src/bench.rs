@@ -647,7 +647,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
-            let config = TreeletConfig { rounds, gamma, max_leaf, verify: false };
+            let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
             let treelets = (builder == TreeBuilder::Trbvh).then_some(&config);
             let (adapter, timing, rows) = match device {
                 Device::Gpu => {

@@ -289,17 +289,17 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             });
         }
-        (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights]) => {
+        (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights, marks]) => {
             let p: treelet_core::layout::TreeletParams = params(p);
             let (roots, subsets, nodes, parents) = (view(roots), view(subsets), view(nodes), view(parents));
-            let (counts, costs, heights) = (view(counts), view(costs), view(heights));
+            let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
             let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
             let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
             let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
             workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
-                    phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, &mut stage,
-                    &mut cost, &mut parts,
+                    phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, marks,
+                    &mut stage, &mut cost, &mut parts,
                 );
             });
         }

@@ -137,7 +137,9 @@ impl Kernel {
             }
             Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::TreeletRestructure => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::TreeletRestructure => {
+                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+            }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RenderLinear(_) | Kernel::RenderBvh(_) | Kernel::CastBvh => {
                 &[Read, Read, Read, Read, Read, ReadWrite, Read]

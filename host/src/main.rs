@@ -231,7 +231,7 @@ fn print_summary(r: &BuildReport) {
 fn run(cli: Cli) -> Result<bool> {
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
-            let config = TreeletConfig { rounds, gamma, max_leaf, verify: false };
+            let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
             let scene = Scene::from_spec(&scene)?;
             let (_, report) = match (builder, device) {
                 (Builder::Lbvh, Device::Gpu) => run_build(&mut GpuBackend::new(GpuContext::new()?), &scene, None)?,

@@ -37,6 +37,11 @@ pub struct TreeletConfig {
     /// no collapse). The paper sets no bound; a bound keeps the worst leaf
     /// a ray must test small.
     pub max_leaf: u32,
+    /// Skip treelets kept in an earlier round under which nothing has
+    /// changed since (their DP would keep them again). Off: solve them all
+    /// (the same tree, slower; for tests).
+    #[serde(skip)]
+    pub skip_kept: bool,
     /// After the rounds, climb the tree afresh and check that the counts,
     /// costs and heights the rounds kept current (instead of climbing each
     /// round) match; an error if not. For tests.
@@ -46,7 +51,7 @@ pub struct TreeletConfig {
 
 impl Default for TreeletConfig {
     fn default() -> Self {
-        Self { rounds: 3, gamma: 3, max_leaf: 8, verify: false }
+        Self { rounds: 3, gamma: 3, max_leaf: 8, skip_kept: true, verify: false }
     }
 }
 
@@ -75,6 +80,7 @@ pub fn optimize<B: Backend>(
     let base = base_params(n, root_box, config);
     let scratch = scratch(b, n)?;
     let subsets = b.upload("treelet subset order", &subset_order())?;
+    let marks = b.zeroed("treelet marks", (2 * n as u64 - 1) * 4)?;
     const ROUND_NAMES: [&str; 8] =
         ["round 1", "round 2", "round 3", "round 4", "round 5", "round 6", "round 7", "round 8"];
     let mut gamma = config.gamma;
@@ -116,7 +122,13 @@ pub fn optimize<B: Backend>(
             if count == 0 {
                 continue;
             }
-            let lp = TreeletParams { gamma: 0, level_offset: offsets[level], level_count: count, ..base };
+            let lp = TreeletParams {
+                level_offset: offsets[level],
+                level_count: count,
+                round: round + 1,
+                skip_kept: config.skip_kept as u32,
+                ..base
+            };
             let lp = b.upload("treelet params", &[lp])?;
             if profile_levels {
                 // A stage per height (`round r h<height> n<treelets>`), for
@@ -125,7 +137,7 @@ pub fn optimize<B: Backend>(
             }
             b.dispatch(
                 Kernel::TreeletRestructure,
-                &[&lp, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights],
+                &[&lp, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks],
                 count.div_ceil(TEAMS),
             );
         }

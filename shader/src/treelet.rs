@@ -98,6 +98,7 @@ pub fn treelet_restructure_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] counts: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] costs: &mut [f32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] heights: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] marks: &mut [u32],
     #[spirv(workgroup)] stage: &mut [u32; TEAM_STAGE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_COSTS],
     #[spirv(workgroup)] parts: &mut [u32; TEAM_PARTS],
@@ -105,7 +106,8 @@ pub fn treelet_restructure_cs(
     let group = linear_group(group.x, group.y, groups.x);
     for phase in 0..RESTRUCTURE_PHASES {
         treelet_restructure_phase(
-            phase, lid, group, params, roots, subsets, nodes, parents, counts, costs, heights, stage, cost, parts,
+            phase, lid, group, params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage, cost,
+            parts,
         );
         barrier();
     }
