@@ -103,9 +103,10 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
     }
 
     let seed = treelet_tests::fresh_seed();
-    for max_leaf in [1, 8] {
+    // Gamma 1 makes every internal node a treelet root, two-leaf ones included.
+    for (max_leaf, gamma) in [(1, 3), (8, 3), (8, 1)] {
         // `verify`: the counts, costs and heights the rounds keep current equal a fresh climb's.
-        let config = TreeletConfig { max_leaf, verify: true, ..Default::default() };
+        let config = TreeletConfig { max_leaf, gamma, verify: true, ..Default::default() };
         for n in [2usize, 3, 7, 64, 1000, 30_000] {
             let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
             let (c, before) = run(&mut CpuBackend::new(), &spheres, &config);
@@ -175,24 +176,27 @@ fn skipping_kept_treelets_changes_nothing() {
     use treelet::lbvh::{build_on_device, Bvh};
     use treelet::trbvh::{optimize, root_box, TreeletConfig};
 
-    fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], skip_kept: bool) -> Bvh {
+    fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], gamma: u32, skip_kept: bool) -> Bvh {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
         let rb = root_box(b, &dbvh).unwrap();
-        let config = TreeletConfig { rounds: 5, skip_kept, verify: true, ..Default::default() };
+        let config = TreeletConfig { rounds: 5, gamma, skip_kept, verify: true, ..Default::default() };
         optimize(b, dbvh, &rb, &config).unwrap().0.read(b).unwrap()
     }
     let seed = treelet_tests::fresh_seed();
     let spheres = treelet::scene::random_spheres(20_000, seed);
-    let (all, skipping) = (run(&mut CpuBackend::new(), &spheres, false), run(&mut CpuBackend::new(), &spheres, true));
-    assert!(validate(&spheres, &skipping.nodes, &skipping.parents, &skipping.prim_indices).is_valid());
-    assert!(all.nodes == skipping.nodes && all.parents == skipping.parents, "cpu: skipping changed the tree");
-    let Some(ctx) = treelet_tests::gpu() else { return };
-    let mut gpu = GpuBackend::new(ctx);
-    if gpu.runs_on_cpu() {
-        return; // unfused Fma there: near-ties may differ from the CPU's (see above)
+    for gamma in [1, 3] {
+        let cpu = |skip| run(&mut CpuBackend::new(), &spheres, gamma, skip);
+        let (all, skipping) = (cpu(false), cpu(true));
+        assert!(validate(&spheres, &skipping.nodes, &skipping.parents, &skipping.prim_indices).is_valid());
+        assert!(all.nodes == skipping.nodes && all.parents == skipping.parents, "cpu, gamma {gamma}: skipping changed the tree");
+        let Some(ctx) = treelet_tests::gpu() else { continue };
+        let mut gpu = GpuBackend::new(ctx);
+        if gpu.runs_on_cpu() {
+            continue; // unfused Fma there: near-ties may differ from the CPU's (see above)
+        }
+        let (all, skipping) = (run(&mut gpu, &spheres, gamma, false), run(&mut gpu, &spheres, gamma, true));
+        assert!(all.nodes == skipping.nodes && all.parents == skipping.parents, "gpu, gamma {gamma}: skipping changed the tree");
     }
-    let (all, skipping) = (run(&mut gpu, &spheres, false), run(&mut gpu, &spheres, true));
-    assert!(all.nodes == skipping.nodes && all.parents == skipping.parents, "gpu: skipping changed the tree");
 }
 
 /// The collapse alone on hand-made trees: identical spheres collapse into

@@ -1,14 +1,15 @@
 //! The device schedule of treelet restructuring ([`crate::treelet`]).
 //!
-//! A round: [`treelet_init_kernel`] climbs from the leaves once and writes
-//! every node's primitive count, SAH cost and height; the roots of this
-//! round's treelets (subtrees of at least `gamma` primitives) are counted and
-//! listed by height ([`treelet_histogram_phase`], [`treelet_scatter_phase`]);
-//! then one dispatch per height, bottom up, restructures them
+//! Before the first round, [`treelet_init_kernel`] climbs from the leaves
+//! and writes every node's primitive count, SAH cost and height;
+//! restructuring keeps them current, so later rounds need no new climb. A
+//! round: the roots of its treelets (subtrees of at least `gamma`
+//! primitives) are counted and listed by height
+//! ([`treelet_histogram_phase`], [`treelet_scatter_phase`]); then one
+//! dispatch per height, bottom up, restructures them
 //! ([`treelet_restructure_phase`]). Nodes of one height never contain each
 //! other, so one dispatch works on disjoint subtrees, and each sees the
-//! subtrees below it finished. Restructuring keeps counts, costs and heights
-//! up to date, so later rounds need no new climb.
+//! subtrees below it finished.
 //!
 //! Restructuring is a team of 32 lanes per treelet (a slice of a workgroup,
 //! so no subgroup size is assumed), as in the paper's warp-wide scheme, the
@@ -333,10 +334,11 @@ pub fn treelet_restructure_phase(
         stage[b + T_CHANGED] = changed;
         let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
         if f.leaf_count < 3 {
-            // Two leaves: only one tree.
+            // Two leaves: only one tree, nothing for the team to solve.
             node_costs[root as usize] = f.current;
             heights[root as usize] = f.height;
             marks[root as usize] = mark(changed, true);
+            stage[b + T_COUNT] = 0;
             return;
         }
         let mut k = 0;

@@ -3,9 +3,8 @@
 //! bottom-up pass computes each node's primitive count, SAH cost and height
 //! once; each round lists the roots of its treelets (at least `gamma`
 //! primitives) by height, then restructures them with one dispatch per
-//! height, from the leaves up, a team of lanes per treelet: wide teams
-//! where a height has few treelets, narrow ones where it has many.
-//! Last, the SAH leaf collapse writes the tree anew in depth-first order
+//! height, from the leaves up, a team of 32 lanes per treelet, skipping
+//! treelets kept before under which nothing changed. Last, the SAH leaf collapse writes the tree anew in depth-first order
 //! with leaves of up to `max_leaf` primitives.
 //! Nodes of one height never contain each other, so each dispatch works on
 //! disjoint subtrees. (The paper instead restructures during one bottom-up
