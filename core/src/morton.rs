@@ -2,7 +2,11 @@
 //!
 //! Centroids are quantized to 21 bits per axis inside the *centroid* bounds
 //! of the scene (tighter than the primitive bounds, so no bits are wasted),
-//! and interleaved into a 63-bit key.
+//! and interleaved into a 63-bit key. The cells are cubes, sized by the
+//! longest axis: stretching each axis to the full range instead makes a flat
+//! scene split its thin axis as often as the long ones, which costs a
+//! height-field terrain 22% of SAH in the LBVH and 6% after treelet
+//! optimization (terrain:1000000: LBVH 89.6 -> 73.5, TRBVH 64.5 -> 60.9).
 //!
 //! Bit-exact on every device: the frame is precomputed on the host as an
 //! offset and a scale ([`MortonFrame`]), so a kernel only does `c*0.5 - o`
@@ -27,7 +31,8 @@ const MAX_CELL: f32 = CELLS - 1.0;
 pub struct MortonFrame {
     /// Half the lower corner of the centroid bounds.
     pub offset: Vec3,
-    /// Cells per half unit; zero on axes where all centroids agree.
+    /// Cells per half unit, the same on every axis (cubic cells); zero on
+    /// axes where all centroids agree.
     pub scale: Vec3,
 }
 
@@ -52,7 +57,12 @@ impl MortonFrame {
                 0.0
             }
         };
-        let scale = Vec3::new(axis(half_extent.x), axis(half_extent.y), axis(half_extent.z));
+        let s = axis(half_extent.max_element());
+        let scale = Vec3::new(
+            if half_extent.x > 0.0 { s } else { 0.0 },
+            if half_extent.y > 0.0 { s } else { 0.0 },
+            if half_extent.z > 0.0 { s } else { 0.0 },
+        );
         Self { offset, scale }
     }
 
@@ -153,6 +163,19 @@ mod tests {
         assert_eq!(f.quantize(Vec3::new(1.0, 0.0, 5.0)), UVec3::new(MAX_CELL as u32, 0, 0));
         let tiny = Aabb::new(Vec3::ZERO, Vec3::splat(1e-38));
         assert!(MortonFrame::new(&tiny).scale.is_finite());
+    }
+
+    #[test]
+    fn cells_are_cubes_sized_by_the_longest_axis() {
+        // 10 x 1 x 4: the long axis spans every cell, the others a share.
+        let b = Aabb::new(Vec3::ZERO, Vec3::new(10.0, 1.0, 4.0));
+        let f = MortonFrame::new(&b);
+        assert_eq!(f.scale.x, f.scale.y);
+        assert_eq!(f.scale.x, f.scale.z);
+        let q = f.quantize(Vec3::new(10.0, 1.0, 4.0));
+        assert_eq!(q.x, MAX_CELL as u32);
+        assert_eq!(q.y, (CELLS / 10.0) as u32);
+        assert_eq!(q.z, (CELLS * 0.4) as u32);
     }
 
     #[test]
