@@ -54,8 +54,10 @@ fn mesh_lbvh_matches_cpu_and_is_valid() {
     }
 }
 
-/// The TRBVH of a mesh: valid on both devices, at least 15% below the LBVH's
-/// SAH and above the sweep's. Its decisions compare float costs, and a GPU
+/// The TRBVH of a mesh: valid on both devices, its SAH closing at least
+/// three quarters of the gap from the LBVH's to the sweep's (a ratio that
+/// does not depend on how good the LBVH already is) and not below the
+/// sweep's. Its decisions compare float costs, and a GPU
 /// compiler may fuse a multiply and an add that the CPU rounds twice, so on
 /// near ties the two devices may pick different (equally good) trees: the
 /// test requires their SAH to agree within 1e-4 and reports how many nodes
@@ -74,7 +76,10 @@ fn mesh_trbvh_lowers_sah_on_both_devices() {
     let sweep = treelet::sweep::build_collapsed_boxes(&prims.boxes(), config.max_leaf).unwrap();
     let sweep = sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA);
     eprintln!("terrain of {} triangles: SAH lbvh {lbvh:.3}, trbvh {trbvh:.3}, sweep {sweep:.3}", tris.len());
-    assert!(trbvh < 0.85 * lbvh, "TRBVH {trbvh} not well below the LBVH's {lbvh}");
+    assert!(
+        trbvh - sweep < 0.25 * (lbvh - sweep),
+        "TRBVH {trbvh} closes too little of the gap from the LBVH's {lbvh} to the sweep's {sweep}"
+    );
     assert!(sweep <= trbvh * 1.001, "the sweep reference {sweep} is worse than the TRBVH {trbvh}");
     let Some(ctx) = treelet_tests::gpu() else { return };
     let g = build(&mut GpuBackend::new(ctx), &tris, Some(&config));
