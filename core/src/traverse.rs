@@ -29,7 +29,6 @@ impl<'a> Prims<'a> {
         self.sphere_count + self.triangle_count
     }
 
-    /// Distance along the ray to primitive `prim`, below `t_max`, honouring the start surface.
     /// Whether primitive `prim` is a sphere, decided at compile time when
     /// `F` (see [`crate::features`]) has only one primitive kind.
     #[inline]
@@ -43,7 +42,8 @@ impl<'a> Prims<'a> {
         }
     }
 
-    /// Distance to primitive `prim` along the ray; `F` (see
+    /// Distance to primitive `prim` along the ray (a triangle's only up to
+    /// `t_max`, inclusive); `F` (see
     /// [`crate::features`]) leaves out the test of a kind the scene lacks.
     #[inline]
     fn distance<const F: u32>(
@@ -82,6 +82,15 @@ impl Hit {
     #[inline]
     pub fn is_hit(&self) -> bool {
         self.prim != u32::MAX
+    }
+
+    /// Whether a hit at `t` on `prim` beats this one. Equal distances go to
+    /// the lower index, so every traversal order finds the same hit (a ray
+    /// through the rim of smallpt's light, which dips into the ceiling,
+    /// meets both at one distance).
+    #[inline]
+    pub fn is_beaten_by(&self, t: f32, prim: u32) -> bool {
+        t < self.t || (t == self.t && t != MISS && prim < self.prim)
     }
 }
 
@@ -129,7 +138,7 @@ pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prim
     let count = prims.count();
     while i < count {
         let t = prims.distance::<F>(o, d, &ray, from, i, hit.t);
-        if t < hit.t {
+        if hit.is_beaten_by(t, i) {
             hit = Hit { t, prim: i };
         }
         i += 1;
@@ -161,7 +170,7 @@ pub fn closest_hit_bvh_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: 
             while k < node.prim_count() {
                 let prim = prim_indices[(node.left + k) as usize];
                 let t = prims.distance::<F>(o, d, &ray, from, prim, hit.t);
-                if t < hit.t {
+                if hit.is_beaten_by(t, prim) {
                     hit = Hit { t, prim };
                 }
                 k += 1;
@@ -190,4 +199,48 @@ pub fn closest_hit_linear(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit 
 #[inline]
 pub fn closest_hit_bvh(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
     closest_hit_bvh_for::<{ features::ALL }>(o, d, from, prims, nodes, prim_indices)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::LEAF_BIT;
+    use crate::triangle::Triangle;
+
+    /// Two leaves under one root; the tree visits the primitive of
+    /// `prim_indices[0]` first when both boxes are equally near.
+    fn two_leaf_tree(a: crate::Aabb, b: crate::Aabb) -> [Node; 3] {
+        let mut nodes = [Node::default(); 3];
+        nodes[0].set_aabb(a.union(&b));
+        (nodes[0].left, nodes[0].right) = (1, 2);
+        for (k, bx) in [(1, a), (2, b)] {
+            nodes[k].set_aabb(bx);
+            (nodes[k].left, nodes[k].right) = (k as u32 - 1, LEAF_BIT | 1);
+        }
+        nodes
+    }
+
+    #[test]
+    fn ties_go_to_the_lower_index_in_any_traversal_order() {
+        let (o, d) = (Vec3::ZERO, Vec3::X);
+        // Two spheres the ray meets at one distance; the tree visits index 1 first.
+        let spheres = [Sphere::new([5.0, 0.0, 0.0], 1.0), Sphere::new([5.0, 0.0, 0.0], 1.0)];
+        let prims = Prims::spheres(&spheres);
+        let nodes = two_leaf_tree(spheres[1].aabb(), spheres[0].aabb());
+        for hit in [closest_hit_linear(o, d, Origin::NONE, &prims), closest_hit_bvh(o, d, Origin::NONE, &prims, &nodes, &[1, 0])] {
+            assert_eq!((hit.prim, hit.t), (0, 4.0));
+        }
+        // Two triangles sharing the edge the ray crosses.
+        let tris = [
+            Triangle::new([3.0, -1.0, 0.0], [3.0, 1.0, 0.0], [3.0, 0.0, 1.0]),
+            Triangle::new([3.0, 1.0, 0.0], [3.0, -1.0, 0.0], [3.0, 0.0, -1.0]),
+        ];
+        let d = Vec3::new(1.0, 0.1, 0.0).normalize(); // crosses the shared edge (z = 0)
+        let prims = Prims { spheres: &[], sphere_count: 0, triangles: &tris, triangle_count: 2 };
+        let nodes = two_leaf_tree(tris[1].aabb(), tris[0].aabb());
+        let linear = closest_hit_linear(o, d, Origin::NONE, &prims);
+        let bvh = closest_hit_bvh(o, d, Origin::NONE, &prims, &nodes, &[1, 0]);
+        assert!(linear.is_hit());
+        assert_eq!((bvh.prim, bvh.t), (linear.prim, linear.t));
+    }
 }

@@ -98,7 +98,8 @@ impl WatertightRay {
 }
 
 /// Distance (in units of the ray direction's length) to the hit with `tri`
-/// strictly between 0 and `t_max`, or [`MISS`]. Both faces are hit; a
+/// beyond 0 and up to `t_max` (inclusive, so that a tie with the closest
+/// hit so far can go to the lower index), or [`MISS`]. Both faces are hit; a
 /// triangle whose area seen from the ray computes to zero (degenerate, or
 /// seen edge-on) is never hit.
 #[inline]
@@ -126,7 +127,7 @@ pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
     }
     let t_scaled = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
     let t = t_scaled / det;
-    if t > 0.0 && t < t_max {
+    if t > 0.0 && t <= t_max {
         t
     } else {
         MISS

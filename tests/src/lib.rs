@@ -26,7 +26,11 @@ use treelet_core::Sphere;
 
 /// A fresh random seed, printed so that a failure can be replayed.
 pub fn fresh_seed() -> u64 {
-    let seed = rand::rng().random();
+    // TREELET_TEST_SEED replays a failure a run printed.
+    let seed = match std::env::var("TREELET_TEST_SEED") {
+        Ok(s) => s.parse().expect("TREELET_TEST_SEED must be an unsigned integer"),
+        Err(_) => rand::rng().random(),
+    };
     eprintln!("seed {seed}");
     seed
 }
