@@ -83,6 +83,57 @@ fn one_round_keeps_invariants_and_lowers_sah() {
     }
 }
 
+/// The device kernel's team-parallel DP (run by the CPU runner) makes the
+/// very tree of the one-invocation reference ([`restructure`]) applied to
+/// the same treelets in the kernel's order: the roots of at least `gamma`
+/// primitives, by their height before the round, bottom up.
+#[test]
+fn kernel_round_equals_the_one_invocation_reference() {
+    use treelet::backend::Backend;
+    use treelet::cpu_runner::CpuBackend;
+    use treelet::lbvh::{build_on_device, DeviceBvh};
+    use treelet::trbvh::{collapse, optimize, root_box, TreeletConfig};
+
+    let seed = treelet_tests::fresh_seed();
+    for (n, gamma, max_leaf) in [(3000usize, 3, 8), (20_000, 7, 1), (5000, 1, 8)] {
+        let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
+        let b = &mut CpuBackend::new();
+        let (device, _) = build_on_device(b, &spheres).unwrap();
+        let mut bvh = device.read(b).unwrap();
+        let rb = root_box(b, &device).unwrap();
+        let config = TreeletConfig { rounds: 1, gamma, max_leaf, ..Default::default() };
+        let kernel = optimize(b, device, &rb, &config).unwrap().0.read(b).unwrap();
+
+        // The reference, with the kernel's constants and area scale.
+        let extent = rb.extent().max_element();
+        let costs = TreeletCosts { node: 1.2, prim: 1.0, inv_extent: (1.0 / extent).min(f32::MAX), max_leaf };
+        let (mut node_costs, mut counts, mut heights) = subtree_costs(&bvh.nodes, &costs);
+        let mut roots: Vec<u32> = (0..n as u32 - 1).filter(|&i| counts[i as usize] >= gamma).collect();
+        roots.sort_by_key(|&i| heights[i as usize]);
+        for root in roots {
+            let h = &mut heights;
+            restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut counts, &mut node_costs, h, &costs);
+        }
+        let reference = DeviceBvh {
+            n: n as u32,
+            node_count: bvh.nodes.len() as u32,
+            nodes: b.upload("nodes", &bvh.nodes).unwrap(),
+            parents: b.upload("parents", &bvh.parents).unwrap(),
+            prim_indices: b.upload("primitive indices", &bvh.prim_indices).unwrap(),
+            sorted_keys: b.upload("keys", &bvh.sorted_keys).unwrap(),
+            centroid_bounds: bvh.centroid_bounds,
+        };
+        let reference = collapse(b, reference, max_leaf).unwrap().read(b).unwrap();
+        let what = format!("n = {n}, gamma {gamma}, max_leaf {max_leaf}");
+        assert_eq!(kernel.nodes.len(), reference.nodes.len(), "{what}");
+        let differing = (0..kernel.nodes.len()).filter(|&i| kernel.nodes[i] != reference.nodes[i]).count();
+        assert_eq!(differing, 0, "{what}: {differing} nodes differ");
+        assert_eq!(kernel.parents, reference.parents, "{what}");
+        assert_eq!(kernel.prim_indices, reference.prim_indices, "{what}");
+        eprintln!("{what}: SAH {:.3}", sah_cost(&kernel.nodes, SahCosts::KARRAS_AILA));
+    }
+}
+
 /// The device pass (both backends): valid trees, SAH well below the LBVH's,
 /// leaves within the bound, and the GPU tree equal to the CPU run of the
 /// same kernels.

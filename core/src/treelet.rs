@@ -30,7 +30,7 @@
 //! treelet spread over a team of lanes.
 use crate::aabb::Aabb;
 use crate::layout::{Node, TreeletParams};
-use crate::unchecked::{get, set};
+use crate::unchecked::{at, get, put, set};
 
 /// Leaves of a treelet (the paper's 7).
 pub const TREELET_LEAVES: usize = 7;
@@ -151,12 +151,39 @@ pub fn staged_box<const N: usize>(stage: &[u32; N], b: usize, k: usize) -> Aabb 
 pub fn stage_box<const N: usize>(stage: &mut [u32; N], b: usize, k: usize, x: &Aabb) {
     let f = b + T_BOXES + 6 * k;
     let (lo, hi) = (x.min, x.max);
-    stage[f] = lo[0].to_bits();
-    stage[f + 1] = lo[1].to_bits();
-    stage[f + 2] = lo[2].to_bits();
-    stage[f + 3] = hi[0].to_bits();
-    stage[f + 4] = hi[1].to_bits();
-    stage[f + 5] = hi[2].to_bits();
+    set(stage, f, lo[0].to_bits());
+    set(stage, f + 1, lo[1].to_bits());
+    set(stage, f + 2, lo[2].to_bits());
+    set(stage, f + 3, hi[0].to_bits());
+    set(stage, f + 4, hi[1].to_bits());
+    set(stage, f + 5, hi[2].to_bits());
+}
+
+/// Stages node `id` (with its primitive count, cost and height) as leaf
+/// `slot` of the treelet being formed, with what expanding it needs.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn stage_leaf<const N: usize>(
+    stage: &mut [u32; N],
+    b: usize,
+    slot: usize,
+    id: u32,
+    node: &Node,
+    count: u32,
+    cost: f32,
+    height: u32,
+    costs: &TreeletCosts,
+) {
+    let x = node.aabb();
+    set(stage, b + T_LEAVES + slot, id);
+    stage_box(stage, b, slot, &x);
+    set(stage, b + F_LEFTS + slot, node.left);
+    set(stage, b + F_RIGHTS + slot, node.right);
+    let area = if node.is_leaf() { -1.0 } else { costs.area(&x) };
+    set(stage, b + F_AREAS + slot, area.to_bits());
+    set(stage, b + T_PRIMS + slot, count);
+    set(stage, b + T_COSTS + slot, cost.to_bits());
+    set(stage, b + T_HEIGHTS + slot, height);
 }
 
 /// What [`form_treelet`] finds besides the staged treelet.
@@ -191,30 +218,22 @@ pub fn form_treelet<const N: usize>(
     b: usize,
 ) -> Formed {
     stage[b + T_INTERNALS] = root;
-    let r = nodes[root as usize];
-    let root_count = counts[root as usize];
+    let r = at(nodes, root as usize);
+    let root_count = at(counts, root as usize);
     let mut internal_count = 1usize;
     let mut leaf_count = 2usize;
     // Slot `best` takes the left child, a new slot the right one.
     let mut best = 0usize;
     let (mut left, mut right) = (r.left, r.right);
     loop {
-        let mut side = 0;
-        while side < 2 {
-            let (slot, id) = if side == 0 { (best, left) } else { (leaf_count - 1, right) };
-            let node = nodes[id as usize];
-            let x = node.aabb();
-            stage[b + T_LEAVES + slot] = id;
-            stage_box(stage, b, slot, &x);
-            stage[b + F_LEFTS + slot] = node.left;
-            stage[b + F_RIGHTS + slot] = node.right;
-            let area = if node.is_leaf() { -1.0 } else { costs.area(&x) };
-            stage[b + F_AREAS + slot] = area.to_bits();
-            stage[b + T_PRIMS + slot] = counts[id as usize];
-            stage[b + T_COSTS + slot] = node_costs[id as usize].to_bits();
-            stage[b + T_HEIGHTS + slot] = heights[id as usize];
-            side += 1;
-        }
+        // Both new leaves' data first, then the stage writes: the loads
+        // wait on no one, one round trip to memory per expansion.
+        let (ln, rn) = (at(nodes, left as usize), at(nodes, right as usize));
+        let (lc, rc) = (at(counts, left as usize), at(counts, right as usize));
+        let (lk, rk) = (at(node_costs, left as usize), at(node_costs, right as usize));
+        let (lh, rh) = (at(heights, left as usize), at(heights, right as usize));
+        stage_leaf(stage, b, best, left, &ln, lc, lk, lh, costs);
+        stage_leaf(stage, b, leaf_count - 1, right, &rn, rc, rk, rh, costs);
         if leaf_count == 2 {
             // The root's children, before either is expanded.
             let (c0, c1) = (f32::from_bits(stage[b + T_COSTS]), f32::from_bits(stage[b + T_COSTS + 1]));
@@ -228,7 +247,7 @@ pub fn form_treelet<const N: usize>(
         let mut best_area = -1.0f32;
         let mut i = 0;
         while i < leaf_count {
-            let a = f32::from_bits(stage[b + F_AREAS + i]);
+            let a = f32::from_bits(get(stage, b + F_AREAS + i));
             if a > best_area {
                 best_area = a;
                 best = i;
@@ -238,10 +257,10 @@ pub fn form_treelet<const N: usize>(
         if best == usize::MAX {
             break;
         }
-        stage[b + T_INTERNALS + internal_count] = stage[b + T_LEAVES + best];
+        set(stage, b + T_INTERNALS + internal_count, get(stage, b + T_LEAVES + best));
         internal_count += 1;
-        left = stage[b + F_LEFTS + best];
-        right = stage[b + F_RIGHTS + best];
+        left = get(stage, b + F_LEFTS + best);
+        right = get(stage, b + F_RIGHTS + best);
         leaf_count += 1;
     }
     stage[b + T_COUNT] = leaf_count as u32;
@@ -272,13 +291,13 @@ pub fn packed_bits(s: u32, p: u32) -> u32 {
 /// Union of the boxes of the leaves in subset `s` of the treelet staged at `b`.
 #[inline]
 pub fn subset_box<const N: usize>(s: u32, n: u32, stage: &[u32; N], b: usize) -> Aabb {
+    // Set bits only, lowest first: no branch per leaf (lanes of a team
+    // hold different subsets and would take both sides of it).
     let mut x = Aabb::EMPTY;
-    let mut i = 0;
-    while i < n {
-        if s & (1 << i) != 0 {
-            x = x.union(&staged_box(stage, b, i as usize));
-        }
-        i += 1;
+    let mut rest = s & ((1u32 << n) - 1);
+    while rest != 0 {
+        x = x.union(&staged_box(stage, b, rest.trailing_zeros() as usize));
+        rest &= rest - 1;
     }
     x
 }
@@ -287,12 +306,10 @@ pub fn subset_box<const N: usize>(s: u32, n: u32, stage: &[u32; N], b: usize) ->
 #[inline]
 pub fn subset_count<const N: usize>(s: u32, n: u32, stage: &[u32; N], b: usize) -> u32 {
     let mut c = 0;
-    let mut i = 0;
-    while i < n {
-        if s & (1 << i) != 0 {
-            c += get(stage, b + T_PRIMS + i as usize);
-        }
-        i += 1;
+    let mut rest = s & ((1u32 << n) - 1);
+    while rest != 0 {
+        c += get(stage, b + T_PRIMS + rest.trailing_zeros() as usize);
+        rest &= rest - 1;
     }
     c
 }
@@ -331,6 +348,37 @@ pub fn solve_subset<const N: usize>(
     }
     set(cost, base + s as usize, costs.subtree(area, count, best));
     best_p
+}
+
+/// Partition number `m` (1 to `2^(n-1) - 1`) of a whole treelet of `n`
+/// leaves: the `m`-th that [`solve_subset`] enumerates for it (the
+/// sub-masks of all leaves but the first, increasing).
+#[inline]
+pub fn whole_partition(m: u32) -> u32 {
+    m << 1
+}
+
+/// One lane's share of [`solve_subset`] over a whole treelet of `n` leaves:
+/// partitions `m = lane + 1, lane + 1 + lanes, ...`; returns the cheapest
+/// sum of part costs and its `m` (the first of equal costs; `u32::MAX` if
+/// none is below `f32::MAX`). The smallest `m` among the lanes' cheapest is
+/// the partition [`solve_subset`] would pick.
+#[inline]
+pub fn best_whole_partition<const N: usize>(n: u32, lane: u32, lanes: u32, cost: &[f32; N], base: usize) -> (f32, u32) {
+    let full = (1u32 << n) - 1;
+    let count = (1u32 << (n - 1)) - 1;
+    let (mut best, mut best_m) = (f32::MAX, u32::MAX);
+    let mut m = lane + 1;
+    while m <= count {
+        let p = whole_partition(m);
+        let c = get(cost, base + p as usize) + get(cost, base + (full ^ p) as usize);
+        if c < best {
+            best = c;
+            best_m = m;
+        }
+        m += lanes;
+    }
+    (best, best_m)
 }
 
 /// The optimal tree over a treelet's leaves: `cost[s]` is the cost of the
@@ -374,28 +422,28 @@ pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts
 /// heights, into the stage's scratch for [`rewire_internal`].
 #[inline]
 pub fn plan_rewire<const N: usize, const M: usize>(stage: &mut [u32; N], b: usize, parts: &[u32; M], base: usize) {
-    let n = stage[b + T_COUNT];
+    let n = get(stage, b + T_COUNT);
     // Children: a leaf index below 8, or 8 + the child's internal slot. A
     // stack of internal slots still to split, at most as deep as there
     // are internal nodes.
-    stage[b + A_SETS] = (1u32 << n) - 1;
-    stage[b + A_STACK] = 0;
+    set(stage, b + A_SETS, (1u32 << n) - 1);
+    set(stage, b + A_STACK, 0);
     let mut top = 1usize;
     let mut next_internal = 1usize;
     while top > 0 {
         top -= 1;
-        let k = stage[b + A_STACK + top] as usize;
-        let s = stage[b + A_SETS + k];
+        let k = get(stage, b + A_STACK + top) as usize;
+        let s = get(stage, b + A_SETS + k);
         let p = packed_partition(parts, base, s);
         let mut side = 0;
         while side < 2 {
             let part = if side == 0 { p } else { s ^ p };
             if part.count_ones() == 1 {
-                stage[b + A_KIDS + 2 * k + side] = part.trailing_zeros();
+                set(stage, b + A_KIDS + 2 * k + side, part.trailing_zeros());
             } else {
-                stage[b + A_KIDS + 2 * k + side] = 8 + next_internal as u32;
-                stage[b + A_SETS + next_internal] = part;
-                stage[b + A_STACK + top] = next_internal as u32;
+                set(stage, b + A_KIDS + 2 * k + side, 8 + next_internal as u32);
+                set(stage, b + A_SETS + next_internal, part);
+                set(stage, b + A_STACK + top, next_internal as u32);
                 top += 1;
                 next_internal += 1;
             }
@@ -409,12 +457,12 @@ pub fn plan_rewire<const N: usize, const M: usize>(stage: &mut [u32; N], b: usiz
         let mut height = 0u32;
         let mut side = 0;
         while side < 2 {
-            let kid = stage[b + A_KIDS + 2 * k + side] as usize;
-            let h = if kid < 8 { stage[b + T_HEIGHTS + kid] } else { stage[b + A_HEIGHTS + kid - 8] };
+            let kid = get(stage, b + A_KIDS + 2 * k + side) as usize;
+            let h = if kid < 8 { get(stage, b + T_HEIGHTS + kid) } else { get(stage, b + A_HEIGHTS + kid - 8) };
             height = height.max(h + 1);
             side += 1;
         }
-        stage[b + A_HEIGHTS + k] = height;
+        set(stage, b + A_HEIGHTS + k, height);
     }
 }
 
@@ -437,26 +485,26 @@ pub fn rewire_internal<const N: usize, const C: usize>(
     node_costs: &mut [f32],
     heights: &mut [u32],
 ) {
-    let n = stage[b + T_COUNT];
-    let s = stage[b + A_SETS + k];
-    let node = stage[b + T_INTERNALS + k];
-    let mut side = 0;
-    while side < 2 {
-        let kid = stage[b + A_KIDS + 2 * k + side] as usize;
-        let child = if kid < 8 { stage[b + T_LEAVES + kid] } else { stage[b + T_INTERNALS + kid - 8] };
-        if side == 0 {
-            nodes[node as usize].left = child;
+    let n = get(stage, b + T_COUNT);
+    let s = get(stage, b + A_SETS + k);
+    let node = get(stage, b + T_INTERNALS + k) as usize;
+    let child = |side: usize| {
+        let kid = get(stage, b + A_KIDS + 2 * k + side) as usize;
+        if kid < 8 {
+            get(stage, b + T_LEAVES + kid)
         } else {
-            nodes[node as usize].right = child;
+            get(stage, b + T_INTERNALS + kid - 8)
         }
-        parents[child as usize] = node;
-        side += 1;
-    }
-    let node = node as usize;
-    nodes[node].set_aabb(subset_box(s, n, stage, b));
-    counts[node] = subset_count(s, n, stage, b);
-    node_costs[node] = cost[cb + s as usize];
-    heights[node] = stage[b + A_HEIGHTS + k];
+    };
+    let (left, right) = (child(0), child(1));
+    // The whole node in one store: it is not read here, only written.
+    let x = subset_box(s, n, stage, b);
+    put(nodes, node, Node { min: x.min, left, max: x.max, right });
+    put(parents, left as usize, node as u32);
+    put(parents, right as usize, node as u32);
+    put(counts, node, subset_count(s, n, stage, b));
+    put(node_costs, node, get(cost, cb + s as usize));
+    put(heights, node, get(stage, b + A_HEIGHTS + k));
 }
 
 /// SAH cost of the subtree under `node` with `count` primitives, given its
@@ -590,6 +638,35 @@ mod tests {
                         (got - expected).abs() <= 1e-5 * expected,
                         "max_leaf {max_leaf} n {n} seed {seed}: dp {got} brute {expected}"
                     );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_sharing_the_whole_treelet_pick_the_partition_of_one_lane() {
+        // Costs with many ties (few distinct values), so that the first of
+        // equal costs matters.
+        let mut state = 0x9e37_79b9u32;
+        for n in 3..=TREELET_LEAVES as u32 {
+            for trial in 0..200 {
+                let mut cost = [0f32; SUBSETS];
+                for c in cost.iter_mut() {
+                    state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                    *c = if trial % 2 == 0 { (state >> 29) as f32 } else { (state >> 8) as f32 };
+                }
+                let full = (1u32 << n) - 1;
+                let mut one = cost;
+                let expected = solve_subset(full, 0, 1.0, 1, &mut one, &TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 1.0, max_leaf: 1 });
+                for lanes in [1u32, 5, 32] {
+                    let (mut best, mut best_m) = (f32::MAX, u32::MAX);
+                    for lane in 0..lanes {
+                        let (c, m) = best_whole_partition(n, lane, lanes, &cost, 0);
+                        if c < best || (c == best && m < best_m) {
+                            (best, best_m) = (c, m);
+                        }
+                    }
+                    assert_eq!(whole_partition(best_m), expected, "n {n} trial {trial} lanes {lanes}");
                 }
             }
         }

@@ -17,15 +17,24 @@
 //! lives in per-invocation arrays, which GPUs keep in slow local memory
 //! when indexed at run time. The result does not depend on which lane
 //! solves which subset: every subset's cost is the same minimum over the
-//! same partitions in the same order.
+//! same partitions in the same order (for the whole treelet, whose
+//! partitions the lanes share, the first of equal costs across lanes).
+//!
+//! What one treelet's latency is made of (H100, one treelet per dispatch,
+//! `TREELET_PROFILE_LEVELS`): the launch 7 µs, forming 5 µs, the subset
+//! sizes 2 to 6 about 2 µs each, the whole treelet and its plan 6 µs, the
+//! rewiring 2 µs. Global reads are unchecked (`crate::unchecked`): a bounds
+//! check's branch kept the GPU from issuing the next load before the last
+//! one returned, which made forming 12 µs.
 use crate::atomics;
 use crate::fit::second_arrival;
 use crate::layout::{Node, TreeletParams};
 use crate::treelet::{
-    form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
+    best_whole_partition, form_treelet, improves, whole_partition, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
     subset_count, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
     T_CHANGED, T_INTERNALS, T_REWIRE,
 };
+use crate::unchecked::{at, get, set};
 use crate::workgroup::{WG, WORKGROUP_SIZE};
 
 /// Kernel (one invocation per leaf, climbing like [`crate::fit`]): writes
@@ -268,18 +277,24 @@ fn mark(changed_round: u32, kept: bool) -> u32 {
 }
 
 // Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7
-// (the lane that solves the whole treelet plans the rewiring right away);
-// rewire.
-const P_REWIRE: u32 = 7;
+// (the whole treelet's partitions dealt to all lanes); choose the whole
+// treelet's best partition and plan the rewiring; rewire.
+const P_CHOOSE: u32 = 7;
+const P_REWIRE: u32 = 8;
 pub const RESTRUCTURE_PHASES: u32 = P_REWIRE + 1;
+/// Workgroup memory for each lane's best partition of the whole treelet
+/// (cost bits, then partition number), per team.
+pub const TEAM_VOTES: usize = TEAMS as usize * 2 * TEAM as usize;
 
 /// Kernel ([`TEAMS`] teams of [`TEAM`] lanes per workgroup, phase by
 /// phase): restructures the treelets of `roots[level_offset..][..level_count]`,
 /// one per team. One lane forms the treelet into workgroup memory; the team
 /// solves the subsets of one size per phase, dealt round-robin to its lanes
-/// (`subsets` is [`subset_order`]); if that lowers the treelet's cost, one
-/// lane plans the new topology and a lane per internal node rewires it, or
-/// else one lane stores the root's current cost and height. `marks` (see
+/// (`subsets` is [`subset_order`], copied to `order`), and the whole
+/// treelet's partitions dealt to all lanes (their best in `votes`); one lane
+/// picks the best of those and, if that lowers the treelet's cost, plans the
+/// new topology, which a lane per internal node rewires, or else it stores
+/// the root's current cost and height. `marks` (see
 /// [`mark`]; zeroed before the first round) let later rounds skip treelets
 /// that were kept and under which nothing changed: every node whose
 /// subtree changes this round is a treelet root or inside a rewired
@@ -304,6 +319,8 @@ pub fn treelet_restructure_phase(
     stage: &mut [u32; TEAM_STAGE],
     cost: &mut [f32; TEAM_COSTS],
     parts: &mut [u32; TEAM_PARTS],
+    order: &mut [u32; SUBSETS],
+    votes: &mut [u32; TEAM_VOTES],
 ) {
     let round = params.round;
     let team = lid / TEAM;
@@ -312,8 +329,14 @@ pub fn treelet_restructure_phase(
     let (b, cb, pb) = (team as usize * TREELET_WORDS, team as usize * COST_ROW, team as usize * PARTS_ROW);
     let costs = params.costs();
     if phase == 0 {
-        if (lane as usize) < PACKED_WORDS {
-            parts[pb + lane as usize] = 0;
+        // The subset order, into workgroup memory once for all phases.
+        if (lid as usize) < SUBSETS {
+            order[lid as usize] = at(subsets, lid as usize);
+        }
+        let mut w = lane as usize;
+        while w < PACKED_WORDS {
+            parts[pb + w] = 0;
+            w += TEAM as usize;
         }
         if lane != 0 {
             return;
@@ -322,10 +345,10 @@ pub fn treelet_restructure_phase(
         if index >= params.level_count {
             return;
         }
-        let root = roots[(params.level_offset + index) as usize];
-        let r = nodes[root as usize];
-        let below = marks[r.left as usize] >> 1 == round || marks[r.right as usize] >> 1 == round;
-        let old = marks[root as usize];
+        let root = at(roots, (params.level_offset + index) as usize);
+        let r = at(nodes, root as usize);
+        let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
+        let old = at(marks, root as usize);
         if params.skip_kept == 1 && old & 1 == 1 && !below {
             return; // kept, and nothing under it changed: it would be kept again
         }
@@ -352,26 +375,54 @@ pub fn treelet_restructure_phase(
     if n == 0 {
         return;
     }
-    if phase < P_REWIRE {
-        // Subsets of one size, dealt round-robin to the lanes.
+    let vb = team as usize * 2 * TEAM as usize;
+    if phase < P_CHOOSE {
         let size = phase + 1;
         if size > n {
             return;
         }
+        if size == n {
+            // The whole treelet, after every smaller subset: its many
+            // partitions dealt to the lanes, the best of each lane kept
+            // (the first of equal costs) for the next phase to choose from.
+            let (best, m) = best_whole_partition(n, lane, TEAM, cost, cb);
+            votes[vb + lane as usize] = best.to_bits();
+            votes[vb + (TEAM + lane) as usize] = m;
+            return;
+        }
+        // Subsets of one size, dealt round-robin to the lanes.
         let (start, total) = (subset_order_start(size), binomial(n, size));
         let mut rank = lane;
         while rank < total {
-            let s = subsets[start + rank as usize];
+            let s = get(order, start + rank as usize);
             let area = costs.area(&subset_box(s, n, stage, b));
             let p = solve_subset(s, cb, area, subset_count(s, n, stage, b), cost, &costs);
             atomics::or_workgroup(&mut parts[pb + (s / 4) as usize], packed_bits(s, p));
             rank += TEAM;
         }
-        if size == n && lane == 0 {
-            // The whole treelet, solved by this lane after every smaller
-            // subset (earlier phases): rewire it if that lowers its cost.
+        return;
+    }
+    if phase == P_CHOOSE {
+        if lane == 0 {
+            // The lanes' best partitions: the cheapest, the first of equal
+            // costs, as one lane enumerating them all would find.
+            let (mut best, mut best_m) = (f32::MAX, u32::MAX);
+            let mut l = 0;
+            while l < TEAM as usize {
+                let (c, m) = (f32::from_bits(get(votes, vb + l)), get(votes, vb + TEAM as usize + l));
+                if c < best || (c == best && m < best_m) {
+                    (best, best_m) = (c, m);
+                }
+                l += 1;
+            }
+            let full = (1u32 << n) - 1;
+            let p = if best_m == u32::MAX { 0 } else { whole_partition(best_m) };
+            let area = costs.area(&subset_box(full, n, stage, b));
+            set(cost, cb + full as usize, costs.subtree(area, subset_count(full, n, stage, b), best));
+            atomics::or_workgroup(&mut parts[pb + (full / 4) as usize], packed_bits(full, p));
+            // Rewire the treelet if that lowers its cost.
             let current = f32::from_bits(stage[b + T_CURRENT]);
-            let rewire = improves(cost[cb + (1usize << n) - 1], current);
+            let rewire = improves(cost[cb + full as usize], current);
             if rewire {
                 plan_rewire(stage, b, parts, pb);
             } else {

@@ -34,3 +34,35 @@ pub fn set<T: Copy, const N: usize>(a: &mut [T; N], i: usize, v: T) {
         a[i] = v;
     }
 }
+
+/// `a[i]` of a slice (a storage buffer), unchecked on the GPU. Besides the
+/// check itself, its branch splits the code into blocks, and GPU compilers
+/// then do not start a load before the previous one's value is used.
+#[inline]
+pub fn at<T: Copy>(a: &[T], i: usize) -> T {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::arch::IndexUnchecked;
+        // SAFETY: as in `get`.
+        unsafe { *a.index_unchecked(i) }
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        a[i]
+    }
+}
+
+/// `a[i] = v` of a slice (a storage buffer), unchecked on the GPU.
+#[inline]
+pub fn put<T: Copy>(a: &mut [T], i: usize, v: T) {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::arch::IndexUnchecked;
+        // SAFETY: as in `get`.
+        unsafe { *a.index_unchecked_mut(i) = v }
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        a[i] = v;
+    }
+}

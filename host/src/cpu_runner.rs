@@ -296,10 +296,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
             let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
             let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
+            let mut order = [0u32; treelet_core::treelet::SUBSETS];
+            let mut votes = [0u32; treelet_kernels::TEAM_VOTES];
             workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
                     phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, marks,
-                    &mut stage, &mut cost, &mut parts,
+                    &mut stage, &mut cost, &mut parts, &mut order, &mut votes,
                 );
             });
         }

@@ -85,6 +85,8 @@ pub fn optimize<B: Backend>(
     let mut gamma = config.gamma;
     // Developers' profiling switch: time each height as its own stage.
     let profile_levels = std::env::var_os("TREELET_PROFILE_LEVELS").is_some();
+    // ... and with `empty`, an empty launch after each height.
+    let profile_empty = std::env::var("TREELET_PROFILE_LEVELS").is_ok_and(|v| v == "empty");
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
         if round == 0 {
@@ -139,6 +141,17 @@ pub fn optimize<B: Backend>(
                 &[&lp, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks],
                 count.div_ceil(TEAMS),
             );
+            if profile_empty {
+                // The same launch with no treelets: what a height costs
+                // before any treelet work.
+                let ep = b.upload("treelet params", &[TreeletParams { level_count: 0, ..base }])?;
+                b.stage(Box::leak(format!("r{round} h{level:02} empty").into_boxed_str()));
+                b.dispatch(
+                    Kernel::TreeletRestructure,
+                    &[&ep, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks],
+                    count.div_ceil(TEAMS),
+                );
+            }
         }
     }
     if config.verify {

@@ -4,8 +4,9 @@ use treelet_core::layout::{Node, TreeletParams};
 use treelet_core::collapse::collapse_kernel;
 use treelet_core::treelet_kernels::{
     treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase, HISTOGRAM_PHASES,
-    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE,
+    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES,
 };
+use treelet_core::treelet::SUBSETS;
 use treelet_core::workgroup::{barrier, linear_group, linear_id, WG};
 
 /// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
@@ -102,12 +103,16 @@ pub fn treelet_restructure_cs(
     #[spirv(workgroup)] stage: &mut [u32; TEAM_STAGE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_COSTS],
     #[spirv(workgroup)] parts: &mut [u32; TEAM_PARTS],
+    #[spirv(workgroup)] order: &mut [u32; SUBSETS],
+    #[spirv(workgroup)] votes: &mut [u32; TEAM_VOTES],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
+    // Read once: each phase would load it again after its barrier.
+    let params = *params;
     for phase in 0..RESTRUCTURE_PHASES {
         treelet_restructure_phase(
-            phase, lid, group, params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage, cost,
-            parts,
+            phase, lid, group, &params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage, cost,
+            parts, order, votes,
         );
         barrier();
     }
