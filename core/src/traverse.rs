@@ -138,7 +138,9 @@ pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prim
     let count = prims.count();
     while i < count {
         let t = prims.distance::<F>(o, d, &ray, from, i, hit.t);
-        if hit.is_beaten_by(t, i) {
+        // In index order, the first of equal distances stays: the lower
+        // index, as [`Hit::is_beaten_by`] picks, without its extra test.
+        if t < hit.t {
             hit = Hit { t, prim: i };
         }
         i += 1;
