@@ -381,6 +381,17 @@ pub fn best_whole_partition<const N: usize>(n: u32, lane: u32, lanes: u32, cost:
     (best, best_m)
 }
 
+/// Of two lanes' results of [`best_whole_partition`], the one
+/// [`solve_subset`] would keep: the cheaper, the lower number on equal costs.
+#[inline]
+pub fn first_cheapest(a: (f32, u32), b: (f32, u32)) -> (f32, u32) {
+    if b.0 < a.0 || (b.0 == a.0 && b.1 < a.1) {
+        b
+    } else {
+        a
+    }
+}
+
 /// The optimal tree over a treelet's leaves: `cost[s]` is the cost of the
 /// best subtree over subset `s`; its root splits `s` into `p` and `s ^ p`,
 /// `p` = [`packed_partition`]`(&parts, 0, s)`.
@@ -659,13 +670,11 @@ mod tests {
                 let mut one = cost;
                 let expected = solve_subset(full, 0, 1.0, 1, &mut one, &TreeletCosts { node: 1.2, prim: 1.0, inv_extent: 1.0, max_leaf: 1 });
                 for lanes in [1u32, 5, 32] {
-                    let (mut best, mut best_m) = (f32::MAX, u32::MAX);
+                    let mut vote = (f32::MAX, u32::MAX);
                     for lane in 0..lanes {
-                        let (c, m) = best_whole_partition(n, lane, lanes, &cost, 0);
-                        if c < best || (c == best && m < best_m) {
-                            (best, best_m) = (c, m);
-                        }
+                        vote = first_cheapest(vote, best_whole_partition(n, lane, lanes, &cost, 0));
                     }
+                    let best_m = vote.1;
                     assert_eq!(whole_partition(best_m), expected, "n {n} trial {trial} lanes {lanes}");
                 }
             }

@@ -30,8 +30,8 @@ use crate::atomics;
 use crate::fit::second_arrival;
 use crate::layout::{Node, TreeletParams};
 use crate::treelet::{
-    best_whole_partition, form_treelet, improves, whole_partition, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box,
-    subset_count, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
+    best_whole_partition, first_cheapest, form_treelet, improves, node_cost, packed_bits, plan_rewire,
+    rewire_internal, solve_subset, subset_box, subset_count, whole_partition, PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT,
     T_CHANGED, T_INTERNALS, T_REWIRE,
 };
 use crate::unchecked::{at, get, set};
@@ -406,15 +406,14 @@ pub fn treelet_restructure_phase(
         if lane == 0 {
             // The lanes' best partitions: the cheapest, the first of equal
             // costs, as one lane enumerating them all would find.
-            let (mut best, mut best_m) = (f32::MAX, u32::MAX);
+            let mut vote = (f32::MAX, u32::MAX);
             let mut l = 0;
             while l < TEAM as usize {
-                let (c, m) = (f32::from_bits(get(votes, vb + l)), get(votes, vb + TEAM as usize + l));
-                if c < best || (c == best && m < best_m) {
-                    (best, best_m) = (c, m);
-                }
+                let lane_vote = (f32::from_bits(get(votes, vb + l)), get(votes, vb + TEAM as usize + l));
+                vote = first_cheapest(vote, lane_vote);
                 l += 1;
             }
+            let (best, best_m) = vote;
             let full = (1u32 << n) - 1;
             let p = if best_m == u32::MAX { 0 } else { whole_partition(best_m) };
             let area = costs.area(&subset_box(full, n, stage, b));

@@ -136,21 +136,17 @@ pub fn optimize<B: Backend>(
                 // `bench build`: what a height costs against its treelets.
                 b.stage(Box::leak(format!("r{round} h{level:02} n{count}").into_boxed_str()));
             }
-            b.dispatch(
-                Kernel::TreeletRestructure,
-                &[&lp, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks],
-                count.div_ceil(TEAMS),
-            );
+            let restructure = |b: &mut B, p: &B::Buffer| {
+                let buffers = [p, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
+                b.dispatch(Kernel::TreeletRestructure, &buffers, count.div_ceil(TEAMS));
+            };
+            restructure(b, &lp);
             if profile_empty {
                 // The same launch with no treelets: what a height costs
                 // before any treelet work.
                 let ep = b.upload("treelet params", &[TreeletParams { level_count: 0, ..base }])?;
                 b.stage(Box::leak(format!("r{round} h{level:02} empty").into_boxed_str()));
-                b.dispatch(
-                    Kernel::TreeletRestructure,
-                    &[&ep, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks],
-                    count.div_ceil(TEAMS),
-                );
+                restructure(b, &ep);
             }
         }
     }
