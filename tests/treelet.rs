@@ -89,7 +89,6 @@ fn one_round_keeps_invariants_and_lowers_sah() {
 /// primitives, by their height before the round, bottom up.
 #[test]
 fn kernel_round_equals_the_one_invocation_reference() {
-    use treelet::backend::Backend;
     use treelet::cpu_runner::CpuBackend;
     use treelet::lbvh::{build_on_device, DeviceBvh};
     use treelet::trbvh::{collapse, optimize, root_box, TreeletConfig};
@@ -114,15 +113,7 @@ fn kernel_round_equals_the_one_invocation_reference() {
             let h = &mut heights;
             restructure(root, &mut bvh.nodes, &mut bvh.parents, &mut counts, &mut node_costs, h, &costs);
         }
-        let reference = DeviceBvh {
-            n: n as u32,
-            node_count: bvh.nodes.len() as u32,
-            nodes: b.upload("nodes", &bvh.nodes).unwrap(),
-            parents: b.upload("parents", &bvh.parents).unwrap(),
-            prim_indices: b.upload("primitive indices", &bvh.prim_indices).unwrap(),
-            sorted_keys: b.upload("keys", &bvh.sorted_keys).unwrap(),
-            centroid_bounds: bvh.centroid_bounds,
-        };
+        let reference = DeviceBvh::upload(b, &bvh).unwrap();
         let reference = collapse(b, reference, max_leaf).unwrap().read(b).unwrap();
         let what = format!("n = {n}, gamma {gamma}, max_leaf {max_leaf}");
         assert_eq!(kernel.nodes.len(), reference.nodes.len(), "{what}");

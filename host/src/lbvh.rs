@@ -44,6 +44,22 @@ pub struct DeviceBvh<B: Backend> {
 }
 
 impl<B: Backend> DeviceBvh<B> {
+    /// A host tree on the device (at least two primitives); a tree without
+    /// Morton keys (the sweep's) gets zeros in their place.
+    pub fn upload(b: &mut B, bvh: &Bvh) -> Result<Self> {
+        let n = bvh.prim_indices.len();
+        let keys = if bvh.sorted_keys.is_empty() { vec![0u64; n] } else { bvh.sorted_keys.clone() };
+        Ok(DeviceBvh {
+            n: n as u32,
+            node_count: bvh.nodes.len() as u32,
+            nodes: b.upload("nodes", &bvh.nodes)?,
+            parents: b.upload("parents", &bvh.parents)?,
+            prim_indices: b.upload("primitive indices", &bvh.prim_indices)?,
+            sorted_keys: b.upload("keys", &keys)?,
+            centroid_bounds: bvh.centroid_bounds,
+        })
+    }
+
     /// Copies the tree back to the host.
     pub fn read(&self, b: &mut B) -> Result<Bvh> {
         if self.n == 0 {

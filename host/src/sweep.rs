@@ -30,16 +30,7 @@ pub fn build_collapsed_boxes(boxes: &[Aabb], max_leaf: u32) -> anyhow::Result<Bv
         return Ok(tree);
     }
     let b = &mut CpuBackend::new();
-    use crate::backend::Backend;
-    let device = DeviceBvh {
-        n,
-        node_count: tree.nodes.len() as u32,
-        nodes: b.upload("nodes", &tree.nodes)?,
-        parents: b.upload("parents", &tree.parents)?,
-        prim_indices: b.upload("primitive indices", &tree.prim_indices)?,
-        sorted_keys: b.upload("keys", &vec![0u64; n as usize])?, // not read: the sweep sorts no keys
-        centroid_bounds: Aabb::EMPTY,
-    };
+    let device = DeviceBvh::upload(b, &tree)?;
     crate::trbvh::collapse(b, device, max_leaf)?.read(b).map(|t| Bvh { sorted_keys: Vec::new(), ..t })
 }
 
