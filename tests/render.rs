@@ -3,6 +3,7 @@
 use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
+use treelet::layout::Layout;
 use treelet::render::{render, Accel, RenderSettings};
 use treelet::variant::KernelChoice;
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
@@ -27,7 +28,7 @@ fn mesh() -> Scene {
 }
 
 fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> RenderSettings {
-    RenderSettings { width, height, spp, seed, accel, kernel: KernelChoice::Auto }
+    RenderSettings { width, height, spp, seed, accel, layout: Layout::Auto, kernel: KernelChoice::Auto }
 }
 
 fn pixels<B: Backend>(b: &mut B, scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {
@@ -75,24 +76,26 @@ fn gpu_render_matches_cpu() {
 }
 
 #[test]
-fn bvh_and_linear_scan_find_the_same_hits() {
+fn every_tree_and_layout_renders_what_the_scan_renders() {
     let seed = treelet_tests::fresh_seed();
-    let scene = random_scene("random:400", 400, seed);
-    let none = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::None));
-    let bvh = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Lbvh));
-    assert_eq!(mismatch_fraction(&none, &bvh, 1e-6), 0.0, "BVH traversal missed or invented hits");
-    let trbvh = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Trbvh));
-    assert_eq!(mismatch_fraction(&none, &trbvh, 1e-6), 0.0, "optimized BVH traversal missed or invented hits");
-    let sweep = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::Sweep));
-    assert_eq!(mismatch_fraction(&none, &sweep, 1e-6), 0.0, "sweep BVH traversal missed or invented hits");
-    // Triangles and spheres in one tree.
-    let scene = mesh();
-    let none = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, Accel::None));
-    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
-        let tree = pixels(&mut CpuBackend::new(), &scene, &settings(40, 30, 8, seed as u32, accel));
-        assert_eq!(mismatch_fraction(&none, &tree, 1e-6), 0.0, "{accel:?} traversal of a mesh missed or invented hits");
+    // Spheres alone, then triangles and spheres in one tree.
+    for scene in [random_scene("random:400", 400, seed), mesh()] {
+        let s = |accel| settings(40, 30, 8, seed as u32, accel);
+        let none = pixels(&mut CpuBackend::new(), &scene, &s(Accel::None));
+        assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{}: NaN or negative pixels", scene.name);
+        for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+            for layout in Layout::ALL {
+                let tree = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { layout, ..s(accel) });
+                assert_eq!(
+                    mismatch_fraction(&none, &tree, 1e-6),
+                    0.0,
+                    "{}: {accel:?} traversal in the {} layout missed or invented hits",
+                    scene.name,
+                    layout.name()
+                );
+            }
+        }
     }
-    assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "NaN or negative pixels in the mesh scene");
 }
 
 #[test]
@@ -145,19 +148,17 @@ fn render_rejects_bad_settings() {
     assert!(e.to_string().contains("reference image is 3x3"), "{e}");
 }
 
-/// The ray-casting benchmark's kernel: primary and diffuse rays through the
-/// TRBVH of a mesh scene, GPU against the CPU run of the same kernel.
+/// The ray-casting benchmark's kernels: primary and diffuse rays through the
+/// TRBVH of a mesh scene in each layout (and cwbvh with its stack's top in
+/// workgroup memory), GPU against the CPU run of the same kernel.
 #[test]
-fn cast_kernel_matches_cpu() {
+fn cast_kernels_match_cpu() {
     use treelet::kernels::Kernel;
-    use treelet::lbvh::upload_or_placeholder;
     use treelet::primitives::Primitives;
     use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
-    fn cast<B: Backend>(b: &mut B, scene: &Scene, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
+    fn cast<B: Backend>(b: &mut B, scene: &Scene, layout: Layout, kernel: Kernel, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
         let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
-        let (nodes, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh).unwrap();
-        let spheres = upload_or_placeholder(b, "spheres", &scene.spheres).unwrap();
-        let triangles = upload_or_placeholder(b, "triangles", &scene.triangles).unwrap();
+        let (tree, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh, layout).unwrap();
         let materials = b.upload("materials", &scene.materials).unwrap();
         let rays = b.zeroed("rays", (w * h) as u64 * 32).unwrap();
         let base = treelet_core::RenderParams {
@@ -172,28 +173,40 @@ fn cast_kernel_matches_cpu() {
         };
         for mode in [CAST_PRIMARY, CAST_DIFFUSE] {
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, ..base }]).unwrap();
-            let bindings = [&p, &spheres, &materials, &nodes, &prims, &rays, &triangles];
-            b.dispatch(Kernel::CastBvh, &bindings, (w * h).div_ceil(256));
+            let bindings = [&p, &prims.spheres, &materials, &tree.nodes, &tree.prims, &rays, &prims.triangles];
+            b.dispatch(kernel, &bindings, (w * h).div_ceil(256));
         }
         b.read(&rays, (2 * w * h) as usize).unwrap()
     }
     let scene = mesh();
-    let c = cast(&mut CpuBackend::new(), &scene, (64, 48));
-    let hits = c.iter().step_by(2).filter(|r| r[3] > 0.0).count();
+    let kernels = [
+        (Layout::Classic, Kernel::Cast(treelet::kernels::Method::Classic)),
+        (Layout::Bvh2, Kernel::Cast(treelet::kernels::Method::Bvh2)),
+        (Layout::Cwbvh, Kernel::Cast(treelet::kernels::Method::Cwbvh)),
+        (Layout::Cwbvh, Kernel::CastWideWorkgroupStack),
+    ];
+    let reference = cast(&mut CpuBackend::new(), &scene, Layout::Classic, kernels[0].1, (64, 48));
+    let hits = reference.iter().step_by(2).filter(|r| r[3] > 0.0).count();
     assert!(hits > 64 * 48 / 2, "only {hits} diffuse rays hit");
-    let Some(ctx) = gpu() else { return };
-    let g = cast(&mut GpuBackend::new(ctx), &scene, (64, 48));
-    // Lavapipe does not fuse its `Fma` (the wall intersection's error terms
-    // vanish), so hits on smallpt's 1e5-radius walls land up to ~0.02 units
-    // apart: positions and distances are compared with that allowance.
-    let near = |a: f32, b: f32, abs: f32, rel: f32| (a - b).abs() <= abs + rel * b.abs();
-    let same = |i: usize| {
-        let (go, co, gd, cd) = (g[i], c[i], g[i + 1], c[i + 1]);
-        (0..3).all(|k| near(go[k], co[k], 0.05, 1e-4) && near(gd[k], cd[k], 1e-3, 0.0))
-            && (go[3] > 0.0) == (co[3] > 0.0)
-            && near(go[3], co[3], 0.1, 1e-3)
-    };
-    let agree = (0..g.len()).step_by(2).filter(|&i| same(i)).count();
-    eprintln!("{agree} of {} pixels cast the same diffuse ray to the same hit", 64 * 48);
-    assert!(agree as f64 >= 0.95 * (64 * 48) as f64, "GPU and CPU casts differ: {agree} agree");
+    let ctx = gpu();
+    for (layout, kernel) in kernels {
+        // Every layout finds the same hits on the CPU runner, bit for bit.
+        let c = cast(&mut CpuBackend::new(), &scene, layout, kernel, (64, 48));
+        assert!(c == reference, "{kernel:?}: the CPU runner's casts differ from the classic layout's");
+        let Some(ctx) = &ctx else { continue };
+        let g = cast(&mut GpuBackend::new(ctx.clone()), &scene, layout, kernel, (64, 48));
+        // Lavapipe does not fuse its `Fma` (the wall intersection's error terms
+        // vanish), so hits on smallpt's 1e5-radius walls land up to ~0.02 units
+        // apart: positions and distances are compared with that allowance.
+        let near = |a: f32, b: f32, abs: f32, rel: f32| (a - b).abs() <= abs + rel * b.abs();
+        let same = |i: usize| {
+            let (go, co, gd, cd) = (g[i], c[i], g[i + 1], c[i + 1]);
+            (0..3).all(|k| near(go[k], co[k], 0.05, 1e-4) && near(gd[k], cd[k], 1e-3, 0.0))
+                && (go[3] > 0.0) == (co[3] > 0.0)
+                && near(go[3], co[3], 0.1, 1e-3)
+        };
+        let agree = (0..g.len()).step_by(2).filter(|&i| same(i)).count();
+        eprintln!("{kernel:?}: {agree} of {} pixels cast the same diffuse ray to the same hit", 64 * 48);
+        assert!(agree as f64 >= 0.95 * (64 * 48) as f64, "{kernel:?}: GPU and CPU casts differ: {agree} agree");
+    }
 }

@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
+use treelet::layout::Layout;
 use treelet::render::{render, Accel, RenderResult, RenderSettings};
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU};
@@ -54,7 +55,7 @@ fn scenes(seed: u64) -> Vec<(Scene, &'static str)> {
 }
 
 fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel, seed: u32) -> RenderResult {
-    let s = RenderSettings { width: 40, height: 30, spp: 8, seed, accel, kernel };
+    let s = RenderSettings { width: 40, height: 30, spp: 8, seed, accel, layout: Layout::Auto, kernel };
     render(b, scene, &s, None, |_| {}).unwrap()
 }
 
@@ -100,7 +101,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, Accel::Auto, kernel, true);
+            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, true);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
             if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
@@ -110,6 +111,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             assert_eq!(p.accel == Accel::None, n <= LINEAR_MAX_CPU, "{}: {n} primitives, {:?}", scene.name, p.accel);
         }
         // Forced choices stay as asked.
-        assert_eq!(plan(&scene, Accel::Sweep, KernelChoice::Auto, false).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, Accel::Sweep, Layout::Auto, KernelChoice::Auto, false).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, Accel::Sweep, Layout::Bvh2, KernelChoice::Auto, false).layout, Layout::Bvh2);
     }
 }

@@ -101,6 +101,49 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
     Vec3::new(inv(d.x), inv(d.y), inv(d.z))
 }
 
+/// Reciprocal of a direction for the branch-free slab tests of the
+/// traversal layouts ([`crate::bvh2`], [`crate::cwbvh`]): an axis the ray
+/// runs parallel to (or too nearly to invert) gets `±f32::MAX`, with the
+/// direction's sign, instead of an infinity. `(plane - origin) * inverse`
+/// then is never NaN (never `0 * inf`), and on such an axis its sign, which
+/// is all the test needs there, is exact: a parallel ray inside the slab
+/// gets an interval reaching from below 0 to above any hit, one outside it
+/// an interval that starts beyond any hit worth having (or a harmless false
+/// accept for slabs within `t_max / f32::MAX` of it).
+#[inline]
+pub fn finite_inverse(d: Vec3) -> [f32; 3] {
+    let inv = |x: f32| {
+        let r = 1.0 / x;
+        if r.abs() <= f32::MAX {
+            r
+        } else {
+            f32::from_bits((x.to_bits() & 0x8000_0000) | f32::MAX.to_bits())
+        }
+    };
+    [inv(d.x), inv(d.y), inv(d.z)]
+}
+
+/// How much a slab test widens its far distance (Ize, "Robust BVH Ray
+/// Traversal", 2013: `1 + 2γ(3)`, three roundings of `(plane - o) * inv`),
+/// so that rounding never culls a box the ray touches.
+pub const FAR_WIDENING: f32 = 1.000_000_4;
+
+/// The interval `[near, far]` (far widened by [`FAR_WIDENING`]) over which
+/// the ray `o + t / inv` is inside the box `lo..hi`, clipped to
+/// `0..=t_max`; the ray meets the box where `near <= far`. `inv` comes from
+/// [`finite_inverse`].
+#[inline]
+pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], inv: [f32; 3], t_max: f32) -> (f32, f32) {
+    let t = |k: usize| {
+        let (a, b) = ((lo[k] - o[k]) * inv[k], (hi[k] - o[k]) * inv[k]);
+        (a.min(b), a.max(b))
+    };
+    let ((nx, fx), (ny, fy), (nz, fz)) = (t(0), t(1), t(2));
+    let near = nx.max(ny).max(nz.max(0.0));
+    let far = (fx.min(fy).min(fz) * FAR_WIDENING).min(t_max);
+    (near, far)
+}
+
 /// Slab test of a node's box against a ray, hits between 0 and `t_max`.
 /// An axis the ray runs parallel to (zero in `inv_d`) admits every `t` when
 /// the origin lies within the slab, boundaries included, and none otherwise.
@@ -121,7 +164,7 @@ pub fn ray_box(node: &Node, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
             let t1 = (lo[k] - o[k]) * inv_d[k];
             let t2 = (hi[k] - o[k]) * inv_d[k];
             near = near.max(t1.min(t2));
-            far = far.min(t1.max(t2) * 1.000_000_4);
+            far = far.min(t1.max(t2) * FAR_WIDENING);
         }
     }
     near <= far

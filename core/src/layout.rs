@@ -220,3 +220,103 @@ pub struct TreeletParams {
     pub _pad: [u32; 2],
 }
 const _: () = assert!(core::mem::size_of::<TreeletParams>() == 48);
+
+/// A primitive stored where its leaf reads it (the traversal layouts
+/// [`Bvh2Node`] and [`WideNode`] keep primitives in leaf order, so a leaf
+/// reads them directly instead of through an index). repr(C), Pod, 48 bytes:
+/// a triangle's three vertices as the watertight test reads them
+/// ([`crate::triangle::Triangle`]'s rows), or a sphere's centre in `p0` and
+/// radius in `p1[0]`; `prim` is the primitive's index in the scene
+/// (spheres first, then triangles), which decides its kind, material and
+/// the tie-break between equal hit distances.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct LeafPrim {
+    pub p0: [f32; 3],
+    pub prim: u32,
+    pub p1: [f32; 3],
+    pub _pad1: u32,
+    pub p2: [f32; 3],
+    pub _pad2: u32,
+}
+const _: () = assert!(core::mem::size_of::<LeafPrim>() == 48);
+
+/// A binary node holding both children's boxes (Aila & Laine 2009), so a
+/// ray tests both children with the one load that reached their parent.
+/// repr(C), Pod, 64 bytes.
+///
+/// A child with a count of 0 is the internal node of that index; a child
+/// with a count `c > 0` is a leaf of the `c` [`LeafPrim`]s from its index on.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Bvh2Node {
+    pub left_min: [f32; 3],
+    pub left: u32,
+    pub left_max: [f32; 3],
+    pub right: u32,
+    pub right_min: [f32; 3],
+    pub left_count: u32,
+    pub right_max: [f32; 3],
+    pub right_count: u32,
+}
+const _: () = assert!(core::mem::size_of::<Bvh2Node>() == 64);
+
+/// A node of the compressed 8-wide BVH (Ylitie, Karras & Laine 2017,
+/// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+/// BVHs"). repr(C), Pod, 80 bytes.
+///
+/// Child boxes are 8-bit offsets on a grid of the node's own: child `j`'s
+/// box on axis `k` spans `origin[k] + q * 2^(e[k] - 127)` for its `q_lo` and
+/// `q_hi` bytes, rounded outwards so that it contains the exact box (see
+/// [`crate::cwbvh`]). Byte `j` of a `[u32; 2]` field is child `j`'s.
+///
+/// * `exp_imask`: bytes 0..3 the biased exponents `e` of x, y, z; byte 3
+///   the mask of children that are internal nodes;
+/// * `child_base`: index of the first internal child (internal children
+///   are contiguous, in slot order); `prim_base`: index of the first
+///   [`LeafPrim`] of the leaf children (contiguous too);
+/// * `meta`, per child: 0 for an empty slot; `0b001_11xxx` (24 + slot) for
+///   an internal child; for a leaf of `c <= 3` primitives, `c` ones in the
+///   top three bits and the offset of its first primitive from `prim_base`
+///   in the low five.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct WideNode {
+    pub origin: [f32; 3],
+    pub exp_imask: u32,
+    pub child_base: u32,
+    pub prim_base: u32,
+    pub meta: [u32; 2],
+    pub lo_x: [u32; 2],
+    pub lo_y: [u32; 2],
+    pub lo_z: [u32; 2],
+    pub hi_x: [u32; 2],
+    pub hi_y: [u32; 2],
+    pub hi_z: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<WideNode>() == 80);
+
+/// Parameters of the traversal-layout kernels ([`crate::bvh2`],
+/// [`crate::cwbvh_build`]). repr(C), Pod, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct LayoutParams {
+    /// Primitives (leaves of the binary tree).
+    pub n: u32,
+    /// Nodes of the binary tree the layout is made from.
+    pub nodes: u32,
+    /// How many primitives are spheres (the rest are triangles).
+    pub spheres: u32,
+    pub _pad0: u32,
+    /// SAH cost per wide node and per primitive (per unit area).
+    pub node_cost: f32,
+    pub prim_cost: f32,
+    /// Boxes are scaled by this before taking areas.
+    pub inv_extent: f32,
+    pub _pad1: u32,
+}
+const _: () = assert!(core::mem::size_of::<LayoutParams>() == 32);

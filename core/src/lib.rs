@@ -41,7 +41,10 @@
 pub mod aabb;
 pub mod atomics;
 pub mod bounds;
+pub mod bvh2;
 pub mod collapse;
+pub mod cwbvh;
+pub mod cwbvh_build;
 pub mod features;
 pub mod fill;
 pub mod fit;
@@ -65,6 +68,7 @@ pub mod workgroup;
 
 pub use aabb::Aabb;
 pub use layout::{
-    BuildParams, Camera, FillParams, Material, Node, RenderParams, ScanParams, SortParams, Sphere, INVALID, LEAF_BIT,
+    BuildParams, Bvh2Node, Camera, FillParams, LayoutParams, LeafPrim, Material, Node, RenderParams, ScanParams,
+    SortParams, Sphere, WideNode, INVALID, LEAF_BIT,
 };
 pub use workgroup::WORKGROUP_SIZE;

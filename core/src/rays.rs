@@ -8,7 +8,7 @@ use crate::layout::RenderParams;
 use crate::features;
 use crate::render::{closest_hit, cosine_direction, hit_normal, surface_offset, SceneRefs};
 use crate::rng::BounceRng;
-use crate::traverse::Origin;
+use crate::traverse::{ClosestHit, Origin};
 
 /// [`RenderParams::cast_mode`]: camera rays, which leave the diffuse rays.
 pub const CAST_PRIMARY: u32 = 0;
@@ -19,7 +19,14 @@ pub const CAST_DIFFUSE: u32 = 1;
 /// `rays[2 id]` = (origin, 1 if a ray is to be cast, else 0) and
 /// `rays[2 id + 1]` = (direction, bits of the primitive it leaves) for the
 /// diffuse pass; the diffuse pass writes its hit distance into the last.
-pub fn cast_kernel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &SceneRefs, rays: &mut [[f32; 4]]) {
+pub fn cast_kernel<T: ClosestHit, const S: usize>(
+    id: u32,
+    params: &RenderParams,
+    scene: &SceneRefs<T>,
+    rays: &mut [[f32; 4]],
+    stack: &mut [u32; S],
+    lane: u32,
+) {
     let (w, h) = (params.width, params.height);
     if id >= w * h {
         return;
@@ -28,7 +35,7 @@ pub fn cast_kernel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &Sce
     if params.cast_mode == CAST_PRIMARY {
         let rng = BounceRng::new(params.seed, id, params.first_sample, 0);
         let (o, d) = params.camera.primary_ray(id % w, h - 1 - id / w, 0, w, h, &rng);
-        let hit = closest_hit::<ACCEL, { features::ALL }>(o, d, Origin::NONE, scene);
+        let hit = closest_hit::<T, { features::ALL }, S>(o, d, Origin::NONE, scene, stack, lane);
         if !hit.is_hit() {
             rays[i] = [0.0; 4];
             return;
@@ -46,7 +53,7 @@ pub fn cast_kernel<const ACCEL: u32>(id: u32, params: &RenderParams, scene: &Sce
         let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
         let prim = rays[j][3].to_bits();
         // Leaving the surface outwards: it cannot be hit again.
-        let hit = closest_hit::<ACCEL, { features::ALL }>(o, d, Origin { prim, into: false }, scene);
+        let hit = closest_hit::<T, { features::ALL }, S>(o, d, Origin { prim, into: false }, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
 }

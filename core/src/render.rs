@@ -20,11 +20,11 @@
 //! Random numbers are counter-based ([`crate::rng`]).
 use glam::Vec3;
 
-use crate::layout::{Camera, Material, Node, RenderParams, Sphere, DIFFUSE, MIRROR};
+use crate::layout::{Camera, Material, RenderParams, Sphere, DIFFUSE, MIRROR};
 use crate::triangle::Triangle;
 use crate::rng::BounceRng;
 use crate::features::{self, has};
-use crate::traverse::{closest_hit_bvh_for, closest_hit_linear_for, Hit, Origin, Prims};
+use crate::traverse::{ClosestHit, Hit, Origin, Prims};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
@@ -109,64 +109,59 @@ pub fn cosine_direction(w: Vec3, u1: f32, u2: f32) -> Vec3 {
     (u * cos * r2s + v * sin * r2s + w * libm::sqrtf(1.0 - u2)).normalize()
 }
 
-/// Which closest-hit search a kernel uses.
-pub const ACCEL_NONE: u32 = 0;
-pub const ACCEL_BVH: u32 = 1;
-
-/// Scene buffers of a render.
-pub struct SceneRefs<'a> {
+/// Scene buffers of a render, and the way closest hits are found in them
+/// (the scan or a tree in one of the traversal layouts: see
+/// [`ClosestHit`]).
+pub struct SceneRefs<'a, T> {
     /// Spheres then triangles; one material per primitive, in that order.
     pub prims: Prims<'a>,
     pub materials: &'a [Material],
-    pub nodes: &'a [Node],
-    pub prim_indices: &'a [u32],
+    pub tree: T,
 }
 
-impl<'a> SceneRefs<'a> {
+impl<'a, T: ClosestHit> SceneRefs<'a, T> {
     /// The scene the render and cast kernels see: their bindings, with the
     /// primitive counts from `params` (buffers may be longer than their content).
     #[inline]
-    pub fn new(
-        params: &RenderParams,
-        spheres: &'a [Sphere],
-        triangles: &'a [Triangle],
-        materials: &'a [Material],
-        nodes: &'a [Node],
-        prim_indices: &'a [u32],
-    ) -> Self {
+    pub fn new(params: &RenderParams, spheres: &'a [Sphere], triangles: &'a [Triangle], materials: &'a [Material], tree: T) -> Self {
         let prims = Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
-        SceneRefs { prims, materials, nodes, prim_indices }
+        SceneRefs { prims, materials, tree }
     }
 }
 
-/// The closest hit by the scan (`ACCEL_NONE`) or the tree (`ACCEL_BVH`),
-/// testing the primitive kinds of `F` (see [`crate::features`]).
+/// The closest hit, testing the primitive kinds of `F` (see [`crate::features`]).
 #[inline]
-pub fn closest_hit<const ACCEL: u32, const F: u32>(o: Vec3, d: Vec3, from: Origin, scene: &SceneRefs) -> Hit {
-    if ACCEL == ACCEL_BVH {
-        closest_hit_bvh_for::<F>(o, d, from, &scene.prims, scene.nodes, scene.prim_indices)
-    } else {
-        closest_hit_linear_for::<F>(o, d, from, &scene.prims)
-    }
+pub fn closest_hit<T: ClosestHit, const F: u32, const S: usize>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    scene: &SceneRefs<T>,
+    stack: &mut [u32; S],
+    lane: u32,
+) -> Hit {
+    scene.tree.closest_hit::<F, S>(o, d, from, &scene.prims, stack, lane)
 }
 
 /// Radiance along one path (smallpt's `radiance`, as a loop), with the
 /// code for the features `F` only (see [`crate::features`]).
 #[inline]
-pub fn radiance<const ACCEL: u32, const F: u32>(
+#[allow(clippy::too_many_arguments)]
+pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     mut o: Vec3,
     mut d: Vec3,
     params: &RenderParams,
     pixel: u32,
     sample: u32,
-    scene: &SceneRefs,
+    scene: &SceneRefs<T>,
+    stack: &mut [u32; S],
+    lane: u32,
 ) -> Vec3 {
     let mut result = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut depth = 0u32;
     let mut from = Origin::NONE;
     while depth < MAX_BOUNCES {
-        let hit = closest_hit::<ACCEL, F>(o, d, from, scene);
+        let hit = closest_hit::<T, F, S>(o, d, from, scene, stack, lane);
         if !hit.is_hit() {
             break;
         }
@@ -264,7 +259,13 @@ pub fn hit_normal_for<const F: u32>(prims: &Prims, prim: u32, x: Vec3, d: Vec3) 
 /// features compiled in (see [`crate::features`]); the scene's must be
 /// among them.
 #[inline]
-pub fn render_pixel<const ACCEL: u32, const F: u32>(id: u32, params: &RenderParams, scene: &SceneRefs) -> [f32; 4] {
+pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
+    id: u32,
+    params: &RenderParams,
+    scene: &SceneRefs<T>,
+    stack: &mut [u32; S],
+    lane: u32,
+) -> [f32; 4] {
     let (w, h) = (params.width, params.height);
     let (x, y) = (id % w, h - 1 - id / w);
     let mut sum = Vec3::ZERO;
@@ -274,7 +275,7 @@ pub fn render_pixel<const ACCEL: u32, const F: u32>(id: u32, params: &RenderPara
         let sample = params.first_sample + s;
         let rng = BounceRng::new(params.seed, id, sample, 0);
         let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
-        let l = radiance::<ACCEL, F>(o, d, params, id, sample, scene);
+        let l = radiance::<T, F, S>(o, d, params, id, sample, scene, stack, lane);
         sum += l;
         let lum = luminance(l);
         sum_sq += lum * lum;

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use crate::features::{self, has};
 use crate::intersect::{ray_box, ray_sphere_mode, safe_inverse, MISS};
-use crate::layout::{Node, Sphere};
+use crate::layout::{LeafPrim, Node, Sphere};
 use crate::triangle::{ray_triangle, Triangle, WatertightRay};
 
 /// The primitives rays are traced against (counts given apart from the
@@ -62,6 +62,107 @@ impl<'a> Prims<'a> {
         } else {
             ray_triangle(ray, &self.triangles[(prim - self.sphere_count) as usize], t_max)
         }
+    }
+}
+
+impl Prims<'_> {
+    /// Distance to a primitive stored in leaf order ([`LeafPrim`]), as
+    /// [`Prims::distance`] finds it from the scene's own arrays: the same
+    /// tests on the same numbers.
+    #[inline]
+    pub fn leaf_distance<const F: u32>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        ray: &WatertightRay,
+        from: Origin,
+        leaf: &LeafPrim,
+        t_max: f32,
+    ) -> f32 {
+        let prim = leaf.prim;
+        if self.is_sphere::<F>(prim) {
+            from.distance(o, d, &Sphere::new(leaf.p0, leaf.p1[0]), prim)
+        } else if prim == from.prim {
+            MISS
+        } else {
+            ray_triangle(ray, &Triangle::new(leaf.p0, leaf.p1, leaf.p2), t_max)
+        }
+    }
+
+    /// Primitive `prim` as its leaf stores it.
+    #[inline]
+    pub fn leaf_prim(&self, prim: u32) -> LeafPrim {
+        if prim < self.sphere_count {
+            let s = self.spheres[prim as usize];
+            LeafPrim { p0: s.center, prim, p1: [s.radius, 0.0, 0.0], ..Default::default() }
+        } else {
+            let t = self.triangles[(prim - self.sphere_count) as usize];
+            LeafPrim { p0: t.v0, prim, p1: t.v1, p2: t.v2, ..Default::default() }
+        }
+    }
+}
+
+/// A way to find closest hits: the scan, or a tree in one of the traversal
+/// layouts (the seed's 32-byte nodes here; [`crate::bvh2`],
+/// [`crate::cwbvh`]). The renderer and the ray-casting kernels are generic
+/// over it, so each layout gets kernels of its own.
+pub trait ClosestHit {
+    /// The closest hit of the ray `o + t d` (`d` of unit length) among the
+    /// primitives, ties to the lower index; `F` (see [`crate::features`])
+    /// may leave out the test of a kind the scene lacks. `stack` is
+    /// workgroup memory a traversal may keep the top of its stack in, at
+    /// `lane + WG * k` (see [`crate::cwbvh::closest_hit_cwbvh_with`]); a
+    /// one-word array means none.
+    fn closest_hit<const F: u32, const S: usize>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        from: Origin,
+        prims: &Prims,
+        stack: &mut [u32; S],
+        lane: u32,
+    ) -> Hit;
+}
+
+/// Every primitive tested: no tree. (Not zero-sized: rust-gpu cannot take
+/// the address of a zero-sized field.)
+pub struct Scan {
+    _unused: u32,
+}
+
+impl Scan {
+    /// The scan, from the bindings a tree would have (which it ignores).
+    #[inline]
+    pub fn new(_nodes: &[Node], _prim_indices: &[u32]) -> Self {
+        Scan { _unused: 0 }
+    }
+}
+
+impl ClosestHit for Scan {
+    #[inline]
+    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        closest_hit_linear_for::<F>(o, d, from, prims)
+    }
+}
+
+/// The seed's layout: 32-byte nodes that hold their own box, leaves that
+/// name their primitives through `prim_indices`.
+pub struct ClassicTree<'a> {
+    pub nodes: &'a [Node],
+    pub prim_indices: &'a [u32],
+}
+
+impl<'a> ClassicTree<'a> {
+    #[inline]
+    pub fn new(nodes: &'a [Node], prim_indices: &'a [u32]) -> Self {
+        ClassicTree { nodes, prim_indices }
+    }
+}
+
+impl ClosestHit for ClassicTree<'_> {
+    #[inline]
+    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        closest_hit_bvh_for::<F>(o, d, from, prims, self.nodes, self.prim_indices)
     }
 }
 

@@ -5,6 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use treelet::backend::{Backend, StageTimes};
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
+use treelet::layout::Layout;
 use treelet::lbvh;
 use treelet::render::{render, Accel, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
@@ -100,6 +101,12 @@ pub enum BenchCommand {
         scene: String,
         #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![Accel::Lbvh, Accel::Trbvh])]
         accels: Vec<Accel>,
+        /// Traversal layouts of each tree.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = Layout::ALL.to_vec())]
+        layouts: Vec<Layout>,
+        /// Also time cwbvh with the top of each ray's stack in workgroup memory.
+        #[arg(long)]
+        workgroup_stack: bool,
         #[arg(long, default_value_t = 1024)]
         width: u32,
         #[arg(long, default_value_t = 768)]
@@ -190,6 +197,7 @@ fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&Treele
 pub(crate) struct RenderRow {
     pub(crate) scene: String,
     pub(crate) accel: Accel,
+    pub(crate) layout: Layout,
     /// The render kernel variant that ran.
     pub(crate) kernel: &'static str,
     pub(crate) width: u32,
@@ -212,24 +220,24 @@ pub(crate) fn bench_render<B: Backend>(
     spp: u32,
     accel: Accel,
 ) -> Result<RenderRow> {
-    bench_render_kernel(b, scene, width, height, spp, accel, KernelChoice::Auto)
+    bench_render_kernel(b, scene, (width, height, spp), accel, Layout::Auto, KernelChoice::Auto)
 }
 
 pub(crate) fn bench_render_kernel<B: Backend>(
     b: &mut B,
     scene: &Scene,
-    width: u32,
-    height: u32,
-    spp: u32,
+    (width, height, spp): (u32, u32, u32),
     accel: Accel,
+    layout: Layout,
     kernel: KernelChoice,
 ) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel, kernel };
+    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
     Ok(RenderRow {
         scene: scene.name.clone(),
         accel: r.plan.accel,
+        layout: r.plan.layout,
         kernel: r.plan.kernel,
         width,
         height,
@@ -274,7 +282,7 @@ fn bench_variants<B: Backend>(
         // of each warms pipelines and clocks.
         for r in 0..=repeats {
             for (choice, times) in [(KernelChoice::Auto, &mut auto), (KernelChoice::Full, &mut full)] {
-                let row = bench_render_kernel(b, &scene, width, height, spp, Accel::Auto, choice)?;
+                let row = bench_render_kernel(b, &scene, (width, height, spp), Accel::Auto, Layout::Auto, choice)?;
                 if choice == KernelChoice::Auto {
                     (accel, kernel) = (row.accel, row.kernel);
                 }
@@ -285,7 +293,7 @@ fn bench_variants<B: Backend>(
             }
         }
         let entry = |name: &str| {
-            let method = if accel == Accel::None { "linear" } else { "bvh" };
+            let method = if accel == Accel::None { "linear" } else { Layout::Auto.method().name() };
             (b.device_kind() == "gpu")
                 .then(|| treelet::gpu::context::entry_point_words(&format!("render::render_{method}_{name}_cs")))
                 .flatten()
@@ -437,8 +445,14 @@ pub(crate) fn bench_sizes<B: Backend>(
 pub(crate) struct RaysRow {
     pub(crate) scene: String,
     pub(crate) accel: Accel,
+    pub(crate) layout: Layout,
+    /// Where the traversal stack lives: "private" or "workgroup".
+    pub(crate) stack: &'static str,
     pub(crate) primitives: usize,
+    /// The binary tree's build (ms).
     pub(crate) build_ms: f64,
+    /// Its layout for traversal (ms, collapse included).
+    pub(crate) layout_ms: f64,
     pub(crate) primary_rays: u64,
     pub(crate) diffuse_rays: u64,
     pub(crate) primary_median_ms: f64,
@@ -447,17 +461,25 @@ pub(crate) struct RaysRow {
     pub(crate) diffuse_mrays_per_s: f64,
 }
 
+/// What `bench rays` times through one tree: its layouts, each with its
+/// stacks (the workgroup-memory stack exists for cwbvh only).
+pub(crate) struct RaysPlan {
+    pub(crate) layouts: Vec<Layout>,
+    pub(crate) workgroup_stack: bool,
+}
+
+/// Rays per second through the tree `accel` builds, in each layout of `plan`.
 pub(crate) fn bench_rays<B: Backend>(
     b: &mut B,
     scene: &Scene,
     accel: Accel,
+    plan: &RaysPlan,
     (width, height): (u32, u32),
     repeats: usize,
-) -> Result<RaysRow> {
+) -> Result<Vec<RaysRow>> {
     use treelet::kernels::Kernel;
+    use treelet::layout::PrimBuffers;
     use treelet::primitives::Primitives;
-    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
-    use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
     anyhow::ensure!(
         !matches!(accel, Accel::None | Accel::Auto),
         "bench rays traces trees: pick lbvh, trbvh or sweep (not {accel:?})"
@@ -466,24 +488,66 @@ pub(crate) fn bench_rays<B: Backend>(
     all.check()?;
     let pixels = width as u64 * height as u64;
     anyhow::ensure!(pixels > 0 && pixels <= u32::MAX as u64 / 4, "image size {width}x{height} out of range");
-    b.begin_build();
-    let (nodes, prim_indices, build_ms) = treelet::render::scene_tree(b, all, accel)?;
-    b.take_times()?;
-    let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
-    let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
+    let Some(built) = treelet::render::binary_tree(b, all, accel)? else { unreachable!("a tree was asked for") };
+    let buffers = PrimBuffers::upload(b, all)?;
     let materials = b.upload("materials", &scene.materials)?;
     let rays = b.zeroed("rays", pixels * 32)?;
-    let camera = scene.camera.camera(width, height);
+    b.take_times()?;
+    let mut rows = Vec::new();
+    for &layout in &plan.layouts {
+        let layout = layout.resolve();
+        let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
+        let mut kernels = vec![("private", Kernel::Cast(layout.method()))];
+        if plan.workgroup_stack && layout == Layout::Cwbvh {
+            kernels.push(("workgroup", Kernel::CastWideWorkgroupStack));
+        }
+        for (stack, kernel) in kernels {
+            let bindings = [&buffers.spheres, &materials, &tree.nodes, &tree.prims, &rays, &buffers.triangles];
+            let (primary_ms, diffuse_ms, diffuse_rays) = time_casts(b, scene, kernel, &bindings, (width, height), repeats)?;
+            rows.push(RaysRow {
+                scene: scene.name.clone(),
+                accel,
+                layout,
+                stack,
+                primitives: all.len(),
+                build_ms: built.build_ms,
+                layout_ms,
+                primary_rays: pixels,
+                diffuse_rays,
+                primary_median_ms: primary_ms,
+                diffuse_median_ms: diffuse_ms,
+                primary_mrays_per_s: pixels as f64 / primary_ms / 1e3,
+                diffuse_mrays_per_s: diffuse_rays as f64 / diffuse_ms / 1e3,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Median kernel times (ms) of the primary and the diffuse pass of `kernel`
+/// (bindings 1.. as the cast kernels take them), and the number of diffuse
+/// rays (pixels whose camera ray hit).
+fn time_casts<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    kernel: treelet::kernels::Kernel,
+    bindings: &[&B::Buffer; 6],
+    (width, height): (u32, u32),
+    repeats: usize,
+) -> Result<(f64, f64, u64)> {
+    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+    let pixels = width * height;
     let base = treelet_core::RenderParams {
         width,
         height,
         samples: 1,
         prims: scene.spheres.len() as u32,
         triangles: scene.triangles.len() as u32,
-        camera,
+        camera: scene.camera.camera(width, height),
         ..Default::default()
     };
-    let groups = groups_for(pixels as u32, WORKGROUP_SIZE);
+    let groups = groups_for(pixels, WORKGROUP_SIZE);
     let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,
@@ -497,13 +561,13 @@ pub(crate) fn bench_rays<B: Backend>(
         for (stage, mode) in [("primary", CAST_PRIMARY), ("diffuse", CAST_DIFFUSE)] {
             b.stage(stage);
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
-            b.dispatch(Kernel::CastBvh, &[&p, &spheres, &materials, &nodes, &prim_indices, &rays, &triangles], groups);
+            let [spheres, materials, nodes, prims, rays, triangles] = *bindings;
+            b.dispatch(kernel, &[&p, spheres, materials, nodes, prims, rays, triangles], groups);
         }
         let t = b.take_times()?;
         if r == 0 {
-            // Count the diffuse rays (pixels whose camera ray hit).
-            let r: Vec<[f32; 4]> = b.read(&rays, 2 * pixels as usize)?;
-            diffuse_rays = r.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
+            let rays: Vec<[f32; 4]> = b.read(bindings[4], 2 * pixels as usize)?;
+            diffuse_rays = rays.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
         }
         if r == warm_passes {
             if warm.elapsed().as_secs_f64() < 0.5 {
@@ -514,50 +578,45 @@ pub(crate) fn bench_rays<B: Backend>(
         primary.push(t.get("primary"));
         diffuse.push(t.get("diffuse"));
     }
-    let (p_ms, d_ms) = (median(primary), median(diffuse));
-    Ok(RaysRow {
-        scene: scene.name.clone(),
-        accel,
-        primitives: all.len(),
-        build_ms,
-        primary_rays: pixels,
-        diffuse_rays,
-        primary_median_ms: p_ms,
-        diffuse_median_ms: d_ms,
-        primary_mrays_per_s: pixels as f64 / p_ms / 1e3,
-        diffuse_mrays_per_s: diffuse_rays as f64 / d_ms / 1e3,
-    })
+    Ok((median(primary), median(diffuse), diffuse_rays))
 }
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
-        BenchCommand::Rays { scene, accels, width, height, device, repeats, mesh_only, json } => {
+        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, json } => {
             let scene = Scene::from_spec(&scene)?;
             let scene = if mesh_only { scene.mesh_only()? } else { scene };
+            let plan = RaysPlan { layouts, workgroup_stack };
             let mut rows = Vec::new();
             let adapter = match device {
                 Device::Gpu => {
                     let mut b = GpuBackend::new(GpuContext::new()?);
                     for &a in &accels {
-                        rows.push(bench_rays(&mut b, &scene, a, (width, height), repeats)?);
+                        rows.extend(bench_rays(&mut b, &scene, a, &plan, (width, height), repeats)?);
                     }
                     b.adapter()
                 }
                 Device::Cpu => {
                     let mut b = CpuBackend::new();
                     for &a in &accels {
-                        rows.push(bench_rays(&mut b, &scene, a, (width, height), repeats)?);
+                        rows.extend(bench_rays(&mut b, &scene, a, &plan, (width, height), repeats)?);
                     }
                     b.adapter()
                 }
             };
             println!("rays per second, {} ({} primitives), {width}x{height}, {adapter}, median of {repeats}", scene.name, rows.first().map_or(0, |r| r.primitives));
-            println!("{:>6}{:>12}{:>14}{:>14}{:>16}{:>16}", "accel", "build ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s");
+            println!(
+                "{:>6}{:>8}{:>10}{:>11}{:>11}{:>12}{:>12}{:>16}{:>16}",
+                "accel", "layout", "stack", "build ms", "layout ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s"
+            );
             for r in &rows {
                 println!(
-                    "{:>6}{:>12.3}{:>14.3}{:>14.3}{:>16.1}{:>16.1}",
+                    "{:>6}{:>8}{:>10}{:>11.3}{:>11.3}{:>12.3}{:>12.3}{:>16.1}{:>16.1}",
                     format!("{:?}", r.accel).to_lowercase(),
+                    r.layout.name(),
+                    r.stack,
                     r.build_ms,
+                    r.layout_ms,
                     r.primary_median_ms,
                     r.diffuse_median_ms,
                     r.primary_mrays_per_s,

@@ -13,12 +13,16 @@ use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::aabb::Aabb;
 use treelet_core::features::VARIANTS;
-use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
+use treelet_core::bvh2::Bvh2Tree;
+use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
+use treelet_core::render::{accumulate, render_pixel, SceneRefs};
+use treelet_core::traverse::{ClassicTree, ClosestHit, Scan};
+use treelet_core::{bvh2, cwbvh_build};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
 
 use crate::backend::{Backend, StageTimes};
-use crate::kernels::Kernel;
+use crate::kernels::{Kernel, Method};
 
 /// A CPU buffer: 8-byte words, so that any Pod type of alignment ≤ 8 views it.
 pub type CpuBuffer = Rc<RefCell<Vec<u64>>>;
@@ -66,15 +70,33 @@ fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
 }
 
 /// `render_pixel` compiled for `VARIANTS[v]`, as the shader's entry points are.
-fn render_variant<const ACCEL: u32>(v: u8, id: u32, p: &treelet_core::RenderParams, scene: &SceneRefs) -> [f32; 4] {
+fn render_variant<T: ClosestHit>(v: u8, id: u32, p: &treelet_core::RenderParams, scene: &SceneRefs<T>) -> [f32; 4] {
     const _: () = assert!(VARIANTS.len() == 6, "one arm per variant");
+    let stack = &mut [0u32; 1];
     match v {
-        0 => render_pixel::<ACCEL, { VARIANTS[0].0 }>(id, p, scene),
-        1 => render_pixel::<ACCEL, { VARIANTS[1].0 }>(id, p, scene),
-        2 => render_pixel::<ACCEL, { VARIANTS[2].0 }>(id, p, scene),
-        3 => render_pixel::<ACCEL, { VARIANTS[3].0 }>(id, p, scene),
-        4 => render_pixel::<ACCEL, { VARIANTS[4].0 }>(id, p, scene),
-        _ => render_pixel::<ACCEL, { VARIANTS[5].0 }>(id, p, scene),
+        0 => render_pixel::<T, { VARIANTS[0].0 }, 1>(id, p, scene, stack, 0),
+        1 => render_pixel::<T, { VARIANTS[1].0 }, 1>(id, p, scene, stack, 0),
+        2 => render_pixel::<T, { VARIANTS[2].0 }, 1>(id, p, scene, stack, 0),
+        3 => render_pixel::<T, { VARIANTS[3].0 }, 1>(id, p, scene, stack, 0),
+        4 => render_pixel::<T, { VARIANTS[4].0 }, 1>(id, p, scene, stack, 0),
+        _ => render_pixel::<T, { VARIANTS[5].0 }, 1>(id, p, scene, stack, 0),
+    }
+}
+
+/// Every pixel of a render dispatch (pixels are independent: the one
+/// kernel the CPU runs in parallel).
+fn render_all<T: ClosestHit + Sync>(v: u8, p: &treelet_core::RenderParams, scene: &SceneRefs<T>, accum: &mut [[f32; 4]], groups: u32) {
+    let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
+    accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene)));
+}
+
+/// Every invocation of a cast dispatch, `S` words of workgroup stack each
+/// (one invocation at a time: each gets the whole array as its own).
+fn cast_all<T: ClosestHit, const S: usize>(p: &treelet_core::RenderParams, scene: &SceneRefs<T>, rays: &mut [[f32; 4]], groups: u32) {
+    let mut stack = vec![0u32; S];
+    let stack: &mut [u32; S] = stack.as_mut_slice().try_into().unwrap();
+    for id in ids(groups) {
+        treelet_core::rays::cast_kernel(id, p, scene, rays, stack, id % WORKGROUP_SIZE);
     }
 }
 
@@ -305,29 +327,111 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             });
         }
-        (Kernel::CastBvh, [p, spheres, materials, nodes, prims, rays, triangles]) => {
-            let p: treelet_core::RenderParams = params(p);
-            let scene = SceneRefs::new(&p, view(spheres), view(triangles), view(materials), view(nodes), view(prims));
-            let rays: &mut [[f32; 4]] = view(rays);
+        (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, parents, out) = (view(nodes), view(parents), view(out));
             for id in ids(groups) {
-                treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, &p, &scene, rays);
+                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
         }
-        (Kernel::RenderLinear(v) | Kernel::RenderBvh(v), [p, spheres, materials, nodes, prims, accum, triangles]) => {
-            // Pixels are independent: the one kernel the CPU runs in parallel.
+        (Kernel::LeafPrims, [p, prim_indices, spheres, triangles, out]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (prim_indices, spheres, triangles, out) = (view(prim_indices), view(spheres), view(triangles), view(out));
+            for id in ids(groups) {
+                bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, triangles, out);
+            }
+        }
+        (Kernel::WideDp | Kernel::WideDpRelaxed, [p, nodes, parents, flags, counts, costs, decisions]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
+            let (counts, costs, decisions) = (view(counts), view(costs), view(decisions));
+            for id in ids(groups) {
+                cwbvh_build::wide_dp_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, decisions);
+            }
+        }
+        (Kernel::WideCount, [p, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, parents, counts, decisions) = (view(nodes), view(parents), view(counts), view(decisions));
+            let (is_wide, child_counts, prim_counts) = (view(is_wide), view(child_counts), view(prim_counts));
+            for id in ids(groups) {
+                cwbvh_build::wide_count_kernel(
+                    id, &p, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts,
+                );
+            }
+        }
+        (Kernel::WidePlace, [p, nodes, decisions, is_wide, child_offsets, positions]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, decisions, is_wide) = (view(nodes), view(decisions), view(is_wide));
+            let (child_offsets, positions) = (view(child_offsets), view(positions));
+            for id in ids(groups) {
+                cwbvh_build::wide_place_kernel(id, &p, nodes, decisions, is_wide, child_offsets, positions);
+            }
+        }
+        (
+            Kernel::WideEmit,
+            [p, nodes, decisions, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles, out_nodes, out_prims],
+        ) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, decisions, is_wide) = (view(nodes), view(decisions), view(is_wide));
+            let (child_offsets, prim_offsets, positions) = (view(child_offsets), view(prim_offsets), view(positions));
+            let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
+            let (out_nodes, out_prims) = (view(out_nodes), view(out_prims));
+            for id in ids(groups) {
+                cwbvh_build::wide_emit_kernel(
+                    id, &p, nodes, decisions, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres,
+                    triangles, out_nodes, out_prims,
+                );
+            }
+        }
+        (
+            Kernel::Cast(_) | Kernel::CastWideWorkgroupStack,
+            [p, spheres, materials, nodes, prims, rays, triangles],
+        ) => {
             let p: treelet_core::RenderParams = params(p);
-            let scene = SceneRefs::new(&p, view(spheres), view(triangles), view(materials), view(nodes), view(prims));
+            let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
+            let rays: &mut [[f32; 4]] = view(rays);
+            match kernel {
+                Kernel::Cast(Method::Classic) => {
+                    let scene = SceneRefs::new(&p, spheres, triangles, materials, ClassicTree::new(view(nodes), view(prims)));
+                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                }
+                Kernel::Cast(Method::Bvh2) => {
+                    let scene = SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view(nodes), view(prims)));
+                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                }
+                Kernel::Cast(Method::Cwbvh) => {
+                    let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                }
+                Kernel::CastWideWorkgroupStack => {
+                    let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                    cast_all::<_, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
+                }
+                _ => panic!("{kernel:?}: no such cast kernel"),
+            }
+        }
+        (Kernel::Render(method, v), [p, spheres, materials, nodes, prims, accum, triangles]) => {
+            let p: treelet_core::RenderParams = params(p);
+            let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
             let accum: &mut [[f32; 4]] = view(accum);
-            let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
-            let bvh = matches!(kernel, Kernel::RenderBvh(_));
-            accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
-                let add = if bvh {
-                    render_variant::<ACCEL_BVH>(v, id as u32, &p, &scene)
-                } else {
-                    render_variant::<ACCEL_NONE>(v, id as u32, &p, &scene)
-                };
-                accumulate(acc, add);
-            });
+            match method {
+                Method::Scan => {
+                    let tree = Scan::new(&[], &[]);
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                }
+                Method::Classic => {
+                    let tree = ClassicTree::new(view(nodes), view(prims));
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                }
+                Method::Bvh2 => {
+                    let tree = Bvh2Tree::new(view(nodes), view(prims));
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                }
+                Method::Cwbvh => {
+                    let tree = WideTree::new(view(nodes), view(prims));
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                }
+            }
         }
         (kernel, b) => panic!("{kernel:?} dispatched with {} bindings", b.len()),
     }

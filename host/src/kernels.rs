@@ -11,14 +11,49 @@ pub enum Access {
 use treelet_core::features::VARIANTS;
 use Access::{Read, ReadWrite};
 
-/// Entry points of the render variants, `[linear, BVH]` per entry of
-/// `VARIANTS`, named from its names as the shader crate's `render_kernel!`
-/// lines are (`render::render_{linear,bvh}_<name>_cs`).
-fn render_entry_points() -> &'static [[String; 2]] {
-    static NAMES: std::sync::OnceLock<Vec<[String; 2]>> = std::sync::OnceLock::new();
-    NAMES.get_or_init(|| {
-        VARIANTS.iter().map(|(_, n)| [format!("render::render_linear_{n}_cs"), format!("render::render_bvh_{n}_cs")]).collect()
-    })
+/// How a render or cast kernel finds closest hits: the scan, or a tree in
+/// one of the traversal layouts (see [`crate::layout::Layout`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Method {
+    Scan,
+    Classic,
+    Bvh2,
+    Cwbvh,
+}
+
+impl Method {
+    /// The name in entry points (`render::render_<name>_<variant>_cs`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Scan => "linear",
+            Method::Classic => "classic",
+            Method::Bvh2 => "bvh2",
+            Method::Cwbvh => "cwbvh",
+        }
+    }
+
+    /// Whether the shader compiles this method for every feature set
+    /// (else only for the general one): the scan and the default tree do;
+    /// the binary layouts, kept for comparison, have the general kernel.
+    pub fn specialized(self) -> bool {
+        matches!(self, Method::Scan | Method::Cwbvh)
+    }
+
+    pub const ALL: [Method; 4] = [Method::Scan, Method::Classic, Method::Bvh2, Method::Cwbvh];
+}
+
+/// Entry point of render kernel `(method, variant)`, named from
+/// `VARIANTS` as the shader crate's `render_kernel!` lines are.
+fn render_entry_point(method: Method, variant: u8) -> &'static str {
+    static NAMES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+    let names = NAMES.get_or_init(|| {
+        Method::ALL
+            .iter()
+            .flat_map(|m| VARIANTS.iter().map(move |(_, v)| format!("render::render_{}_{v}_cs", m.name())))
+            .collect()
+    });
+    let m = Method::ALL.iter().position(|&x| x == method).unwrap();
+    &names[m * VARIANTS.len() + variant as usize]
 }
 
 /// Every compute kernel of Treelet.
@@ -49,17 +84,31 @@ pub enum Kernel {
     TreeletRestructure,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
-    /// Path tracing, closest hit by scanning every primitive, compiled for
-    /// the feature set `treelet_core::features::VARIANTS[i]`.
-    RenderLinear(u8),
-    /// Path tracing, closest hit through the BVH, for `VARIANTS[i]`.
-    RenderBvh(u8),
-    /// Ray-casting throughput through the BVH (primary or diffuse rays).
-    CastBvh,
+    /// The two-box binary layout from a collapsed tree.
+    Bvh2Nodes,
+    /// Primitives in leaf order.
+    LeafPrims,
+    /// The compressed wide BVH: SAH DP over the binary tree (bottom up).
+    WideDp,
+    /// [`Kernel::WideDp`] with relaxed counters, for CPU adapters.
+    WideDpRelaxed,
+    /// The compressed wide BVH: which nodes are wide nodes, their children's counts.
+    WideCount,
+    /// The compressed wide BVH: indices of wide nodes.
+    WidePlace,
+    /// The compressed wide BVH: nodes and leaf primitives.
+    WideEmit,
+    /// Path tracing with a closest-hit method, compiled for the feature set
+    /// `treelet_core::features::VARIANTS[i]` (binary layouts: the general one only).
+    Render(Method, u8),
+    /// Ray-casting throughput (primary or diffuse rays) through a tree.
+    Cast(Method),
+    /// [`Kernel::Cast`] through the wide BVH with the top of the stack in workgroup memory.
+    CastWideWorkgroupStack,
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 19] = [
+    const FIXED: [Kernel; 28] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -78,17 +127,31 @@ impl Kernel {
         Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
         Kernel::Collapse,
-        Kernel::CastBvh,
+        Kernel::Bvh2Nodes,
+        Kernel::LeafPrims,
+        Kernel::WideDp,
+        Kernel::WideDpRelaxed,
+        Kernel::WideCount,
+        Kernel::WidePlace,
+        Kernel::WideEmit,
+        Kernel::Cast(Method::Classic),
+        Kernel::Cast(Method::Bvh2),
+        Kernel::Cast(Method::Cwbvh),
     ];
 
-    /// Every kernel: the fixed ones and each render variant.
+    /// Every kernel: the fixed ones and each render kernel the shader has.
     pub fn all() -> Vec<Kernel> {
-        let variants = 0..VARIANTS.len() as u8;
-        Self::FIXED
-            .into_iter()
-            .chain(variants.clone().map(Kernel::RenderLinear))
-            .chain(variants.map(Kernel::RenderBvh))
-            .collect()
+        let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::features::ALL).unwrap() as u8;
+        let mut all = Self::FIXED.to_vec();
+        all.push(Kernel::CastWideWorkgroupStack);
+        for method in Method::ALL {
+            for v in 0..VARIANTS.len() as u8 {
+                if method.specialized() || v == full {
+                    all.push(Kernel::Render(method, v));
+                }
+            }
+        }
+        all
     }
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
@@ -112,9 +175,19 @@ impl Kernel {
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
             Kernel::Collapse => "treelet::collapse_cs",
-            Kernel::RenderLinear(i) => &render_entry_points()[i as usize][0],
-            Kernel::RenderBvh(i) => &render_entry_points()[i as usize][1],
-            Kernel::CastBvh => "render::cast_bvh_cs",
+            Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
+            Kernel::LeafPrims => "bvh2::leaf_prims_cs",
+            Kernel::WideDp => "cwbvh::wide_dp_cs",
+            Kernel::WideDpRelaxed => "cwbvh::wide_dp_relaxed_cs",
+            Kernel::WideCount => "cwbvh::wide_count_cs",
+            Kernel::WidePlace => "cwbvh::wide_place_cs",
+            Kernel::WideEmit => "cwbvh::wide_emit_cs",
+            Kernel::Render(method, v) => render_entry_point(method, v),
+            Kernel::Cast(Method::Classic) => "render::cast_classic_cs",
+            Kernel::Cast(Method::Bvh2) => "render::cast_bvh2_cs",
+            Kernel::Cast(Method::Cwbvh) => "render::cast_cwbvh_cs",
+            Kernel::Cast(Method::Scan) => panic!("no cast kernel scans"),
+            Kernel::CastWideWorkgroupStack => "render::cast_cwbvh_workgroup_cs",
         }
     }
 
@@ -141,7 +214,15 @@ impl Kernel {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RenderLinear(_) | Kernel::RenderBvh(_) | Kernel::CastBvh => {
+            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
+            Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
+            Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::WideEmit => {
+                &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite]
+            }
+            Kernel::Render(..) | Kernel::Cast(_) | Kernel::CastWideWorkgroupStack => {
                 &[Read, Read, Read, Read, Read, ReadWrite, Read]
             }
         }

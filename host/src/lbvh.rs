@@ -30,7 +30,8 @@ pub struct Bvh {
     pub centroid_bounds: Aabb,
 }
 
-/// A BVH still on the device, as a renderer uses it.
+/// A BVH still on the device, as a renderer uses it. Cloning clones the
+/// buffer handles, not the data.
 pub struct DeviceBvh<B: Backend> {
     /// Primitives.
     pub n: u32,
@@ -41,6 +42,20 @@ pub struct DeviceBvh<B: Backend> {
     pub prim_indices: B::Buffer,
     pub sorted_keys: B::Buffer,
     pub centroid_bounds: Aabb,
+}
+
+impl<B: Backend> Clone for DeviceBvh<B> {
+    fn clone(&self) -> Self {
+        DeviceBvh {
+            n: self.n,
+            node_count: self.node_count,
+            nodes: self.nodes.clone(),
+            parents: self.parents.clone(),
+            prim_indices: self.prim_indices.clone(),
+            sorted_keys: self.sorted_keys.clone(),
+            centroid_bounds: self.centroid_bounds,
+        }
+    }
 }
 
 impl<B: Backend> DeviceBvh<B> {

@@ -17,6 +17,7 @@ pub mod cpu_runner;
 pub mod gpu;
 pub mod image_io;
 pub mod kernels;
+pub mod layout;
 pub mod lbvh;
 pub mod mesh;
 pub mod primitives;

@@ -1,4 +1,4 @@
-//! `treelet`: build BVHs and (soon) render, on the GPU or the CPU.
+//! `treelet`: build BVHs, trace and render them, on the GPU or the CPU.
 use std::process::ExitCode;
 
 use anyhow::Result;
@@ -8,6 +8,7 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::image_io;
+use treelet::layout::Layout;
 use treelet::plot::Series;
 use treelet::render::{render, Accel, PassRow, RenderSettings};
 use treelet::report::{run_build, run_build_sweep, BuildReport};
@@ -91,6 +92,9 @@ struct RenderArgs {
     /// crossover in primitive count, else the treelet-optimized BVH.
     #[arg(long, value_enum, default_value = "auto")]
     accel: Accel,
+    /// How the tree is laid out for traversal; auto: the fastest measured (cwbvh).
+    #[arg(long, value_enum, default_value = "auto")]
+    layout: Layout,
     /// Render kernel: auto, the variant compiled for the scene's features
     /// only; full, the general one (for comparison).
     #[arg(long, value_enum, default_value = "auto")]
@@ -122,6 +126,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         spp: args.spp,
         seed: args.seed,
         accel: args.accel,
+        layout: args.layout,
         kernel: args.kernel,
     };
     let bar = ProgressBar::new(args.spp as u64);
@@ -137,7 +142,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     let explain = |b: &dyn Fn() -> bool| {
         if args.explain {
-            bar.suspend(|| eprintln!("{}", variant::plan(&scene, args.accel, args.kernel, b()).explain()));
+            bar.suspend(|| eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain()));
         }
     };
     let (result, device, adapter) = match args.device {

@@ -7,12 +7,12 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::layout::{Node, RenderParams};
 use treelet_core::render::luminance;
-use treelet_core::traverse::STACK_DEPTH;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use crate::backend::Backend;
 use crate::image_io::HdrImage;
-use crate::kernels::Kernel;
+use crate::kernels::{Kernel, Method};
+use crate::layout::{lay_out, Layout, PrimBuffers, TracedTree};
 use crate::lbvh;
 use crate::scene::Scene;
 use crate::primitives::Primitives;
@@ -44,6 +44,8 @@ pub struct RenderSettings {
     pub spp: u32,
     pub seed: u32,
     pub accel: Accel,
+    /// How the tree is laid out for traversal.
+    pub layout: Layout,
     /// The render kernel: the smallest variant for the scene, or the general one.
     pub kernel: KernelChoice,
 }
@@ -104,7 +106,7 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel, kernel } = *settings;
+    let RenderSettings { width, height, spp, seed, accel, layout, kernel } = *settings;
     if width == 0 || height == 0 || spp == 0 {
         bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
     }
@@ -123,18 +125,15 @@ pub fn render<B: Backend>(
     if scene.materials.len() != all.len() {
         bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
     }
-    let plan = variant::plan(scene, accel, kernel, b.runs_on_cpu());
+    let plan = variant::plan(scene, accel, layout, kernel, b.runs_on_cpu());
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;
 
-    let (nodes, prim_indices, build_ms) = scene_tree(b, all, plan.accel)?;
-    let spheres = lbvh::upload_or_placeholder(b, "spheres", &scene.spheres)?;
-    let triangles = lbvh::upload_or_placeholder(b, "triangles", &scene.triangles)?;
+    let (tree, buffers, build_ms) = scene_tree(b, all, plan.accel, plan.layout)?;
     let materials = b.upload("materials", &scene.materials)?;
     let accum = b.zeroed("accumulation", pixels * 16)?;
     let camera = scene.camera.camera(width, height);
-    let variant = plan.variant as u8;
-    let kernel = if plan.accel == Accel::None { Kernel::RenderLinear(variant) } else { Kernel::RenderBvh(variant) };
+    let kernel = Kernel::Render(plan.method(), plan.variant as u8);
     let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
 
     let mut rows = Vec::new();
@@ -160,7 +159,7 @@ pub fn render<B: Backend>(
             let p = b.upload("render params", &[params])?;
             b.dispatch(
                 kernel,
-                &[&p, &spheres, &materials, &nodes, &prim_indices, &accum, &triangles],
+                &[&p, &buffers.spheres, &materials, &tree.nodes, &tree.prims, &accum, &buffers.triangles],
                 groups_for(pixels as u32, WORKGROUP_SIZE),
             );
             done += samples;
@@ -174,21 +173,6 @@ pub fn render<B: Backend>(
     let image =
         HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
     Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
-}
-
-/// Longest root-to-leaf path (edges) of a tree rooted at node 0.
-fn tree_depth(nodes: &[Node]) -> usize {
-    let mut deepest = 0;
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((i, d)) = stack.pop() {
-        deepest = deepest.max(d);
-        let n = &nodes[i];
-        if !n.is_leaf() {
-            stack.push((n.left as usize, d + 1));
-            stack.push((n.right as usize, d + 1));
-        }
-    }
-    deepest
 }
 
 fn error_row(pass: u32, spp: u32, elapsed_s: f64, sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
@@ -236,37 +220,91 @@ mod tests {
     }
 }
 
-/// The tree `accel` traces for these primitives, on the device: node and
-/// primitive-index buffers (placeholders for the scan) and the build time
-/// (ms). `Accel::Auto` must have been resolved (see [`variant::plan`]).
-pub fn scene_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<(B::Buffer, B::Buffer, f64)> {
-    Ok(match accel {
+/// The tree `accel` traces for these primitives, on the device, laid out
+/// as `layout`, with the primitives' buffers (uploaded after the build, as
+/// the render and cast kernels bind them) and the build time (ms: device
+/// stages, or the CPU build of the sweep plus its layout on the device). The
+/// scan gets placeholders. `Accel::Auto` must have been resolved (see
+/// [`variant::plan`]).
+pub fn scene_tree<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    accel: Accel,
+    layout: Layout,
+) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
+    let Some(built) = binary_tree(b, all, accel)? else {
+        let buffers = PrimBuffers::upload(b, all)?;
+        let tree = TracedTree {
+            layout: Layout::Classic,
+            nodes: b.upload("no nodes", &[Node::default()])?,
+            prims: b.upload("no indices", &[0u32])?,
+            node_count: 0,
+        };
+        return Ok((tree, buffers, 0.0));
+    };
+    let buffers = PrimBuffers::upload(b, all)?;
+    let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
+    Ok((tree, buffers, built.build_ms + layout_ms))
+}
+
+/// A binary tree of one primitive per leaf, on the device, as a builder
+/// left it: what every traversal layout is made from.
+pub struct BuiltTree<B: Backend> {
+    pub bvh: lbvh::DeviceBvh<B>,
+    /// The largest leaf the binary layouts' SAH collapse makes (1: none).
+    pub max_leaf: u32,
+    /// Build time (ms): device stages, or the sweep's CPU build.
+    pub build_ms: f64,
+}
+
+impl<B: Backend> BuiltTree<B> {
+    /// Lays the tree out (it stays usable for other layouts); returns the
+    /// layout's device time (ms).
+    pub fn lay_out(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, f64)> {
+        b.take_times()?;
+        let tree = lay_out(b, self.bvh.clone(), layout, self.max_leaf, prims)?;
+        Ok((tree, b.take_times()?.total()))
+    }
+}
+
+/// The binary tree `accel` traces (None for the scan): the LBVH as built,
+/// the TRBVH's restructured tree before its leaf collapse, or the full-sweep
+/// tree built on the CPU and uploaded. Starts a new build on `b`.
+pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<Option<BuiltTree<B>>> {
+    let config = TreeletConfig::default();
+    Ok(Some(match accel {
         Accel::Auto => bail!("internal: --accel auto reached the tree builder unresolved"),
+        Accel::None => return Ok(None),
         Accel::Lbvh | Accel::Trbvh => {
             let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
             let mut build_ms = times.total();
             if accel == Accel::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
-                let (optimized, times) = trbvh::optimize(b, bvh, &root, &TreeletConfig::default())?;
-                bvh = optimized;
+                let (restructured, times) = trbvh::restructure(b, bvh, &root, &config)?;
+                bvh = restructured;
                 build_ms += times.total();
             }
-            let depth = tree_depth(&b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?);
-            if depth + 1 > STACK_DEPTH {
-                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
-            }
-            (bvh.nodes, bvh.prim_indices, build_ms)
+            // The LBVH is traced as built (one primitive per leaf).
+            let max_leaf = if accel == Accel::Trbvh { config.max_leaf } else { 1 };
+            BuiltTree { bvh, max_leaf, build_ms }
         }
         Accel::Sweep => {
-            let build = Instant::now();
-            let bvh = crate::sweep::build_collapsed_boxes(&all.boxes(), TreeletConfig::default().max_leaf)?;
+            let build = std::time::Instant::now();
+            let tree = crate::sweep::build_boxes(&all.boxes());
             let build_ms = build.elapsed().as_secs_f64() * 1e3;
-            let depth = tree_depth(&bvh.nodes);
-            if depth + 1 > STACK_DEPTH {
-                bail!("the BVH is {depth} levels deep; traversal supports {}", STACK_DEPTH - 1);
-            }
-            (b.upload("sweep nodes", &bvh.nodes)?, b.upload("sweep primitive indices", &bvh.prim_indices)?, build_ms)
+            b.begin_build();
+            BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
         }
-        Accel::None => (b.upload("no nodes", &[Node::default()])?, b.upload("no indices", &[0u32])?, 0.0),
-    })
+    }))
+}
+
+impl Plan {
+    /// The closest-hit method of the render kernel.
+    pub fn method(&self) -> Method {
+        if self.accel == Accel::None {
+            Method::Scan
+        } else {
+            self.layout.method()
+        }
+    }
 }

@@ -10,13 +10,14 @@ use serde::{Deserialize, Serialize};
 use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
+use treelet::layout::Layout;
 use treelet::plot::{chart, Chart, Series};
 use treelet::render::{render, Accel, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::trbvh::TreeletConfig;
 use treelet::variant::KernelChoice;
 
-use crate::bench::{bench_rays, bench_render_kernel, bench_sizes, median};
+use crate::bench::{bench_rays, bench_render_kernel, bench_sizes, median, RaysPlan};
 use crate::Device;
 
 /// The figures: the seed's five, then three it lacks.
@@ -338,19 +339,24 @@ fn render_times<B: Backend>(
     b: &mut B,
     scene: &Scene,
     (w, h, spp): (u32, u32, u32),
-    accel: Accel,
+    (accel, layout): (Accel, Layout),
     repeats: usize,
 ) -> Result<Vec<f64>> {
-    bench_render_kernel(b, scene, w, h, spp.min(4), accel, KernelChoice::Auto)?;
+    bench_render_kernel(b, scene, (w, h, spp.min(4)), accel, layout, KernelChoice::Auto)?;
     let mut v = Vec::new();
     for _ in 0..repeats {
-        v.push(bench_render_kernel(b, scene, w, h, spp, accel, KernelChoice::Auto)?.kernel_s);
+        v.push(bench_render_kernel(b, scene, (w, h, spp), accel, layout, KernelChoice::Auto)?.kernel_s);
         // One run of several seconds is enough: its noise is small.
         if v[0] > 5.0 {
             break;
         }
     }
     Ok(v)
+}
+
+/// A tree and its layout, as the figures name them ("TRBVH, cwbvh").
+fn tree_name(a: Accel, layout: Layout) -> String {
+    format!("{}, {}", accel_name(a), layout.resolve().name())
 }
 
 fn accel_name(a: Accel) -> &'static str {
@@ -378,13 +384,13 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             if let Runner::Gpu(ctx) = runner {
                 let b = &mut GpuBackend::new(ctx.clone());
                 for &spp in &gpu_spp {
-                    d.points.push(Point::of(format!("GPU ({})", ctx.info.name), spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), Accel::Auto, r)?));
+                    d.points.push(Point::of(format!("GPU ({})", ctx.info.name), spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), (Accel::Auto, Layout::Auto), r)?));
                     pb.inc(1);
                 }
             }
             let b = &mut CpuBackend::new();
             for &spp in &cpu_spp {
-                d.points.push(Point::of("CPU runner (rayon)", spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), Accel::Auto, r.min(2))?));
+                d.points.push(Point::of("CPU runner (rayon)", spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), (Accel::Auto, Layout::Auto), r.min(2))?));
                 pb.inc(1);
             }
             pb.finish_and_clear();
@@ -394,10 +400,19 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
         Figure::Graph2 | Figure::Graph3 => {
             let (size, sizes, accels, title) = if figure == Figure::Graph2 {
                 let sizes: Vec<usize> = if q { vec![10, 100, 1000] } else { vec![100, 1000, 4000, 16000, 65536] };
-                ((128, 96, 4), sizes, vec![Accel::None, Accel::Lbvh, Accel::Trbvh], "random:N at 4 spp: linear scan against BVHs")
+                let accels = [Accel::None, Accel::Lbvh, Accel::Trbvh].map(|a| (a, Layout::Auto));
+                ((128, 96, 4), sizes, accels.to_vec(), "random:N at 4 spp: linear scan against BVHs")
             } else {
                 let sizes: Vec<usize> = if q { vec![1000, 10000] } else { vec![1000, 10000, 100000, 1000000] };
-                ((128, 96, 4), sizes, vec![Accel::Lbvh, Accel::Trbvh, Accel::Sweep], "random:N at 4 spp: LBVH against optimized BVHs")
+                let trees = vec![
+                    (Accel::Lbvh, Layout::Cwbvh),
+                    (Accel::Trbvh, Layout::Cwbvh),
+                    (Accel::Sweep, Layout::Cwbvh),
+                    (Accel::Lbvh, Layout::Classic),
+                    (Accel::Trbvh, Layout::Classic),
+                    (Accel::Trbvh, Layout::Bvh2),
+                ];
+                ((128, 96, 4), sizes, trees, "random:N at 4 spp: LBVH against optimized BVHs, in each layout")
             };
             let size = if q { size } else { (1024, 768, 4) };
             let mut d = doc(figure, title, "spheres (N, plus the 9 of the room)", "render-kernel time (s)", (true, true));
@@ -406,9 +421,10 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             with_backend!(runner, |b| {
                 for &n in &sizes {
                     let scene = Scene::from_spec(&format!("random:{n}"))?;
-                    for &a in &accels {
-                        pb.set_message(format!("random:{n} {}", accel_name(a)));
-                        d.points.push(Point::of(accel_name(a), n as f64, &render_times(b, &scene, size, a, r)?));
+                    for &(a, layout) in &accels {
+                        let name = if a == Accel::None { accel_name(a).to_string() } else { tree_name(a, layout) };
+                        pb.set_message(format!("random:{n} {name}"));
+                        d.points.push(Point::of(name, n as f64, &render_times(b, &scene, size, (a, layout), r)?));
                         pb.inc(1);
                     }
                 }
@@ -482,7 +498,8 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             let scene = Scene::from_spec(spec)?;
             with_backend!(runner, |b| {
                 for a in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
-                    let settings = RenderSettings { width: w, height: h, spp, seed: 1, accel: a, kernel: KernelChoice::Auto };
+                    let layout = Layout::Auto;
+                    let settings = RenderSettings { width: w, height: h, spp, seed: 1, accel: a, layout, kernel: KernelChoice::Auto };
                     let res = render(b, &scene, &settings, None, |_| {})?;
                     for row in &res.rows {
                         if let Some(e) = row.mean_std_error {
@@ -518,6 +535,12 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                     ] {
                         let (sah, ms) = device_build(b, &scene, config.as_ref())?;
                         found.push((name.to_string(), ms, sah));
+                        if name == "LBVH" || name == "TRBVH g3" {
+                            // The same tree laid out as a compressed wide BVH:
+                            // its build time with the layout (its binary SAH).
+                            let wide_ms = device_build_wide(b, &scene, config.as_ref())?;
+                            found.push((format!("{name} + cwbvh layout"), wide_ms, sah));
+                        }
                     }
                 });
                 found.extend(cpu_builds_scored(&scene.primitives().boxes())?);
@@ -543,10 +566,15 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                 for &n in &sizes {
                     let scene = Scene::from_spec(&format!("terrain:{n}"))?.mesh_only()?;
                     for a in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
-                        let row = bench_rays(b, &scene, a, (w, h), r.max(3))?;
-                        let x = row.primitives as f64;
-                        d.points.push(Point::once(format!("{} primary", accel_name(a)), x, row.primary_mrays_per_s));
-                        d.points.push(Point::once(format!("{} diffuse", accel_name(a)), x, row.diffuse_mrays_per_s));
+                        // The seed's layout and the compressed wide one for every
+                        // tree; the two-box binary layout for the TRBVH.
+                        let layouts = if a == Accel::Trbvh { Layout::ALL.to_vec() } else { vec![Layout::Classic, Layout::Cwbvh] };
+                        let plan = RaysPlan { layouts, workgroup_stack: false };
+                        for row in bench_rays(b, &scene, a, &plan, (w, h), r.max(3))? {
+                            let (x, name) = (row.primitives as f64, tree_name(a, row.layout));
+                            d.points.push(Point::once(format!("{name} primary"), x, row.primary_mrays_per_s));
+                            d.points.push(Point::once(format!("{name} diffuse"), x, row.diffuse_mrays_per_s));
+                        }
                         pb.inc(1);
                     }
                 }
@@ -599,6 +627,35 @@ fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletCon
         }
     }
     Ok((sah, median(times)))
+}
+
+/// Build time (ms, as [`device_build`]) of the tree laid out as a
+/// compressed wide BVH: the LBVH, the treelet rounds if `config`, the wide
+/// layout (which does its own leaf collapse).
+fn device_build_wide<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<f64> {
+    use treelet::layout::{lay_out, PrimBuffers};
+    use treelet::{lbvh, trbvh};
+    let all = scene.primitives();
+    let once = |b: &mut B| -> Result<f64> {
+        b.begin_build();
+        let (mut bvh, t) = lbvh::build_primitives_on_device(b, all)?;
+        let mut ms = t.total();
+        if let Some(c) = config {
+            let root = trbvh::root_box(b, &bvh)?;
+            let (o, t) = trbvh::restructure(b, bvh, &root, c)?;
+            (bvh, ms) = (o, ms + t.total());
+        }
+        let prims = PrimBuffers::upload(b, all)?;
+        b.take_times()?;
+        lay_out(b, bvh, Layout::Cwbvh, 1, &prims)?;
+        Ok(ms + b.take_times()?.total())
+    };
+    let warm = std::time::Instant::now();
+    while warm.elapsed().as_secs_f64() < 0.5 {
+        once(b)?;
+    }
+    let times = (0..3).map(|_| once(b)).collect::<Result<Vec<_>>>()?;
+    Ok(median(times))
 }
 
 /// The CPU builders over `boxes`: (name, build ms).

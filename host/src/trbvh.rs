@@ -72,10 +72,40 @@ pub fn optimize<B: Backend>(
     root_box: &Aabb,
     config: &TreeletConfig,
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
-    let n = bvh.n;
-    if n < 2 {
+    if bvh.n < 2 {
         return Ok((bvh, b.take_times()?));
     }
+    let (bvh, scratch, base) = rounds(b, bvh, root_box, config)?;
+    b.stage("collapse");
+    let collapsed = collapse_pass(b, &bvh, &scratch, &base)?;
+    Ok((collapsed, b.take_times()?))
+}
+
+/// The restructuring rounds of [`optimize`] alone: the tree keeps one
+/// primitive per leaf and the LBVH layout, for layouts that collapse
+/// leaves their own way ([`crate::layout::Layout::Cwbvh`]).
+pub fn restructure<B: Backend>(
+    b: &mut B,
+    bvh: DeviceBvh<B>,
+    root_box: &Aabb,
+    config: &TreeletConfig,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    if bvh.n < 2 {
+        return Ok((bvh, b.take_times()?));
+    }
+    let (bvh, _, _) = rounds(b, bvh, root_box, config)?;
+    Ok((bvh, b.take_times()?))
+}
+
+/// The rounds, in place; returns the tree, the per-node scratch and the
+/// parameters the collapse goes on with.
+fn rounds<B: Backend>(
+    b: &mut B,
+    bvh: DeviceBvh<B>,
+    root_box: &Aabb,
+    config: &TreeletConfig,
+) -> Result<(DeviceBvh<B>, Scratch<B>, TreeletParams)> {
+    let n = bvh.n;
     let base = base_params(n, root_box, config);
     let scratch = scratch(b, n)?;
     let subsets = b.upload("treelet subset order", &subset_order())?;
@@ -153,9 +183,7 @@ pub fn optimize<B: Backend>(
     if config.verify {
         verify_current(b, &bvh, &scratch, &base)?;
     }
-    b.stage("collapse");
-    let collapsed = collapse_pass(b, &bvh, &scratch, &base)?;
-    Ok((collapsed, b.take_times()?))
+    Ok((bvh, scratch, base))
 }
 
 /// Only the SAH leaf collapse and compaction (what [`optimize`] ends with),

@@ -7,6 +7,8 @@
 #![cfg_attr(target_arch = "spirv", no_std)]
 
 pub mod bounds;
+pub mod bvh2;
+pub mod cwbvh;
 pub mod fill;
 pub mod fit;
 pub mod morton;

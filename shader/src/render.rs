@@ -1,16 +1,20 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::features::VARIANTS;
-use treelet_core::layout::{Material, Node, RenderParams, Sphere};
-use treelet_core::render::{accumulate, render_pixel, SceneRefs, ACCEL_BVH, ACCEL_NONE};
+use treelet_core::bvh2::Bvh2Tree;
+use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
+use treelet_core::features::{ALL, VARIANTS};
+use treelet_core::layout::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
+use treelet_core::render::{accumulate, render_pixel, SceneRefs};
+use treelet_core::traverse::{ClassicTree, Scan};
 use treelet_core::triangle::Triangle;
 use treelet_core::workgroup::linear_id;
 
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
-/// and one feature set (see `treelet_core::features::VARIANTS`, whose names
-/// these must match: the feature sets come from it by index).
+/// (`$tree` made from bindings 3 and 4) and one feature set (see
+/// `treelet_core::features::VARIANTS`, whose names these must match: the
+/// feature sets come from it by index). The stack stays private.
 macro_rules! render_kernel {
-    ($name:ident, $accel:expr, $features:expr) => {
+    ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -18,15 +22,16 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
             #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             if id < params.width * params.height {
-                let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
-                accumulate(&mut accum[id as usize], render_pixel::<{ $accel }, { $features }>(id, params, &scene));
+                let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
+                let sums = render_pixel::<_, { $features }, 1>(id, params, &scene, &mut [0u32; 1], 0);
+                accumulate(&mut accum[id as usize], sums);
             }
         }
     };
@@ -34,33 +39,66 @@ macro_rules! render_kernel {
 
 const _: () = assert!(VARIANTS.len() == 6, "one pair of lines per variant");
 
-render_kernel!(render_linear_spheres_diffuse_cs, ACCEL_NONE, VARIANTS[0].0);
-render_kernel!(render_bvh_spheres_diffuse_cs, ACCEL_BVH, VARIANTS[0].0);
-render_kernel!(render_linear_spheres_mirror_cs, ACCEL_NONE, VARIANTS[1].0);
-render_kernel!(render_bvh_spheres_mirror_cs, ACCEL_BVH, VARIANTS[1].0);
-render_kernel!(render_linear_spheres_cs, ACCEL_NONE, VARIANTS[2].0);
-render_kernel!(render_bvh_spheres_cs, ACCEL_BVH, VARIANTS[2].0);
-render_kernel!(render_linear_triangles_diffuse_cs, ACCEL_NONE, VARIANTS[3].0);
-render_kernel!(render_bvh_triangles_diffuse_cs, ACCEL_BVH, VARIANTS[3].0);
-render_kernel!(render_linear_mixed_diffuse_cs, ACCEL_NONE, VARIANTS[4].0);
-render_kernel!(render_bvh_mixed_diffuse_cs, ACCEL_BVH, VARIANTS[4].0);
-render_kernel!(render_linear_full_cs, ACCEL_NONE, VARIANTS[5].0);
-render_kernel!(render_bvh_full_cs, ACCEL_BVH, VARIANTS[5].0);
+// The scan and the compressed wide BVH (the default tree), per feature set.
+render_kernel!(render_linear_spheres_diffuse_cs, Node, u32, Scan::new, VARIANTS[0].0);
+render_kernel!(render_cwbvh_spheres_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[0].0);
+render_kernel!(render_linear_spheres_mirror_cs, Node, u32, Scan::new, VARIANTS[1].0);
+render_kernel!(render_cwbvh_spheres_mirror_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[1].0);
+render_kernel!(render_linear_spheres_cs, Node, u32, Scan::new, VARIANTS[2].0);
+render_kernel!(render_cwbvh_spheres_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[2].0);
+render_kernel!(render_linear_triangles_diffuse_cs, Node, u32, Scan::new, VARIANTS[3].0);
+render_kernel!(render_cwbvh_triangles_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[3].0);
+render_kernel!(render_linear_mixed_diffuse_cs, Node, u32, Scan::new, VARIANTS[4].0);
+render_kernel!(render_cwbvh_mixed_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[4].0);
+render_kernel!(render_linear_full_cs, Node, u32, Scan::new, VARIANTS[5].0);
+render_kernel!(render_cwbvh_full_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[5].0);
+// The binary layouts, kept for comparison: the general kernel only.
+render_kernel!(render_classic_full_cs, Node, u32, ClassicTree::new, ALL);
+render_kernel!(render_bvh2_full_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, ALL);
 
-/// Ray-casting throughput: one primary or one diffuse ray per pixel, through a BVH.
+/// Ray-casting throughput: one primary or one diffuse ray per pixel,
+/// through one layout (`$tree` from bindings 3 and 4), its stack private.
+macro_rules! cast_kernel {
+    ($name:ident, $node:ty, $prim:ty, $tree:path) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
+            treelet_core::rays::cast_kernel(id, params, &scene, rays, &mut [0u32; 1], 0);
+        }
+    };
+}
+
+cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new);
+cast_kernel!(cast_bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new);
+cast_kernel!(cast_cwbvh_cs, WideNode, LeafPrim, WideTree::new);
+
+/// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.
 #[spirv(compute(threads(256)))]
-pub fn cast_bvh_cs(
+pub fn cast_cwbvh_workgroup_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(local_invocation_index)] lane: u32,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prim_indices: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[WideNode],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[LeafPrim],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+    #[spirv(workgroup)] stack: &mut [u32; WORKGROUP_STACK_WORDS],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    let scene = SceneRefs::new(params, spheres, triangles, materials, nodes, prim_indices);
-    treelet_core::rays::cast_kernel::<ACCEL_BVH>(id, params, &scene, rays);
+    let scene = SceneRefs::new(params, spheres, triangles, materials, WideTree::new(nodes, prims));
+    treelet_core::rays::cast_kernel(id, params, &scene, rays, stack, lane);
 }

@@ -1,0 +1,212 @@
+//! The binary layout made for GPUs (Aila & Laine 2009, "Understanding the
+//! Efficiency of Ray Traversal on GPUs"): each node holds both children's
+//! boxes ([`Bvh2Node`], 64 bytes), so one load tests both children; the
+//! ray goes on into the nearer child it hits, by the slab test's entry
+//! distance, and pushes the other (with that distance, to skip it on the
+//! way back if a hit came nearer). Leaves read their primitives in leaf
+//! order ([`LeafPrim`]): no index indirection.
+//!
+//! It is made from a collapsed tree in depth-first order (what
+//! [`crate::collapse`] writes: leaves of several primitives, `out_prims`
+//! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
+//! (internal node `i` of the input becomes node `f(i)` of the output, the
+//! number of internal nodes before it in depth-first order, found by
+//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use glam::Vec3;
+
+use crate::features;
+use crate::intersect::{finite_inverse, slab_interval};
+use crate::layout::{Bvh2Node, LeafPrim, Node, Sphere};
+use crate::traverse::{ClosestHit, Hit, Origin, Prims, STACK_DEPTH};
+use crate::triangle::{Triangle, WatertightRay};
+use crate::unchecked::{at, get, set};
+
+/// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
+/// nodes, root 0, depth-first order: a left child follows its parent, a
+/// right child `right = i + 2 L` where `L` is its left sibling's leaf
+/// count): each internal node writes its [`Bvh2Node`]. A tree of one leaf
+/// gets a root whose second child is an empty box.
+pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32], out: &mut [Bvh2Node]) {
+    if i >= node_count {
+        return;
+    }
+    let node = nodes[i as usize];
+    if node.is_leaf() {
+        if node_count == 1 {
+            let mut root = Bvh2Node { left: node.left, left_count: node.prim_count(), ..Default::default() };
+            (root.left_min, root.left_max) = (node.min, node.max);
+            (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
+            root.right_count = 1; // a leaf that no ray reaches
+            out[0] = root;
+        }
+        return;
+    }
+    // f(i): internal nodes before i in depth-first order. A left child is
+    // its parent's next; a right child comes after its left sibling's L - 1
+    // internal nodes.
+    let mut index = 0u32;
+    let mut x = i;
+    while x != 0 {
+        let p = parents[x as usize];
+        index += if x == p + 1 { 1 } else { (x - p) / 2 };
+        x = p;
+    }
+    let (l, r) = (nodes[node.left as usize], nodes[node.right as usize]);
+    let (left, left_count) = child_ref(&l, index + 1);
+    let (right, right_count) = child_ref(&r, index + (node.right - i) / 2);
+    out[index as usize] = Bvh2Node {
+        left_min: l.min,
+        left,
+        left_max: l.max,
+        right,
+        right_min: r.min,
+        left_count,
+        right_max: r.max,
+        right_count,
+    };
+}
+
+/// A child as its parent refers to it: a leaf by its first primitive and
+/// count, an internal node by its index in the output.
+#[inline]
+fn child_ref(c: &Node, internal_index: u32) -> (u32, u32) {
+    if c.is_leaf() {
+        (c.left, c.prim_count())
+    } else {
+        (internal_index, 0)
+    }
+}
+
+/// Kernel, one invocation per primitive slot `j < n`: the primitive of
+/// slot `j` (`prim_indices[j]`, in leaf order) as its leaf stores it.
+pub fn leaf_prims_kernel(
+    j: u32,
+    n: u32,
+    sphere_count: u32,
+    prim_indices: &[u32],
+    spheres: &[Sphere],
+    triangles: &[Triangle],
+    out: &mut [LeafPrim],
+) {
+    if j >= n {
+        return;
+    }
+    let prims = Prims { spheres, sphere_count, triangles, triangle_count: n - sphere_count };
+    out[j as usize] = prims.leaf_prim(prim_indices[j as usize]);
+}
+
+/// A tree in the layout of this module.
+pub struct Bvh2Tree<'a> {
+    pub nodes: &'a [Bvh2Node],
+    pub leaf_prims: &'a [LeafPrim],
+}
+
+impl<'a> Bvh2Tree<'a> {
+    #[inline]
+    pub fn new(nodes: &'a [Bvh2Node], leaf_prims: &'a [LeafPrim]) -> Self {
+        Bvh2Tree { nodes, leaf_prims }
+    }
+}
+
+impl ClosestHit for Bvh2Tree<'_> {
+    #[inline]
+    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        closest_hit_bvh2::<F>(o, d, from, prims, self.nodes, self.leaf_prims)
+    }
+}
+
+/// Tests the `count` primitives of a leaf from `first` on.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn leaf<const F: u32>(
+    hit: &mut Hit,
+    first: u32,
+    count: u32,
+    (o, d, from): (Vec3, Vec3, Origin),
+    ray: &WatertightRay,
+    prims: &Prims,
+    leaf_prims: &[LeafPrim],
+) {
+    let mut k = 0;
+    while k < count {
+        let p = at(leaf_prims, (first + k) as usize);
+        let t = prims.leaf_distance::<F>(o, d, ray, from, &p, hit.t);
+        if hit.is_beaten_by(t, p.prim) {
+            *hit = Hit { t, prim: p.prim };
+        }
+        k += 1;
+    }
+}
+
+/// The closest hit through a [`Bvh2Node`] tree (root 0), nearer child
+/// first; see the module doc. `F` as for
+/// [`crate::traverse::closest_hit_linear_for`].
+#[inline]
+pub fn closest_hit_bvh2<const F: u32>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    prims: &Prims,
+    nodes: &[Bvh2Node],
+    leaf_prims: &[LeafPrim],
+) -> Hit {
+    let mut hit = Hit::NONE;
+    if prims.count() == 0 {
+        return hit;
+    }
+    let inv = finite_inverse(d);
+    let ray = WatertightRay::new(o, d);
+    let origin = o.to_array();
+    let at_ray = (o, d, from);
+    // Entries: node index and the entry distance it was pushed with.
+    let mut stack = [0u32; 2 * STACK_DEPTH];
+    let mut top = 0usize;
+    let mut node = 0u32;
+    loop {
+        let n = at(nodes, node as usize);
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, origin, inv, hit.t);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, origin, inv, hit.t);
+        let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
+        // Leaves are tested at once; only internal children are walked.
+        if go_left && n.left_count > 0 {
+            leaf::<F>(&mut hit, n.left, n.left_count, at_ray, &ray, prims, leaf_prims);
+            go_left = false;
+        }
+        if go_right && n.right_count > 0 {
+            leaf::<F>(&mut hit, n.right, n.right_count, at_ray, &ray, prims, leaf_prims);
+            go_right = false;
+        }
+        if go_left && go_right {
+            let (near, far, far_t) = if ln <= rn { (n.left, n.right, rn) } else { (n.right, n.left, ln) };
+            if top < STACK_DEPTH {
+                set(&mut stack, 2 * top, far);
+                set(&mut stack, 2 * top + 1, far_t.to_bits());
+                top += 1;
+            }
+            node = near;
+        } else if go_left {
+            node = n.left;
+        } else if go_right {
+            node = n.right;
+        } else {
+            // Back to the nearest pushed child still worth entering.
+            let mut next = u32::MAX;
+            while top > 0 && next == u32::MAX {
+                top -= 1;
+                if f32::from_bits(get(&stack, 2 * top + 1)) <= hit.t {
+                    next = get(&stack, 2 * top);
+                }
+            }
+            if next == u32::MAX {
+                return hit;
+            }
+            node = next;
+        }
+    }
+}
+
+/// [`closest_hit_bvh2`] with every primitive kind compiled in.
+#[inline]
+pub fn closest_hit_bvh2_all(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Bvh2Node], leaf_prims: &[LeafPrim]) -> Hit {
+    closest_hit_bvh2::<{ features::ALL }>(o, d, from, prims, nodes, leaf_prims)
+}

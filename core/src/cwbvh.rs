@@ -1,0 +1,428 @@
+//! The compressed 8-wide BVH (Ylitie, Karras & Laine 2017, "Efficient
+//! Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs"): its
+//! node ([`WideNode`], 80 bytes) quantizes the eight child boxes to bytes
+//! on a grid of the node's own, so a ray tests eight boxes with one
+//! 80-byte load. How the tree is made: [`crate::cwbvh_build`].
+//!
+//! ## Traversal
+//! As in the paper: the ray carries a *node group* (the base index of a
+//! node's internal children and a mask of those it hit, in visiting order)
+//! and a *primitive group* (a node's first leaf primitive and a mask of the
+//! leaf primitives it hit). Children sit in the slots of their octant (see
+//! `assign_slots` in the builder), so for a ray of octant `o` visiting
+//! slots by `slot ^ (7 - o)` descending goes roughly front to back; the
+//! stack holds groups, not nodes.
+//!
+//! ## Never missing a hit
+//! Every layout must find exactly the scan's closest hit, so the box test
+//! must never cull a box the ray touches, whatever the rounding:
+//! * the builder rounds each child's box outwards to the grid with exact
+//!   arithmetic ([`quantize_lo`], [`quantize_hi`]): the dequantized box
+//!   `origin + q 2^e` contains the exact one in real numbers;
+//! * the traversal computes a plane as `((origin - o) ± slack) + q 2^e`,
+//!   then `(…) * inv`: the rounding of `origin - o` is an error relative
+//!   to the ray's distance from the node's corner, not from the plane;
+//!   each plane is pushed out by [`SLACK`] grid cells, eight times the
+//!   worst such error (`2 ε (|plane - o| + 255 · 2^e)`), and the far
+//!   distance is widened by [`WIDE_FAR_WIDENING`] for the rest, all of it
+//!   relative to the distance (Ize 2013's argument with five roundings);
+//! * directions parallel to an axis get `±f32::MAX` for an inverse
+//!   ([`crate::intersect::finite_inverse`]): no NaN, and exact signs.
+//!
+//! The stack is a private array: see [`STACK_KINDS`] for the measured
+//! alternatives.
+use glam::Vec3;
+
+use crate::intersect::finite_inverse;
+use crate::layout::{LeafPrim, WideNode};
+use crate::traverse::{ClosestHit, Hit, Origin, Prims, STACK_DEPTH};
+use crate::triangle::WatertightRay;
+use crate::unchecked::{at, get, set};
+
+/// Children per node.
+pub const WIDTH: usize = 8;
+/// Most primitives in one leaf child (three bits of unary count in `meta`).
+pub const MAX_LEAF_PRIMS: u32 = 3;
+/// Flag of an internal child's `meta` byte: `0b001` over `24 + slot`.
+pub const META_INTERNAL: u32 = 0b001_00000;
+
+/// Grid cells each plane is pushed out by in the traversal (see the module
+/// doc): 2^-12, against a worst rounding error of 2 ε · 255 ≈ 2^-15 cells.
+pub const SLACK: f32 = 1.0 / 4096.0;
+/// The far distance's widening: `1 + 2^-20`, more than `1 + 2γ(5)`.
+pub const WIDE_FAR_WIDENING: f32 = 1.0 + 1.0 / 1_048_576.0;
+
+/// The grid step `2^(e - 127)` of a biased exponent byte `e` (1..=254).
+#[inline]
+pub fn grid_step(biased: u32) -> f32 {
+    f32::from_bits(biased << 23)
+}
+
+/// `a - b` as an unevaluated sum `s + err`, exactly (Knuth's two-sum).
+#[inline]
+fn difference(a: f32, b: f32) -> (f32, f32) {
+    let s = a - b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (-b - bb))
+}
+
+/// Whether `v <= s + err` exactly, for `|err| <= ulp(s) / 2` (a two-sum).
+#[inline]
+fn at_most(v: f32, (s, err): (f32, f32)) -> bool {
+    v < s || (v == s && err >= 0.0)
+}
+
+/// Whether `v >= s + err` exactly, for `|err| <= ulp(s) / 2`.
+#[inline]
+fn at_least(v: f32, (s, err): (f32, f32)) -> bool {
+    v > s || (v == s && err <= 0.0)
+}
+
+/// The biased exponent (`e + 127`) of the smallest grid step `s = 2^e`,
+/// `e >= -126`, with `255 s >= hi - lo` in exact arithmetic: the node
+/// `lo..hi` fits 255 steps. `hi - lo` must be finite.
+#[inline]
+pub fn grid_exponent(lo: f32, hi: f32) -> u32 {
+    let extent = difference(hi, lo);
+    // A first guess from the rounded extent, then up to the exact answer.
+    let guess = ((extent.0 * (1.0 / 255.0)).to_bits() >> 23) & 0xFF; // floor(log2) + 127, or 0
+    let mut biased = if guess > 2 { guess - 1 } else { 1 };
+    let mut k = 0;
+    while k < 4 && !at_least(255.0 * grid_step(biased), extent) {
+        biased += 1;
+        k += 1;
+    }
+    biased
+}
+
+/// The largest `q` in `0..=255` with `origin + q s <= lo` exactly (`lo >= origin`).
+#[inline]
+pub fn quantize_lo(lo: f32, origin: f32, s: f32) -> u32 {
+    let d = difference(lo, origin);
+    let mut q = libm::floorf(d.0 / s).clamp(0.0, 255.0);
+    if !at_most(q * s, d) {
+        q -= 1.0;
+    }
+    q.max(0.0) as u32
+}
+
+/// The smallest `q` in `0..=255` with `origin + q s >= hi` exactly (`hi` at
+/// most the node's top, which `s` fits).
+#[inline]
+pub fn quantize_hi(hi: f32, origin: f32, s: f32) -> u32 {
+    let d = difference(hi, origin);
+    let mut q = libm::ceilf(d.0 / s).clamp(0.0, 255.0);
+    if !at_least(q * s, d) {
+        q += 1.0;
+    }
+    q.min(255.0) as u32
+}
+
+/// Byte `shift / 8` of `word` as an f32, by the exponent trick
+/// (`2^23 + b` has `b` in its low mantissa bits): integer operations and
+/// one subtraction instead of a conversion, which GPUs run at a quarter
+/// of the rate.
+#[inline]
+fn byte_f32(word: u32, shift: u32) -> f32 {
+    f32::from_bits(0x4B00_0000 | ((word >> shift) & 0xFF)) - 8_388_608.0
+}
+
+/// Per axis of one node, what its eight child tests share: the byte words
+/// of the planes the ray meets first and last (by its direction's sign),
+/// the grid step, those planes' offsets from the ray origin (slack
+/// included) and the inverse direction.
+#[derive(Clone, Copy)]
+struct Axis {
+    near: [u32; 2],
+    far: [u32; 2],
+    step: f32,
+    near_offset: f32,
+    far_offset: f32,
+    inv: f32,
+}
+
+impl Axis {
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn new(lo: [u32; 2], hi: [u32; 2], biased: u32, origin: f32, o: f32, inv: f32) -> Axis {
+        let step = grid_step(biased);
+        let from_ray = origin - o;
+        let (lo_offset, hi_offset) = (from_ray - SLACK * step, from_ray + SLACK * step);
+        if inv >= 0.0 {
+            Axis { near: lo, far: hi, step, near_offset: lo_offset, far_offset: hi_offset, inv }
+        } else {
+            Axis { near: hi, far: lo, step, near_offset: hi_offset, far_offset: lo_offset, inv }
+        }
+    }
+
+    /// Distances to child `(word, shift)`'s near and far planes on this axis.
+    #[inline]
+    fn planes(&self, word: usize, shift: u32) -> (f32, f32) {
+        let near = (byte_f32(get(&self.near, word), shift) * self.step + self.near_offset) * self.inv;
+        let far = (byte_f32(get(&self.far, word), shift) * self.step + self.far_offset) * self.inv;
+        (near, far)
+    }
+}
+
+/// Whether the ray meets child `(word, shift)`'s box before `t_max`.
+#[inline]
+fn child_hit(x: &Axis, y: &Axis, z: &Axis, word: usize, shift: u32, t_max: f32) -> bool {
+    let ((nx, fx), (ny, fy), (nz, fz)) = (x.planes(word, shift), y.planes(word, shift), z.planes(word, shift));
+    let near = nx.max(ny).max(nz.max(0.0));
+    let far = (fx.min(fy).min(fz) * WIDE_FAR_WIDENING).min(t_max);
+    near <= far
+}
+
+/// Spreads bit 7 of each byte over the byte.
+#[inline]
+fn byte_masks(x: u32) -> u32 {
+    ((x >> 7) & 0x0101_0101) * 0xFF
+}
+
+/// The hit bits of the four children in `word` (0: slots 0..4, 1: 4..8):
+/// an internal child sets bit `24 + (slot ^ oct_inv)`, a leaf child one
+/// bit per primitive at its offset.
+#[inline]
+fn hit_bits(x: &Axis, y: &Axis, z: &Axis, meta: u32, word: usize, oct_inv4: u32, t_max: f32) -> u32 {
+    let is_internal = (meta & (meta << 1)) & 0x1010_1010;
+    let bit_index = (meta ^ (oct_inv4 & byte_masks(is_internal << 3))) & 0x1F1F_1F1F;
+    let child_bits = (meta >> 5) & 0x0707_0707;
+    let mut mask = 0u32;
+    let mut shift = 0u32;
+    while shift < 32 {
+        if child_hit(x, y, z, word, shift, t_max) {
+            mask |= ((child_bits >> shift) & 0xFF) << ((bit_index >> shift) & 0x1F);
+        }
+        shift += 8;
+    }
+    mask
+}
+
+/// A tree in this layout: nodes (root 0) and leaf primitives.
+pub struct WideTree<'a> {
+    pub nodes: &'a [WideNode],
+    pub leaf_prims: &'a [LeafPrim],
+}
+
+impl<'a> WideTree<'a> {
+    #[inline]
+    pub fn new(nodes: &'a [WideNode], leaf_prims: &'a [LeafPrim]) -> Self {
+        WideTree { nodes, leaf_prims }
+    }
+}
+
+impl ClosestHit for WideTree<'_> {
+    #[inline]
+    fn closest_hit<const F: u32, const S: usize>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        from: Origin,
+        prims: &Prims,
+        stack: &mut [u32; S],
+        lane: u32,
+    ) -> Hit {
+        let mut private = [0u32; 2 * WIDE_STACK];
+        closest_hit_cwbvh_with::<F, S>(o, d, from, prims, self.nodes, self.leaf_prims, &mut private, stack, lane as usize)
+    }
+}
+
+/// Stack layouts measured for this traversal on the H100 (`treelet bench
+/// rays --stacks`): the private array kept here, and workgroup memory for
+/// the top entries with the private array below them (the paper's choice).
+pub const STACK_KINDS: [&str; 2] = ["private", "workgroup"];
+
+/// Stack entries per ray kept in workgroup memory by the kernels that
+/// try it (the paper kept 12, the authors' code 8).
+pub const WORKGROUP_STACK_ENTRIES: usize = 8;
+/// Words of workgroup memory those kernels declare: two per entry and lane.
+pub const WORKGROUP_STACK_WORDS: usize = 2 * WORKGROUP_STACK_ENTRIES * crate::workgroup::WG;
+
+/// Most groups a ray's stack holds: a node pushes at most one group, and
+/// the tree is no deeper than the binary tree it was made from, which the
+/// host keeps below [`STACK_DEPTH`].
+pub const WIDE_STACK: usize = STACK_DEPTH;
+
+/// The closest hit through a compressed wide BVH (root 0); see the
+/// module doc. `F` as for [`crate::traverse::closest_hit_linear_for`].
+#[inline]
+pub fn closest_hit_cwbvh<const F: u32>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    prims: &Prims,
+    nodes: &[WideNode],
+    leaf_prims: &[LeafPrim],
+) -> Hit {
+    let mut stack = [0u32; 2 * WIDE_STACK];
+    closest_hit_cwbvh_with::<F, 1>(o, d, from, prims, nodes, leaf_prims, &mut stack, &mut [0u32; 1], 0)
+}
+
+/// [`closest_hit_cwbvh`] with its stack in `private` and, for its top
+/// `SHARED / WG` entries, in `shared` at `lane + WG * entry` (workgroup
+/// memory, interleaved across lanes); `SHARED = 1` keeps it all private.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    prims: &Prims,
+    nodes: &[WideNode],
+    leaf_prims: &[LeafPrim],
+    private: &mut [u32; 2 * WIDE_STACK],
+    shared: &mut [u32; SHARED],
+    lane: usize,
+) -> Hit {
+    let mut hit = Hit::NONE;
+    if prims.count() == 0 {
+        return hit;
+    }
+    let inv = finite_inverse(d);
+    let ray = WatertightRay::new(o, d);
+    let octant = ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32;
+    let oct_inv = 7 - octant;
+    let oct_inv4 = oct_inv * 0x0101_0101;
+    // Shared entries per lane (0 when the stack is all private).
+    let shared_entries = if SHARED > 1 { SHARED / crate::workgroup::WG / 2 } else { 0 };
+    // The root's group: one hit internal child at base 0.
+    let (mut node_base, mut node_hits) = (0u32, 0x8000_0000u32);
+    let mut top = 0usize;
+    loop {
+        let mut prim_base = 0u32;
+        let mut prim_hits = 0u32;
+        if node_hits > 0x00FF_FFFF {
+            // The next child of the group, in visiting order.
+            let bit = 31 - node_hits.leading_zeros();
+            node_hits &= !(1u32 << bit);
+            let slot = (bit - 24) ^ oct_inv;
+            let index = node_base + (node_hits & !(0xFFFF_FFFFu32 << slot)).count_ones();
+            if node_hits > 0x00FF_FFFF {
+                push(private, shared, lane, shared_entries, &mut top, node_base, node_hits);
+            }
+            let n = at(nodes, index as usize);
+            let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0]);
+            let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1]);
+            let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2]);
+            let mask = hit_bits(&x, &y, &z, n.meta[0], 0, oct_inv4, hit.t)
+                | hit_bits(&x, &y, &z, n.meta[1], 1, oct_inv4, hit.t);
+            node_base = n.child_base;
+            node_hits = (mask & 0xFF00_0000) | (n.exp_imask >> 24);
+            prim_base = n.prim_base;
+            prim_hits = mask & 0x00FF_FFFF;
+        }
+        while prim_hits != 0 {
+            let bit = 31 - prim_hits.leading_zeros();
+            prim_hits &= !(1u32 << bit);
+            let p = at(leaf_prims, (prim_base + bit) as usize);
+            let t = prims.leaf_distance::<F>(o, d, &ray, from, &p, hit.t);
+            if hit.is_beaten_by(t, p.prim) {
+                hit = Hit { t, prim: p.prim };
+            }
+        }
+        if node_hits <= 0x00FF_FFFF {
+            if top == 0 {
+                return hit;
+            }
+            (node_base, node_hits) = pop(private, shared, lane, shared_entries, &mut top);
+        }
+    }
+}
+
+#[inline]
+fn push<const SHARED: usize>(
+    private: &mut [u32; 2 * WIDE_STACK],
+    shared: &mut [u32; SHARED],
+    lane: usize,
+    shared_entries: usize,
+    top: &mut usize,
+    base: u32,
+    hits: u32,
+) {
+    let t = *top;
+    if t < shared_entries {
+        let slot = lane + 2 * t * crate::workgroup::WG;
+        set(shared, slot, base);
+        set(shared, slot + crate::workgroup::WG, hits);
+    } else if t - shared_entries < WIDE_STACK {
+        set(private, 2 * (t - shared_entries), base);
+        set(private, 2 * (t - shared_entries) + 1, hits);
+    }
+    *top = t + 1;
+}
+
+#[inline]
+fn pop<const SHARED: usize>(
+    private: &mut [u32; 2 * WIDE_STACK],
+    shared: &mut [u32; SHARED],
+    lane: usize,
+    shared_entries: usize,
+    top: &mut usize,
+) -> (u32, u32) {
+    let t = *top - 1;
+    *top = t;
+    if t < shared_entries {
+        let slot = lane + 2 * t * crate::workgroup::WG;
+        (get(shared, slot), get(shared, slot + crate::workgroup::WG))
+    } else if t - shared_entries < WIDE_STACK {
+        (get(private, 2 * (t - shared_entries)), get(private, 2 * (t - shared_entries) + 1))
+    } else {
+        (0, 0) // never pushed: the host keeps trees shallower than the stack
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_fits_the_extent_exactly_and_is_smallest() {
+        for (lo, hi) in [(0.0f32, 1.0f32), (-3.0, 7.5), (1e30, 1.0000001e30), (-1e-30, 1e-30), (5.0, 5.0), (0.1, 0.3)] {
+            let e = grid_exponent(lo, hi);
+            let s = grid_step(e) as f64;
+            let extent = hi as f64 - lo as f64;
+            assert!(255.0 * s >= extent, "{lo}..{hi}: step {s} too small");
+            if e > 1 {
+                assert!(255.0 * s / 2.0 < extent, "{lo}..{hi}: step {s} not the smallest");
+            }
+        }
+    }
+
+    #[test]
+    fn quantized_planes_contain_the_exact_box() {
+        let mut seed = 12345u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        for _ in 0..20_000 {
+            let scale = [1e-20f32, 1e-3, 1.0, 1e4, 1e20][(next() * 5.0) as usize % 5];
+            let offset = [0.0f32, 1.0, -1e6, 3e8][(next() * 4.0) as usize % 4];
+            let (a, b) = (offset + next() * scale, offset + next() * scale);
+            let (lo, hi) = (a.min(b), a.max(b));
+            let (c0, c1) = (lo + (hi - lo) * next(), lo + (hi - lo) * next());
+            let (clo, chi) = (c0.min(c1).max(lo), c0.max(c1).min(hi));
+            let e = grid_exponent(lo, hi);
+            let s = grid_step(e);
+            let (ql, qh) = (quantize_lo(clo, lo, s), quantize_hi(chi, lo, s));
+            assert!(ql <= qh && qh <= 255, "{lo}..{hi} child {clo}..{chi}: {ql} {qh}");
+            // In exact (f64, which holds these sums exactly) arithmetic.
+            let (pl, ph) = (lo as f64 + ql as f64 * s as f64, lo as f64 + qh as f64 * s as f64);
+            assert!(pl <= clo as f64 && ph >= chi as f64, "{lo}..{hi} child {clo}..{chi}: {pl} {ph}");
+            // And tight: one step less would not contain it (where f64
+            // still holds `lo + s` exactly).
+            if lo as f64 + s as f64 - lo as f64 == s as f64 {
+                assert!(ql == 255 || lo as f64 + (ql + 1) as f64 * (s as f64) > clo as f64);
+                assert!(qh == 0 || lo as f64 + (qh - 1) as f64 * (s as f64) < chi as f64);
+            }
+        }
+    }
+
+    #[test]
+    fn bytes_convert_exactly() {
+        for b in 0..256u32 {
+            let word = b << 16 | 0xAB;
+            assert_eq!(byte_f32(word, 16), b as f32);
+        }
+    }
+}

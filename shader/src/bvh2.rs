@@ -1,0 +1,34 @@
+use spirv_std::glam::UVec3;
+use spirv_std::spirv;
+use treelet_core::layout::{Bvh2Node, LayoutParams, LeafPrim, Node, Sphere};
+use treelet_core::triangle::Triangle;
+use treelet_core::workgroup::linear_id;
+
+/// One node of a collapsed tree into the two-box layout.
+#[spirv(compute(threads(256)))]
+pub fn bvh2_nodes_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Bvh2Node],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::bvh2::bvh2_node_kernel(id, params.nodes, nodes, parents, out);
+}
+
+/// One primitive, in leaf order, as its leaf stores it.
+#[spirv(compute(threads(256)))]
+pub fn leaf_prims_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] prim_indices: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [LeafPrim],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_core::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
+}
