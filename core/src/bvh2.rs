@@ -15,7 +15,7 @@
 use glam::Vec3;
 
 use crate::features;
-use crate::intersect::{finite_inverse, slab_interval};
+use crate::intersect::{slab_interval, SlabRay};
 use crate::layout::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::traverse::{ClosestHit, Hit, Origin, Prims, STACK_DEPTH};
 use crate::triangle::{Triangle, WatertightRay};
@@ -154,9 +154,8 @@ pub fn closest_hit_bvh2<const F: u32>(
     if prims.count() == 0 {
         return hit;
     }
-    let inv = finite_inverse(d);
+    let slabs = SlabRay::new(o, d);
     let ray = WatertightRay::new(o, d);
-    let origin = o.to_array();
     let at_ray = (o, d, from);
     // Entries: node index and the entry distance it was pushed with.
     let mut stack = [0u32; 2 * STACK_DEPTH];
@@ -164,8 +163,8 @@ pub fn closest_hit_bvh2<const F: u32>(
     let mut node = 0u32;
     loop {
         let n = at(nodes, node as usize);
-        let (ln, lf) = slab_interval(n.left_min, n.left_max, origin, inv, hit.t);
-        let (rn, rf) = slab_interval(n.right_min, n.right_max, origin, inv, hit.t);
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
         // Leaves are tested at once; only internal children are walked.
         if go_left && n.left_count > 0 {

@@ -27,13 +27,15 @@
 //!   distance is widened by [`WIDE_FAR_WIDENING`] for the rest, all of it
 //!   relative to the distance (Ize 2013's argument with five roundings);
 //! * directions parallel to an axis get `±f32::MAX` for an inverse
-//!   ([`crate::intersect::finite_inverse`]): no NaN, and exact signs.
+//!   ([`crate::intersect::SlabRay`]): no NaN, and exact signs; a ray lying
+//!   in a child's face is inside the slab, as the slack puts the face
+//!   strictly beyond it.
 //!
 //! The stack is a private array: see [`STACK_KINDS`] for the measured
 //! alternatives.
 use glam::Vec3;
 
-use crate::intersect::finite_inverse;
+use crate::intersect::SlabRay;
 use crate::layout::{LeafPrim, WideNode};
 use crate::traverse::{ClosestHit, Hit, Origin, Prims, STACK_DEPTH};
 use crate::triangle::WatertightRay;
@@ -278,7 +280,9 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
     if prims.count() == 0 {
         return hit;
     }
-    let inv = finite_inverse(d);
+    // Parallel axes need no far bias here: the planes' slack keeps a ray
+    // lying in a face inside the slab (see the module doc).
+    let inv = SlabRay::new(o, d).inv;
     let ray = WatertightRay::new(o, d);
     let octant = ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32;
     let oct_inv = 7 - octant;

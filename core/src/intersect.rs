@@ -101,26 +101,42 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
     Vec3::new(inv(d.x), inv(d.y), inv(d.z))
 }
 
-/// Reciprocal of a direction for the branch-free slab tests of the
-/// traversal layouts ([`crate::bvh2`], [`crate::cwbvh`]): an axis the ray
-/// runs parallel to (or too nearly to invert) gets `±f32::MAX`, with the
-/// direction's sign, instead of an infinity. `(plane - origin) * inverse`
-/// then is never NaN (never `0 * inf`), and on such an axis its sign, which
-/// is all the test needs there, is exact: a parallel ray inside the slab
-/// gets an interval reaching from below 0 to above any hit, one outside it
-/// an interval that starts beyond any hit worth having (or a harmless false
-/// accept for slabs within `t_max / f32::MAX` of it).
-#[inline]
-pub fn finite_inverse(d: Vec3) -> [f32; 3] {
-    let inv = |x: f32| {
-        let r = 1.0 / x;
-        if r.abs() <= f32::MAX {
-            r
-        } else {
-            f32::from_bits((x.to_bits() & 0x8000_0000) | f32::MAX.to_bits())
+/// A ray as the branch-free slab tests of the traversal layouts
+/// ([`crate::bvh2`], [`crate::cwbvh`]) take it: origin, reciprocal
+/// direction, and a bias for far distances.
+///
+/// An axis the ray runs parallel to (or too nearly to invert) gets
+/// `±f32::MAX`, with the direction's sign, for an inverse instead of an
+/// infinity, so `(plane - origin) * inverse` is never NaN (never `0 * inf`)
+/// and its sign is exact. That alone would make a ray lying exactly in a
+/// box's far face leave the slab at `t = 0`, so far distances on such an
+/// axis get `+f32::MAX` added: the ray then stays in the slab unless it lies
+/// more than `t_max / f32::MAX` outside it (a harmless false accept below
+/// that). Near distances need nothing: a ray in a near face enters at 0.
+#[derive(Clone, Copy)]
+pub struct SlabRay {
+    pub o: [f32; 3],
+    pub inv: [f32; 3],
+    pub far_bias: [f32; 3],
+}
+
+impl SlabRay {
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let d = d.to_array();
+        let mut inv = [0.0f32; 3];
+        let mut far_bias = [0.0f32; 3];
+        for k in 0..3 {
+            let r = 1.0 / d[k];
+            if r.abs() <= f32::MAX {
+                inv[k] = r;
+            } else {
+                inv[k] = f32::from_bits((d[k].to_bits() & 0x8000_0000) | f32::MAX.to_bits());
+                far_bias[k] = f32::MAX;
+            }
         }
-    };
-    [inv(d.x), inv(d.y), inv(d.z)]
+        SlabRay { o: o.to_array(), inv, far_bias }
+    }
 }
 
 /// How much a slab test widens its far distance (Ize, "Robust BVH Ray
@@ -129,14 +145,13 @@ pub fn finite_inverse(d: Vec3) -> [f32; 3] {
 pub const FAR_WIDENING: f32 = 1.000_000_4;
 
 /// The interval `[near, far]` (far widened by [`FAR_WIDENING`]) over which
-/// the ray `o + t / inv` is inside the box `lo..hi`, clipped to
-/// `0..=t_max`; the ray meets the box where `near <= far`. `inv` comes from
-/// [`finite_inverse`].
+/// the ray is inside the box `lo..hi`, clipped to `0..=t_max`; the ray
+/// meets the box where `near <= far`.
 #[inline]
-pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], o: [f32; 3], inv: [f32; 3], t_max: f32) -> (f32, f32) {
+pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], ray: &SlabRay, t_max: f32) -> (f32, f32) {
     let t = |k: usize| {
-        let (a, b) = ((lo[k] - o[k]) * inv[k], (hi[k] - o[k]) * inv[k]);
-        (a.min(b), a.max(b))
+        let (near, far) = if ray.inv[k] >= 0.0 { (lo[k], hi[k]) } else { (hi[k], lo[k]) };
+        ((near - ray.o[k]) * ray.inv[k], (far - ray.o[k]) * ray.inv[k] + ray.far_bias[k])
     };
     let ((nx, fx), (ny, fy), (nz, fz)) = (t(0), t(1), t(2));
     let near = nx.max(ny).max(nz.max(0.0));

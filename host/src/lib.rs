@@ -30,4 +30,5 @@ pub mod sort;
 pub mod sweep;
 pub mod trbvh;
 pub mod validate;
+pub mod validate_layout;
 pub mod variant;

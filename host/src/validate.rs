@@ -35,6 +35,14 @@ fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
     (lo, hi)
 }
 
+/// The box of primitive `i` (spheres first, then triangles), computed here.
+pub(crate) fn primitive_box(prims: Primitives, i: usize) -> ([f32; 3], [f32; 3]) {
+    match i.checked_sub(prims.spheres.len()) {
+        None => sphere_box(&prims.spheres[i]),
+        Some(t) => triangle_box(&prims.triangles[t]),
+    }
+}
+
 fn encloses(outer_lo: &[f32; 3], outer_hi: &[f32; 3], lo: &[f32; 3], hi: &[f32; 3]) -> bool {
     (0..3).all(|k| outer_lo[k] <= lo[k] && outer_hi[k] >= hi[k])
 }

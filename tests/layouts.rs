@@ -1,0 +1,283 @@
+//! The traversal layouts (`classic`, `bvh2`, `cwbvh`): every layout of every
+//! tree (LBVH, TRBVH, sweep) finds exactly the scan's closest hit, distance
+//! and primitive, on random, mesh and stiff scenes, for rays from outside,
+//! from inside, along the axes and leaving a surface; each layout passes
+//! the independent validator (which checks, among the rest, that quantized
+//! boxes contain their children's exact boxes); and the GPU builds the
+//! layouts the CPU runner builds.
+use glam::Vec3;
+use treelet::backend::Backend;
+use treelet::cpu_runner::CpuBackend;
+use treelet::gpu::GpuBackend;
+use treelet::layout::{wide_nodes, Layout, TracedTree};
+use treelet::primitives::Primitives;
+use treelet::render::{scene_tree, Accel};
+use treelet::scene::{random_spheres, Scene};
+use treelet::validate_layout::{validate_bvh2, validate_wide};
+use treelet_core::bvh2::closest_hit_bvh2;
+use treelet_core::cwbvh::closest_hit_cwbvh;
+use treelet_core::features::ALL;
+use treelet_core::layout::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
+use treelet_core::rng::BounceRng;
+use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Hit, Origin, Prims};
+use treelet_core::triangle::Triangle;
+
+/// A laid-out tree, read back.
+enum HostTree {
+    Classic(Vec<Node>, Vec<u32>),
+    Bvh2(Vec<Bvh2Node>, Vec<LeafPrim>),
+    Wide(Vec<WideNode>, Vec<LeafPrim>),
+}
+
+fn read<B: Backend>(b: &mut B, tree: &TracedTree<B>, n: usize) -> HostTree {
+    match tree.layout {
+        Layout::Classic => HostTree::Classic(b.read(&tree.nodes, tree.node_count as usize).unwrap(), b.read(&tree.prims, n).unwrap()),
+        Layout::Bvh2 => HostTree::Bvh2(b.read(&tree.nodes, tree.node_count as usize).unwrap(), b.read(&tree.prims, n).unwrap()),
+        _ => HostTree::Wide(wide_nodes(b, tree).unwrap(), b.read(&tree.prims, n).unwrap()),
+    }
+}
+
+fn build<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> HostTree {
+    let (tree, _, _) = scene_tree(b, prims, accel, layout).unwrap();
+    read(b, &tree, prims.len())
+}
+
+impl HostTree {
+    fn trace(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
+        match self {
+            HostTree::Classic(nodes, idx) => closest_hit_bvh(o, d, from, prims, nodes, idx),
+            HostTree::Bvh2(nodes, leaf) => closest_hit_bvh2::<ALL>(o, d, from, prims, nodes, leaf),
+            HostTree::Wide(nodes, leaf) => closest_hit_cwbvh::<ALL>(o, d, from, prims, nodes, leaf),
+        }
+    }
+
+    fn validate(&self, prims: Primitives) {
+        let v = match self {
+            HostTree::Classic(..) => return, // the binary validator's business (tests/invariants.rs)
+            HostTree::Bvh2(nodes, leaf) => validate_bvh2(prims, nodes, leaf),
+            HostTree::Wide(nodes, leaf) => validate_wide(prims, nodes, leaf),
+        };
+        assert!(v.is_valid(), "{:?}", v.errors);
+    }
+}
+
+fn vec3(r: &BounceRng, k: u32) -> Vec3 {
+    Vec3::new(r.uniform(k), r.uniform(k + 1), r.uniform(k + 2))
+}
+
+fn primitive_centre(prims: &Prims, p: u32) -> Vec3 {
+    if p < prims.sphere_count {
+        Vec3::from_array(prims.spheres[p as usize].center)
+    } else {
+        let t = prims.triangles[(p - prims.sphere_count) as usize];
+        (Vec3::from_array(t.v0) + Vec3::from_array(t.v1) + Vec3::from_array(t.v2)) / 3.0
+    }
+}
+
+/// Rays that probe a scene of bounds `lo..hi`: from outside through it,
+/// from inside, exactly along an axis, and leaving the surface a scan hit
+/// (`Origin` set, as the renderer's bounces are). Each with the scan's hit.
+fn rays(prims: &Prims, lo: Vec3, hi: Vec3, seed: u32, count: u32) -> Vec<(Vec3, Vec3, Origin, Hit)> {
+    let (center, size) = ((lo + hi) * 0.5, (hi - lo).max_element().max(1e-30));
+    let mut out = Vec::new();
+    for i in 0..count {
+        let r = BounceRng::new(seed, i, 0, 0);
+        let target = lo + (hi - lo) * vec3(&r, 0);
+        let (o, d) = match i % 4 {
+            0 => {
+                let d = (vec3(&r, 3) - 0.5).normalize_or(Vec3::X);
+                (target - d * (2.0 * size), d)
+            }
+            1 => (lo + (hi - lo) * vec3(&r, 6), (vec3(&r, 3) - 0.5).normalize_or(Vec3::Y)),
+            2 => {
+                // Along one axis: two direction components exactly zero.
+                let axis = (r.uniform(9) * 3.0) as usize % 3;
+                let mut d = [0.0f32; 3];
+                d[axis] = if r.uniform(10) < 0.5 { -1.0 } else { 1.0 };
+                let d = Vec3::from_array(d);
+                (target - d * (2.0 * size), d)
+            }
+            _ => {
+                // At a random primitive's centre, from outside the scene.
+                let p = ((r.uniform(13) * prims.count() as f32) as u32).min(prims.count() - 1);
+                let aim = primitive_centre(prims, p);
+                let d = (aim - center + (vec3(&r, 3) - 0.5) * size * 1e-3).normalize_or(Vec3::Z);
+                (aim - d * (2.0 * size), d)
+            }
+        };
+        let hit = closest_hit_linear(o, d, Origin::NONE, prims);
+        out.push((o, d, Origin::NONE, hit));
+        if hit.is_hit() {
+            // Leave the surface hit, outwards, as a bounce does.
+            let x = o + d * hit.t;
+            let n = treelet_core::render::hit_normal(prims, hit.prim, x, d);
+            let nl = if n.dot(d) < 0.0 { n } else { -n };
+            let d2 = treelet_core::render::cosine_direction(nl, r.uniform(11), r.uniform(12));
+            let from = Origin { prim: hit.prim, into: d2.dot(n) < 0.0 };
+            let o2 = x + nl * treelet_core::render::surface_offset(x);
+            out.push((o2, d2, from, closest_hit_linear(o2, d2, from, prims)));
+        }
+    }
+    out
+}
+
+/// Every tree in every layout, built by the CPU runner, finds exactly the
+/// scan's hits in `spheres` and `triangles`, and passes the validator.
+fn every_layout_traces_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[Triangle], seed: u32) {
+    let prims = Primitives { spheres, triangles };
+    prims.check().unwrap();
+    let scene = Prims { spheres, sphere_count: spheres.len() as u32, triangles, triangle_count: triangles.len() as u32 };
+    let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
+    let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 600);
+    let hits = probes.iter().filter(|p| p.3.is_hit()).count();
+    assert!(hits * 8 > probes.len(), "{what}: only {hits} of {} rays hit: a weak test", probes.len());
+    let b = &mut CpuBackend::new();
+    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+        for layout in Layout::ALL {
+            let tree = build(b, prims, accel, layout);
+            tree.validate(prims);
+            for (k, &(o, d, from, scan)) in probes.iter().enumerate() {
+                let hit = tree.trace(o, d, from, &scene);
+                assert!(
+                    hit.t.to_bits() == scan.t.to_bits() && hit.prim == scan.prim,
+                    "{what}, {accel:?} in {}: ray {k} (o {o}, d {d}) hit {} at {}, the scan {} at {}",
+                    layout.name(),
+                    hit.prim,
+                    hit.t,
+                    scan.prim,
+                    scan.t
+                );
+            }
+        }
+    }
+}
+
+fn terrain(n: usize) -> Vec<Triangle> {
+    Scene::from_spec(&format!("terrain:{n}")).unwrap().triangles
+}
+
+#[test]
+fn random_spheres_and_meshes() {
+    let seed = treelet_tests::fresh_seed() as u32;
+    every_layout_traces_like_the_scan("random spheres", &random_spheres(3000, seed as u64), &[], seed);
+    every_layout_traces_like_the_scan("terrain", &[], &terrain(3000), seed);
+    // A mesh in smallpt's room: walls of radius 1e5 and triangles in one tree.
+    let room = Scene::from_spec("terrain:2000").unwrap();
+    every_layout_traces_like_the_scan("terrain in the room", &room.spheres, &room.triangles, seed);
+}
+
+#[test]
+fn stiff_scenes() {
+    let seed = treelet_tests::fresh_seed() as u32;
+    let base = terrain(1500);
+    let map = |f: &dyn Fn([f32; 3]) -> [f32; 3]| -> Vec<Triangle> {
+        base.iter().map(|t| Triangle::new(f(t.v0), f(t.v1), f(t.v2))).collect()
+    };
+    every_layout_traces_like_the_scan("terrain at 1e6", &[], &map(&|v| v.map(|x| x + 1e6)), seed);
+    every_layout_traces_like_the_scan("terrain scaled 1e-4", &[], &map(&|v| v.map(|x| x * 1e-4)), seed);
+    let doubled: Vec<Triangle> = base.iter().flat_map(|t| [*t, *t]).collect();
+    every_layout_traces_like_the_scan("every triangle twice", &[], &doubled, seed);
+    let degenerate: Vec<Triangle> =
+        base.iter().enumerate().map(|(i, t)| if i % 7 == 0 { Triangle::new(t.v0, t.v0, t.v1) } else { *t }).collect();
+    every_layout_traces_like_the_scan("with zero-area triangles", &[], &degenerate, seed);
+    // One box for all: triangles spanning the same unit cube.
+    let corner = |i: usize| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32];
+    let spanning: Vec<Triangle> = (0..2000)
+        .map(|i| {
+            let t = [[0, 6, 3], [1, 7, 2], [4, 2, 7], [5, 3, 6]][i % 4];
+            Triangle::new(corner(t[0]), corner(t[1]), corner(t[2]))
+        })
+        .collect();
+    every_layout_traces_like_the_scan("2000 triangles with one box", &[], &spanning, seed);
+    let spheres = random_spheres(1500, seed as u64);
+    // As far out and as small as f32 sphere tests themselves stay exact
+    // (their squares must not overflow or underflow).
+    for (scale, what) in [(1e16f32, "spheres near ±1e18"), (1e-17, "spheres near 1e-15")] {
+        let s: Vec<Sphere> = spheres.iter().map(|s| Sphere::new(s.center.map(|x| (x - 50.0) * scale), s.radius * scale)).collect();
+        every_layout_traces_like_the_scan(what, &s, &[], seed);
+    }
+    let same: Vec<Sphere> = (0..1000).map(|i| Sphere::new([5.0, -3.0, 2.0], 0.1 + i as f32 * 1e-3)).collect();
+    every_layout_traces_like_the_scan("identical centres", &same, &[], seed);
+}
+
+#[test]
+fn tiny_scenes() {
+    let seed = treelet_tests::fresh_seed() as u32;
+    for n in [1usize, 2, 3, 4, 5, 9, 17] {
+        every_layout_traces_like_the_scan(&format!("{n} spheres"), &random_spheres(n, seed as u64 + n as u64), &[], seed);
+        every_layout_traces_like_the_scan(&format!("{n} triangles"), &[], &terrain(50)[..n], seed);
+    }
+}
+
+/// The validators must catch broken layouts, or the checks above prove nothing.
+#[test]
+fn validators_catch_corruption() {
+    let tris = terrain(500);
+    let prims = Primitives::triangles(&tris);
+    let b = &mut CpuBackend::new();
+    let HostTree::Wide(nodes, leaf) = build(b, prims, Accel::Trbvh, Layout::Cwbvh) else { unreachable!() };
+    assert!(validate_wide(prims, &nodes, &leaf).is_valid());
+    let wide = |mutate: &dyn Fn(&mut Vec<WideNode>, &mut Vec<LeafPrim>), needle: &str| {
+        let (mut n, mut l) = (nodes.clone(), leaf.clone());
+        mutate(&mut n, &mut l);
+        let v = validate_wide(prims, &n, &l);
+        assert!(v.errors.iter().any(|e| e.contains(needle)), "expected `{needle}` in {:?}", v.errors);
+    };
+    // A quantized box shrunk by one step on some child (the first internal one).
+    let slot = (0..8).find(|&s| nodes[0].exp_imask >> (24 + s) & 1 == 1).unwrap();
+    wide(&|n, _| n[0].hi_x[slot / 4] -= 1 << (8 * (slot % 4)), "does not contain");
+    wide(&|n, _| n[0].lo_y[slot / 4] += 1 << (8 * (slot % 4)), "does not contain");
+    wide(&|_, l| l[3].p1[1] += 1e-3, "as the scene has it");
+    wide(&|_, l| l[5].prim = l[6].prim, "stored 2 times");
+    wide(&|n, _| n[0].child_base += 1, "reached");
+    wide(&|n, _| n[0].exp_imask ^= 1 << (24 + slot), "");
+    let HostTree::Bvh2(nodes, leaf) = build(b, prims, Accel::Trbvh, Layout::Bvh2) else { unreachable!() };
+    assert!(validate_bvh2(prims, &nodes, &leaf).is_valid());
+    let mut bad = nodes.clone();
+    bad[0].left_max[2] -= 1.0;
+    assert!(validate_bvh2(prims, &bad, &leaf).errors.iter().any(|e| e.contains("does not contain")));
+    let mut bad = leaf.clone();
+    bad[1].prim = bad[0].prim;
+    assert!(validate_bvh2(prims, &nodes, &bad).errors.iter().any(|e| e.contains("stored")));
+}
+
+/// The GPU lays out the trees the CPU runner does: the same buffers where
+/// the GPU fuses multiply-adds as the CPU's `fmaf` (the DP's sums then
+/// round alike), and on CPU adapters (lavapipe, which does not fuse) valid
+/// layouts that find the scan's hits.
+#[test]
+fn gpu_layouts_equal_cpu() {
+    let Some(ctx) = treelet_tests::gpu() else { return };
+    let seed = treelet_tests::fresh_seed() as u32;
+    let fused = !GpuBackend::new(ctx.clone()).runs_on_cpu();
+    let spheres = random_spheres(20_000, seed as u64);
+    let tris = terrain(20_000);
+    for (what, prims) in [("random spheres", Primitives::spheres(&spheres)), ("terrain", Primitives::triangles(&tris))] {
+        let scene = Prims {
+            spheres: prims.spheres,
+            sphere_count: prims.spheres.len() as u32,
+            triangles: prims.triangles,
+            triangle_count: prims.triangles.len() as u32,
+        };
+        let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
+        let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 300);
+        for layout in [Layout::Bvh2, Layout::Cwbvh] {
+            let g = build(&mut GpuBackend::new(ctx.clone()), prims, Accel::Trbvh, layout);
+            let c = build(&mut CpuBackend::new(), prims, Accel::Trbvh, layout);
+            g.validate(prims);
+            match (&g, &c) {
+                (HostTree::Wide(gn, gl), HostTree::Wide(cn, cl)) if fused => {
+                    assert!(gn == cn && gl == cl, "{what}: GPU and CPU wide trees differ");
+                }
+                (HostTree::Bvh2(gn, gl), HostTree::Bvh2(cn, cl)) if fused => {
+                    assert!(gn == cn && gl == cl, "{what}: GPU and CPU two-box trees differ");
+                }
+                _ => {}
+            }
+            for (k, &(o, d, from, scan)) in probes.iter().enumerate() {
+                let hit = g.trace(o, d, from, &scene);
+                assert!(hit.t == scan.t && hit.prim == scan.prim, "{what}, GPU-built {}: ray {k} differs", layout.name());
+            }
+        }
+    }
+}
