@@ -51,8 +51,9 @@ pub const META_INTERNAL: u32 = 0b001_00000;
 /// Grid cells each plane is pushed out by in the traversal (see the module
 /// doc): 2^-12, against a worst rounding error of 2 ε · 255 ≈ 2^-15 cells.
 pub const SLACK: f32 = 1.0 / 4096.0;
-/// The far distance's widening: `1 + 2^-20`, more than `1 + 2γ(5)`.
-pub const WIDE_FAR_WIDENING: f32 = 1.0 + 1.0 / 1_048_576.0;
+/// The far distance's widening: `1 + 2^-19`, more than `1 + 2γ(6)` (five
+/// roundings of the distance and one of the widened inverse).
+pub const WIDE_FAR_WIDENING: f32 = 1.0 + 1.0 / 524_288.0;
 
 /// The grid step `2^(e - 127)` of a biased exponent byte `e` (1..=254).
 #[inline]
@@ -141,27 +142,38 @@ struct Axis {
     near_offset: f32,
     far_offset: f32,
     inv: f32,
+    /// `inv` times [`WIDE_FAR_WIDENING`] (kept finite): far distances come
+    /// out widened without a multiply per child.
+    inv_far: f32,
+}
+
+/// The ray's per-axis inverse, plain and widened for far planes.
+#[inline]
+fn inverses(d: Vec3) -> ([f32; 3], [f32; 3]) {
+    let inv = SlabRay::new(Vec3::ZERO, d).inv;
+    let widen = |x: f32| (x * WIDE_FAR_WIDENING).clamp(-f32::MAX, f32::MAX);
+    (inv, [widen(inv[0]), widen(inv[1]), widen(inv[2])])
 }
 
 impl Axis {
     #[inline]
     #[allow(clippy::too_many_arguments)]
-    fn new(lo: [u32; 2], hi: [u32; 2], biased: u32, origin: f32, o: f32, inv: f32) -> Axis {
+    fn new(lo: [u32; 2], hi: [u32; 2], biased: u32, origin: f32, o: f32, inv: f32, inv_far: f32) -> Axis {
         let step = grid_step(biased);
         let from_ray = origin - o;
         let (lo_offset, hi_offset) = (from_ray - SLACK * step, from_ray + SLACK * step);
         if inv >= 0.0 {
-            Axis { near: lo, far: hi, step, near_offset: lo_offset, far_offset: hi_offset, inv }
+            Axis { near: lo, far: hi, step, near_offset: lo_offset, far_offset: hi_offset, inv, inv_far }
         } else {
-            Axis { near: hi, far: lo, step, near_offset: hi_offset, far_offset: lo_offset, inv }
+            Axis { near: hi, far: lo, step, near_offset: hi_offset, far_offset: lo_offset, inv, inv_far }
         }
     }
 
-    /// Distances to child `(word, shift)`'s near and far planes on this axis.
+    /// Distances to child `(word, shift)`'s near and (widened) far planes on this axis.
     #[inline]
     fn planes(&self, word: usize, shift: u32) -> (f32, f32) {
         let near = (byte_f32(get(&self.near, word), shift) * self.step + self.near_offset) * self.inv;
-        let far = (byte_f32(get(&self.far, word), shift) * self.step + self.far_offset) * self.inv;
+        let far = (byte_f32(get(&self.far, word), shift) * self.step + self.far_offset) * self.inv_far;
         (near, far)
     }
 }
@@ -171,7 +183,7 @@ impl Axis {
 fn child_hit(x: &Axis, y: &Axis, z: &Axis, word: usize, shift: u32, t_max: f32) -> bool {
     let ((nx, fx), (ny, fy), (nz, fz)) = (x.planes(word, shift), y.planes(word, shift), z.planes(word, shift));
     let near = nx.max(ny).max(nz.max(0.0));
-    let far = (fx.min(fy).min(fz) * WIDE_FAR_WIDENING).min(t_max);
+    let far = fx.min(fy).min(fz.min(t_max));
     near <= far
 }
 
@@ -282,7 +294,7 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
     }
     // Parallel axes need no far bias here: the planes' slack keeps a ray
     // lying in a face inside the slab (see the module doc).
-    let inv = SlabRay::new(o, d).inv;
+    let (inv, inv_far) = inverses(d);
     let ray = WatertightRay::new(o, d);
     let octant = ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32;
     let oct_inv = 7 - octant;
@@ -305,9 +317,9 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
                 push(private, shared, lane, shared_entries, &mut top, node_base, node_hits);
             }
             let n = at(nodes, index as usize);
-            let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0]);
-            let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1]);
-            let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2]);
+            let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0], inv_far[0]);
+            let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1], inv_far[1]);
+            let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2], inv_far[2]);
             let mask = hit_bits(&x, &y, &z, n.meta[0], 0, oct_inv4, hit.t)
                 | hit_bits(&x, &y, &z, n.meta[1], 1, oct_inv4, hit.t);
             node_base = n.child_base;

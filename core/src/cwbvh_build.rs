@@ -205,6 +205,11 @@ fn child_budgets(decisions: &[u32], node: u32, state: u32) -> (u32, u32) {
 /// climbing (at most 64 levels: bits of a u64).
 #[inline]
 pub fn is_wide_node(m: u32, nodes: &[Node], parents: &[u32], decisions: &[u32]) -> bool {
+    // Only a node whose own one-child choice is a wide node can be one:
+    // most nodes (those near the leaves) need no walk.
+    if m != 0 && decision(decisions, m, 1) & LEAF != 0 {
+        return false;
+    }
     let mut path = 0u64;
     let mut depth = 0u32;
     let mut x = m;

@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use crate::layout::RenderParams;
 use crate::features;
-use crate::render::{closest_hit, cosine_direction, hit_normal, surface_offset, SceneRefs};
+use crate::render::{closest_hit, cosine_direction, hit_normal, surface_offset, tiled_pixel, SceneRefs};
 use crate::rng::BounceRng;
 use crate::traverse::{ClosestHit, Origin};
 
@@ -15,12 +15,14 @@ pub const CAST_PRIMARY: u32 = 0;
 /// [`RenderParams::cast_mode`]: the diffuse rays the primary pass left.
 pub const CAST_DIFFUSE: u32 = 1;
 
-/// Kernel (one invocation per pixel): casts pixel `id`'s ray and writes
+/// Kernel (one invocation per pixel, in tiles: see
+/// [`crate::render::tiled_pixel`]): casts the ray of invocation
+/// `invocation`'s pixel `id` and writes
 /// `rays[2 id]` = (origin, 1 if a ray is to be cast, else 0) and
 /// `rays[2 id + 1]` = (direction, bits of the primitive it leaves) for the
 /// diffuse pass; the diffuse pass writes its hit distance into the last.
 pub fn cast_kernel<T: ClosestHit, const S: usize>(
-    id: u32,
+    invocation: u32,
     params: &RenderParams,
     scene: &SceneRefs<T>,
     rays: &mut [[f32; 4]],
@@ -28,7 +30,8 @@ pub fn cast_kernel<T: ClosestHit, const S: usize>(
     lane: u32,
 ) {
     let (w, h) = (params.width, params.height);
-    if id >= w * h {
+    let id = tiled_pixel(invocation, w, h);
+    if id == u32::MAX {
         return;
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);

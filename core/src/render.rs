@@ -254,6 +254,35 @@ pub fn hit_normal_for<const F: u32>(prims: &Prims, prim: u32, x: Vec3, d: Vec3) 
     }
 }
 
+/// Pixels are given to invocations in tiles of `TILE_W x TILE_H` (a
+/// subgroup of 32 on most GPUs), row-major within a tile: the rays of one
+/// subgroup then start close together and go through the same nodes, so
+/// they diverge less than a row of 32 pixels would.
+pub const TILE_W: u32 = 8;
+pub const TILE_H: u32 = 4;
+
+/// Invocations a dispatch needs to cover a `width x height` image in tiles.
+#[inline]
+pub fn tiled_invocations(width: u32, height: u32) -> u32 {
+    width.div_ceil(TILE_W) * TILE_W * height.div_ceil(TILE_H) * TILE_H
+}
+
+/// The pixel (row-major from the top row) of invocation `id`, or
+/// `u32::MAX` for an invocation past the image (edge tiles, the last
+/// workgroup).
+#[inline]
+pub fn tiled_pixel(id: u32, width: u32, height: u32) -> u32 {
+    let tiles_x = width.div_ceil(TILE_W);
+    let (tile, lane) = (id / (TILE_W * TILE_H), id % (TILE_W * TILE_H));
+    let x = (tile % tiles_x) * TILE_W + lane % TILE_W;
+    let y = (tile / tiles_x) * TILE_H + lane / TILE_W;
+    if x < width && y < height {
+        y * width + x
+    } else {
+        u32::MAX
+    }
+}
+
 /// Kernel body (one invocation per pixel): `params.samples` camera paths
 /// of pixel `id`, as sums of radiance and of squared luminance. `F`: the
 /// features compiled in (see [`crate::features`]); the scene's must be
@@ -302,6 +331,21 @@ pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
 mod tests {
     use super::*;
     use crate::rng::BounceRng;
+
+    #[test]
+    fn tiles_cover_every_pixel_once() {
+        extern crate std;
+        for (w, h) in [(1u32, 1u32), (8, 4), (9, 5), (1920, 1080), (33, 7)] {
+            let mut seen = std::vec![0u8; (w * h) as usize];
+            for id in 0..tiled_invocations(w, h) {
+                let p = tiled_pixel(id, w, h);
+                if p != u32::MAX {
+                    seen[p as usize] += 1;
+                }
+            }
+            assert!(seen.iter().all(|&c| c == 1), "{w}x{h}");
+        }
+    }
 
     #[test]
     fn sin_cos_turns_is_accurate() {

@@ -89,11 +89,24 @@ impl WatertightRay {
         let mut kx = if kz == 2 { 0 } else { kz + 1 };
         let mut ky = if kx == 2 { 0 } else { kx + 1 };
         // Keep the frame's winding when the ray points down its z axis.
-        if d[kz] < 0.0 {
+        if pick(d, kz) < 0.0 {
             core::mem::swap(&mut kx, &mut ky);
         }
-        let inv = 1.0 / d[kz];
-        WatertightRay { origin: origin.to_array(), axes: [kx, ky, kz], shear: [d[kx] * inv, d[ky] * inv, inv] }
+        let inv = 1.0 / pick(d, kz);
+        WatertightRay { origin: origin.to_array(), axes: [kx, ky, kz], shear: [pick(d, kx) * inv, pick(d, ky) * inv, inv] }
+    }
+}
+
+/// `v[k]` by selects: a GPU keeps an array indexed at run time in slow
+/// local memory.
+#[inline]
+fn pick(v: [f32; 3], k: usize) -> f32 {
+    if k == 0 {
+        v[0]
+    } else if k == 1 {
+        v[1]
+    } else {
+        v[2]
     }
 }
 
@@ -111,9 +124,10 @@ pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
     let a = [tri.v0[0] - o[0], tri.v0[1] - o[1], tri.v0[2] - o[2]];
     let b = [tri.v1[0] - o[0], tri.v1[1] - o[1], tri.v1[2] - o[2]];
     let c = [tri.v2[0] - o[0], tri.v2[1] - o[1], tri.v2[2] - o[2]];
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+    let (az, bz, cz) = (pick(a, kz), pick(b, kz), pick(c, kz));
+    let (ax, ay) = (pick(a, kx) - sx * az, pick(a, ky) - sy * az);
+    let (bx, by) = (pick(b, kx) - sx * bz, pick(b, ky) - sy * bz);
+    let (cx, cy) = (pick(c, kx) - sx * cz, pick(c, ky) - sy * cz);
     // Scaled barycentrics: the signed areas seen from the ray.
     let u = difference_of_products(cx, by, cy, bx);
     let v = difference_of_products(ax, cy, ay, cx);
@@ -125,7 +139,7 @@ pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
     if det == 0.0 {
         return MISS;
     }
-    let t_scaled = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
+    let t_scaled = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
     let t = t_scaled / det;
     if t > 0.0 && t <= t_max {
         t

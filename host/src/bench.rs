@@ -547,7 +547,7 @@ fn time_casts<B: Backend>(
         camera: scene.camera.camera(width, height),
         ..Default::default()
     };
-    let groups = groups_for(pixels, WORKGROUP_SIZE);
+    let groups = groups_for(treelet_core::render::tiled_invocations(width, height), WORKGROUP_SIZE);
     let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,

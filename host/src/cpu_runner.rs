@@ -84,7 +84,8 @@ fn render_variant<T: ClosestHit>(v: u8, id: u32, p: &treelet_core::RenderParams,
 }
 
 /// Every pixel of a render dispatch (pixels are independent: the one
-/// kernel the CPU runs in parallel).
+/// kernel the CPU runs in parallel; the GPU's tiling of pixels, see
+/// `treelet_core::render::tiled_pixel`, only orders them).
 fn render_all<T: ClosestHit + Sync>(v: u8, p: &treelet_core::RenderParams, scene: &SceneRefs<T>, accum: &mut [[f32; 4]], groups: u32) {
     let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
     accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene)));

@@ -170,14 +170,27 @@ fn check_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<()> {
     Ok(())
 }
 
+/// The wide DP's cost model: the defaults, or for developers tuning it,
+/// `TREELET_WIDE_COSTS=NODE,PRIM`.
+fn wide_costs() -> (f32, f32) {
+    std::env::var("TREELET_WIDE_COSTS")
+        .ok()
+        .and_then(|v| {
+            let (a, b) = v.split_once(',')?;
+            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+        })
+        .unwrap_or((WIDE_NODE_COST, WIDE_PRIM_COST))
+}
+
 fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -> LayoutParams {
     let extent = root.extent().max_element();
+    let (node_cost, prim_cost) = wide_costs();
     LayoutParams {
         n: bvh.n,
         nodes: bvh.node_count,
         spheres: prims.sphere_count,
-        node_cost: WIDE_NODE_COST,
-        prim_cost: WIDE_PRIM_COST,
+        node_cost,
+        prim_cost,
         inv_extent: if extent > 0.0 { (1.0 / extent).min(f32::MAX) } else { 1.0 },
         ..Default::default()
     }

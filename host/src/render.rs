@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::layout::{Node, RenderParams};
-use treelet_core::render::luminance;
+use treelet_core::render::{luminance, tiled_invocations};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use crate::backend::Backend;
@@ -160,7 +160,7 @@ pub fn render<B: Backend>(
             b.dispatch(
                 kernel,
                 &[&p, &buffers.spheres, &materials, &tree.nodes, &tree.prims, &accum, &buffers.triangles],
-                groups_for(pixels as u32, WORKGROUP_SIZE),
+                groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
             );
             done += samples;
         }
