@@ -453,6 +453,8 @@ pub(crate) struct RaysRow {
     pub(crate) build_ms: f64,
     /// Its layout for traversal (ms, collapse included).
     pub(crate) layout_ms: f64,
+    /// The layout's stages (ms).
+    pub(crate) layout_stages: Vec<(&'static str, f64)>,
     pub(crate) primary_rays: u64,
     pub(crate) diffuse_rays: u64,
     pub(crate) primary_median_ms: f64,
@@ -496,7 +498,9 @@ pub(crate) fn bench_rays<B: Backend>(
     let mut rows = Vec::new();
     for &layout in &plan.layouts {
         let layout = layout.resolve();
-        let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
+        let (tree, stages) = built.lay_out_timed(b, layout, &buffers)?;
+        let layout_ms = stages.total();
+        let layout_stages: Vec<_> = stages.order.iter().map(|&s| (s, stages.get(s))).collect();
         let mut kernels = vec![("private", Kernel::Cast(layout.method()))];
         if plan.workgroup_stack && layout == Layout::Cwbvh {
             kernels.push(("workgroup", Kernel::CastWideWorkgroupStack));
@@ -512,6 +516,7 @@ pub(crate) fn bench_rays<B: Backend>(
                 primitives: all.len(),
                 build_ms: built.build_ms,
                 layout_ms,
+                layout_stages: layout_stages.clone(),
                 primary_rays: pixels,
                 diffuse_rays,
                 primary_median_ms: primary_ms,
@@ -552,6 +557,11 @@ fn time_casts<B: Backend>(
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,
     // which drop while a CPU-built tree is being made), then the timed ones.
+    // The first casts of a process warm up for two seconds (GPUs were seen
+    // to run their first seconds of work at a fraction of their speed),
+    // later ones for half a second.
+    static WARMED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    let warm_s = if WARMED.swap(true, std::sync::atomic::Ordering::Relaxed) { 0.5 } else { 2.0 };
     let warm = std::time::Instant::now();
     let mut warm_passes = 0;
     for r in 0.. {
@@ -570,7 +580,7 @@ fn time_casts<B: Backend>(
             diffuse_rays = rays.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
         }
         if r == warm_passes {
-            if warm.elapsed().as_secs_f64() < 0.5 {
+            if warm.elapsed().as_secs_f64() < warm_s {
                 warm_passes += 1;
             }
             continue;
@@ -609,6 +619,10 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 "{:>6}{:>8}{:>10}{:>11}{:>11}{:>12}{:>12}{:>16}{:>16}",
                 "accel", "layout", "stack", "build ms", "layout ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s"
             );
+            for r in rows.iter().filter(|r| r.layout_stages.len() > 1) {
+                let stages: Vec<String> = r.layout_stages.iter().map(|(s, ms)| format!("{s} {ms:.3}")).collect();
+                eprintln!("{} layout of the {:?} tree, ms: {}", r.layout.name(), r.accel, stages.join(", "));
+            }
             for r in &rows {
                 println!(
                     "{:>6}{:>8}{:>10}{:>11.3}{:>11.3}{:>12.3}{:>12.3}{:>16.1}{:>16.1}",

@@ -247,23 +247,29 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let costs = b.scratch("wide DP costs", nodes * 32)?;
     let decisions = b.scratch("wide DP decisions", nodes * 8)?;
     let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
+    // A stage per step, so that `bench rays` shows where the time goes.
+    b.stage("wide dp");
     b.dispatch(dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));
 
     let is_wide = b.scratch("wide node flags", internal as u64 * 4)?;
     let child_offsets = b.scratch("wide child offsets", internal as u64 * 4)?;
     let prim_offsets = b.scratch("wide primitive offsets", internal as u64 * 4)?;
     let groups = groups_for(internal, WORKGROUP_SIZE);
+    b.stage("wide count");
     b.dispatch(
         Kernel::WideCount,
         &[&p, &bvh.nodes, &bvh.parents, &counts, &decisions, &is_wide, &child_offsets, &prim_offsets],
         groups,
     );
+    b.stage("wide scans");
     crate::sort::exclusive_scan(b, &child_offsets, internal)?;
     crate::sort::exclusive_scan(b, &prim_offsets, internal)?;
     let positions = b.scratch("wide node positions", internal as u64 * 4)?;
+    b.stage("wide place");
     b.dispatch(Kernel::WidePlace, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions], groups);
     let out_nodes = b.scratch("wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
     let out_prims = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    b.stage("wide emit");
     b.dispatch(
         Kernel::WideEmit,
         &[

@@ -9,7 +9,7 @@ use treelet_core::layout::{Node, RenderParams};
 use treelet_core::render::{luminance, tiled_invocations};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::Backend;
+use crate::backend::{Backend, StageTimes};
 use crate::image_io::HdrImage;
 use crate::kernels::{Kernel, Method};
 use crate::layout::{lay_out, Layout, PrimBuffers, TracedTree};
@@ -261,9 +261,15 @@ impl<B: Backend> BuiltTree<B> {
     /// Lays the tree out (it stays usable for other layouts); returns the
     /// layout's device time (ms).
     pub fn lay_out(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, f64)> {
+        let (tree, times) = self.lay_out_timed(b, layout, prims)?;
+        Ok((tree, times.total()))
+    }
+
+    /// [`BuiltTree::lay_out`] with the layout's stage times.
+    pub fn lay_out_timed(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, StageTimes)> {
         b.take_times()?;
         let tree = lay_out(b, self.bvh.clone(), layout, self.max_leaf, prims)?;
-        Ok((tree, b.take_times()?.total()))
+        Ok((tree, b.take_times()?))
     }
 }
 

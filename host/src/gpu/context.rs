@@ -13,7 +13,7 @@ use anyhow::{bail, Context as _, Result};
 use crate::kernels::{Access, Kernel};
 
 /// The SPIR-V module compiled from the `shader` crate by `build.rs`.
-const SHADER_SPV: &[u8] = include_bytes!(env!("treelet_shader.spv"));
+pub const SHADER_SPV: &[u8] = include_bytes!(env!("treelet_shader.spv"));
 
 pub struct Pipeline {
     pub pipeline: wgpu::ComputePipeline,
