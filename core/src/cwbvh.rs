@@ -147,18 +147,12 @@ struct Axis {
     inv_far: f32,
 }
 
-/// The ray's per-axis inverse, plain and widened for far planes.
-#[inline]
-fn inverses(d: Vec3) -> ([f32; 3], [f32; 3]) {
-    let inv = SlabRay::new(Vec3::ZERO, d).inv;
-    let widen = |x: f32| (x * WIDE_FAR_WIDENING).clamp(-f32::MAX, f32::MAX);
-    (inv, [widen(inv[0]), widen(inv[1]), widen(inv[2])])
-}
-
 impl Axis {
+    /// (The widened inverse is made here, per node, rather than kept per
+    /// ray: three multiplies a node against three registers all along.)
     #[inline]
-    #[allow(clippy::too_many_arguments)]
-    fn new(lo: [u32; 2], hi: [u32; 2], biased: u32, origin: f32, o: f32, inv: f32, inv_far: f32) -> Axis {
+    fn new(lo: [u32; 2], hi: [u32; 2], biased: u32, origin: f32, o: f32, inv: f32) -> Axis {
+        let inv_far = (inv * WIDE_FAR_WIDENING).clamp(-f32::MAX, f32::MAX);
         let step = grid_step(biased);
         let from_ray = origin - o;
         let (lo_offset, hi_offset) = (from_ray - SLACK * step, from_ray + SLACK * step);
@@ -294,7 +288,7 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
     }
     // Parallel axes need no far bias here: the planes' slack keeps a ray
     // lying in a face inside the slab (see the module doc).
-    let (inv, inv_far) = inverses(d);
+    let inv = SlabRay::new(Vec3::ZERO, d).inv;
     let ray = WatertightRay::new(o, d);
     let octant = ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32;
     let oct_inv = 7 - octant;
@@ -317,9 +311,9 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
                 push(private, shared, lane, shared_entries, &mut top, node_base, node_hits);
             }
             let n = at(nodes, index as usize);
-            let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0], inv_far[0]);
-            let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1], inv_far[1]);
-            let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2], inv_far[2]);
+            let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0]);
+            let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1]);
+            let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2]);
             let mask = hit_bits(&x, &y, &z, n.meta[0], 0, oct_inv4, hit.t)
                 | hit_bits(&x, &y, &z, n.meta[1], 1, oct_inv4, hit.t);
             node_base = n.child_base;

@@ -67,8 +67,9 @@ pub fn difference_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
 #[derive(Clone, Copy)]
 pub struct WatertightRay {
     pub origin: [f32; 3],
-    /// Axis indices (x, y, z) of the sheared frame.
-    pub axes: [usize; 3],
+    /// Axis indices (x, y, z) of the sheared frame, two bits each (one
+    /// register instead of three, in kernels that keep it all along).
+    pub axes: u32,
     /// Shear constants: `d[kx] / d[kz]`, `d[ky] / d[kz]`, `1 / d[kz]`.
     pub shear: [f32; 3],
 }
@@ -93,7 +94,8 @@ impl WatertightRay {
             core::mem::swap(&mut kx, &mut ky);
         }
         let inv = 1.0 / pick(d, kz);
-        WatertightRay { origin: origin.to_array(), axes: [kx, ky, kz], shear: [pick(d, kx) * inv, pick(d, ky) * inv, inv] }
+        let axes = (kx | ky << 2 | kz << 4) as u32;
+        WatertightRay { origin: origin.to_array(), axes, shear: [pick(d, kx) * inv, pick(d, ky) * inv, inv] }
     }
 }
 
@@ -117,7 +119,7 @@ fn pick(v: [f32; 3], k: usize) -> f32 {
 /// seen edge-on) is never hit.
 #[inline]
 pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
-    let [kx, ky, kz] = ray.axes;
+    let (kx, ky, kz) = ((ray.axes & 3) as usize, (ray.axes >> 2 & 3) as usize, (ray.axes >> 4) as usize);
     let [sx, sy, sz] = ray.shear;
     let o = ray.origin;
     // Vertices relative to the origin, sheared into the ray's frame.
