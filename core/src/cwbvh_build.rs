@@ -23,8 +23,9 @@
 //!    layout needs. (The order of blocks is the binary nodes' order; only
 //!    siblings need be contiguous.)
 //! 4. [`wide_place_kernel`], per wide node: its children to slots by octant
-//!    (the paper's ordering, greedily, as the authors' code does), and each
-//!    internal child's index from the block and its slot order.
+//!    (the paper's ordering, greedily, as the authors' code does), kept for
+//!    the next step, and each internal child's index from the block and its
+//!    slot order.
 //! 5. [`wide_emit_kernel`], per wide node: its [`WideNode`] at its index,
 //!    child boxes quantized outwards ([`crate::cwbvh::quantize_lo`]), and
 //!    its leaf primitives.
@@ -363,7 +364,8 @@ pub fn assign_slots(w_box: &Aabb, children: &[u32; WIDTH], count: usize, nodes: 
 }
 
 /// Kernel, one invocation per binary internal node `m`: a wide node writes
-/// the index of each wide child (`positions[child]`): its block's start
+/// its children by slot (`slots[8 m + s]`, see [`assign_slots`]) and the
+/// index of each wide child (`positions[child]`): its block's start
 /// (`1 + child_offsets[m]`) plus the child's rank in slot order. The root
 /// writes its own (0).
 #[allow(clippy::too_many_arguments)]
@@ -375,6 +377,7 @@ pub fn wide_place_kernel(
     is_wide: &[u32],
     child_offsets: &[u32],
     positions: &mut [u32],
+    slots_out: &mut [u32],
 ) {
     if m >= params.n.max(2) - 1 || is_wide[m as usize] == 0 {
         return;
@@ -389,6 +392,7 @@ pub fn wide_place_kernel(
     let mut next = 1 + child_offsets[m as usize];
     for s in 0..WIDTH {
         let c = slots[s];
+        slots_out[m as usize * WIDTH + s] = c;
         if c != u32::MAX && c & CHILD_LEAF == 0 {
             positions[c as usize] = next;
             next += 1;
@@ -398,13 +402,14 @@ pub fn wide_place_kernel(
 
 /// Kernel, one invocation per binary internal node `m`: a wide node writes
 /// its [`WideNode`] at `positions[m]` and its leaf children's primitives
-/// from `prim_offsets[m]` on, in slot order.
+/// from `prim_offsets[m]` on, in slot order (`slots`, as
+/// [`wide_place_kernel`] left them).
 #[allow(clippy::too_many_arguments)]
 pub fn wide_emit_kernel(
     m: u32,
     params: &LayoutParams,
     nodes: &[Node],
-    decisions: &[u32],
+    slots: &[u32],
     is_wide: &[u32],
     child_offsets: &[u32],
     prim_offsets: &[u32],
@@ -419,11 +424,7 @@ pub fn wide_emit_kernel(
         return;
     }
     let prims = Prims { spheres, sphere_count: params.spheres, triangles, triangle_count: params.n - params.spheres };
-    let mut children = [0u32; WIDTH];
-    let count = wide_children(m, nodes, decisions, &mut children);
-    let mut slots = [0u32; WIDTH];
     let w_box = nodes[m as usize].aabb();
-    assign_slots(&w_box, &children, count, nodes, &mut slots);
     let origin = w_box.min;
     let e = [
         grid_exponent(w_box.min[0], w_box.max[0]),
@@ -440,7 +441,7 @@ pub fn wide_emit_kernel(
     let mut imask = 0u32;
     let mut prim_offset = 0u32;
     for s in 0..WIDTH {
-        let c = slots[s];
+        let c = slots[m as usize * WIDTH + s];
         if c == u32::MAX {
             continue;
         }

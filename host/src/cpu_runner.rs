@@ -360,26 +360,26 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 );
             }
         }
-        (Kernel::WidePlace, [p, nodes, decisions, is_wide, child_offsets, positions]) => {
+        (Kernel::WidePlace, [p, nodes, decisions, is_wide, child_offsets, positions, slots]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, decisions, is_wide) = (view(nodes), view(decisions), view(is_wide));
-            let (child_offsets, positions) = (view(child_offsets), view(positions));
+            let (child_offsets, positions, slots) = (view(child_offsets), view(positions), view(slots));
             for id in ids(groups) {
-                cwbvh_build::wide_place_kernel(id, &p, nodes, decisions, is_wide, child_offsets, positions);
+                cwbvh_build::wide_place_kernel(id, &p, nodes, decisions, is_wide, child_offsets, positions, slots);
             }
         }
         (
             Kernel::WideEmit,
-            [p, nodes, decisions, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles, out_nodes, out_prims],
+            [p, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles, out_nodes, out_prims],
         ) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (nodes, decisions, is_wide) = (view(nodes), view(decisions), view(is_wide));
+            let (nodes, slots, is_wide) = (view(nodes), view(slots), view(is_wide));
             let (child_offsets, prim_offsets, positions) = (view(child_offsets), view(prim_offsets), view(positions));
             let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
             let (out_nodes, out_prims) = (view(out_nodes), view(out_prims));
             for id in ids(groups) {
                 cwbvh_build::wide_emit_kernel(
-                    id, &p, nodes, decisions, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres,
+                    id, &p, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres,
                     triangles, out_nodes, out_prims,
                 );
             }

@@ -218,7 +218,7 @@ impl Kernel {
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::WideEmit => {
                 &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite]
             }

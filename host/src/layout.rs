@@ -238,6 +238,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     // nodes are among them.
     let internal = (n - 1).max(1);
     check_fits(b, "wide DP costs", nodes * 32)?;
+    check_fits(b, "wide node slots", internal as u64 * 32)?;
     check_fits(b, "wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
     check_fits(b, "leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
     let root = trbvh::root_box(b, bvh)?;
@@ -265,8 +266,9 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     crate::sort::exclusive_scan(b, &child_offsets, internal)?;
     crate::sort::exclusive_scan(b, &prim_offsets, internal)?;
     let positions = b.scratch("wide node positions", internal as u64 * 4)?;
+    let slots = b.scratch("wide node slots", internal as u64 * 32)?;
     b.stage("wide place");
-    b.dispatch(Kernel::WidePlace, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions], groups);
+    b.dispatch(Kernel::WidePlace, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions, &slots], groups);
     let out_nodes = b.scratch("wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
     let out_prims = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
     b.stage("wide emit");
@@ -275,7 +277,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
         &[
             &p,
             &bvh.nodes,
-            &decisions,
+            &slots,
             &is_wide,
             &child_offsets,
             &prim_offsets,

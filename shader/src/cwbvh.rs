@@ -68,9 +68,10 @@ pub fn wide_place_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] is_wide: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] child_offsets: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] positions: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] slots: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions);
+    wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions, slots);
 }
 
 /// Each wide node writes its node and its leaf primitives.
@@ -80,7 +81,7 @@ pub fn wide_emit_cs(
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] decisions: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] slots: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] is_wide: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] child_offsets: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] prim_offsets: &[u32],
@@ -93,7 +94,7 @@ pub fn wide_emit_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     wide_emit_kernel(
-        id, params, nodes, decisions, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles,
+        id, params, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles,
         out_nodes, out_prims,
     );
 }
