@@ -155,7 +155,7 @@ fn render_rejects_bad_settings() {
 fn cast_kernels_match_cpu() {
     use treelet::kernels::Kernel;
     use treelet::primitives::Primitives;
-    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     fn cast<B: Backend>(b: &mut B, scene: &Scene, layout: Layout, kernel: Kernel, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
         let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
         let (tree, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh, layout).unwrap();
@@ -171,30 +171,43 @@ fn cast_kernels_match_cpu() {
             camera: scene.camera.camera(w, h),
             ..Default::default()
         };
-        for mode in [CAST_PRIMARY, CAST_DIFFUSE] {
+        for mode in [CAST_PRIMARY, CAST_BOUNCE, CAST_DIFFUSE] {
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, ..base }]).unwrap();
             let bindings = [&p, &prims.spheres, &materials, &tree.nodes, &tree.prims, &rays, &prims.triangles];
             b.dispatch(kernel, &bindings, treelet_core::render::tiled_invocations(w, h).div_ceil(256));
         }
         b.read(&rays, (2 * w * h) as usize).unwrap()
     }
-    let scene = mesh();
+    use treelet::kernels::Method;
+    let room = mesh();
+    // A height field alone: its bounce rays meet its own hills.
+    let alone = Scene::from_spec("terrain:3000").unwrap().mesh_only().unwrap();
     let kernels = [
-        (Layout::Classic, Kernel::Cast(treelet::kernels::Method::Classic)),
-        (Layout::Bvh2, Kernel::Cast(treelet::kernels::Method::Bvh2)),
-        (Layout::Cwbvh, Kernel::Cast(treelet::kernels::Method::Cwbvh)),
-        (Layout::Cwbvh, Kernel::CastWideWorkgroupStack),
+        (&room, Layout::Classic, Kernel::Cast(Method::Classic, false)),
+        (&room, Layout::Bvh2, Kernel::Cast(Method::Bvh2, false)),
+        (&room, Layout::Cwbvh, Kernel::Cast(Method::Cwbvh, false)),
+        (&room, Layout::Cwbvh, Kernel::CastWideWorkgroupStack),
+        // The kernels compiled for triangles alone, on the mesh alone.
+        (&alone, Layout::Classic, Kernel::Cast(Method::Classic, false)),
+        (&alone, Layout::Classic, Kernel::Cast(Method::Classic, true)),
+        (&alone, Layout::Bvh2, Kernel::Cast(Method::Bvh2, true)),
+        (&alone, Layout::Cwbvh, Kernel::Cast(Method::Cwbvh, true)),
     ];
-    let reference = cast(&mut CpuBackend::new(), &scene, Layout::Classic, kernels[0].1, (64, 48));
-    let hits = reference.iter().step_by(2).filter(|r| r[3] > 0.0).count();
-    assert!(hits > 64 * 48 / 2, "only {hits} diffuse rays hit");
+    let reference = |scene: &Scene| cast(&mut CpuBackend::new(), scene, Layout::Classic, kernels[0].2, (64, 48));
+    let (room_reference, alone_reference) = (reference(&room), reference(&alone));
+    for r in [&room_reference, &alone_reference] {
+        let cast = r.iter().step_by(2).filter(|r| r[3] != 0.0).count();
+        let hits = r.iter().step_by(2).filter(|r| r[3] > 0.0).count();
+        assert!(cast > 64 * 48 / 4 && hits > 64 * 48 / 50, "{cast} camera rays hit and {hits} diffuse rays: a weak test");
+    }
     let ctx = gpu();
-    for (layout, kernel) in kernels {
+    for (scene, layout, kernel) in kernels {
         // Every layout finds the same hits on the CPU runner, bit for bit.
-        let c = cast(&mut CpuBackend::new(), &scene, layout, kernel, (64, 48));
-        assert!(c == reference, "{kernel:?}: the CPU runner's casts differ from the classic layout's");
+        let c = cast(&mut CpuBackend::new(), scene, layout, kernel, (64, 48));
+        let reference = if std::ptr::eq(scene, &room) { &room_reference } else { &alone_reference };
+        assert!(c == *reference, "{kernel:?}: the CPU runner's casts differ from the classic layout's");
         let Some(ctx) = &ctx else { continue };
-        let g = cast(&mut GpuBackend::new(ctx.clone()), &scene, layout, kernel, (64, 48));
+        let g = cast(&mut GpuBackend::new(ctx.clone()), scene, layout, kernel, (64, 48));
         // Lavapipe does not fuse its `Fma` (the wall intersection's error terms
         // vanish), so hits on smallpt's 1e5-radius walls land up to ~0.02 units
         // apart: positions and distances are compared with that allowance.

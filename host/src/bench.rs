@@ -501,7 +501,9 @@ pub(crate) fn bench_rays<B: Backend>(
         let (tree, stages) = built.lay_out_timed(b, layout, &buffers)?;
         let layout_ms = stages.total();
         let layout_stages: Vec<_> = stages.order.iter().map(|&s| (s, stages.get(s))).collect();
-        let mut kernels = vec![("private", Kernel::Cast(layout.method()))];
+        // Meshes get the kernels compiled for triangles alone.
+        let triangles_only = scene.spheres.is_empty();
+        let mut kernels = vec![("private", Kernel::Cast(layout.method(), triangles_only))];
         if plan.workgroup_stack && layout == Layout::Cwbvh {
             kernels.push(("workgroup", Kernel::CastWideWorkgroupStack));
         }
@@ -540,7 +542,7 @@ fn time_casts<B: Backend>(
     (width, height): (u32, u32),
     repeats: usize,
 ) -> Result<(f64, f64, u64)> {
-    use treelet_core::rays::{CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
     let pixels = width * height;
     let base = treelet_core::RenderParams {
@@ -568,7 +570,8 @@ fn time_casts<B: Backend>(
         if r > warm_passes + repeats {
             break;
         }
-        for (stage, mode) in [("primary", CAST_PRIMARY), ("diffuse", CAST_DIFFUSE)] {
+        // The bounce rays are made between the two timed passes.
+        for (stage, mode) in [("primary", CAST_PRIMARY), ("bounce", CAST_BOUNCE), ("diffuse", CAST_DIFFUSE)] {
             b.stage(stage);
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
             let [spheres, materials, nodes, prims, rays, triangles] = *bindings;

@@ -93,11 +93,26 @@ fn render_all<T: ClosestHit + Sync>(v: u8, p: &treelet_core::RenderParams, scene
 
 /// Every invocation of a cast dispatch, `S` words of workgroup stack each
 /// (one invocation at a time: each gets the whole array as its own).
-fn cast_all<T: ClosestHit, const S: usize>(p: &treelet_core::RenderParams, scene: &SceneRefs<T>, rays: &mut [[f32; 4]], groups: u32) {
+fn cast_all<T: ClosestHit, const F: u32, const S: usize>(
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    rays: &mut [[f32; 4]],
+    groups: u32,
+) {
     let mut stack = vec![0u32; S];
     let stack: &mut [u32; S] = stack.as_mut_slice().try_into().unwrap();
     for id in ids(groups) {
-        treelet_core::rays::cast_kernel(id, p, scene, rays, stack, id % WORKGROUP_SIZE);
+        treelet_core::rays::cast_kernel::<T, F, S>(id, p, scene, rays, stack, id % WORKGROUP_SIZE);
+    }
+}
+
+/// [`cast_all`] compiled for every primitive kind, or triangles alone.
+fn cast_variant<T: ClosestHit>(triangles: bool, p: &treelet_core::RenderParams, scene: &SceneRefs<T>, rays: &mut [[f32; 4]], groups: u32) {
+    use treelet_core::features::{ALL, TRIANGLES};
+    if triangles {
+        cast_all::<T, TRIANGLES, 1>(p, scene, rays, groups)
+    } else {
+        cast_all::<T, ALL, 1>(p, scene, rays, groups)
     }
 }
 
@@ -385,28 +400,28 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             }
         }
         (
-            Kernel::Cast(_) | Kernel::CastWideWorkgroupStack,
+            Kernel::Cast(..) | Kernel::CastWideWorkgroupStack,
             [p, spheres, materials, nodes, prims, rays, triangles],
         ) => {
             let p: treelet_core::RenderParams = params(p);
             let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
             let rays: &mut [[f32; 4]] = view(rays);
             match kernel {
-                Kernel::Cast(Method::Classic) => {
+                Kernel::Cast(Method::Classic, tri) => {
                     let scene = SceneRefs::new(&p, spheres, triangles, materials, ClassicTree::new(view(nodes), view(prims)));
-                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                    cast_variant(tri, &p, &scene, rays, groups);
                 }
-                Kernel::Cast(Method::Bvh2) => {
+                Kernel::Cast(Method::Bvh2, tri) => {
                     let scene = SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view(nodes), view(prims)));
-                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                    cast_variant(tri, &p, &scene, rays, groups);
                 }
-                Kernel::Cast(Method::Cwbvh) => {
+                Kernel::Cast(Method::Cwbvh, tri) => {
                     let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
-                    cast_all::<_, 1>(&p, &scene, rays, groups);
+                    cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::CastWideWorkgroupStack => {
                     let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
-                    cast_all::<_, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
+                    cast_all::<_, { treelet_core::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
                 }
                 _ => panic!("{kernel:?}: no such cast kernel"),
             }

@@ -101,14 +101,15 @@ pub enum Kernel {
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::features::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
-    /// Ray-casting throughput (primary or diffuse rays) through a tree.
-    Cast(Method),
+    /// Ray-casting throughput (primary, bounce or diffuse passes) through a
+    /// tree; `true`: compiled for triangles alone (meshes).
+    Cast(Method, bool),
     /// [`Kernel::Cast`] through the wide BVH with the top of the stack in workgroup memory.
     CastWideWorkgroupStack,
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 28] = [
+    const FIXED: [Kernel; 31] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -134,9 +135,12 @@ impl Kernel {
         Kernel::WideCount,
         Kernel::WidePlace,
         Kernel::WideEmit,
-        Kernel::Cast(Method::Classic),
-        Kernel::Cast(Method::Bvh2),
-        Kernel::Cast(Method::Cwbvh),
+        Kernel::Cast(Method::Classic, false),
+        Kernel::Cast(Method::Bvh2, false),
+        Kernel::Cast(Method::Cwbvh, false),
+        Kernel::Cast(Method::Classic, true),
+        Kernel::Cast(Method::Bvh2, true),
+        Kernel::Cast(Method::Cwbvh, true),
     ];
 
     /// Every kernel: the fixed ones and each render kernel the shader has.
@@ -183,10 +187,13 @@ impl Kernel {
             Kernel::WidePlace => "cwbvh::wide_place_cs",
             Kernel::WideEmit => "cwbvh::wide_emit_cs",
             Kernel::Render(method, v) => render_entry_point(method, v),
-            Kernel::Cast(Method::Classic) => "render::cast_classic_cs",
-            Kernel::Cast(Method::Bvh2) => "render::cast_bvh2_cs",
-            Kernel::Cast(Method::Cwbvh) => "render::cast_cwbvh_cs",
-            Kernel::Cast(Method::Scan) => panic!("no cast kernel scans"),
+            Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
+            Kernel::Cast(Method::Bvh2, false) => "render::cast_bvh2_cs",
+            Kernel::Cast(Method::Cwbvh, false) => "render::cast_cwbvh_cs",
+            Kernel::Cast(Method::Classic, true) => "render::cast_classic_triangles_cs",
+            Kernel::Cast(Method::Bvh2, true) => "render::cast_bvh2_triangles_cs",
+            Kernel::Cast(Method::Cwbvh, true) => "render::cast_cwbvh_triangles_cs",
+            Kernel::Cast(Method::Scan, _) => panic!("no cast kernel scans"),
             Kernel::CastWideWorkgroupStack => "render::cast_cwbvh_workgroup_cs",
         }
     }
@@ -222,7 +229,7 @@ impl Kernel {
             Kernel::WideEmit => {
                 &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite]
             }
-            Kernel::Render(..) | Kernel::Cast(_) | Kernel::CastWideWorkgroupStack => {
+            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => {
                 &[Read, Read, Read, Read, Read, ReadWrite, Read]
             }
         }

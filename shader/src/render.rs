@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::bvh2::Bvh2Tree;
 use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
-use treelet_core::features::{ALL, VARIANTS};
+use treelet_core::features::{ALL, TRIANGLES, VARIANTS};
 use treelet_core::layout::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
 use treelet_core::render::{accumulate, render_pixel, tiled_pixel, SceneRefs};
 use treelet_core::traverse::{ClassicTree, Scan};
@@ -57,9 +57,10 @@ render_kernel!(render_classic_full_cs, Node, u32, ClassicTree::new, ALL);
 render_kernel!(render_bvh2_full_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
-/// through one layout (`$tree` from bindings 3 and 4), its stack private.
+/// through one layout (`$tree` from bindings 3 and 4), its stack private,
+/// testing the primitive kinds of `$features`.
 macro_rules! cast_kernel {
-    ($name:ident, $node:ty, $prim:ty, $tree:path) => {
+    ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -74,14 +75,18 @@ macro_rules! cast_kernel {
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
-            treelet_core::rays::cast_kernel(id, params, &scene, rays, &mut [0u32; 1], 0);
+            treelet_core::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
 }
 
-cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new);
-cast_kernel!(cast_bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new);
-cast_kernel!(cast_cwbvh_cs, WideNode, LeafPrim, WideTree::new);
+// Every kind of primitive, and triangles alone (meshes).
+cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new, ALL);
+cast_kernel!(cast_bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, ALL);
+cast_kernel!(cast_cwbvh_cs, WideNode, LeafPrim, WideTree::new, ALL);
+cast_kernel!(cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
+cast_kernel!(cast_bvh2_triangles_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, TRIANGLES);
+cast_kernel!(cast_cwbvh_triangles_cs, WideNode, LeafPrim, WideTree::new, TRIANGLES);
 
 /// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.
 #[spirv(compute(threads(256)))]
@@ -100,5 +105,5 @@ pub fn cast_cwbvh_workgroup_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     let scene = SceneRefs::new(params, spheres, triangles, materials, WideTree::new(nodes, prims));
-    treelet_core::rays::cast_kernel(id, params, &scene, rays, stack, lane);
+    treelet_core::rays::cast_kernel::<_, ALL, WORKGROUP_STACK_WORDS>(id, params, &scene, rays, stack, lane);
 }
