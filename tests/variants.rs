@@ -101,7 +101,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, true);
+            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, treelet::backend::DeviceClass::CpuRunner);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
             if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
@@ -111,7 +111,8 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             assert_eq!(p.accel == Accel::None, n <= LINEAR_MAX_CPU, "{}: {n} primitives, {:?}", scene.name, p.accel);
         }
         // Forced choices stay as asked.
-        assert_eq!(plan(&scene, Accel::Sweep, Layout::Auto, KernelChoice::Auto, false).accel, Accel::Sweep);
-        assert_eq!(plan(&scene, Accel::Sweep, Layout::Bvh2, KernelChoice::Auto, false).layout, Layout::Bvh2);
+        use treelet::backend::DeviceClass::Gpu;
+        assert_eq!(plan(&scene, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu).layout, Layout::Cwbvh);
     }
 }

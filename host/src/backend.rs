@@ -36,6 +36,19 @@ impl StageTimes {
     }
 }
 
+/// What kind of device runs the kernels: what is fastest differs (the
+/// crossover of the scan, the traversal layout).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DeviceClass {
+    /// A GPU.
+    Gpu,
+    /// A Vulkan adapter that runs on CPU cores (lavapipe).
+    CpuAdapter,
+    /// The CPU runner.
+    CpuRunner,
+}
+
 pub trait Backend {
     /// A device buffer; cloning clones the handle, not the data.
     type Buffer: Clone;
@@ -47,6 +60,14 @@ pub trait Backend {
     /// Whether the kernels run on CPU cores (the CPU runner, or a CPU
     /// Vulkan adapter such as lavapipe): what is fastest differs there.
     fn runs_on_cpu(&self) -> bool;
+    /// What kind of device this is.
+    fn class(&self) -> DeviceClass {
+        match (self.device_kind(), self.runs_on_cpu()) {
+            ("cpu", _) => DeviceClass::CpuRunner,
+            (_, true) => DeviceClass::CpuAdapter,
+            _ => DeviceClass::Gpu,
+        }
+    }
     /// False on devices that mis-execute ordered atomics in divergent control
     /// flow (lavapipe): they get the relaxed variants of such kernels.
     fn ordered_atomics_in_divergent_flow(&self) -> bool {

@@ -293,7 +293,7 @@ fn bench_variants<B: Backend>(
             }
         }
         let entry = |name: &str| {
-            let method = if accel == Accel::None { "linear" } else { Layout::Auto.method().name() };
+            let method = if accel == Accel::None { "linear" } else { Layout::Auto.resolve(b.class()).method().name() };
             (b.device_kind() == "gpu")
                 .then(|| treelet::gpu::context::entry_point_words(&format!("render::render_{method}_{name}_cs")))
                 .flatten()
@@ -497,7 +497,7 @@ pub(crate) fn bench_rays<B: Backend>(
     b.take_times()?;
     let mut rows = Vec::new();
     for &layout in &plan.layouts {
-        let layout = layout.resolve();
+        let layout = layout.resolve(b.class());
         let (tree, stages) = built.lay_out_timed(b, layout, &buffers)?;
         let layout_ms = stages.total();
         let layout_stages: Vec<_> = stages.order.iter().map(|&s| (s, stages.get(s))).collect();

@@ -33,10 +33,11 @@ impl Method {
     }
 
     /// Whether the shader compiles this method for every feature set
-    /// (else only for the general one): the scan and the default tree do;
-    /// the binary layouts, kept for comparison, have the general kernel.
+    /// (else only for the general one): the scan and the layouts `auto`
+    /// picks do; the seed's layout, kept for comparison, has the general
+    /// kernel.
     pub fn specialized(self) -> bool {
-        matches!(self, Method::Scan | Method::Cwbvh)
+        !matches!(self, Method::Classic)
     }
 
     pub const ALL: [Method; 4] = [Method::Scan, Method::Classic, Method::Bvh2, Method::Cwbvh];

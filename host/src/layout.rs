@@ -10,7 +10,7 @@ use treelet_core::layout::{Bvh2Node, LayoutParams, LeafPrim, Node, WideNode};
 use treelet_core::traverse::STACK_DEPTH;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::{check_fits, Backend};
+use crate::backend::{check_fits, Backend, DeviceClass};
 use crate::kernels::{Kernel, Method};
 use crate::lbvh::{upload_or_placeholder, DeviceBvh};
 use crate::primitives::Primitives;
@@ -20,7 +20,8 @@ use crate::trbvh;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Layout {
-    /// The fastest measured: cwbvh (H100, lavapipe and the CPU runner).
+    /// The fastest measured on the device: bvh2 on GPUs and the CPU runner,
+    /// cwbvh on lavapipe (see [`Layout::resolve`]).
     Auto,
     /// The seed's: 32-byte nodes that hold their own box; leaves name their
     /// primitives through an index array.
@@ -37,12 +38,19 @@ impl Layout {
     /// The layouts a tree can be traced in, `auto` aside.
     pub const ALL: [Layout; 3] = [Layout::Classic, Layout::Bvh2, Layout::Cwbvh];
 
-    /// What `auto` stands for: the layout with the most rays per second in
-    /// `treelet bench rays` on every device measured (see the README).
-    pub fn resolve(self) -> Layout {
-        match self {
-            Layout::Auto => Layout::Cwbvh,
-            other => other,
+    /// What `auto` stands for on `device`: the layout that rendered fastest
+    /// there (`treelet render --layout L --report F`, render-kernel time;
+    /// TRBVH, 1024x768):
+    /// * H100: bvh2 0.35 s, cwbvh 0.44 s, classic 0.84 s (a 940 544-triangle
+    ///   mesh in smallpt's room, 64 spp); bvh2 also casts the most diffuse
+    ///   rays (`treelet bench rays`, 0.95 G/s against 0.88);
+    /// * lavapipe: cwbvh 0.58 s, bvh2 0.86 s (terrain:20000, 128x96, 8 spp);
+    /// * the CPU runner: bvh2 0.20 s, cwbvh 0.24 s (the same).
+    pub fn resolve(self, device: DeviceClass) -> Layout {
+        match (self, device) {
+            (Layout::Auto, DeviceClass::CpuAdapter) => Layout::Cwbvh,
+            (Layout::Auto, _) => Layout::Bvh2,
+            (other, _) => other,
         }
     }
 
@@ -56,12 +64,13 @@ impl Layout {
         }
     }
 
-    /// The kernels' closest-hit method for this layout.
+    /// The kernels' closest-hit method for this (resolved) layout.
     pub fn method(self) -> Method {
-        match self.resolve() {
+        match self {
             Layout::Classic => Method::Classic,
             Layout::Bvh2 => Method::Bvh2,
-            _ => Method::Cwbvh,
+            Layout::Cwbvh => Method::Cwbvh,
+            Layout::Auto => panic!("internal: a layout must be resolved for its device first"),
         }
     }
 }
@@ -115,7 +124,7 @@ pub fn lay_out<B: Backend>(
     max_leaf: u32,
     prims: &PrimBuffers<B>,
 ) -> Result<TracedTree<B>> {
-    let layout = layout.resolve();
+    let layout = layout.resolve(b.class());
     if bvh.n == 0 {
         bail!("no primitives to lay out");
     }

@@ -140,7 +140,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         };
         bar.set_message(err);
     };
-    let explain = |b: &dyn Fn() -> bool| {
+    let explain = |b: &dyn Fn() -> treelet::backend::DeviceClass| {
         if args.explain {
             bar.suspend(|| eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain()));
         }
@@ -148,13 +148,13 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let (result, device, adapter) = match args.device {
         Device::Gpu => {
             let mut b = GpuBackend::new(GpuContext::new()?);
-            explain(&|| b.runs_on_cpu());
+            explain(&|| b.class());
             let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
             (r, "gpu", b.adapter())
         }
         Device::Cpu => {
             let mut b = CpuBackend::new();
-            explain(&|| b.runs_on_cpu());
+            explain(&|| b.class());
             (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into())
         }
     };

@@ -125,7 +125,7 @@ pub fn render<B: Backend>(
     if scene.materials.len() != all.len() {
         bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
     }
-    let plan = variant::plan(scene, accel, layout, kernel, b.runs_on_cpu());
+    let plan = variant::plan(scene, accel, layout, kernel, b.class());
     let start = Instant::now();
     let prims = scene.spheres.len() as u32;
 

@@ -356,7 +356,10 @@ fn render_times<B: Backend>(
 
 /// A tree and its layout, as the figures name them ("TRBVH, cwbvh").
 fn tree_name(a: Accel, layout: Layout) -> String {
-    format!("{}, {}", accel_name(a), layout.resolve().name())
+    match layout {
+        Layout::Auto => accel_name(a).to_string(),
+        _ => format!("{}, {}", accel_name(a), layout.name()),
+    }
 }
 
 fn accel_name(a: Accel) -> &'static str {

@@ -6,6 +6,7 @@ use serde::Serialize;
 use treelet_core::features::{self, VARIANTS};
 use treelet_core::layout::{DIFFUSE, GLASS, MIRROR};
 
+use crate::backend::DeviceClass;
 use crate::layout::Layout;
 use crate::render::Accel;
 use crate::scene::Scene;
@@ -146,9 +147,10 @@ pub struct Plan {
 /// for `scene` on a device that `runs_on_cpu` or not. `Accel::Auto` picks
 /// the linear scan up to the measured crossover, else the treelet-optimized
 /// BVH; `Layout::Auto` the fastest measured layout.
-pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, runs_on_cpu: bool) -> Plan {
+pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
     let features = SceneFeatures::of(scene);
     let n = features.primitives();
+    let runs_on_cpu = class != DeviceClass::Gpu;
     let (linear_max, device) = if runs_on_cpu { (LINEAR_MAX_CPU, "a CPU device") } else { (LINEAR_MAX_GPU, "a GPU") };
     let (accel, accel_reason) = match accel {
         Accel::Auto if n <= linear_max => (
@@ -163,10 +165,15 @@ pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, r
     };
     let (layout, layout_reason) = match layout {
         _ if accel == Accel::None => (Layout::Auto, "no tree".to_string()),
-        Layout::Auto => (
-            Layout::Auto.resolve(),
-            "compressed 8-wide nodes: the most rays per second measured (treelet bench rays)".to_string(),
-        ),
+        Layout::Auto => {
+            let chosen = Layout::Auto.resolve(class);
+            let on = match class {
+                DeviceClass::Gpu => "GPUs (H100)",
+                DeviceClass::CpuAdapter => "CPU Vulkan adapters (lavapipe)",
+                DeviceClass::CpuRunner => "the CPU runner",
+            };
+            (chosen, format!("the layout that renders fastest on {on}, as measured (see `treelet::layout::Layout::resolve`)"))
+        }
         other => (other, "as asked (--layout)".to_string()),
     };
     let method = if accel == Accel::None { crate::kernels::Method::Scan } else { layout.method() };

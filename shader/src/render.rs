@@ -37,24 +37,30 @@ macro_rules! render_kernel {
     };
 }
 
-const _: () = assert!(VARIANTS.len() == 6, "one pair of lines per variant");
+const _: () = assert!(VARIANTS.len() == 6, "three lines per variant");
 
-// The scan and the compressed wide BVH (the default tree), per feature set.
+// The scan and the two layouts `auto` picks, per feature set (in the order
+// of `VARIANTS`).
 render_kernel!(render_linear_spheres_diffuse_cs, Node, u32, Scan::new, VARIANTS[0].0);
+render_kernel!(render_bvh2_spheres_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[0].0);
 render_kernel!(render_cwbvh_spheres_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[0].0);
 render_kernel!(render_linear_spheres_mirror_cs, Node, u32, Scan::new, VARIANTS[1].0);
+render_kernel!(render_bvh2_spheres_mirror_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[1].0);
 render_kernel!(render_cwbvh_spheres_mirror_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[1].0);
 render_kernel!(render_linear_spheres_cs, Node, u32, Scan::new, VARIANTS[2].0);
+render_kernel!(render_bvh2_spheres_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[2].0);
 render_kernel!(render_cwbvh_spheres_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[2].0);
 render_kernel!(render_linear_triangles_diffuse_cs, Node, u32, Scan::new, VARIANTS[3].0);
+render_kernel!(render_bvh2_triangles_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[3].0);
 render_kernel!(render_cwbvh_triangles_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[3].0);
 render_kernel!(render_linear_mixed_diffuse_cs, Node, u32, Scan::new, VARIANTS[4].0);
+render_kernel!(render_bvh2_mixed_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[4].0);
 render_kernel!(render_cwbvh_mixed_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[4].0);
 render_kernel!(render_linear_full_cs, Node, u32, Scan::new, VARIANTS[5].0);
+render_kernel!(render_bvh2_full_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[5].0);
 render_kernel!(render_cwbvh_full_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[5].0);
-// The binary layouts, kept for comparison: the general kernel only.
+// The seed's layout, kept for comparison: the general kernel only.
 render_kernel!(render_classic_full_cs, Node, u32, ClassicTree::new, ALL);
-render_kernel!(render_bvh2_full_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
 /// through one layout (`$tree` from bindings 3 and 4), its stack private,
