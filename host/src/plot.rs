@@ -85,7 +85,23 @@ pub fn chart(path: &Path, c: &Chart, series: &[Series]) -> Result<()> {
     let root = BitMapBackend::new(path, (1000, 650)).into_drawing_area();
     let err = |e: &dyn std::fmt::Display| anyhow!("plotting {}: {e}", path.display());
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let colors = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0), RGBColor(120, 60, 180)];
+    // Fourteen distinguishable colours (figures compare up to that many series).
+    let colors = [
+        RGBColor(31, 119, 180),
+        RGBColor(214, 39, 40),
+        RGBColor(44, 160, 44),
+        RGBColor(255, 127, 14),
+        RGBColor(148, 103, 189),
+        RGBColor(140, 86, 75),
+        RGBColor(227, 119, 194),
+        RGBColor(90, 90, 90),
+        RGBColor(188, 189, 34),
+        RGBColor(23, 190, 207),
+        RGBColor(0, 0, 128),
+        RGBColor(0, 128, 128),
+        RGBColor(128, 0, 0),
+        RGBColor(0, 0, 0),
+    ];
     // The four axis combinations are four chart types in plotters.
     macro_rules! draw {
         ($x:expr, $y:expr) => {{
