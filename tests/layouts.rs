@@ -223,10 +223,12 @@ fn validators_catch_corruption() {
         let v = validate_wide(prims, &n, &l);
         assert!(v.errors.iter().any(|e| e.contains(needle)), "expected `{needle}` in {:?}", v.errors);
     };
-    // A quantized box shrunk by one step on some child (the first internal one).
+    // A quantized box collapsed onto its node's corner, or pushed to its
+    // top, on some child (the first internal one).
     let slot = (0..8).find(|&s| nodes[0].exp_imask >> (24 + s) & 1 == 1).unwrap();
-    wide(&|n, _| n[0].hi_x[slot / 4] -= 1 << (8 * (slot % 4)), "does not contain");
-    wide(&|n, _| n[0].lo_y[slot / 4] += 1 << (8 * (slot % 4)), "does not contain");
+    let byte = 0xFFu32 << (8 * (slot % 4));
+    wide(&|n, _| n[0].hi_x[slot / 4] &= !byte, "does not contain");
+    wide(&|n, _| n[0].lo_y[slot / 4] |= byte & 0xFEFE_FEFE, "does not contain");
     wide(&|_, l| l[3].p1[1] += 1e-3, "as the scene has it");
     wide(&|_, l| l[5].prim = l[6].prim, "stored 2 times");
     wide(&|n, _| n[0].child_base += 1, "reached");
