@@ -162,12 +162,13 @@ fn run_render(args: RenderArgs) -> Result<()> {
     image_io::write(&args.out, &result.image)?;
     let paths = args.width as f64 * args.height as f64 * args.spp as f64;
     eprintln!(
-        "{}: {}x{} at {} spp on {adapter} (accel {:?}, kernel {}), {:.3} s ({:.1} M camera paths/s), wrote {}",
+        "{}: {}x{} at {} spp on {adapter} (accel {}, layout {}, kernel {}), {:.3} s ({:.1} M camera paths/s), wrote {}",
         scene.name,
         args.width,
         args.height,
         args.spp,
-        result.plan.accel,
+        format!("{:?}", result.plan.accel).to_lowercase(),
+        if result.plan.accel == Accel::None { "-" } else { result.plan.layout.name() },
         result.plan.kernel,
         result.total_s,
         paths / result.total_s / 1e6,
