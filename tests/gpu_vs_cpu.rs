@@ -21,27 +21,60 @@ fn sort_matches_cpu_and_std_on_random_keys() {
     let Some(ctx) = gpu() else { return };
     let seed = treelet_tests::fresh_seed();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-    for n in [1u32, 255, 256, 2049, 70_000] {
+    // Sizes around the tile (2048 keys) and many tiles, so that look-backs
+    // cross several tiles.
+    for n in [1u32, 255, 256, 2047, 2049, 6145, 70_000] {
         // Few distinct high bits, so that many keys tie on some passes.
         let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
-        let values: Vec<u32> = (0..n).collect();
-        let g = run_sort(&mut GpuBackend::new(ctx.clone()), &keys, &values);
-        let c = run_sort(&mut CpuBackend::new(), &keys, &values);
-        let mut expected: Vec<(u64, u32)> = keys.iter().copied().zip(values.iter().copied()).collect();
-        expected.sort_by_key(|&(k, _)| k); // stable, like the radix sort
-        let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
-        assert_eq!(c.0, ek, "cpu keys, n = {n}");
-        assert_eq!(c.1, ev, "cpu values (stability), n = {n}");
-        assert_eq!(g.0, ek, "gpu keys, n = {n}");
-        assert_eq!(g.1, ev, "gpu values (stability), n = {n}");
+        check_sort(&ctx, &keys, 64, &format!("random, n = {n}, seed {seed}"));
     }
 }
 
-fn run_sort<B: Backend>(b: &mut B, keys: &[u64], values: &[u32]) -> (Vec<u64>, Vec<u32>) {
+/// The shapes a radix sort gets wrong: all keys equal (one digit takes
+/// every key of every tile), already sorted, reversed, and keys of fewer
+/// bits than the sort's passes cover or more than it sorts.
+#[test]
+fn sort_handles_equal_sorted_and_reversed_keys() {
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let n = 50_000u64;
+    let random: Vec<u64> = (0..n).map(|_| rng.random()).collect();
+    let mut sorted = random.clone();
+    sorted.sort();
+    let reversed: Vec<u64> = sorted.iter().rev().copied().collect();
+    check_sort(&ctx, &vec![0x1234_5678_9abc_def0; n as usize], 64, "all equal");
+    check_sort(&ctx, &vec![0; 4099], 64, "all zero");
+    check_sort(&ctx, &sorted, 64, &format!("sorted, seed {seed}"));
+    check_sort(&ctx, &reversed, 64, &format!("reversed, seed {seed}"));
+    check_sort(&ctx, &(0..n).map(|k| (n - k) << 40).collect::<Vec<_>>(), 64, "reversed, low bits zero");
+    let low: Vec<u64> = random.iter().map(|k| k & ((1 << 30) - 1)).collect();
+    check_sort(&ctx, &low, 30, &format!("30-bit keys, seed {seed}"));
+    check_sort(&ctx, &low, 63, &format!("30-bit keys sorted on 63 bits, seed {seed}"));
+}
+
+/// Sorts `keys` (values: their indices) on the GPU and the CPU runner by
+/// their low `key_bits` bits and compares both with a stable std sort.
+fn check_sort(ctx: &std::sync::Arc<treelet::gpu::GpuContext>, keys: &[u64], key_bits: u32, what: &str) {
+    let n = keys.len();
+    let values: Vec<u32> = (0..n as u32).collect();
+    let g = run_sort(&mut GpuBackend::new(ctx.clone()), keys, &values, key_bits);
+    let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits);
+    let mask = if key_bits >= 64 { u64::MAX } else { (1u64 << key_bits) - 1 };
+    let mut expected: Vec<(u64, u32)> = keys.iter().copied().zip(values.iter().copied()).collect();
+    expected.sort_by_key(|&(k, _)| k & mask); // stable, like the radix sort
+    let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
+    assert!(c.0 == ek, "cpu keys, {what}");
+    assert!(c.1 == ev, "cpu values (stability), {what}");
+    assert!(g.0 == ek, "gpu keys, {what}");
+    assert!(g.1 == ev, "gpu values (stability), {what}");
+}
+
+fn run_sort<B: Backend>(b: &mut B, keys: &[u64], values: &[u32], key_bits: u32) -> (Vec<u64>, Vec<u32>) {
     let n = keys.len() as u32;
     let kb = b.upload("keys", keys).unwrap();
     let vb = b.upload("values", values).unwrap();
-    let (k, v) = treelet::sort::radix_sort(b, &kb, &vb, n, 64).unwrap();
+    let (k, v) = treelet::sort::radix_sort(b, &kb, &vb, n, key_bits).unwrap();
     (b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap())
 }
 

@@ -88,18 +88,19 @@ pub struct BuildParams {
 }
 const _: () = assert!(core::mem::size_of::<BuildParams>() == 48);
 
-/// Parameters of one radix-sort pass. repr(C), Pod, 16 bytes.
+/// Parameters of the radix sort's kernels. repr(C), Pod, 16 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
 pub struct SortParams {
     /// Number of keys.
     pub n: u32,
-    /// Bit offset of this pass's digit.
-    pub shift: u32,
-    /// Number of sort tiles (workgroups of the histogram and scatter kernels).
-    pub blocks: u32,
-    pub _pad0: u32,
+    /// Tiles of a one-sweep pass.
+    pub tiles: u32,
+    /// This pass (one-sweep kernel only).
+    pub pass: u32,
+    /// Passes of the whole sort.
+    pub passes: u32,
 }
 const _: () = assert!(core::mem::size_of::<SortParams>() == 16);
 

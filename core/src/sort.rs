@@ -1,23 +1,58 @@
-//! Stable LSD radix sort of `(u64 key, u32 value)` pairs, 8 bits per pass.
+//! Stable LSD radix sort of `(u64 key, u32 value)` pairs, 8 bits per pass,
+//! one sweep over the keys per pass: Adinets & Merrill, "Onesweep: A Faster
+//! Least Significant Digit Radix Sort for GPUs", 2022.
 //!
-//! Each pass runs three stages over tiles of [`SORT_TILE`] keys:
-//! 1. [`histogram_phase`]: each workgroup counts the digits of its tile in
-//!    workgroup memory and writes them *digit-major*:
-//!    `block_hist[digit * blocks + tile]`;
-//! 2. an exclusive prefix sum over that array ([`crate::scan`]), after which
-//!    entry `(digit, tile)` is where the tile's first key of that digit goes;
-//! 3. [`scatter_phase`]: each workgroup walks its tile in rounds of
-//!    `WORKGROUP_SIZE` consecutive keys; an invocation's rank among equal
-//!    digits of its round is the number of lower local ids holding the same
-//!    digit: per-chunk digit counts scanned over the round's chunks, plus a
-//!    count within its own chunk four digits at a time ([`count_before`]).
-//!    So the scatter is stable and the result is identical on every device
-//!    and on the CPU.
+//! 1. [`histogram_phase`]: one read of the keys counts the digits of *every*
+//!    pass at once (workgroup counters, then device atomics);
+//! 2. [`offsets_phase`]: one workgroup per pass scans its 256 counts, so that
+//!    each digit knows where its keys start;
+//! 3. one [`onesweep_phase`] dispatch per pass: a workgroup takes the next
+//!    tile of [`SORT_TILE`] keys, ranks them stably within the tile,
+//!    publishes its digit counts, finds how many keys of each digit all
+//!    earlier tiles hold by *decoupled look-back* (Merrill & Garland, "Single-
+//!    pass Parallel Prefix Scan with Decoupled Look-back", 2016), and writes
+//!    its keys in digit order, so that each digit's run leaves as one
+//!    contiguous stretch of memory.
+//!
+//! So a sort of `p` passes is `p + 3` dispatches (with the fill of its state)
+//! where a reduce-then-scan sort needs five per pass.
+//!
+//! **Forward progress.** The look-back waits on earlier tiles, and Vulkan
+//! promises nothing about the order in which workgroups start or whether a
+//! waiting one lets another run. So tiles are not workgroup ids: each
+//! workgroup takes a ticket from a device counter when it starts, and the
+//! tile it sorts is its ticket. A workgroup only ever waits on tickets taken
+//! before its own, by workgroups that were therefore already running (or
+//! done); a running workgroup is never waiting on one that has not started.
+//! On lavapipe, which runs each workgroup to its end on one of a few
+//! threads, an earlier ticket's workgroup is done or running on another
+//! thread; on the CPU runner, which runs workgroups one after another, it is
+//! done, and the look-back never waits. No spin depends on scheduling order.
+//!
+//! **Memory model.** A tile's status is one 32-bit word per digit holding
+//! both its flag and its count, written and read with device-scope atomics:
+//! a reader sees a count together with the flag that says what it is, and
+//! needs no ordering against any other memory: relaxed atomics suffice.
+//!
+//! **lavapipe.** On Mesa 22.3's lavapipe the look-back gave some tiles wrong
+//! offsets now and then: about one sort in a hundred of 70 000 keys and three
+//! or more passes, and only with the CPU busy (the test threads beside it).
+//! Neither reading the status by an atomic add of zero (which no compiler
+//! may hoist) nor a fresh status region per pass nor a loop without
+//! `continue` cured it, and the cause was not found. There (the host asks
+//! `Backend::look_back_works`) each pass runs without look-back instead:
+//! [`tile_counts_phase`] counts each tile's digits, a prefix sum over them
+//! (digit-major) gives every tile its offsets, and the same
+//! [`onesweep_phase`] ranks and writes the keys: three dispatches more per
+//! pass, and no workgroup ever waits on another.
+//!
+//! Ranks are counted as in Satish, Harris & Garland (2009) without warp
+//! ballots (so the same code runs on the CPU): per round of 256 keys,
+//! per-chunk digit counts scanned over the round's chunks, plus a count
+//! within the chunk four packed digits at a time ([`count_before`]). The
+//! result is identical on every device and on the CPU.
 //!
 //! Kernels are phase functions: see [`crate::workgroup`].
-//!
-//! (Satish, Harris & Garland, "Designing Efficient Sorting Algorithms for
-//! Manycore GPUs", 2009, without their in-tile local sort.)
 use crate::atomics;
 use crate::layout::SortParams;
 use crate::workgroup::{WG, WORKGROUP_SIZE};
@@ -27,10 +62,17 @@ pub const RADIX_BITS: u32 = 8;
 /// Number of distinct digits; equal to the workgroup size, one counter each.
 pub const RADIX: u32 = 1 << RADIX_BITS;
 const _: () = assert!(RADIX == WORKGROUP_SIZE);
+/// Most passes a sort makes (64-bit keys).
+pub const MAX_PASSES: u32 = 64 / RADIX_BITS;
 /// Rounds of `WORKGROUP_SIZE` keys per tile.
 pub const SORT_ITEMS: u32 = 8;
-/// Keys per workgroup of [`histogram`] and [`scatter`].
+/// Keys per workgroup of [`onesweep_phase`].
 pub const SORT_TILE: u32 = WORKGROUP_SIZE * SORT_ITEMS;
+/// Keys per workgroup of [`histogram_phase`]: large, so that few workgroups
+/// add their counts to the same device counters.
+pub const HISTOGRAM_TILE: u32 = WORKGROUP_SIZE * 32;
+/// Most keys a sort takes: a status word keeps 30 bits for a count.
+pub const MAX_KEYS: u32 = COUNT_MASK;
 
 /// Passes needed to sort keys of `key_bits` significant bits.
 #[inline]
@@ -43,43 +85,180 @@ pub fn digit(key: u64, shift: u32) -> u32 {
     ((key >> shift) & (RADIX as u64 - 1)) as u32
 }
 
-#[inline]
-fn key_index(tile: u32, round: u32, lid: u32) -> u32 {
-    tile * SORT_TILE + round * WORKGROUP_SIZE + lid
+/// The sort's state buffer, zeroed before the first kernel: the digit
+/// counts of every pass (then their offsets), a ticket counter per pass, and
+/// two regions of tile status words used by alternate passes (each pass
+/// zeroes the other region for the next one).
+pub mod state {
+    use super::{MAX_PASSES, RADIX};
+    /// `counts[pass * RADIX + digit]`, scanned in place into offsets.
+    pub const COUNTS: u32 = 0;
+    /// Ticket counter of each pass.
+    pub const TICKETS: u32 = MAX_PASSES * RADIX;
+    /// First status region.
+    pub const STATUS: u32 = TICKETS + RADIX;
+    /// Words of the state of a sort of `tiles` tiles.
+    #[inline]
+    pub const fn words(tiles: u32) -> u32 {
+        STATUS + 2 * tiles * RADIX
+    }
+    /// Words that must be zero before the first kernel (pass 0 clears the
+    /// second region).
+    #[inline]
+    pub const fn zeroed_words(tiles: u32) -> u32 {
+        STATUS + tiles * RADIX
+    }
+    /// Status word of `digit` in `tile` for pass `pass`.
+    #[inline]
+    pub fn status(tiles: u32, pass: u32, tile: u32, digit: u32) -> usize {
+        (STATUS + ((pass % 2) * tiles + tile) * RADIX + digit) as usize
+    }
 }
 
-/// Phases of [`histogram_phase`]: clear, count, write.
+/// Flag bits of a status word: nothing published yet, this tile's own
+/// count, or the count of this tile and every tile before it (plus the
+/// digit's global offset).
+const FLAG_SHIFT: u32 = 30;
+const COUNT_MASK: u32 = (1 << FLAG_SHIFT) - 1;
+const AGGREGATE: u32 = 1 << FLAG_SHIFT;
+const INCLUSIVE: u32 = 2 << FLAG_SHIFT;
+
+/// Phases of [`histogram_phase`]: clear, count, add.
 pub const HISTOGRAM_PHASES: u32 = 3;
 
-/// Kernel: digit counts of one tile, written digit-major into `block_hist`.
+/// Kernel: digit counts of every pass over one tile of
+/// [`HISTOGRAM_TILE`] keys, added to the state's counts.
 pub fn histogram_phase(
     phase: u32,
     lid: u32,
     tile: u32,
     params: &SortParams,
     keys: &[u64],
-    block_hist: &mut [u32],
+    sort_state: &mut [u32],
+    counts: &mut [u32; (MAX_PASSES * RADIX) as usize],
+) {
+    let l = lid as usize;
+    match phase {
+        0 => {
+            for p in 0..MAX_PASSES as usize {
+                counts[p * WG + l] = 0;
+            }
+        }
+        1 => {
+            for round in 0..HISTOGRAM_TILE / WORKGROUP_SIZE {
+                let i = tile * HISTOGRAM_TILE + round * WORKGROUP_SIZE + lid;
+                if i < params.n {
+                    let key = keys[i as usize];
+                    for p in 0..params.passes {
+                        atomics::add_workgroup(&mut counts[(p * RADIX + digit(key, p * RADIX_BITS)) as usize], 1);
+                    }
+                }
+            }
+        }
+        _ => {
+            for p in 0..params.passes {
+                let c = counts[(p * RADIX) as usize + l];
+                if c != 0 {
+                    atomics::add_device(&mut sort_state[(state::COUNTS + p * RADIX + lid) as usize], c);
+                }
+            }
+        }
+    }
+}
+
+/// Phases of [`tile_counts_phase`]: clear, count, write.
+pub const TILE_COUNTS_PHASES: u32 = 3;
+
+/// Kernel of the sort without look-back (see [`onesweep_phase`]): this
+/// pass's digit counts of one tile, written digit-major,
+/// `tile_counts[digit * tiles + tile]`, so that their exclusive prefix sum
+/// is where each tile's keys of each digit go.
+pub fn tile_counts_phase(
+    phase: u32,
+    lid: u32,
+    tile: u32,
+    params: &SortParams,
+    keys: &[u64],
+    tile_counts: &mut [u32],
     counts: &mut [u32; WG],
 ) {
     if phase == 0 {
         counts[lid as usize] = 0;
     } else if phase == 1 {
         for round in 0..SORT_ITEMS {
-            let i = key_index(tile, round, lid);
+            let i = tile * SORT_TILE + round * WORKGROUP_SIZE + lid;
             if i < params.n {
-                let d = digit(keys[i as usize], params.shift);
+                let d = digit(keys[i as usize], params.pass * RADIX_BITS);
                 atomics::add_workgroup(&mut counts[d as usize], 1);
             }
         }
-    } else if tile < params.blocks {
-        block_hist[(lid * params.blocks + tile) as usize] = counts[lid as usize];
+    } else if tile < params.tiles {
+        tile_counts[(lid * params.tiles + tile) as usize] = counts[lid as usize];
     }
 }
 
-/// Phases of [`scatter_phase`]: load offsets, then four per round of
-/// `WORKGROUP_SIZE` keys (read and count digits; pack them and scan counts;
-/// rank and move; advance offsets).
-pub const SCATTER_PHASES: u32 = 1 + 4 * SORT_ITEMS;
+/// Phases of [`small_scan_phase`].
+pub const SMALL_SCAN_PHASES: u32 = 3;
+
+/// Exclusive prefix sum of 256 values in three phases: sixteen invocations
+/// each scan sixteen values, one scans their sums, all add. (Cheaper here
+/// than a Hillis-Steele scan's sixteen phases: the values are few.)
+#[inline]
+pub fn small_scan_phase(phase: u32, lid: u32, values: &[u32; WG], out: &mut [u32; WG], sums: &mut [u32; 16]) {
+    let l = lid as usize;
+    match phase {
+        0 => {
+            if l < 16 {
+                let mut sum = 0;
+                for k in 16 * l..16 * l + 16 {
+                    out[k] = sum;
+                    sum += values[k];
+                }
+                sums[l] = sum;
+            }
+        }
+        1 => {
+            if l == 0 {
+                let mut sum = 0;
+                for k in 0..16 {
+                    let v = sums[k];
+                    sums[k] = sum;
+                    sum += v;
+                }
+            }
+        }
+        _ => out[l] += sums[l / 16],
+    }
+}
+
+/// Phases of [`offsets_phase`]: load, scan, store.
+pub const OFFSETS_PHASES: u32 = 1 + SMALL_SCAN_PHASES + 1;
+
+/// Kernel: workgroup `pass` turns that pass's digit counts into the offsets
+/// where each digit's keys start.
+pub fn offsets_phase(
+    phase: u32,
+    lid: u32,
+    pass: u32,
+    params: &SortParams,
+    sort_state: &mut [u32],
+    values: &mut [u32; WG],
+    out: &mut [u32; WG],
+    sums: &mut [u32; 16],
+) {
+    let slot = (state::COUNTS + pass * RADIX + lid) as usize;
+    if pass >= params.passes {
+        return;
+    }
+    if phase == 0 {
+        values[lid as usize] = sort_state[slot];
+    } else if phase <= SMALL_SCAN_PHASES {
+        small_scan_phase(phase - 1, lid, values, out, sums);
+    } else {
+        sort_state[slot] = out[lid as usize];
+    }
+}
+
 /// Digits packed four to a word, one byte each.
 pub const PACKED_DIGITS: usize = WG / 4;
 /// Keys per chunk of a round: ranks are counted within a chunk, and chunk
@@ -87,8 +266,10 @@ pub const PACKED_DIGITS: usize = WG / 4;
 pub const CHUNK: u32 = 32;
 /// Chunks per round.
 pub const CHUNKS: usize = (WORKGROUP_SIZE / CHUNK) as usize;
-/// Per-chunk digit counters: `chunk * RADIX + digit`.
+/// Per-chunk digit counters, `chunk * RADIX + digit`; after ranking, the
+/// same array holds the tile's key order (see [`onesweep_phase`]).
 pub const CHUNK_COUNTS: usize = CHUNKS * RADIX as usize;
+const _: () = assert!(CHUNK_COUNTS == SORT_TILE as usize, "the counters are reused as the tile's order");
 
 /// Bit 7 of each byte of the result is set where that byte of `x` is zero
 /// (exact, no carries between bytes).
@@ -113,83 +294,175 @@ pub fn count_before(packed: &[u32; PACKED_DIGITS], from: u32, lid: u32, d: u32) 
     count + partial.count_ones()
 }
 
-/// Kernel: moves the tile's pairs to their sorted places. `offsets` is the
-/// scanned `block_hist`.
+/// Phases of [`onesweep_phase`]: ticket; four per round of ranking; look-back
+/// (with the first step of the local scan); two more scan steps; order;
+/// write.
+pub const ONESWEEP_PHASES: u32 = 1 + 4 * SORT_ITEMS + SMALL_SCAN_PHASES + 2;
+const LOOK_BACK_PHASE: u32 = 1 + 4 * SORT_ITEMS;
+
+/// Kernel: one pass over one tile. See the module documentation.
 ///
-/// In each round, invocation `lid` holds one key of digit `d`; its place is
-/// `running[d]` (keys of digit `d` placed by earlier rounds and tiles) plus
-/// the keys of digit `d` in earlier chunks of the round (`counts`, scanned
-/// over chunks by one invocation per digit) plus those before it in its own
-/// chunk (`count_before`).
+/// `LOOK_BACK`: find the tile's offsets by decoupled look-back, with
+/// `sort_state` as laid out in [`state`]. Without it (on lavapipe, see
+/// `treelet::backend::Backend::look_back_works`), the tile is the workgroup
+/// `group` and `sort_state` holds the scanned [`tile_counts_phase`] counts.
+///
+/// Workgroup memory (passed one array at a time: rust-gpu cannot hold
+/// references in a struct): `ticket`, the tile this workgroup sorts;
+/// `running`, keys of each digit ranked so far, at the end the tile's digit
+/// counts; `digits` and `packed`, this round's digits by local id, plain and
+/// four to a word; `counts`, chunk counters while ranking, then the tile's
+/// keys in sorted order; `totals`, this round's count of each digit;
+/// `ranks`, each key's rank among the tile's keys of its digit, and the
+/// digit (`rank | digit << 16`); `local_offsets` and `global_offsets`, where
+/// each digit's keys start within the tile and in the output; `scan_sums`,
+/// scratch of the local scan.
 #[allow(clippy::too_many_arguments)]
-pub fn scatter_phase(
+pub fn onesweep_phase<const LOOK_BACK: bool>(
     phase: u32,
     lid: u32,
-    tile: u32,
+    group: u32,
     params: &SortParams,
     keys_in: &[u64],
     values_in: &[u32],
-    offsets: &[u32],
     keys_out: &mut [u64],
     values_out: &mut [u32],
+    sort_state: &mut [u32],
+    ticket: &mut [u32; 1],
     running: &mut [u32; WG],
     digits: &mut [u32; WG],
     packed: &mut [u32; PACKED_DIGITS],
     counts: &mut [u32; CHUNK_COUNTS],
     totals: &mut [u32; WG],
+    ranks: &mut [u32; SORT_TILE as usize],
+    local_offsets: &mut [u32; WG],
+    global_offsets: &mut [u32; WG],
+    scan_sums: &mut [u32; 16],
 ) {
     let l = lid as usize;
+    let shift = params.pass * RADIX_BITS;
     if phase == 0 {
-        if tile < params.blocks {
-            running[l] = offsets[(lid * params.blocks + tile) as usize];
+        if lid == 0 {
+            ticket[0] = if LOOK_BACK {
+                atomics::add_device(&mut sort_state[(state::TICKETS + params.pass) as usize], 1)
+            } else {
+                group
+            };
         }
+        running[l] = 0;
         for c in 0..CHUNKS {
             counts[c * WG + l] = 0;
         }
         return;
     }
-    let round = (phase - 1) / 4;
-    let first = key_index(tile, round, 0);
-    // Keys of the round sit at local ids 0..valid (only the last tile is short).
-    let valid = if first < params.n { (params.n - first).min(WORKGROUP_SIZE) } else { 0 };
-    let i = first + lid;
-    let chunk = lid / CHUNK;
-    match (phase - 1) % 4 {
-        0 => {
-            let d = if lid < valid { digit(keys_in[i as usize], params.shift) } else { 0 };
-            digits[l] = d;
-            if lid < valid {
-                atomics::add_workgroup(&mut counts[(chunk * RADIX + d) as usize], 1);
+    let tile = ticket[0];
+    if tile >= params.tiles {
+        return; // A workgroup of the dispatch grid's padding.
+    }
+    let base = tile * SORT_TILE;
+    // Keys of the tile: 0..valid (only the last tile is short).
+    let valid = (params.n - base).min(SORT_TILE);
+    if phase < LOOK_BACK_PHASE {
+        let round = (phase - 1) / 4;
+        let k = round * WORKGROUP_SIZE + lid;
+        let chunk = lid / CHUNK;
+        match (phase - 1) % 4 {
+            0 => {
+                let d = if k < valid { digit(keys_in[(base + k) as usize], shift) } else { 0 };
+                digits[l] = d;
+                if k < valid {
+                    atomics::add_workgroup(&mut counts[(chunk * RADIX + d) as usize], 1);
+                }
+            }
+            1 => {
+                if l < PACKED_DIGITS {
+                    let b = 4 * l;
+                    packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
+                }
+                // Invocation `lid` scans digit `lid`'s counts over the chunks.
+                let mut sum = 0;
+                for c in 0..CHUNKS {
+                    let i = c * WG + l;
+                    let v = counts[i];
+                    counts[i] = sum;
+                    sum += v;
+                }
+                totals[l] = sum;
+            }
+            2 => {
+                if k < valid {
+                    let d = digits[l];
+                    let before = counts[(chunk * RADIX + d) as usize]
+                        + count_before(packed, chunk * CHUNK, lid, d);
+                    ranks[k as usize] = (running[d as usize] + before) | (d << 16);
+                }
+            }
+            _ => {
+                running[l] += totals[l];
+                for c in 0..CHUNKS {
+                    counts[c * WG + l] = 0;
+                }
             }
         }
-        1 => {
-            if l < PACKED_DIGITS {
-                let b = 4 * l;
-                packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
+        return;
+    }
+    if phase == LOOK_BACK_PHASE && !LOOK_BACK {
+        global_offsets[l] = sort_state[(lid * params.tiles + tile) as usize];
+    } else if phase == LOOK_BACK_PHASE {
+        // Invocation `lid` looks back for digit `lid`.
+        let count = running[l];
+        let own = state::status(params.tiles, params.pass, tile, lid);
+        let mut prefix = 0;
+        if tile == 0 {
+            prefix = sort_state[(state::COUNTS + params.pass * RADIX + lid) as usize];
+        } else {
+            atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
+            let mut earlier = tile - 1;
+            // Until a tile's inclusive count, add up aggregates; a tile that
+            // has published nothing yet is read again (its workgroup is
+            // running: see the module doc).
+            loop {
+                // A read-modify-write rather than a load, so that no compiler
+                // may hoist it out of the loop.
+                let s = atomics::add_device(&mut sort_state[state::status(params.tiles, params.pass, earlier, lid)], 0);
+                if s & !COUNT_MASK != 0 {
+                    prefix += s & COUNT_MASK;
+                    if s & INCLUSIVE != 0 {
+                        break;
+                    }
+                    earlier -= 1;
+                }
             }
-            // Invocation `lid` scans digit `lid`'s counts over the chunks.
-            let mut sum = 0;
-            for c in 0..CHUNKS {
-                let k = c * WG + l;
-                let v = counts[k];
-                counts[k] = sum;
-                sum += v;
-            }
-            totals[l] = sum;
         }
-        2 => {
-            if lid < valid {
-                let d = digits[l];
-                let before = counts[(chunk * RADIX + d) as usize] + count_before(packed, chunk * CHUNK, lid, d);
-                let dest = (running[d as usize] + before) as usize;
-                keys_out[dest] = keys_in[i as usize];
-                values_out[dest] = values_in[i as usize];
+        atomics::store_u32(&mut sort_state[own], INCLUSIVE | (prefix + count));
+        global_offsets[l] = prefix;
+        // The next pass uses the other region: clear this tile's row of it.
+        atomics::store_u32(&mut sort_state[state::status(params.tiles, params.pass + 1, tile, lid)], 0);
+    }
+    let scan_step = phase - LOOK_BACK_PHASE;
+    if scan_step < SMALL_SCAN_PHASES {
+        small_scan_phase(scan_step, lid, running, local_offsets, scan_sums);
+    } else if scan_step == SMALL_SCAN_PHASES {
+        // The tile's order: `counts[position] = key`.
+        for round in 0..SORT_ITEMS {
+            let k = round * WORKGROUP_SIZE + lid;
+            if k < valid {
+                let r = ranks[k as usize];
+                let position = local_offsets[(r >> 16) as usize] + (r & 0xffff);
+                counts[position as usize] = k;
             }
         }
-        _ => {
-            running[l] += totals[l];
-            for c in 0..CHUNKS {
-                counts[c * WG + l] = 0;
+    } else {
+        // Consecutive invocations write consecutive places of a digit's run.
+        for round in 0..SORT_ITEMS {
+            let position = round * WORKGROUP_SIZE + lid;
+            if position < valid {
+                let k = counts[position as usize];
+                let key = keys_in[(base + k) as usize];
+                let d = digit(key, shift) as usize;
+                let dest = (global_offsets[d] + position - local_offsets[d]) as usize;
+                keys_out[dest] = key;
+                values_out[dest] = values_in[(base + k) as usize];
             }
         }
     }
@@ -222,6 +495,25 @@ mod tests {
             let d = digits[lid as usize];
             let expected = (from..lid).filter(|&j| digits[j as usize] == d).count() as u32;
             assert_eq!(count_before(&packed, from, lid, d), expected, "lid {lid}");
+        }
+    }
+
+    #[test]
+    fn small_scan_is_an_exclusive_prefix_sum() {
+        let mut values = [0u32; WG];
+        for (i, v) in values.iter_mut().enumerate() {
+            *v = (i as u32 * 2654435761) % 97;
+        }
+        let (mut out, mut sums) = ([0u32; WG], [0u32; 16]);
+        for phase in 0..SMALL_SCAN_PHASES {
+            for lid in 0..WORKGROUP_SIZE {
+                small_scan_phase(phase, lid, &values, &mut out, &mut sums);
+            }
+        }
+        let mut sum = 0;
+        for i in 0..WG {
+            assert_eq!(out[i], sum, "at {i}");
+            sum += values[i];
         }
     }
 }

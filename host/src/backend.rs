@@ -73,6 +73,12 @@ pub trait Backend {
     fn ordered_atomics_in_divergent_flow(&self) -> bool {
         true
     }
+    /// False where the radix sort's decoupled look-back was seen to give
+    /// wrong offsets (lavapipe: see `treelet_core::sort`); the sort runs
+    /// without it there.
+    fn look_back_works(&self) -> bool {
+        true
+    }
     /// Largest buffer this device accepts in one binding, in bytes.
     fn max_buffer_bytes(&self) -> u64;
     /// A buffer holding `data`.
@@ -85,9 +91,15 @@ pub trait Backend {
     fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer> {
         let buffer = self.scratch(label, bytes)?;
         let len = u32::try_from(bytes / 4).map_err(|_| anyhow::anyhow!("buffer `{label}` too large to fill"))?;
-        let params = self.upload("fill params", &[FillParams { len, value: 0, _pad0: [0; 2] }])?;
-        self.dispatch(Kernel::Fill, &[&params, &buffer], groups_for(len, WORKGROUP_SIZE));
+        self.zero_words(&buffer, len)?;
         Ok(buffer)
+    }
+    /// Zeroes the first `len` u32 words of `buffer` by a fill dispatch in the
+    /// current stage.
+    fn zero_words(&mut self, buffer: &Self::Buffer, len: u32) -> Result<()> {
+        let params = self.upload("fill params", &[FillParams { len, value: 0, _pad0: [0; 2] }])?;
+        self.dispatch(Kernel::Fill, &[&params, buffer], groups_for(len, WORKGROUP_SIZE));
+        Ok(())
     }
     /// Starts a new build: buffers handed out for the previous one may be
     /// handed out again (their results must have been read back).

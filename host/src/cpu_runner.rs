@@ -205,12 +205,70 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 morton::morton_kernel(id, &p, boxes, keys, values);
             }
         }
-        (Kernel::SortHistogram, [p, keys, hist]) => {
+        (Kernel::SortHistogram, [p, keys, sort_state]) => {
             let p: treelet_core::SortParams = params(p);
-            let (keys, hist) = (view(keys), view(hist));
-            let mut counts = [0u32; WG];
+            let (keys, sort_state) = (view(keys), view(sort_state));
+            let mut counts = [0u32; (sort::MAX_PASSES * sort::RADIX) as usize];
             workgroups(groups, sort::HISTOGRAM_PHASES, |g, phase, lid| {
-                sort::histogram_phase(phase, lid, g, &p, keys, hist, &mut counts)
+                sort::histogram_phase(phase, lid, g, &p, keys, sort_state, &mut counts)
+            });
+        }
+        (Kernel::SortOffsets, [p, sort_state]) => {
+            let p: treelet_core::SortParams = params(p);
+            let sort_state = view(sort_state);
+            let (mut values, mut out, mut sums) = ([0u32; WG], [0u32; WG], [0u32; 16]);
+            workgroups(groups, sort::OFFSETS_PHASES, |g, phase, lid| {
+                sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
+            });
+        }
+        (Kernel::SortTileCounts, [p, keys, tile_counts]) => {
+            let p: treelet_core::SortParams = params(p);
+            let (keys, tile_counts) = (view(keys), view(tile_counts));
+            let mut counts = [0u32; WG];
+            workgroups(groups, sort::TILE_COUNTS_PHASES, |g, phase, lid| {
+                sort::tile_counts_phase(phase, lid, g, &p, keys, tile_counts, &mut counts)
+            });
+        }
+        (
+            kernel @ (Kernel::SortOnesweep | Kernel::SortOnesweepScanned),
+            [p, keys_in, values_in, keys_out, values_out, sort_state],
+        ) => {
+            let look_back = kernel == Kernel::SortOnesweep;
+            let p: treelet_core::SortParams = params(p);
+            let (keys_in, values_in, sort_state) = (view(keys_in), view(values_in), view(sort_state));
+            let (keys_out, values_out) = (view(keys_out), view(values_out));
+            let mut ticket = [0u32; 1];
+            let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
+            let (mut local_offsets, mut global_offsets) = ([0u32; WG], [0u32; WG]);
+            let mut packed = [0u32; sort::PACKED_DIGITS];
+            let mut counts = [0u32; sort::CHUNK_COUNTS];
+            let mut ranks = [0u32; sort::SORT_TILE as usize];
+            let mut scan_sums = [0u32; 16];
+            // Workgroups one after another: every earlier ticket's tile is
+            // done when a look-back reads it, so it never waits.
+            let onesweep = if look_back { sort::onesweep_phase::<true> } else { sort::onesweep_phase::<false> };
+            workgroups(groups, sort::ONESWEEP_PHASES, |g, phase, lid| {
+                onesweep(
+                    phase,
+                    lid,
+                    g,
+                    &p,
+                    keys_in,
+                    values_in,
+                    keys_out,
+                    values_out,
+                    sort_state,
+                    &mut ticket,
+                    &mut running,
+                    &mut digits,
+                    &mut packed,
+                    &mut counts,
+                    &mut totals,
+                    &mut ranks,
+                    &mut local_offsets,
+                    &mut global_offsets,
+                    &mut scan_sums,
+                )
             });
         }
         (Kernel::ScanReduce, [p, data, partials]) => {
@@ -235,32 +293,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
             workgroups(groups, scan::SCAN_SWEEP_PHASES, |g, phase, lid| {
                 scan::scan_downsweep_phase(phase, lid, g, &p, data, partials, &mut a, &mut b)
-            });
-        }
-        (Kernel::SortScatter, [p, keys_in, values_in, offsets, keys_out, values_out]) => {
-            let p: treelet_core::SortParams = params(p);
-            let (keys_in, values_in, offsets) = (view(keys_in), view(values_in), view(offsets));
-            let (keys_out, values_out) = (view(keys_out), view(values_out));
-            let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
-            let mut packed = [0u32; sort::PACKED_DIGITS];
-            let mut counts = [0u32; sort::CHUNK_COUNTS];
-            workgroups(groups, sort::SCATTER_PHASES, |g, phase, lid| {
-                sort::scatter_phase(
-                    phase,
-                    lid,
-                    g,
-                    &p,
-                    keys_in,
-                    values_in,
-                    offsets,
-                    keys_out,
-                    values_out,
-                    &mut running,
-                    &mut digits,
-                    &mut packed,
-                    &mut counts,
-                    &mut totals,
-                )
             });
         }
         (Kernel::RadixTree, [p, keys, nodes, parents]) => {

@@ -64,11 +64,19 @@ pub enum Kernel {
     PrimitiveBoxes,
     ReduceBounds,
     Morton,
+    /// Radix sort: digit counts of every pass.
     SortHistogram,
+    /// Radix sort: where each digit starts, per pass.
+    SortOffsets,
+    /// Radix sort: one pass (one sweep with decoupled look-back).
+    SortOnesweep,
+    /// Radix sort without look-back: this pass's digit counts per tile.
+    SortTileCounts,
+    /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
+    SortOnesweepScanned,
     ScanReduce,
     ScanSpine,
     ScanDownsweep,
-    SortScatter,
     RadixTree,
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
@@ -110,16 +118,19 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 31] = [
+    const FIXED: [Kernel; 34] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
         Kernel::Morton,
         Kernel::SortHistogram,
+        Kernel::SortOffsets,
+        Kernel::SortOnesweep,
+        Kernel::SortTileCounts,
+        Kernel::SortOnesweepScanned,
         Kernel::ScanReduce,
         Kernel::ScanSpine,
         Kernel::ScanDownsweep,
-        Kernel::SortScatter,
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
@@ -167,10 +178,13 @@ impl Kernel {
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
+            Kernel::SortOffsets => "sort::sort_offsets_cs",
+            Kernel::SortOnesweep => "sort::sort_onesweep_cs",
+            Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
+            Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::ScanReduce => "scan::scan_reduce_cs",
             Kernel::ScanSpine => "scan::scan_spine_cs",
             Kernel::ScanDownsweep => "scan::scan_downsweep_cs",
-            Kernel::SortScatter => "sort::sort_scatter_cs",
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
@@ -210,7 +224,9 @@ impl Kernel {
             Kernel::ScanReduce => &[Read, Read, ReadWrite],
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
-            Kernel::SortScatter => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
+            Kernel::SortOffsets => &[Read, ReadWrite],
+            Kernel::SortOnesweep | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {

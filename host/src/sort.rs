@@ -3,7 +3,7 @@
 use anyhow::Result;
 use treelet_core::layout::{ScanParams, SortParams};
 use treelet_core::scan::SCAN_TILE;
-use treelet_core::sort::{passes_for, RADIX, RADIX_BITS, SORT_TILE};
+use treelet_core::sort::{passes_for, state, HISTOGRAM_TILE, MAX_KEYS, RADIX, SORT_TILE};
 use treelet_core::workgroup::groups_for;
 
 use crate::backend::Backend;
@@ -24,8 +24,9 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
 }
 
 /// Sorts `n` `(key, value)` pairs by the low `key_bits` bits of the keys,
-/// stably. Returns the buffers that hold the result (the inputs or the
-/// scratch pair, depending on the number of passes).
+/// stably: one digit histogram for all passes, then one sweep per pass
+/// (see `treelet_core::sort`). Returns the buffers that hold the result (the
+/// inputs or the scratch pair, depending on the number of passes).
 pub fn radix_sort<B: Backend>(
     b: &mut B,
     keys: &B::Buffer,
@@ -33,19 +34,36 @@ pub fn radix_sort<B: Backend>(
     n: u32,
     key_bits: u32,
 ) -> Result<(B::Buffer, B::Buffer)> {
-    let blocks = groups_for(n, SORT_TILE);
     let mut src = (keys.clone(), values.clone());
     if n < 2 {
         return Ok(src);
     }
+    anyhow::ensure!(n <= MAX_KEYS, "{n} keys: the radix sort takes at most {MAX_KEYS}");
+    anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
+    let passes = passes_for(key_bits);
+    let tiles = groups_for(n, SORT_TILE);
     let mut dst = (b.scratch("sort keys scratch", n as u64 * 8)?, b.scratch("sort values scratch", n as u64 * 4)?);
-    let hist_len = RADIX * blocks;
-    let hist = b.scratch("sort histogram", hist_len as u64 * 4)?;
-    for pass in 0..passes_for(key_bits) {
-        let params = b.upload("sort params", &[SortParams { n, shift: pass * RADIX_BITS, blocks, _pad0: 0 }])?;
-        b.dispatch(Kernel::SortHistogram, &[&params, &src.0, &hist], blocks);
-        exclusive_scan(b, &hist, hist_len)?;
-        b.dispatch(Kernel::SortScatter, &[&params, &src.0, &src.1, &hist, &dst.0, &dst.1], blocks);
+    let params = |pass| SortParams { n, tiles, pass, passes };
+    if !b.look_back_works() {
+        // Reduce, then scan, then the same pass kernel without look-back.
+        let tile_counts = b.scratch("sort tile counts", RADIX as u64 * tiles as u64 * 4)?;
+        for pass in 0..passes {
+            let p = b.upload("sort params", &[params(pass)])?;
+            b.dispatch(Kernel::SortTileCounts, &[&p, &src.0, &tile_counts], tiles);
+            exclusive_scan(b, &tile_counts, RADIX * tiles)?;
+            b.dispatch(Kernel::SortOnesweepScanned, &[&p, &src.0, &src.1, &dst.0, &dst.1, &tile_counts], tiles);
+            std::mem::swap(&mut src, &mut dst);
+        }
+        return Ok(src);
+    }
+    let sort_state = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
+    b.zero_words(&sort_state, state::zeroed_words(tiles))?;
+    let p = b.upload("sort params", &[params(0)])?;
+    b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, HISTOGRAM_TILE));
+    b.dispatch(Kernel::SortOffsets, &[&p, &sort_state], passes);
+    for pass in 0..passes {
+        let p = b.upload("sort params", &[params(pass)])?;
+        b.dispatch(Kernel::SortOnesweep, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
         std::mem::swap(&mut src, &mut dst);
     }
     Ok(src)

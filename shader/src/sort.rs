@@ -11,39 +11,154 @@ pub fn sort_histogram_cs(
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] block_hist: &mut [u32],
-    #[spirv(workgroup)] counts: &mut [u32; WG],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] sort_state: &mut [u32],
+    #[spirv(workgroup)] counts: &mut [u32; (sort::MAX_PASSES * sort::RADIX) as usize],
 ) {
     let tile = linear_group(group.x, group.y, groups.x);
     for phase in 0..sort::HISTOGRAM_PHASES {
-        sort::histogram_phase(phase, lid, tile, params, keys, block_hist, counts);
+        sort::histogram_phase(phase, lid, tile, params, keys, sort_state, counts);
         barrier();
     }
 }
 
 #[spirv(compute(threads(256)))]
-pub fn sort_scatter_cs(
+pub fn sort_offsets_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] sort_state: &mut [u32],
+    #[spirv(workgroup)] values: &mut [u32; WG],
+    #[spirv(workgroup)] out: &mut [u32; WG],
+    #[spirv(workgroup)] sums: &mut [u32; 16],
+) {
+    for phase in 0..sort::OFFSETS_PHASES {
+        sort::offsets_phase(phase, lid, group.x, params, sort_state, values, out, sums);
+        barrier();
+    }
+}
+
+/// One sort pass; `LOOK_BACK` as in `treelet_core::sort::onesweep_phase`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn onesweep<const LOOK_BACK: bool>(
+    lid: u32,
+    group: u32,
+    params: &SortParams,
+    keys_in: &[u64],
+    values_in: &[u32],
+    keys_out: &mut [u64],
+    values_out: &mut [u32],
+    sort_state: &mut [u32],
+    ticket: &mut [u32; 1],
+    running: &mut [u32; WG],
+    digits: &mut [u32; WG],
+    packed: &mut [u32; sort::PACKED_DIGITS],
+    counts: &mut [u32; sort::CHUNK_COUNTS],
+    totals: &mut [u32; WG],
+    ranks: &mut [u32; sort::SORT_TILE as usize],
+    local_offsets: &mut [u32; WG],
+    global_offsets: &mut [u32; WG],
+    scan_sums: &mut [u32; 16],
+) {
+    for phase in 0..sort::ONESWEEP_PHASES {
+        sort::onesweep_phase::<LOOK_BACK>(
+            phase,
+            lid,
+            group,
+            params,
+            keys_in,
+            values_in,
+            keys_out,
+            values_out,
+            sort_state,
+            ticket,
+            running,
+            digits,
+            packed,
+            counts,
+            totals,
+            ranks,
+            local_offsets,
+            global_offsets,
+            scan_sums,
+        );
+        barrier();
+    }
+}
+
+#[spirv(compute(threads(256)))]
+#[allow(clippy::too_many_arguments)]
+pub fn sort_onesweep_cs(
     #[spirv(local_invocation_index)] lid: u32,
     #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] offsets: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] keys_out: &mut [u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] values_out: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
+    #[spirv(workgroup)] ticket: &mut [u32; 1],
     #[spirv(workgroup)] running: &mut [u32; WG],
     #[spirv(workgroup)] digits: &mut [u32; WG],
     #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
     #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
     #[spirv(workgroup)] totals: &mut [u32; WG],
+    #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
+    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
+) {
+    let group = linear_group(group.x, group.y, groups.x);
+    onesweep::<true>(
+        lid, group, params, keys_in, values_in, keys_out, values_out, sort_state, ticket, running, digits, packed,
+        counts, totals, ranks, local_offsets, global_offsets, scan_sums,
+    );
+}
+
+#[spirv(compute(threads(256)))]
+#[allow(clippy::too_many_arguments)]
+pub fn sort_onesweep_scanned_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
+    #[spirv(workgroup)] ticket: &mut [u32; 1],
+    #[spirv(workgroup)] running: &mut [u32; WG],
+    #[spirv(workgroup)] digits: &mut [u32; WG],
+    #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
+    #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
+    #[spirv(workgroup)] totals: &mut [u32; WG],
+    #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
+    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
+) {
+    let group = linear_group(group.x, group.y, groups.x);
+    onesweep::<false>(
+        lid, group, params, keys_in, values_in, keys_out, values_out, sort_state, ticket, running, digits, packed,
+        counts, totals, ranks, local_offsets, global_offsets, scan_sums,
+    );
+}
+
+#[spirv(compute(threads(256)))]
+pub fn sort_tile_counts_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(workgroup_id)] group: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] tile_counts: &mut [u32],
+    #[spirv(workgroup)] counts: &mut [u32; WG],
 ) {
     let tile = linear_group(group.x, group.y, groups.x);
-    for phase in 0..sort::SCATTER_PHASES {
-        sort::scatter_phase(
-            phase, lid, tile, params, keys_in, values_in, offsets, keys_out, values_out, running, digits, packed,
-            counts, totals,
-        );
+    for phase in 0..sort::TILE_COUNTS_PHASES {
+        sort::tile_counts_phase(phase, lid, tile, params, keys, tile_counts, counts);
         barrier();
     }
 }

@@ -190,6 +190,9 @@ impl Backend for GpuBackend {
     fn ordered_atomics_in_divergent_flow(&self) -> bool {
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
     }
+    fn look_back_works(&self) -> bool {
+        self.ctx.info.device_type != wgpu::DeviceType::Cpu
+    }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_binding_bytes()
     }
