@@ -53,6 +53,30 @@ fn sort_handles_equal_sorted_and_reversed_keys() {
     check_sort(&ctx, &low, 63, &format!("30-bit keys sorted on 63 bits, seed {seed}"));
 }
 
+/// Many large sorts on the GPU against std's stable sort: look-back across
+/// thousands of tiles, under whatever scheduling the device does. Minutes on
+/// lavapipe, so run by hand on a GPU: `cargo test --release --test
+/// gpu_vs_cpu -- --ignored`.
+#[test]
+#[ignore]
+fn sort_stress_on_large_inputs() {
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let mut b = GpuBackend::new(ctx);
+    for trial in 0..40 {
+        let n = [70_000u32, 1_000_000, 4_000_000][trial % 3];
+        let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
+        let values: Vec<u32> = (0..n).collect();
+        b.begin_build();
+        let g = run_sort(&mut b, &keys, &values, 64);
+        let mut expected: Vec<(u64, u32)> = keys.into_iter().zip(values).collect();
+        expected.sort_by_key(|&(k, _)| k);
+        let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
+        assert!(g.0 == ek && g.1 == ev, "trial {trial}, n = {n}, seed {seed}");
+    }
+}
+
 /// Sorts `keys` (values: their indices) on the GPU and the CPU runner by
 /// their low `key_bits` bits and compares both with a stable std sort.
 fn check_sort(ctx: &std::sync::Arc<treelet::gpu::GpuContext>, keys: &[u64], key_bits: u32, what: &str) {

@@ -70,7 +70,7 @@ impl Node {
     }
 }
 
-/// Parameters of the per-primitive and tree stages. repr(C), Pod, 48 bytes.
+/// Parameters of the per-primitive and tree stages. repr(C), Pod, 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
@@ -85,8 +85,11 @@ pub struct BuildParams {
     pub spheres: u32,
     /// Centroid bounds of the scene (Morton quantization frame).
     pub frame: Aabb,
+    /// Low bits dropped from each Morton key (0: all of [`crate::morton::KEY_BITS`]).
+    pub key_shift: u32,
+    pub _pad0: [u32; 3],
 }
-const _: () = assert!(core::mem::size_of::<BuildParams>() == 48);
+const _: () = assert!(core::mem::size_of::<BuildParams>() == 64);
 
 /// Parameters of the radix sort's kernels. repr(C), Pod, 16 bytes.
 #[repr(C)]

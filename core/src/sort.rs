@@ -38,8 +38,9 @@
 //! offsets now and then: about one sort in a hundred of 70 000 keys and three
 //! or more passes, and only with the CPU busy (the test threads beside it).
 //! Neither reading the status by an atomic add of zero (which no compiler
-//! may hoist) nor a fresh status region per pass nor a loop without
-//! `continue` cured it, and the cause was not found. There (the host asks
+//! may hoist; on the H100 such adds made the sort 3% slower than loads) nor
+//! a fresh status region per pass nor a loop without `continue` cured it,
+//! and the cause was not found. There (the host asks
 //! `Backend::look_back_works`) each pass runs without look-back instead:
 //! [`tile_counts_phase`] counts each tile's digits, a prefix sum over them
 //! (digit-major) gives every tile its offsets, and the same
@@ -52,9 +53,12 @@
 //! within the chunk four packed digits at a time ([`count_before`]). The
 //! result is identical on every device and on the CPU.
 //!
-//! Kernels are phase functions: see [`crate::workgroup`].
+//! Kernels are phase functions: see [`crate::workgroup`]. Hot reads and
+//! writes skip bounds checks on the GPU ([`crate::unchecked`]; the CPU runner
+//! keeps them), as in the treelet kernel.
 use crate::atomics;
 use crate::layout::SortParams;
+use crate::unchecked::{at, get, put, set};
 use crate::workgroup::{WG, WORKGROUP_SIZE};
 
 /// Bits of the key sorted per pass.
@@ -287,10 +291,10 @@ pub fn count_before(packed: &[u32; PACKED_DIGITS], from: u32, lid: u32, d: u32) 
     let mut count = 0;
     let mut w = from / 4;
     while w < lid / 4 {
-        count += zero_bytes(packed[w as usize] ^ pattern).count_ones();
+        count += zero_bytes(get(packed, w as usize) ^ pattern).count_ones();
         w += 1;
     }
-    let partial = zero_bytes(packed[(lid / 4) as usize] ^ pattern) & ((1u32 << (8 * (lid % 4))) - 1);
+    let partial = zero_bytes(get(packed, (lid / 4) as usize) ^ pattern) & ((1u32 << (8 * (lid % 4))) - 1);
     count + partial.count_ones()
 }
 
@@ -368,7 +372,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         let chunk = lid / CHUNK;
         match (phase - 1) % 4 {
             0 => {
-                let d = if k < valid { digit(keys_in[(base + k) as usize], shift) } else { 0 };
+                let d = if k < valid { digit(at(keys_in, (base + k) as usize), shift) } else { 0 };
                 digits[l] = d;
                 if k < valid {
                     atomics::add_workgroup(&mut counts[(chunk * RADIX + d) as usize], 1);
@@ -383,8 +387,8 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
                 let mut sum = 0;
                 for c in 0..CHUNKS {
                     let i = c * WG + l;
-                    let v = counts[i];
-                    counts[i] = sum;
+                    let v = get(counts, i);
+                    set(counts, i, sum);
                     sum += v;
                 }
                 totals[l] = sum;
@@ -392,9 +396,9 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
             2 => {
                 if k < valid {
                     let d = digits[l];
-                    let before = counts[(chunk * RADIX + d) as usize]
+                    let before = get(counts, (chunk * RADIX + d) as usize)
                         + count_before(packed, chunk * CHUNK, lid, d);
-                    ranks[k as usize] = (running[d as usize] + before) | (d << 16);
+                    set(ranks, k as usize, (get(running, d as usize) + before) | (d << 16));
                 }
             }
             _ => {
@@ -422,9 +426,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
             // has published nothing yet is read again (its workgroup is
             // running: see the module doc).
             loop {
-                // A read-modify-write rather than a load, so that no compiler
-                // may hoist it out of the loop.
-                let s = atomics::add_device(&mut sort_state[state::status(params.tiles, params.pass, earlier, lid)], 0);
+                let s = atomics::load_u32(&sort_state[state::status(params.tiles, params.pass, earlier, lid)]);
                 if s & !COUNT_MASK != 0 {
                     prefix += s & COUNT_MASK;
                     if s & INCLUSIVE != 0 {
@@ -447,9 +449,9 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         for round in 0..SORT_ITEMS {
             let k = round * WORKGROUP_SIZE + lid;
             if k < valid {
-                let r = ranks[k as usize];
-                let position = local_offsets[(r >> 16) as usize] + (r & 0xffff);
-                counts[position as usize] = k;
+                let r = get(ranks, k as usize);
+                let position = get(local_offsets, (r >> 16) as usize) + (r & 0xffff);
+                set(counts, position as usize, k);
             }
         }
     } else {
@@ -457,12 +459,12 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         for round in 0..SORT_ITEMS {
             let position = round * WORKGROUP_SIZE + lid;
             if position < valid {
-                let k = counts[position as usize];
-                let key = keys_in[(base + k) as usize];
+                let k = get(counts, position as usize);
+                let key = at(keys_in, (base + k) as usize);
                 let d = digit(key, shift) as usize;
-                let dest = (global_offsets[d] + position - local_offsets[d]) as usize;
-                keys_out[dest] = key;
-                values_out[dest] = values_in[(base + k) as usize];
+                let dest = (get(global_offsets, d) + position - get(local_offsets, d)) as usize;
+                put(keys_out, dest, key);
+                put(values_out, dest, at(values_in, (base + k) as usize));
             }
         }
     }

@@ -5,7 +5,7 @@ use anyhow::Result;
 use treelet_core::aabb::Aabb;
 use treelet_core::bounds::REDUCE_TILE;
 use treelet_core::layout::{BuildParams, Node, Sphere};
-use treelet_core::morton::{MortonFrame, KEY_BITS};
+use treelet_core::morton::{MortonFrame, KEY_BITS, SORTED_KEY_BITS};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use crate::backend::{check_fits, Backend, StageTimes};
@@ -24,7 +24,7 @@ pub struct Bvh {
     pub parents: Vec<u32>,
     /// Primitive index of each sorted position (leaves point into this).
     pub prim_indices: Vec<u32>,
-    /// Morton keys in the LBVH's sorted order.
+    /// Sort keys (the top `SORTED_KEY_BITS` bits of each Morton code) in the LBVH's order.
     pub sorted_keys: Vec<u64>,
     /// Centroid bounds used for the Morton frame.
     pub centroid_bounds: Aabb,
@@ -132,7 +132,13 @@ pub fn build_primitives_on_device<B: Backend>(
     check_fits(b, "nodes", node_count * std::mem::size_of::<Node>() as u64)?;
 
     b.stage("bounds");
-    let mut params = BuildParams { n, ..Default::default() };
+    // Dev knob, to measure other key lengths (sort passes) against tree quality.
+    let key_bits = std::env::var("TREELET_MORTON_KEY_BITS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(SORTED_KEY_BITS)
+        .clamp(1, KEY_BITS);
+    let mut params = BuildParams { n, key_shift: KEY_BITS - key_bits, ..Default::default() };
     params.spheres = prims.spheres.len() as u32;
     let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
@@ -161,7 +167,7 @@ pub fn build_primitives_on_device<B: Backend>(
     b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
-    let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, KEY_BITS)?;
+    let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, key_bits)?;
 
     b.stage("tree");
     let nodes = b.scratch("nodes", node_count * 32)?;

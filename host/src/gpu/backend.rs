@@ -191,7 +191,9 @@ impl Backend for GpuBackend {
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
     }
     fn look_back_works(&self) -> bool {
+        // TREELET_SORT_LOOK_BACK=0 forces the sort without look-back (to measure it).
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
+            && std::env::var("TREELET_SORT_LOOK_BACK").map_or(true, |v| v != "0")
     }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_binding_bytes()
