@@ -37,114 +37,64 @@ pub fn sort_offsets_cs(
     }
 }
 
-/// One sort pass; `LOOK_BACK` as in `treelet_core::sort::onesweep_phase`.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn onesweep<const LOOK_BACK: bool>(
-    lid: u32,
-    group: u32,
-    params: &SortParams,
-    keys_in: &[u64],
-    values_in: &[u32],
-    keys_out: &mut [u64],
-    values_out: &mut [u32],
-    sort_state: &mut [u32],
-    ticket: &mut [u32; 1],
-    running: &mut [u32; WG],
-    digits: &mut [u32; WG],
-    packed: &mut [u32; sort::PACKED_DIGITS],
-    counts: &mut [u32; sort::CHUNK_COUNTS],
-    totals: &mut [u32; WG],
-    ranks: &mut [u32; sort::SORT_TILE as usize],
-    local_offsets: &mut [u32; WG],
-    global_offsets: &mut [u32; WG],
-    scan_sums: &mut [u32; 16],
-) {
-    for phase in 0..sort::ONESWEEP_PHASES {
-        sort::onesweep_phase::<LOOK_BACK>(
-            phase,
-            lid,
-            group,
-            params,
-            keys_in,
-            values_in,
-            keys_out,
-            values_out,
-            sort_state,
-            ticket,
-            running,
-            digits,
-            packed,
-            counts,
-            totals,
-            ranks,
-            local_offsets,
-            global_offsets,
-            scan_sums,
-        );
-        barrier();
-    }
+/// A sort pass's entry point; `$look_back` as in
+/// `treelet_core::sort::onesweep_phase` (entry points cannot be generic).
+macro_rules! onesweep_kernel {
+    ($name:ident, $look_back:literal) => {
+        #[spirv(compute(threads(256)))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $name(
+            #[spirv(local_invocation_index)] lid: u32,
+            #[spirv(workgroup_id)] group: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
+            #[spirv(workgroup)] ticket: &mut [u32; 1],
+            #[spirv(workgroup)] running: &mut [u32; WG],
+            #[spirv(workgroup)] digits: &mut [u32; WG],
+            #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
+            #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
+            #[spirv(workgroup)] totals: &mut [u32; WG],
+            #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
+            #[spirv(workgroup)] local_offsets: &mut [u32; WG],
+            #[spirv(workgroup)] global_offsets: &mut [u32; WG],
+            #[spirv(workgroup)] scan_sums: &mut [u32; 16],
+        ) {
+            let group = linear_group(group.x, group.y, groups.x);
+            for phase in 0..sort::ONESWEEP_PHASES {
+                sort::onesweep_phase::<$look_back>(
+                    phase,
+                    lid,
+                    group,
+                    params,
+                    keys_in,
+                    values_in,
+                    keys_out,
+                    values_out,
+                    sort_state,
+                    ticket,
+                    running,
+                    digits,
+                    packed,
+                    counts,
+                    totals,
+                    ranks,
+                    local_offsets,
+                    global_offsets,
+                    scan_sums,
+                );
+                barrier();
+            }
+        }
+    };
 }
 
-#[spirv(compute(threads(256)))]
-#[allow(clippy::too_many_arguments)]
-pub fn sort_onesweep_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
-    #[spirv(workgroup)] ticket: &mut [u32; 1],
-    #[spirv(workgroup)] running: &mut [u32; WG],
-    #[spirv(workgroup)] digits: &mut [u32; WG],
-    #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
-    #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
-    #[spirv(workgroup)] totals: &mut [u32; WG],
-    #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
-    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
-) {
-    let group = linear_group(group.x, group.y, groups.x);
-    onesweep::<true>(
-        lid, group, params, keys_in, values_in, keys_out, values_out, sort_state, ticket, running, digits, packed,
-        counts, totals, ranks, local_offsets, global_offsets, scan_sums,
-    );
-}
-
-#[spirv(compute(threads(256)))]
-#[allow(clippy::too_many_arguments)]
-pub fn sort_onesweep_scanned_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
-    #[spirv(workgroup)] ticket: &mut [u32; 1],
-    #[spirv(workgroup)] running: &mut [u32; WG],
-    #[spirv(workgroup)] digits: &mut [u32; WG],
-    #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
-    #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
-    #[spirv(workgroup)] totals: &mut [u32; WG],
-    #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
-    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
-) {
-    let group = linear_group(group.x, group.y, groups.x);
-    onesweep::<false>(
-        lid, group, params, keys_in, values_in, keys_out, values_out, sort_state, ticket, running, digits, packed,
-        counts, totals, ranks, local_offsets, global_offsets, scan_sums,
-    );
-}
+onesweep_kernel!(sort_onesweep_cs, true);
+onesweep_kernel!(sort_onesweep_scanned_cs, false);
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(
