@@ -504,7 +504,7 @@ mod tests {
     fn small_scan_is_an_exclusive_prefix_sum() {
         let mut values = [0u32; WG];
         for (i, v) in values.iter_mut().enumerate() {
-            *v = (i as u32 * 2654435761) % 97;
+            *v = (i as u32).wrapping_mul(2654435761) % 97;
         }
         let (mut out, mut sums) = ([0u32; WG], [0u32; 16]);
         for phase in 0..SMALL_SCAN_PHASES {
