@@ -59,7 +59,7 @@
 use crate::atomics;
 use crate::layout::SortParams;
 use crate::unchecked::{at, get, put, set};
-use crate::workgroup::{WG, WORKGROUP_SIZE};
+use crate::workgroup::{small_scan_phase, SMALL_SCAN_PHASES, WG, WORKGROUP_SIZE};
 
 /// Bits of the key sorted per pass.
 pub const RADIX_BITS: u32 = 8;
@@ -198,40 +198,6 @@ pub fn tile_counts_phase(
         }
     } else if tile < params.tiles {
         tile_counts[(lid * params.tiles + tile) as usize] = counts[lid as usize];
-    }
-}
-
-/// Phases of [`small_scan_phase`].
-pub const SMALL_SCAN_PHASES: u32 = 3;
-
-/// Exclusive prefix sum of 256 values in three phases: sixteen invocations
-/// each scan sixteen values, one scans their sums, all add. (Cheaper here
-/// than a Hillis-Steele scan's sixteen phases: the values are few.)
-#[inline]
-pub fn small_scan_phase(phase: u32, lid: u32, values: &[u32; WG], out: &mut [u32; WG], sums: &mut [u32; 16]) {
-    let l = lid as usize;
-    match phase {
-        0 => {
-            if l < 16 {
-                let mut sum = 0;
-                for k in 16 * l..16 * l + 16 {
-                    out[k] = sum;
-                    sum += values[k];
-                }
-                sums[l] = sum;
-            }
-        }
-        1 => {
-            if l == 0 {
-                let mut sum = 0;
-                for k in 0..16 {
-                    let v = sums[k];
-                    sums[k] = sum;
-                    sum += v;
-                }
-            }
-        }
-        _ => out[l] += sums[l / 16],
     }
 }
 
@@ -497,25 +463,6 @@ mod tests {
             let d = digits[lid as usize];
             let expected = (from..lid).filter(|&j| digits[j as usize] == d).count() as u32;
             assert_eq!(count_before(&packed, from, lid, d), expected, "lid {lid}");
-        }
-    }
-
-    #[test]
-    fn small_scan_is_an_exclusive_prefix_sum() {
-        let mut values = [0u32; WG];
-        for (i, v) in values.iter_mut().enumerate() {
-            *v = (i as u32).wrapping_mul(2654435761) % 97;
-        }
-        let (mut out, mut sums) = ([0u32; WG], [0u32; 16]);
-        for phase in 0..SMALL_SCAN_PHASES {
-            for lid in 0..WORKGROUP_SIZE {
-                small_scan_phase(phase, lid, &values, &mut out, &mut sums);
-            }
-        }
-        let mut sum = 0;
-        for i in 0..WG {
-            assert_eq!(out[i], sum, "at {i}");
-            sum += values[i];
         }
     }
 }

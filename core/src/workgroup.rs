@@ -45,6 +45,41 @@ pub fn hillis_steele_step(step: u32, lid: u32, a: &mut [u32; WG], b: &mut [u32; 
     }
 }
 
+/// Phases of [`small_scan_phase`].
+pub const SMALL_SCAN_PHASES: u32 = 3;
+const _: () = assert!(WG == 16 * 16, "sixteen invocations of sixteen values");
+
+/// Exclusive prefix sum of a workgroup's 256 values in three phases: sixteen invocations
+/// each scan sixteen values, one scans their sums, all add. (Cheaper here
+/// than a Hillis-Steele scan's sixteen phases: the values are few.)
+#[inline]
+pub fn small_scan_phase(phase: u32, lid: u32, values: &[u32; WG], out: &mut [u32; WG], sums: &mut [u32; 16]) {
+    let l = lid as usize;
+    match phase {
+        0 => {
+            if l < 16 {
+                let mut sum = 0;
+                for k in 16 * l..16 * l + 16 {
+                    out[k] = sum;
+                    sum += values[k];
+                }
+                sums[l] = sum;
+            }
+        }
+        1 => {
+            if l == 0 {
+                let mut sum = 0;
+                for k in 0..16 {
+                    let v = sums[k];
+                    sums[k] = sum;
+                    sum += v;
+                }
+            }
+        }
+        _ => out[l] += sums[l / 16],
+    }
+}
+
 /// Stride of step `step` (of [`WG_LOG2`]) of a tree reduction: 128, 64, .., 1.
 #[inline]
 pub fn reduction_stride(step: u32) -> u32 {
@@ -89,6 +124,25 @@ pub fn groups_for(n: u32, per_group: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_scan_is_an_exclusive_prefix_sum() {
+        let mut values = [0u32; WG];
+        for (i, v) in values.iter_mut().enumerate() {
+            *v = (i as u32).wrapping_mul(2654435761) % 97;
+        }
+        let (mut out, mut sums) = ([0u32; WG], [0u32; 16]);
+        for phase in 0..SMALL_SCAN_PHASES {
+            for lid in 0..WORKGROUP_SIZE {
+                small_scan_phase(phase, lid, &values, &mut out, &mut sums);
+            }
+        }
+        let mut sum = 0;
+        for i in 0..WG {
+            assert_eq!(out[i], sum, "at {i}");
+            sum += values[i];
+        }
+    }
 
     #[test]
     fn grid_covers_every_group_once() {
