@@ -6,6 +6,7 @@ use treelet::backend::Backend;
 use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::GpuBackend;
 use treelet::scene::random_spheres;
+use treelet::sort::SortTiles;
 use treelet_tests::{compare_builds, gpu};
 
 #[test]
@@ -13,6 +14,48 @@ fn lbvh_matches_cpu_on_random_scenes() {
     let seed = treelet_tests::fresh_seed();
     for n in [1usize, 2, 3, 7, 8, 1000, 4096, 30_000] {
         compare_builds(&random_spheres(n, seed ^ n as u64), &format!("random:{n}:{seed}"));
+    }
+}
+
+/// The agglomerative build (Apetrei 2014) gives the radix tree plus fit's
+/// nodes and parents bit for bit, on the GPU and on the CPU runner, also
+/// where many Morton keys are equal.
+#[test]
+fn agglomerative_build_equals_radix_tree_and_fit() {
+    use treelet::lbvh::{build_with, Hierarchy};
+    let seed = treelet_tests::fresh_seed();
+    let mut scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 5, 1000, 40_000]
+        .iter()
+        .map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64)))
+        .collect();
+    // Many spheres on few distinct centres: long runs of equal keys.
+    let mut clustered = random_spheres(5000, seed);
+    for (k, s) in clustered.iter_mut().enumerate() {
+        s.center = [(k % 7) as f32; 3];
+    }
+    scenes.push((format!("clustered, seed {seed}"), clustered));
+    let gpu_ctx = gpu();
+    for (what, spheres) in &scenes {
+        let reference = build_with(&mut CpuBackend::new(), spheres, Hierarchy::RadixTreeThenFit).unwrap();
+        let mut trees =
+            vec![("cpu agglomerative", build_with(&mut CpuBackend::new(), spheres, Hierarchy::Agglomerative).unwrap())];
+        if let Some(ctx) = &gpu_ctx {
+            let mut b = GpuBackend::new(ctx.clone());
+            trees.push(("gpu radix tree + fit", build_with(&mut b, spheres, Hierarchy::RadixTreeThenFit).unwrap()));
+            trees.push(("gpu agglomerative", build_with(&mut b, spheres, Hierarchy::Agglomerative).unwrap()));
+        }
+        for (how, t) in &trees {
+            assert_eq!(t.prim_indices, reference.prim_indices, "{what}, {how}: order");
+            if let Some(i) = (0..reference.nodes.len()).find(|&i| t.nodes[i] != reference.nodes[i]) {
+                panic!(
+                    "{what}, {how}: node {i}: {:?}, radix tree + fit on the CPU: {:?}",
+                    t.nodes[i], reference.nodes[i]
+                );
+            }
+            assert_eq!(t.parents, reference.parents, "{what}, {how}: parents");
+        }
+        let v = treelet::validate::validate(spheres, &trees[0].1.nodes, &trees[0].1.parents, &trees[0].1.prim_indices);
+        assert!(v.is_valid(), "{what}: agglomerative tree invalid: {:?}", v.errors);
     }
 }
 
@@ -70,36 +113,52 @@ fn sort_stress_on_large_inputs() {
         let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
         let values: Vec<u32> = (0..n).collect();
         b.begin_build();
-        let g = run_sort(&mut b, &keys, &values, 64);
+        let tiles = if trial % 2 == 0 { SortTiles::Large } else { SortTiles::Small };
+        let g = run_sort(&mut b, &keys, &values, 64, tiles);
         let mut expected: Vec<(u64, u32)> = keys.into_iter().zip(values).collect();
         expected.sort_by_key(|&(k, _)| k);
         let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
-        assert!(g.0 == ek && g.1 == ev, "trial {trial}, n = {n}, seed {seed}");
+        assert!(g.0 == ek && g.1 == ev, "trial {trial}, n = {n}, {tiles:?} tiles, seed {seed}");
     }
 }
 
 /// Sorts `keys` (values: their indices) on the GPU and the CPU runner by
 /// their low `key_bits` bits and compares both with a stable std sort.
+/// Sorts with large and with small tiles, on the GPU and the CPU runner,
+/// against std's stable sort.
 fn check_sort(ctx: &std::sync::Arc<treelet::gpu::GpuContext>, keys: &[u64], key_bits: u32, what: &str) {
     let n = keys.len();
     let values: Vec<u32> = (0..n as u32).collect();
-    let g = run_sort(&mut GpuBackend::new(ctx.clone()), keys, &values, key_bits);
-    let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits);
     let mask = if key_bits >= 64 { u64::MAX } else { (1u64 << key_bits) - 1 };
     let mut expected: Vec<(u64, u32)> = keys.iter().copied().zip(values.iter().copied()).collect();
     expected.sort_by_key(|&(k, _)| k & mask); // stable, like the radix sort
     let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
-    assert!(c.0 == ek, "cpu keys, {what}");
-    assert!(c.1 == ev, "cpu values (stability), {what}");
-    assert!(g.0 == ek, "gpu keys, {what}");
-    assert!(g.1 == ev, "gpu values (stability), {what}");
+    // Without look-back (lavapipe) the GPU sorts with large tiles only.
+    let small_on_gpu = GpuBackend::new(ctx.clone()).look_back_works();
+    for tiles in [SortTiles::Large, SortTiles::Small] {
+        let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits, tiles);
+        assert!(c.0 == ek, "cpu keys, {tiles:?} tiles, {what}");
+        assert!(c.1 == ev, "cpu values (stability), {tiles:?} tiles, {what}");
+        if tiles == SortTiles::Small && !small_on_gpu {
+            continue;
+        }
+        let g = run_sort(&mut GpuBackend::new(ctx.clone()), keys, &values, key_bits, tiles);
+        assert!(g.0 == ek, "gpu keys, {tiles:?} tiles, {what}");
+        assert!(g.1 == ev, "gpu values (stability), {tiles:?} tiles, {what}");
+    }
 }
 
-fn run_sort<B: Backend>(b: &mut B, keys: &[u64], values: &[u32], key_bits: u32) -> (Vec<u64>, Vec<u32>) {
+fn run_sort<B: Backend>(
+    b: &mut B,
+    keys: &[u64],
+    values: &[u32],
+    key_bits: u32,
+    tiles: SortTiles,
+) -> (Vec<u64>, Vec<u32>) {
     let n = keys.len() as u32;
     let kb = b.upload("keys", keys).unwrap();
     let vb = b.upload("values", values).unwrap();
-    let (k, v) = treelet::sort::radix_sort(b, &kb, &vb, n, key_bits).unwrap();
+    let (k, v) = treelet::sort::radix_sort_tiled(b, &kb, &vb, n, key_bits, tiles).unwrap();
     (b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap())
 }
 

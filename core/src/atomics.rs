@@ -54,6 +54,36 @@ pub fn add_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
+/// Swaps `value` into a storage-buffer word with device scope, relaxed;
+/// returns the previous value.
+#[inline]
+pub fn exchange_device(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_exchange::<u32, DEVICE, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        use core::sync::atomic::{AtomicU32, Ordering};
+        AtomicU32::from_mut(slot).swap(value, Ordering::Relaxed)
+    }
+}
+
+/// [`exchange_device`] with acquire-release ordering on storage buffers (see
+/// [`add_device_acq_rel`] for the device that needs the relaxed one).
+#[inline]
+pub fn exchange_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_exchange::<u32, DEVICE, ACQ_REL_STORAGE>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        use core::sync::atomic::{AtomicU32, Ordering};
+        AtomicU32::from_mut(slot).swap(value, Ordering::AcqRel)
+    }
+}
+
 /// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).
 #[inline]
 pub fn add_workgroup(slot: &mut u32, value: u32) -> u32 {

@@ -13,7 +13,7 @@ use crate::layout::{Node, INVALID, LEAF_BIT};
 use crate::radix_tree::leaf_node;
 
 #[inline]
-fn store_box(node: &mut Node, b: &Aabb) {
+pub(crate) fn store_box(node: &mut Node, b: &Aabb) {
     for k in 0..3 {
         atomics::store_f32(&mut node.min[k], b.min[k]);
         atomics::store_f32(&mut node.max[k], b.max[k]);
@@ -21,7 +21,7 @@ fn store_box(node: &mut Node, b: &Aabb) {
 }
 
 #[inline]
-fn load_box(node: &Node) -> Aabb {
+pub(crate) fn load_box(node: &Node) -> Aabb {
     let mut b = Aabb::EMPTY;
     for k in 0..3 {
         b.min[k] = atomics::load_f32(&node.min[k]);
@@ -65,15 +65,20 @@ pub fn fit_kernel<const ORDERED: bool>(
         parents[0] = INVALID;
         return;
     }
-    let mut current = leaf;
+    // The climber keeps its subtree's box and reads only the sibling's.
+    let (mut current, mut own) = (leaf, b);
     while current != 0 {
         let parent = parents[current as usize];
         if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
             return; // The sibling's invocation will finish this node.
         }
-        let left = load_box(&nodes[nodes[parent as usize].left as usize]);
-        let right = load_box(&nodes[nodes[parent as usize].right as usize]);
-        store_box(&mut nodes[parent as usize], &left.union(&right));
+        let (left, right) = (nodes[parent as usize].left, nodes[parent as usize].right);
+        own = if left == current {
+            own.union(&load_box(&nodes[right as usize]))
+        } else {
+            load_box(&nodes[left as usize]).union(&own)
+        };
+        store_box(&mut nodes[parent as usize], &own);
         current = parent;
     }
 }

@@ -39,6 +39,7 @@
 #![no_std]
 
 pub mod aabb;
+pub mod agglomerate;
 pub mod atomics;
 pub mod bounds;
 pub mod bvh2;

@@ -70,8 +70,14 @@ const _: () = assert!(RADIX == WORKGROUP_SIZE);
 pub const MAX_PASSES: u32 = 64 / RADIX_BITS;
 /// Rounds of `WORKGROUP_SIZE` keys per tile.
 pub const SORT_ITEMS: u32 = 8;
-/// Keys per workgroup of [`onesweep_phase`].
+/// Keys per workgroup of [`onesweep_phase`] and [`tile_counts_phase`].
 pub const SORT_TILE: u32 = WORKGROUP_SIZE * SORT_ITEMS;
+/// Rounds per tile of the small-tile pass kernel: four times the tiles and
+/// under half the phases, for sorts too small to fill the GPU with large
+/// tiles.
+pub const SMALL_SORT_ITEMS: u32 = 2;
+/// Keys per workgroup of the small-tile pass kernel.
+pub const SMALL_SORT_TILE: u32 = WORKGROUP_SIZE * SMALL_SORT_ITEMS;
 /// Keys per workgroup of [`histogram_phase`]: large, so that few workgroups
 /// add their counts to the same device counters.
 pub const HISTOGRAM_TILE: u32 = WORKGROUP_SIZE * 32;
@@ -239,7 +245,7 @@ pub const CHUNKS: usize = (WORKGROUP_SIZE / CHUNK) as usize;
 /// Per-chunk digit counters, `chunk * RADIX + digit`; after ranking, the
 /// same array holds the tile's key order (see [`onesweep_phase`]).
 pub const CHUNK_COUNTS: usize = CHUNKS * RADIX as usize;
-const _: () = assert!(CHUNK_COUNTS == SORT_TILE as usize, "the counters are reused as the tile's order");
+const _: () = assert!(CHUNK_COUNTS >= SORT_TILE as usize, "the counters are reused as the tile's order");
 
 /// Bit 7 of each byte of the result is set where that byte of `x` is zero
 /// (exact, no carries between bytes).
@@ -264,13 +270,16 @@ pub fn count_before(packed: &[u32; PACKED_DIGITS], from: u32, lid: u32, d: u32) 
     count + partial.count_ones()
 }
 
-/// Phases of [`onesweep_phase`]: ticket; four per round of ranking; look-back
-/// (with the first step of the local scan); two more scan steps; order;
-/// write.
-pub const ONESWEEP_PHASES: u32 = 1 + 4 * SORT_ITEMS + SMALL_SCAN_PHASES + 2;
-const LOOK_BACK_PHASE: u32 = 1 + 4 * SORT_ITEMS;
+/// Phases of [`onesweep_phase`] with `items` rounds: ticket; four per round
+/// of ranking; look-back (with the first step of the local scan); two more
+/// scan steps; order; write.
+pub const fn onesweep_phases(items: u32) -> u32 {
+    1 + 4 * items + SMALL_SCAN_PHASES + 2
+}
 
-/// Kernel: one pass over one tile. See the module documentation.
+/// Kernel: one pass over one tile of `ITEMS` rounds, `TILE` =
+/// `ITEMS * WORKGROUP_SIZE` keys ([`SORT_ITEMS`] or [`SMALL_SORT_ITEMS`]).
+/// See the module documentation.
 ///
 /// `LOOK_BACK`: find the tile's offsets by decoupled look-back, with
 /// `sort_state` as laid out in [`state`]. Without it (on lavapipe, see
@@ -288,7 +297,7 @@ const LOOK_BACK_PHASE: u32 = 1 + 4 * SORT_ITEMS;
 /// each digit's keys start within the tile and in the output; `scan_sums`,
 /// scratch of the local scan.
 #[allow(clippy::too_many_arguments)]
-pub fn onesweep_phase<const LOOK_BACK: bool>(
+pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize>(
     phase: u32,
     lid: u32,
     group: u32,
@@ -304,13 +313,15 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
     packed: &mut [u32; PACKED_DIGITS],
     counts: &mut [u32; CHUNK_COUNTS],
     totals: &mut [u32; WG],
-    ranks: &mut [u32; SORT_TILE as usize],
+    ranks: &mut [u32; TILE],
     local_offsets: &mut [u32; WG],
     global_offsets: &mut [u32; WG],
     scan_sums: &mut [u32; 16],
 ) {
     let l = lid as usize;
     let shift = params.pass * RADIX_BITS;
+    let tile_keys = ITEMS * WORKGROUP_SIZE;
+    let look_back_phase = 1 + 4 * ITEMS;
     if phase == 0 {
         if lid == 0 {
             ticket[0] = if LOOK_BACK {
@@ -329,10 +340,10 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
     if tile >= params.tiles {
         return; // A workgroup of the dispatch grid's padding.
     }
-    let base = tile * SORT_TILE;
+    let base = tile * tile_keys;
     // Keys of the tile: 0..valid (only the last tile is short).
-    let valid = (params.n - base).min(SORT_TILE);
-    if phase < LOOK_BACK_PHASE {
+    let valid = (params.n - base).min(tile_keys);
+    if phase < look_back_phase {
         let round = (phase - 1) / 4;
         let k = round * WORKGROUP_SIZE + lid;
         let chunk = lid / CHUNK;
@@ -376,9 +387,9 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         }
         return;
     }
-    if phase == LOOK_BACK_PHASE && !LOOK_BACK {
+    if phase == look_back_phase && !LOOK_BACK {
         global_offsets[l] = sort_state[(lid * params.tiles + tile) as usize];
-    } else if phase == LOOK_BACK_PHASE {
+    } else if phase == look_back_phase {
         // Invocation `lid` looks back for digit `lid`.
         let count = running[l];
         let own = state::status(params.tiles, params.pass, tile, lid);
@@ -407,12 +418,12 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         // The next pass uses the other region: clear this tile's row of it.
         atomics::store_u32(&mut sort_state[state::status(params.tiles, params.pass + 1, tile, lid)], 0);
     }
-    let scan_step = phase - LOOK_BACK_PHASE;
+    let scan_step = phase - look_back_phase;
     if scan_step < SMALL_SCAN_PHASES {
         small_scan_phase(scan_step, lid, running, local_offsets, scan_sums);
     } else if scan_step == SMALL_SCAN_PHASES {
         // The tile's order: `counts[position] = key`.
-        for round in 0..SORT_ITEMS {
+        for round in 0..ITEMS {
             let k = round * WORKGROUP_SIZE + lid;
             if k < valid {
                 let r = get(ranks, k as usize);
@@ -422,7 +433,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool>(
         }
     } else {
         // Consecutive invocations write consecutive places of a digit's run.
-        for round in 0..SORT_ITEMS {
+        for round in 0..ITEMS {
             let position = round * WORKGROUP_SIZE + lid;
             if position < valid {
                 let k = get(counts, position as usize);

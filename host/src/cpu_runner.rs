@@ -12,14 +12,14 @@ use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::aabb::Aabb;
-use treelet_core::features::VARIANTS;
 use treelet_core::bvh2::Bvh2Tree;
 use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
+use treelet_core::features::VARIANTS;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs};
 use treelet_core::traverse::{ClassicTree, ClosestHit, Scan};
-use treelet_core::{bvh2, cwbvh_build};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
+use treelet_core::{agglomerate, bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
+use treelet_core::{bvh2, cwbvh_build};
 
 use crate::backend::{Backend, StageTimes};
 use crate::kernels::{Kernel, Method};
@@ -86,9 +86,57 @@ fn render_variant<T: ClosestHit>(v: u8, id: u32, p: &treelet_core::RenderParams,
 /// Every pixel of a render dispatch (pixels are independent: the one
 /// kernel the CPU runs in parallel; the GPU's tiling of pixels, see
 /// `treelet_core::render::tiled_pixel`, only orders them).
-fn render_all<T: ClosestHit + Sync>(v: u8, p: &treelet_core::RenderParams, scene: &SceneRefs<T>, accum: &mut [[f32; 4]], groups: u32) {
+fn render_all<T: ClosestHit + Sync>(
+    v: u8,
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    accum: &mut [[f32; 4]],
+    groups: u32,
+) {
     let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
-    accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene)));
+    accum[..pixels]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene)));
+}
+
+/// A sort pass kernel's workgroups, one after another: every earlier
+/// ticket's tile is done when a look-back reads it, so it never waits.
+fn onesweep<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize>(
+    p: &treelet_core::SortParams,
+    (keys_in, values_in, keys_out, values_out, sort_state): (&[u64], &[u32], &mut [u64], &mut [u32], &mut [u32]),
+    groups: u32,
+) {
+    let mut ticket = [0u32; 1];
+    let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
+    let (mut local_offsets, mut global_offsets) = ([0u32; WG], [0u32; WG]);
+    let mut packed = [0u32; sort::PACKED_DIGITS];
+    let mut counts = [0u32; sort::CHUNK_COUNTS];
+    let mut ranks = [0u32; TILE];
+    let mut scan_sums = [0u32; 16];
+    workgroups(groups, sort::onesweep_phases(ITEMS), |g, phase, lid| {
+        sort::onesweep_phase::<LOOK_BACK, ITEMS, TILE>(
+            phase,
+            lid,
+            g,
+            p,
+            keys_in,
+            values_in,
+            keys_out,
+            values_out,
+            sort_state,
+            &mut ticket,
+            &mut running,
+            &mut digits,
+            &mut packed,
+            &mut counts,
+            &mut totals,
+            &mut ranks,
+            &mut local_offsets,
+            &mut global_offsets,
+            &mut scan_sums,
+        )
+    });
 }
 
 /// Every invocation of a cast dispatch, `S` words of workgroup stack each
@@ -107,7 +155,13 @@ fn cast_all<T: ClosestHit, const F: u32, const S: usize>(
 }
 
 /// [`cast_all`] compiled for every primitive kind, or triangles alone.
-fn cast_variant<T: ClosestHit>(triangles: bool, p: &treelet_core::RenderParams, scene: &SceneRefs<T>, rays: &mut [[f32; 4]], groups: u32) {
+fn cast_variant<T: ClosestHit>(
+    triangles: bool,
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    rays: &mut [[f32; 4]],
+    groups: u32,
+) {
     use treelet_core::features::{ALL, TRIANGLES};
     if triangles {
         cast_all::<T, TRIANGLES, 1>(p, scene, rays, groups)
@@ -230,46 +284,20 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             });
         }
         (
-            kernel @ (Kernel::SortOnesweep | Kernel::SortOnesweepScanned),
+            kernel @ (Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned),
             [p, keys_in, values_in, keys_out, values_out, sort_state],
         ) => {
-            let look_back = kernel == Kernel::SortOnesweep;
             let p: treelet_core::SortParams = params(p);
             let (keys_in, values_in, sort_state) = (view(keys_in), view(values_in), view(sort_state));
             let (keys_out, values_out) = (view(keys_out), view(values_out));
-            let mut ticket = [0u32; 1];
-            let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
-            let (mut local_offsets, mut global_offsets) = ([0u32; WG], [0u32; WG]);
-            let mut packed = [0u32; sort::PACKED_DIGITS];
-            let mut counts = [0u32; sort::CHUNK_COUNTS];
-            let mut ranks = [0u32; sort::SORT_TILE as usize];
-            let mut scan_sums = [0u32; 16];
-            // Workgroups one after another: every earlier ticket's tile is
-            // done when a look-back reads it, so it never waits.
-            let onesweep = if look_back { sort::onesweep_phase::<true> } else { sort::onesweep_phase::<false> };
-            workgroups(groups, sort::ONESWEEP_PHASES, |g, phase, lid| {
-                onesweep(
-                    phase,
-                    lid,
-                    g,
-                    &p,
-                    keys_in,
-                    values_in,
-                    keys_out,
-                    values_out,
-                    sort_state,
-                    &mut ticket,
-                    &mut running,
-                    &mut digits,
-                    &mut packed,
-                    &mut counts,
-                    &mut totals,
-                    &mut ranks,
-                    &mut local_offsets,
-                    &mut global_offsets,
-                    &mut scan_sums,
-                )
-            });
+            let io = (&*keys_in, &*values_in, keys_out, values_out, sort_state);
+            match kernel {
+                Kernel::SortOnesweep => onesweep::<true, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }>(&p, io, groups),
+                Kernel::SortOnesweepSmall => {
+                    onesweep::<true, { sort::SMALL_SORT_ITEMS }, { sort::SMALL_SORT_TILE as usize }>(&p, io, groups)
+                }
+                _ => onesweep::<false, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }>(&p, io, groups),
+            }
         }
         (Kernel::ScanReduce, [p, data, partials]) => {
             let p: treelet_core::ScanParams = params(p);
@@ -310,6 +338,14 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, nodes, parents, flags);
             }
         }
+        (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view(nodes));
+            let (parents, ends) = (view(parents), view(ends));
+            for id in ids(groups) {
+                agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, nodes, parents, ends);
+            }
+        }
         (
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed,
             [p, nodes, parents, flags, counts, costs, heights, tree_leaves],
@@ -318,7 +354,17 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
             let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
             for id in ids(groups) {
-                treelet_kernels::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, heights, tree_leaves);
+                treelet_kernels::treelet_init_kernel::<true>(
+                    id,
+                    &p,
+                    nodes,
+                    parents,
+                    flags,
+                    counts,
+                    costs,
+                    heights,
+                    tree_leaves,
+                );
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
@@ -346,7 +392,16 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (counts, heights, level_counts) = (view(counts), view(heights), view(level_counts));
             let mut local = [0u32; WG];
             workgroups(groups, treelet_kernels::HISTOGRAM_PHASES, |group, phase, lid| {
-                treelet_kernels::treelet_histogram_phase(phase, lid, group, &p, counts, heights, level_counts, &mut local);
+                treelet_kernels::treelet_histogram_phase(
+                    phase,
+                    lid,
+                    group,
+                    &p,
+                    counts,
+                    heights,
+                    level_counts,
+                    &mut local,
+                );
             });
         }
         (Kernel::TreeletScatter, [p, counts, heights, cursors, roots]) => {
@@ -370,8 +425,8 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let mut votes = [0u32; treelet_kernels::TEAM_VOTES];
             workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
-                    phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, marks,
-                    &mut stage, &mut cost, &mut parts, &mut order, &mut votes,
+                    phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, marks, &mut stage,
+                    &mut cost, &mut parts, &mut order, &mut votes,
                 );
             });
         }
@@ -384,7 +439,8 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
         }
         (Kernel::LeafPrims, [p, prim_indices, spheres, triangles, out]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (prim_indices, spheres, triangles, out) = (view(prim_indices), view(spheres), view(triangles), view(out));
+            let (prim_indices, spheres, triangles, out) =
+                (view(prim_indices), view(spheres), view(triangles), view(out));
             for id in ids(groups) {
                 bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, triangles, out);
             }
@@ -403,7 +459,15 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (is_wide, child_counts, prim_counts) = (view(is_wide), view(child_counts), view(prim_counts));
             for id in ids(groups) {
                 cwbvh_build::wide_count_kernel(
-                    id, &p, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts,
+                    id,
+                    &p,
+                    nodes,
+                    parents,
+                    counts,
+                    decisions,
+                    is_wide,
+                    child_counts,
+                    prim_counts,
                 );
             }
         }
@@ -426,33 +490,45 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (out_nodes, out_prims) = (view(out_nodes), view(out_prims));
             for id in ids(groups) {
                 cwbvh_build::wide_emit_kernel(
-                    id, &p, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres,
-                    triangles, out_nodes, out_prims,
+                    id,
+                    &p,
+                    nodes,
+                    slots,
+                    is_wide,
+                    child_offsets,
+                    prim_offsets,
+                    positions,
+                    prim_indices,
+                    spheres,
+                    triangles,
+                    out_nodes,
+                    out_prims,
                 );
             }
         }
-        (
-            Kernel::Cast(..) | Kernel::CastWideWorkgroupStack,
-            [p, spheres, materials, nodes, prims, rays, triangles],
-        ) => {
+        (Kernel::Cast(..) | Kernel::CastWideWorkgroupStack, [p, spheres, materials, nodes, prims, rays, triangles]) => {
             let p: treelet_core::RenderParams = params(p);
             let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
             let rays: &mut [[f32; 4]] = view(rays);
             match kernel {
                 Kernel::Cast(Method::Classic, tri) => {
-                    let scene = SceneRefs::new(&p, spheres, triangles, materials, ClassicTree::new(view(nodes), view(prims)));
+                    let scene =
+                        SceneRefs::new(&p, spheres, triangles, materials, ClassicTree::new(view(nodes), view(prims)));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::Cast(Method::Bvh2, tri) => {
-                    let scene = SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view(nodes), view(prims)));
+                    let scene =
+                        SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view(nodes), view(prims)));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::Cast(Method::Cwbvh, tri) => {
-                    let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                    let scene =
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::CastWideWorkgroupStack => {
-                    let scene = SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                    let scene =
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
                     cast_all::<_, { treelet_core::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
                 }
                 _ => panic!("{kernel:?}: no such cast kernel"),

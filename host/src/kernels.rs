@@ -70,6 +70,8 @@ pub enum Kernel {
     SortOffsets,
     /// Radix sort: one pass (one sweep with decoupled look-back).
     SortOnesweep,
+    /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::sort::SMALL_SORT_TILE`).
+    SortOnesweepSmall,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -81,6 +83,10 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
+    /// Hierarchy and boxes in one bottom-up pass (Apetrei 2014).
+    Agglomerate,
+    /// [`Kernel::Agglomerate`] with relaxed exchanges, for CPU adapters.
+    AgglomerateRelaxed,
     /// Treelet optimization: per-node counts, costs, heights (bottom up).
     TreeletInit,
     /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
@@ -118,7 +124,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 34] = [
+    const FIXED: [Kernel; 37] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -126,6 +132,7 @@ impl Kernel {
         Kernel::SortHistogram,
         Kernel::SortOffsets,
         Kernel::SortOnesweep,
+        Kernel::SortOnesweepSmall,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::ScanReduce,
@@ -134,6 +141,8 @@ impl Kernel {
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
+        Kernel::Agglomerate,
+        Kernel::AgglomerateRelaxed,
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletHistogram,
@@ -180,6 +189,7 @@ impl Kernel {
             Kernel::SortHistogram => "sort::sort_histogram_cs",
             Kernel::SortOffsets => "sort::sort_offsets_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
+            Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::ScanReduce => "scan::scan_reduce_cs",
@@ -188,6 +198,8 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
+            Kernel::Agglomerate => "fit::agglomerate_cs",
+            Kernel::AgglomerateRelaxed => "fit::agglomerate_relaxed_cs",
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
@@ -225,10 +237,13 @@ impl Kernel {
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
-            Kernel::SortOnesweep | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
+                &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
+            }
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
@@ -243,9 +258,7 @@ impl Kernel {
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::WideEmit => {
-                &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite]
-            }
+            Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => {
                 &[Read, Read, Read, Read, Read, ReadWrite, Read]
             }

@@ -1,6 +1,7 @@
 //! The LBVH build of Karras 2012, stage by stage, over any [`Backend`]:
 //! primitive boxes → centroid bounds → Morton codes → radix sort →
-//! radix tree → bottom-up fit. The kernels live in `treelet-core`.
+//! radix tree → bottom-up fit (or both at once, [`Hierarchy`]). The kernels
+//! live in `treelet-core`.
 use anyhow::Result;
 use treelet_core::aabb::Aabb;
 use treelet_core::bounds::REDUCE_TILE;
@@ -105,9 +106,22 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
 }
 
 /// Builds the LBVH of spheres or triangles on `b` and leaves it there.
-pub fn build_primitives_on_device<B: Backend>(
+pub fn build_primitives_on_device<B: Backend>(b: &mut B, prims: Primitives) -> Result<(DeviceBvh<B>, StageTimes)> {
+    build_primitives_with(b, prims, Hierarchy::from_env())
+}
+
+/// Builds the LBVH of `spheres` on `b` with the given way of making the
+/// hierarchy, and reads it back (to compare the two).
+pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarchy) -> Result<Bvh> {
+    let (device_bvh, _) = build_primitives_with(b, Primitives::spheres(spheres), hierarchy)?;
+    device_bvh.read(b)
+}
+
+/// [`build_primitives_on_device`] with the given way of making the hierarchy.
+pub fn build_primitives_with<B: Backend>(
     b: &mut B,
     prims: Primitives,
+    hierarchy: Hierarchy,
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
     let n = u32::try_from(prims.len())
         .ok()
@@ -169,19 +183,51 @@ pub fn build_primitives_on_device<B: Backend>(
     b.stage("sort");
     let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, key_bits)?;
 
-    b.stage("tree");
     let nodes = b.scratch("nodes", node_count * 32)?;
     let parents = b.scratch("parents", node_count * 4)?;
-    b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
-
-    b.stage("fit");
-    let flags = b.zeroed("fit flags", (n as u64 - 1) * 4)?;
-    let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
-    b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    let ordered = b.ordered_atomics_in_divergent_flow();
+    match hierarchy {
+        Hierarchy::RadixTreeThenFit => {
+            b.stage("tree");
+            b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
+            b.stage("fit");
+            let flags = b.zeroed("fit flags", (n as u64 - 1) * 4)?;
+            let fit = if ordered { Kernel::Fit } else { Kernel::FitRelaxed };
+            b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
+        }
+        Hierarchy::Agglomerative => {
+            // One kernel makes both: its time is the fit's, the tree's is none.
+            b.stage("fit");
+            let ends = b.zeroed("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
+            let k = if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed };
+            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends], groups_for(n, WORKGROUP_SIZE));
+        }
+    }
 
     let times = b.take_times()?;
     let node_count = node_count as u32;
     Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
+}
+
+/// How the hierarchy and its boxes are made from the sorted keys; both give
+/// the same nodes, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hierarchy {
+    /// Karras 2012: the radix tree (one invocation per internal node), then
+    /// the bottom-up fit.
+    RadixTreeThenFit,
+    /// Apetrei 2014: both in one bottom-up pass.
+    Agglomerative,
+}
+
+impl Hierarchy {
+    /// The default, or `TREELET_HIERARCHY=radix|agglomerative` (to measure).
+    pub fn from_env() -> Hierarchy {
+        match std::env::var("TREELET_HIERARCHY").as_deref() {
+            Ok("agglomerative") => Hierarchy::Agglomerative,
+            _ => Hierarchy::RadixTreeThenFit,
+        }
+    }
 }
 
 /// `data` on the device, or one zeroed element where it is empty (a

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use treelet_core::layout::{ScanParams, SortParams};
 use treelet_core::scan::SCAN_TILE;
-use treelet_core::sort::{passes_for, state, HISTOGRAM_TILE, MAX_KEYS, RADIX, SORT_TILE};
+use treelet_core::sort::{passes_for, state, HISTOGRAM_TILE, MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE};
 use treelet_core::workgroup::groups_for;
 
 use crate::backend::Backend;
@@ -23,6 +23,31 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
     Ok(())
 }
 
+/// Which tiles the sort passes take (with look-back; without it, large).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SortTiles {
+    /// Small tiles up to a size (`TREELET_SORT_SMALL_TILES_UP_TO` overrides
+    /// it, to measure), large above.
+    Auto,
+    /// `treelet_core::sort::SORT_TILE` keys per workgroup.
+    Large,
+    /// `treelet_core::sort::SMALL_SORT_TILE` keys per workgroup.
+    Small,
+}
+
+impl SortTiles {
+    fn small(self, n: u32) -> bool {
+        match self {
+            SortTiles::Large => false,
+            SortTiles::Small => true,
+            SortTiles::Auto => {
+                let up_to = std::env::var("TREELET_SORT_SMALL_TILES_UP_TO").ok().and_then(|v| v.parse().ok());
+                n <= up_to.unwrap_or(0)
+            }
+        }
+    }
+}
+
 /// Sorts `n` `(key, value)` pairs by the low `key_bits` bits of the keys,
 /// stably: one digit histogram for all passes, then one sweep per pass
 /// (see `treelet_core::sort`). Returns the buffers that hold the result (the
@@ -34,6 +59,18 @@ pub fn radix_sort<B: Backend>(
     n: u32,
     key_bits: u32,
 ) -> Result<(B::Buffer, B::Buffer)> {
+    radix_sort_tiled(b, keys, values, n, key_bits, SortTiles::Auto)
+}
+
+/// [`radix_sort`] with the given tiles.
+pub fn radix_sort_tiled<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    key_bits: u32,
+    tile_size: SortTiles,
+) -> Result<(B::Buffer, B::Buffer)> {
     let mut src = (keys.clone(), values.clone());
     if n < 2 {
         return Ok(src);
@@ -41,7 +78,9 @@ pub fn radix_sort<B: Backend>(
     anyhow::ensure!(n <= MAX_KEYS, "{n} keys: the radix sort takes at most {MAX_KEYS}");
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
     let passes = passes_for(key_bits);
-    let tiles = groups_for(n, SORT_TILE);
+    // Small tiles where large ones would leave the GPU idle (look-back only).
+    let small = b.look_back_works() && tile_size.small(n);
+    let tiles = groups_for(n, if small { SMALL_SORT_TILE } else { SORT_TILE });
     let mut dst = (b.scratch("sort keys scratch", n as u64 * 8)?, b.scratch("sort values scratch", n as u64 * 4)?);
     let params = |pass| SortParams { n, tiles, pass, passes };
     if !b.look_back_works() {
@@ -63,7 +102,8 @@ pub fn radix_sort<B: Backend>(
     b.dispatch(Kernel::SortOffsets, &[&p, &sort_state], passes);
     for pass in 0..passes {
         let p = b.upload("sort params", &[params(pass)])?;
-        b.dispatch(Kernel::SortOnesweep, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
+        let kernel = if small { Kernel::SortOnesweepSmall } else { Kernel::SortOnesweep };
+        b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
         std::mem::swap(&mut src, &mut dst);
     }
     Ok(src)

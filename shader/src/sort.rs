@@ -37,10 +37,10 @@ pub fn sort_offsets_cs(
     }
 }
 
-/// A sort pass's entry point; `$look_back` as in
+/// A sort pass's entry point; `$look_back` and `$items` as in
 /// `treelet_core::sort::onesweep_phase` (entry points cannot be generic).
 macro_rules! onesweep_kernel {
-    ($name:ident, $look_back:literal) => {
+    ($name:ident, $look_back:literal, $items:expr) => {
         #[spirv(compute(threads(256)))]
         #[allow(clippy::too_many_arguments)]
         pub fn $name(
@@ -59,14 +59,14 @@ macro_rules! onesweep_kernel {
             #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
             #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
             #[spirv(workgroup)] totals: &mut [u32; WG],
-            #[spirv(workgroup)] ranks: &mut [u32; sort::SORT_TILE as usize],
+            #[spirv(workgroup)] ranks: &mut [u32; ($items * treelet_core::WORKGROUP_SIZE) as usize],
             #[spirv(workgroup)] local_offsets: &mut [u32; WG],
             #[spirv(workgroup)] global_offsets: &mut [u32; WG],
             #[spirv(workgroup)] scan_sums: &mut [u32; 16],
         ) {
             let group = linear_group(group.x, group.y, groups.x);
-            for phase in 0..sort::ONESWEEP_PHASES {
-                sort::onesweep_phase::<$look_back>(
+            for phase in 0..sort::onesweep_phases($items) {
+                sort::onesweep_phase::<$look_back, { $items }, { ($items * treelet_core::WORKGROUP_SIZE) as usize }>(
                     phase,
                     lid,
                     group,
@@ -93,8 +93,9 @@ macro_rules! onesweep_kernel {
     };
 }
 
-onesweep_kernel!(sort_onesweep_cs, true);
-onesweep_kernel!(sort_onesweep_scanned_cs, false);
+onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS);
+onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS);
+onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS);
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(
