@@ -51,7 +51,10 @@
 //! ballots (so the same code runs on the CPU): per round of 256 keys,
 //! per-chunk digit counts scanned over the round's chunks, plus a count
 //! within the chunk four packed digits at a time ([`count_before`]). The
-//! result is identical on every device and on the CPU.
+//! result is identical on every device and on the CPU. A round takes two
+//! phases (barriers), its ranking sharing a phase with the next round's
+//! counting in a second set of counters: on the H100 the phases, not the
+//! memory traffic, bound a pass.
 //!
 //! Kernels are phase functions: see [`crate::workgroup`]. Hot reads and
 //! writes skip bounds checks on the GPU ([`crate::unchecked`]; the CPU runner
@@ -78,9 +81,29 @@ pub const SORT_TILE: u32 = WORKGROUP_SIZE * SORT_ITEMS;
 pub const SMALL_SORT_ITEMS: u32 = 2;
 /// Keys per workgroup of the small-tile pass kernel.
 pub const SMALL_SORT_TILE: u32 = WORKGROUP_SIZE * SMALL_SORT_ITEMS;
+/// Rounds per tile of the huge-tile pass kernel: half the tiles of
+/// [`SORT_ITEMS`], so half the look-backs and per-tile steps, for large sorts.
+pub const HUGE_SORT_ITEMS: u32 = 16;
+/// Keys per workgroup of the huge-tile pass kernel.
+pub const HUGE_SORT_TILE: u32 = WORKGROUP_SIZE * HUGE_SORT_ITEMS;
 /// Keys per workgroup of [`histogram_phase`]: large, so that few workgroups
 /// add their counts to the same device counters.
 pub const HISTOGRAM_TILE: u32 = WORKGROUP_SIZE * 32;
+/// Keys per workgroup of [`histogram_phase`] for sorts of at most
+/// [`SMALL_HISTOGRAM_UP_TO`] keys: enough workgroups to spread the counting.
+pub const SMALL_HISTOGRAM_TILE: u32 = WORKGROUP_SIZE * 8;
+/// See [`SMALL_HISTOGRAM_TILE`].
+pub const SMALL_HISTOGRAM_UP_TO: u32 = 1 << 18;
+
+/// Keys per workgroup of [`histogram_phase`] for a sort of `n` keys.
+#[inline]
+pub fn histogram_tile(n: u32) -> u32 {
+    if n <= SMALL_HISTOGRAM_UP_TO {
+        SMALL_HISTOGRAM_TILE
+    } else {
+        HISTOGRAM_TILE
+    }
+}
 /// Most keys a sort takes: a status word keeps 30 bits for a count.
 pub const MAX_KEYS: u32 = COUNT_MASK;
 
@@ -137,7 +160,7 @@ const INCLUSIVE: u32 = 2 << FLAG_SHIFT;
 pub const HISTOGRAM_PHASES: u32 = 3;
 
 /// Kernel: digit counts of every pass over one tile of
-/// [`HISTOGRAM_TILE`] keys, added to the state's counts.
+/// [`histogram_tile`] keys, added to the state's counts.
 pub fn histogram_phase(
     phase: u32,
     lid: u32,
@@ -155,8 +178,9 @@ pub fn histogram_phase(
             }
         }
         1 => {
-            for round in 0..HISTOGRAM_TILE / WORKGROUP_SIZE {
-                let i = tile * HISTOGRAM_TILE + round * WORKGROUP_SIZE + lid;
+            let keys_per_tile = histogram_tile(params.n);
+            for round in 0..keys_per_tile / WORKGROUP_SIZE {
+                let i = tile * keys_per_tile + round * WORKGROUP_SIZE + lid;
                 if i < params.n {
                     let key = keys[i as usize];
                     for p in 0..params.passes {
@@ -239,13 +263,24 @@ pub fn offsets_phase(
 pub const PACKED_DIGITS: usize = WG / 4;
 /// Keys per chunk of a round: ranks are counted within a chunk, and chunk
 /// counts per digit are scanned, so no key compares against the whole round.
-pub const CHUNK: u32 = 32;
+pub const CHUNK: u32 = 64;
 /// Chunks per round.
 pub const CHUNKS: usize = (WORKGROUP_SIZE / CHUNK) as usize;
-/// Per-chunk digit counters, `chunk * RADIX + digit`; after ranking, the
-/// same array holds the tile's key order (see [`onesweep_phase`]).
-pub const CHUNK_COUNTS: usize = CHUNKS * RADIX as usize;
-const _: () = assert!(CHUNK_COUNTS >= SORT_TILE as usize, "the counters are reused as the tile's order");
+/// Per-chunk digit counters of one round, `chunk * RADIX + digit`.
+pub const ROUND_COUNTS: usize = CHUNKS * RADIX as usize;
+/// Two rounds' counters (one round is ranked while the next is counted);
+/// after ranking, the same array holds the tile's key order (see
+/// [`onesweep_phase`]), so it has `max(CHUNK_COUNTS, tile)` words.
+pub const CHUNK_COUNTS: usize = 2 * ROUND_COUNTS;
+
+/// Words of the counters of [`onesweep_phase`] for tiles of `tile` keys.
+pub const fn order_words(tile: u32) -> usize {
+    if (tile as usize) > CHUNK_COUNTS {
+        tile as usize
+    } else {
+        CHUNK_COUNTS
+    }
+}
 
 /// Bit 7 of each byte of the result is set where that byte of `x` is zero
 /// (exact, no carries between bytes).
@@ -270,15 +305,41 @@ pub fn count_before(packed: &[u32; PACKED_DIGITS], from: u32, lid: u32, d: u32) 
     count + partial.count_ones()
 }
 
-/// Phases of [`onesweep_phase`] with `items` rounds: ticket; four per round
-/// of ranking; look-back (with the first step of the local scan); two more
-/// scan steps; order; write.
+/// Round `round`'s digit of invocation `lid`'s key in the tile at `base`,
+/// kept in `digits` and counted in its chunk's counters of that round
+/// (buffer `round % 2`).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn count_digit<const ORDER: usize>(
+    round: u32,
+    lid: u32,
+    base: u32,
+    valid: u32,
+    shift: u32,
+    keys_in: &[u64],
+    digits: &mut [u32; WG],
+    counts: &mut [u32; ORDER],
+) {
+    let k = round * WORKGROUP_SIZE + lid;
+    let d = if k < valid { digit(at(keys_in, (base + k) as usize), shift) } else { 0 };
+    digits[lid as usize] = d;
+    if k < valid {
+        let counter = (round % 2) as usize * ROUND_COUNTS + ((lid / CHUNK) * RADIX + d) as usize;
+        atomics::add_workgroup(&mut counts[counter], 1);
+    }
+}
+
+/// Phases of [`onesweep_phase`] with `items` rounds: ticket; the first
+/// round's digits; two per round of ranking; the last round's counts; look-back
+/// (with the first step of the local scan); two more scan steps; order;
+/// write.
 pub const fn onesweep_phases(items: u32) -> u32 {
-    1 + 4 * items + SMALL_SCAN_PHASES + 2
+    3 + 2 * items + SMALL_SCAN_PHASES + 2
 }
 
 /// Kernel: one pass over one tile of `ITEMS` rounds, `TILE` =
-/// `ITEMS * WORKGROUP_SIZE` keys ([`SORT_ITEMS`] or [`SMALL_SORT_ITEMS`]).
+/// `ITEMS * WORKGROUP_SIZE` keys ([`SORT_ITEMS`], [`SMALL_SORT_ITEMS`] or
+/// [`HUGE_SORT_ITEMS`]), `ORDER` = [`order_words`]`(TILE)`.
 /// See the module documentation.
 ///
 /// `LOOK_BACK`: find the tile's offsets by decoupled look-back, with
@@ -297,7 +358,7 @@ pub const fn onesweep_phases(items: u32) -> u32 {
 /// each digit's keys start within the tile and in the output; `scan_sums`,
 /// scratch of the local scan.
 #[allow(clippy::too_many_arguments)]
-pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize>(
+pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize, const ORDER: usize>(
     phase: u32,
     lid: u32,
     group: u32,
@@ -311,7 +372,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
     running: &mut [u32; WG],
     digits: &mut [u32; WG],
     packed: &mut [u32; PACKED_DIGITS],
-    counts: &mut [u32; CHUNK_COUNTS],
+    counts: &mut [u32; ORDER],
     totals: &mut [u32; WG],
     ranks: &mut [u32; TILE],
     local_offsets: &mut [u32; WG],
@@ -321,7 +382,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
     let l = lid as usize;
     let shift = params.pass * RADIX_BITS;
     let tile_keys = ITEMS * WORKGROUP_SIZE;
-    let look_back_phase = 1 + 4 * ITEMS;
+    let look_back_phase = 3 + 2 * ITEMS;
     if phase == 0 {
         if lid == 0 {
             ticket[0] = if LOOK_BACK {
@@ -331,7 +392,8 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
             };
         }
         running[l] = 0;
-        for c in 0..CHUNKS {
+        totals[l] = 0;
+        for c in 0..CHUNK_COUNTS / WG {
             counts[c * WG + l] = 0;
         }
         return;
@@ -343,46 +405,46 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
     let base = tile * tile_keys;
     // Keys of the tile: 0..valid (only the last tile is short).
     let valid = (params.n - base).min(tile_keys);
+    let chunk = lid / CHUNK;
     if phase < look_back_phase {
-        let round = (phase - 1) / 4;
-        let k = round * WORKGROUP_SIZE + lid;
-        let chunk = lid / CHUNK;
-        match (phase - 1) % 4 {
-            0 => {
-                let d = if k < valid { digit(at(keys_in, (base + k) as usize), shift) } else { 0 };
-                digits[l] = d;
-                if k < valid {
-                    atomics::add_workgroup(&mut counts[(chunk * RADIX + d) as usize], 1);
-                }
+        // Phase 1 counts round 0; then each round takes two phases, one
+        // round's ranking overlapping the next round's counting.
+        if phase == 1 {
+            count_digit(0, lid, base, valid, shift, keys_in, digits, counts);
+        } else if phase == look_back_phase - 1 {
+            running[l] += totals[l]; // The tile's digit counts.
+        } else if phase % 2 == 0 {
+            // Scan of round `round`: pack its digits, scan digit `lid`'s
+            // chunk counters; take the last round's totals into `running`;
+            // clear the other buffer for the next round.
+            let round = (phase - 2) / 2;
+            if l < PACKED_DIGITS {
+                let b = 4 * l;
+                packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
             }
-            1 => {
-                if l < PACKED_DIGITS {
-                    let b = 4 * l;
-                    packed[l] = digits[b] | (digits[b + 1] << 8) | (digits[b + 2] << 16) | (digits[b + 3] << 24);
-                }
-                // Invocation `lid` scans digit `lid`'s counts over the chunks.
-                let mut sum = 0;
-                for c in 0..CHUNKS {
-                    let i = c * WG + l;
-                    let v = get(counts, i);
-                    set(counts, i, sum);
-                    sum += v;
-                }
-                totals[l] = sum;
+            let (this, other) = ((round % 2) as usize * ROUND_COUNTS, ((round + 1) % 2) as usize * ROUND_COUNTS);
+            let mut sum = 0;
+            for c in 0..CHUNKS {
+                let i = this + c * WG + l;
+                let v = get(counts, i);
+                set(counts, i, sum);
+                sum += v;
+                set(counts, other + c * WG + l, 0);
             }
-            2 => {
-                if k < valid {
-                    let d = digits[l];
-                    let before = get(counts, (chunk * RADIX + d) as usize)
-                        + count_before(packed, chunk * CHUNK, lid, d);
-                    set(ranks, k as usize, (get(running, d as usize) + before) | (d << 16));
-                }
+            running[l] += totals[l];
+            totals[l] = sum;
+        } else {
+            // Ranks of round `round`, then the next round's digit.
+            let round = (phase - 3) / 2;
+            let k = round * WORKGROUP_SIZE + lid;
+            if k < valid {
+                let d = digits[l];
+                let counter = (round % 2) as usize * ROUND_COUNTS + (chunk * RADIX + d) as usize;
+                let before = get(counts, counter) + count_before(packed, chunk * CHUNK, lid, d);
+                set(ranks, k as usize, (get(running, d as usize) + before) | (d << 16));
             }
-            _ => {
-                running[l] += totals[l];
-                for c in 0..CHUNKS {
-                    counts[c * WG + l] = 0;
-                }
+            if round + 1 < ITEMS {
+                count_digit(round + 1, lid, base, valid, shift, keys_in, digits, counts);
             }
         }
         return;

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use treelet_core::layout::{ScanParams, SortParams};
 use treelet_core::scan::SCAN_TILE;
-use treelet_core::sort::{passes_for, state, HISTOGRAM_TILE, MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE};
+use treelet_core::sort::{histogram_tile, passes_for, state, HUGE_SORT_TILE, MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE};
 use treelet_core::workgroup::groups_for;
 
 use crate::backend::Backend;
@@ -26,27 +26,34 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
 /// Which tiles the sort passes take (with look-back; without it, large).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SortTiles {
-    /// Small tiles up to a size (`TREELET_SORT_SMALL_TILES_UP_TO` overrides
-    /// it, to measure), large above.
+    /// By size: `TREELET_SORT_TILES=small|large|huge` overrides it (to measure).
     Auto,
-    /// `treelet_core::sort::SORT_TILE` keys per workgroup.
-    Large,
     /// `treelet_core::sort::SMALL_SORT_TILE` keys per workgroup.
     Small,
+    /// `treelet_core::sort::SORT_TILE` keys per workgroup.
+    Large,
+    /// `treelet_core::sort::HUGE_SORT_TILE` keys per workgroup.
+    Huge,
 }
 
 impl SortTiles {
-    fn small(self, n: u32) -> bool {
-        match self {
-            SortTiles::Large => false,
-            SortTiles::Small => true,
-            SortTiles::Auto => {
-                let up_to = std::env::var("TREELET_SORT_SMALL_TILES_UP_TO").ok().and_then(|v| v.parse().ok());
-                n <= up_to.unwrap_or(0)
-            }
+    /// The tiles a sort of `n` keys takes.
+    fn resolve(self, n: u32) -> SortTiles {
+        if self != SortTiles::Auto {
+            return self;
+        }
+        match std::env::var("TREELET_SORT_TILES").as_deref() {
+            Ok("small") => SortTiles::Small,
+            Ok("large") => SortTiles::Large,
+            Ok("huge") => SortTiles::Huge,
+            _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
+            _ => SortTiles::Large,
         }
     }
 }
+
+/// Largest sort that takes small tiles by default.
+const SMALL_TILES_UP_TO: u32 = 0;
 
 /// Sorts `n` `(key, value)` pairs by the low `key_bits` bits of the keys,
 /// stably: one digit histogram for all passes, then one sweep per pass
@@ -79,8 +86,13 @@ pub fn radix_sort_tiled<B: Backend>(
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
     let passes = passes_for(key_bits);
     // Small tiles where large ones would leave the GPU idle (look-back only).
-    let small = b.look_back_works() && tile_size.small(n);
-    let tiles = groups_for(n, if small { SMALL_SORT_TILE } else { SORT_TILE });
+    let tile_size = if b.look_back_works() { tile_size.resolve(n) } else { SortTiles::Large };
+    let (kernel, tile) = match tile_size {
+        SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
+        SortTiles::Huge => (Kernel::SortOnesweepHuge, HUGE_SORT_TILE),
+        _ => (Kernel::SortOnesweep, SORT_TILE),
+    };
+    let tiles = groups_for(n, tile);
     let mut dst = (b.scratch("sort keys scratch", n as u64 * 8)?, b.scratch("sort values scratch", n as u64 * 4)?);
     let params = |pass| SortParams { n, tiles, pass, passes };
     if !b.look_back_works() {
@@ -98,11 +110,10 @@ pub fn radix_sort_tiled<B: Backend>(
     let sort_state = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
     b.zero_words(&sort_state, state::zeroed_words(tiles))?;
     let p = b.upload("sort params", &[params(0)])?;
-    b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, HISTOGRAM_TILE));
+    b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
     b.dispatch(Kernel::SortOffsets, &[&p, &sort_state], passes);
     for pass in 0..passes {
         let p = b.upload("sort params", &[params(pass)])?;
-        let kernel = if small { Kernel::SortOnesweepSmall } else { Kernel::SortOnesweep };
         b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
         std::mem::swap(&mut src, &mut dst);
     }
