@@ -102,7 +102,7 @@ fn render_all<T: ClosestHit + Sync>(
 
 /// A sort pass kernel's workgroups, one after another: every earlier
 /// ticket's tile is done when a look-back reads it, so it never waits.
-fn onesweep<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize, const ORDER: usize>(
+fn onesweep<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize>(
     p: &treelet_core::SortParams,
     (keys_in, values_in, keys_out, values_out, sort_state): (&[u64], &[u32], &mut [u64], &mut [u32], &mut [u32]),
     groups: u32,
@@ -111,11 +111,11 @@ fn onesweep<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize, const OR
     let (mut running, mut digits, mut totals) = ([0u32; WG], [0u32; WG], [0u32; WG]);
     let (mut local_offsets, mut global_offsets) = ([0u32; WG], [0u32; WG]);
     let mut packed = [0u32; sort::PACKED_DIGITS];
-    let mut counts = [0u32; ORDER];
+    let mut counts = [0u32; sort::CHUNK_COUNTS];
     let mut ranks = [0u32; TILE];
     let mut scan_sums = [0u32; 16];
     workgroups(groups, sort::onesweep_phases(ITEMS), |g, phase, lid| {
-        sort::onesweep_phase::<LOOK_BACK, ITEMS, TILE, ORDER>(
+        sort::onesweep_phase::<LOOK_BACK, ITEMS, TILE>(
             phase,
             lid,
             g,
@@ -284,10 +284,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             });
         }
         (
-            kernel @ (Kernel::SortOnesweep
-            | Kernel::SortOnesweepSmall
-            | Kernel::SortOnesweepHuge
-            | Kernel::SortOnesweepScanned),
+            kernel @ (Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned),
             [p, keys_in, values_in, keys_out, values_out, sort_state],
         ) => {
             let p: treelet_core::SortParams = params(p);
@@ -295,14 +292,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (keys_out, values_out) = (view(keys_out), view(values_out));
             let io = (&*keys_in, &*values_in, keys_out, values_out, sort_state);
             match kernel {
-                Kernel::SortOnesweep => onesweep::<true, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }, { sort::order_words(sort::SORT_TILE) }>(&p, io, groups),
-                Kernel::SortOnesweepHuge => {
-                    onesweep::<true, { sort::HUGE_SORT_ITEMS }, { sort::HUGE_SORT_TILE as usize }, { sort::order_words(sort::HUGE_SORT_TILE) }>(&p, io, groups)
-                }
+                Kernel::SortOnesweep => onesweep::<true, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }>(&p, io, groups),
                 Kernel::SortOnesweepSmall => {
-                    onesweep::<true, { sort::SMALL_SORT_ITEMS }, { sort::SMALL_SORT_TILE as usize }, { sort::order_words(sort::SMALL_SORT_TILE) }>(&p, io, groups)
+                    onesweep::<true, { sort::SMALL_SORT_ITEMS }, { sort::SMALL_SORT_TILE as usize }>(&p, io, groups)
                 }
-                _ => onesweep::<false, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }, { sort::order_words(sort::SORT_TILE) }>(&p, io, groups),
+                _ => onesweep::<false, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }>(&p, io, groups),
             }
         }
         (Kernel::ScanReduce, [p, data, partials]) => {

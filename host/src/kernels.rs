@@ -72,8 +72,6 @@ pub enum Kernel {
     SortOnesweep,
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::sort::SMALL_SORT_TILE`).
     SortOnesweepSmall,
-    /// [`Kernel::SortOnesweep`] with huge tiles (`treelet_core::sort::HUGE_SORT_TILE`).
-    SortOnesweepHuge,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -126,7 +124,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 38] = [
+    const FIXED: [Kernel; 37] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -135,7 +133,6 @@ impl Kernel {
         Kernel::SortOffsets,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
-        Kernel::SortOnesweepHuge,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::ScanReduce,
@@ -193,7 +190,6 @@ impl Kernel {
             Kernel::SortOffsets => "sort::sort_offsets_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
-            Kernel::SortOnesweepHuge => "sort::sort_onesweep_huge_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::ScanReduce => "scan::scan_reduce_cs",
@@ -241,7 +237,7 @@ impl Kernel {
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
-            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepHuge | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],

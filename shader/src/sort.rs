@@ -57,7 +57,7 @@ macro_rules! onesweep_kernel {
             #[spirv(workgroup)] running: &mut [u32; WG],
             #[spirv(workgroup)] digits: &mut [u32; WG],
             #[spirv(workgroup)] packed: &mut [u32; sort::PACKED_DIGITS],
-            #[spirv(workgroup)] counts: &mut [u32; sort::order_words($items * treelet_core::WORKGROUP_SIZE)],
+            #[spirv(workgroup)] counts: &mut [u32; sort::CHUNK_COUNTS],
             #[spirv(workgroup)] totals: &mut [u32; WG],
             #[spirv(workgroup)] ranks: &mut [u32; ($items * treelet_core::WORKGROUP_SIZE) as usize],
             #[spirv(workgroup)] local_offsets: &mut [u32; WG],
@@ -70,7 +70,6 @@ macro_rules! onesweep_kernel {
                     $look_back,
                     { $items },
                     { ($items * treelet_core::WORKGROUP_SIZE) as usize },
-                    { sort::order_words($items * treelet_core::WORKGROUP_SIZE) },
                 >(
                     phase,
                     lid,
@@ -100,7 +99,6 @@ macro_rules! onesweep_kernel {
 
 onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS);
 onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS);
-onesweep_kernel!(sort_onesweep_huge_cs, true, sort::HUGE_SORT_ITEMS);
 onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS);
 
 #[spirv(compute(threads(256)))]
