@@ -20,6 +20,10 @@ use treelet::variant::KernelChoice;
 use crate::bench::{bench_rays, bench_render_kernel, bench_sizes, median, RaysPlan};
 use crate::Device;
 
+/// CUB's sort times on the H100 (`peers/cub`), a reference series of
+/// graph 2.5 and 3.5.
+const CUB_SORT_H100: &str = include_str!("../../docs/results/h100-sort/cub_sort.jsonl");
+
 /// The figures: the seed's five, then three it lacks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Figure {
@@ -475,6 +479,21 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                     }
                 }
             });
+            // What a CUDA user's sort alone costs on the H100 (CUB, measured
+            // by peers/cub in the same lease as Treelet's H100 build figures):
+            // a reference series from the file, not measured by this run.
+            for line in CUB_SORT_H100.lines().filter(|l| !l.trim().is_empty()) {
+                let row: serde_json::Value = serde_json::from_str(line).context("docs/results/h100-sort/cub_sort.jsonl")?;
+                if let (Some(n), Some(ms)) = (row["n"].as_f64(), row["cub_sort_ms_64bit"].as_f64()) {
+                    d.points.push(Point::once("CUB sort alone, 64-bit keys (H100, measured file)", n, ms));
+                }
+            }
+            d.notes.push(
+                "CUB sort (H100): cub::DeviceRadixSort::SortPairs of random 64-bit keys and 32-bit values, median of 21, \
+                 from docs/results/h100-sort/cub_sort.jsonl (peers/cub), not measured by this run; a sort alone, \
+                 the floor under an LBVH build that sorts its keys with it"
+                    .into(),
+            );
             if figure == Figure::Graph25 {
                 // CPU builders over the same boxes, wall clock.
                 let cpu_sizes: Vec<usize> = device_sizes.iter().copied().filter(|&n| n <= if q { 65000 } else { 1_000_000 }).collect();
