@@ -55,7 +55,16 @@ fn scenes(seed: u64) -> Vec<(Scene, &'static str)> {
 }
 
 fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel, seed: u32) -> RenderResult {
-    let s = RenderSettings { width: 40, height: 30, spp: 8, seed, accel, layout: Layout::Auto, kernel };
+    let s = RenderSettings {
+        width: 40,
+        height: 30,
+        spp: 8,
+        seed,
+        accel,
+        layout: Layout::Auto,
+        kernel,
+        integrator: treelet::render::Integrator::Smallpt,
+    };
     render(b, scene, &s, None, |_| {}).unwrap()
 }
 

@@ -175,7 +175,7 @@ mod tests {
             check(&vec![7u64; n as usize]);
             check(&(0..n).map(|k| k / 3).collect::<Vec<_>>());
             check(&(0..n).map(|k| k * k).collect::<Vec<_>>());
-            check(&(0..n).map(|k| (k * 0x9e37_79b9_7f4a_7c15) >> 1).collect::<Vec<_>>().tap_sort());
+            check(&(0..n).map(|k| k.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 1).collect::<Vec<_>>().tap_sort());
         }
         let mut x = 0x1234_5678_9abc_def0u64;
         for n in [200usize, 1000, 4097] {

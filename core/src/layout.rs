@@ -174,7 +174,7 @@ pub struct Camera {
 }
 const _: () = assert!(core::mem::size_of::<Camera>() == 64);
 
-/// Parameters of one render dispatch. repr(C), Pod, 96 bytes.
+/// Parameters of one render dispatch. repr(C), Pod, 112 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
@@ -193,8 +193,18 @@ pub struct RenderParams {
     /// Which rays [`crate::rays::cast_kernel`] casts (primary or diffuse).
     pub cast_mode: u32,
     pub camera: Camera,
+    /// [`SMALLPT`] or [`NEE`]: how the render kernels estimate radiance.
+    pub integrator: u32,
+    /// Entries of the light table ([`crate::lights::Light`]).
+    pub light_count: u32,
+    pub _pad: [u32; 2],
 }
-const _: () = assert!(core::mem::size_of::<RenderParams>() == 96);
+const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
+
+/// smallpt's estimator: emitters are found only by paths that hit them.
+pub const SMALLPT: u32 = 0;
+/// Next-event estimation with multiple importance sampling ([`crate::lights`]).
+pub const NEE: u32 = 1;
 
 /// Parameters of the treelet kernels. repr(C), Pod, 48 bytes.
 #[repr(C)]

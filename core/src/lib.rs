@@ -51,6 +51,7 @@ pub mod fill;
 pub mod fit;
 pub mod intersect;
 pub mod layout;
+pub mod lights;
 pub mod morton;
 pub mod radix_tree;
 pub mod rays;

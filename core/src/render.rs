@@ -20,7 +20,8 @@
 //! Random numbers are counter-based ([`crate::rng`]).
 use glam::Vec3;
 
-use crate::layout::{Camera, Material, RenderParams, Sphere, DIFFUSE, MIRROR};
+use crate::layout::{Camera, Material, RenderParams, Sphere, DIFFUSE, MIRROR, NEE};
+use crate::lights::{light_pdf, light_pmf, power_heuristic, sample_light, select_light, Light};
 use crate::triangle::Triangle;
 use crate::rng::BounceRng;
 use crate::features::{self, has};
@@ -144,6 +145,13 @@ pub fn closest_hit<T: ClosestHit, const F: u32, const S: usize>(
 
 /// Radiance along one path (smallpt's `radiance`, as a loop), with the
 /// code for the features `F` only (see [`crate::features`]).
+///
+/// With `params.integrator == NEE` and a light table, every diffuse bounce
+/// also samples a light ([`crate::lights`]) and casts a shadow ray to it;
+/// that sample and the emission a diffuse bounce's path hits next are both
+/// weighted by the power heuristic. Camera rays and mirror and glass
+/// bounces see emission at full weight, as the shadow ray cannot follow
+/// them: a light behind glass is found only by paths through it.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
@@ -153,6 +161,7 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     pixel: u32,
     sample: u32,
     scene: &SceneRefs<T>,
+    lights: &[Light],
     stack: &mut [u32; S],
     lane: u32,
 ) -> Vec3 {
@@ -160,6 +169,11 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     let mut throughput = Vec3::ONE;
     let mut depth = 0u32;
     let mut from = Origin::NONE;
+    let nee = params.integrator == NEE && params.light_count > 0;
+    // Density of the last bounce's direction if it was diffuse (else 0: a
+    // hit emitter then counts in full), and where that bounce was.
+    let mut bsdf_pdf = 0.0f32;
+    let mut last_x = o;
     while depth < MAX_BOUNCES {
         let hit = closest_hit::<T, F, S>(o, d, from, scene, stack, lane);
         if !hit.is_hit() {
@@ -170,7 +184,15 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
         let n = hit_normal_for::<F>(&scene.prims, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
-        result += throughput * Vec3::from_array(m.emission);
+        let emission = Vec3::from_array(m.emission);
+        if nee && bsdf_pdf > 0.0 && emission != Vec3::ZERO {
+            let light = light_pmf(lights, params.light_count, hit.prim)
+                * light_pdf(&scene.prims, hit.prim, last_x, d, hit.t);
+            result += throughput * emission * power_heuristic(bsdf_pdf, light);
+        } else {
+            result += throughput * emission;
+        }
+        bsdf_pdf = 0.0;
         depth += 1;
         // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
         let rng = BounceRng::new(params.seed, pixel, sample, depth);
@@ -187,8 +209,13 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
         // Branches for materials outside `F` are not compiled (the host
         // never runs such a kernel on a scene that has them).
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
+            if nee {
+                result += throughput * sample_direct::<T, F, S>(x, n, nl, hit.prim, &rng, params, scene, lights, stack, lane);
+            }
             d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
             o = x + nl * eps;
+            bsdf_pdf = nl.dot(d).max(0.0) * core::f32::consts::FRAC_1_PI;
+            last_x = x;
         } else if !has(F, features::GLASS) || (has(F, features::MIRROR) && m.kind == MIRROR) {
             d = d - n * 2.0 * n.dot(d);
             o = x + nl * eps;
@@ -230,10 +257,46 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     result
 }
 
-/// Kernel: `params.samples` samples of pixel `id` (row-major from the top
-/// row), starting at sample `params.first_sample`. Returns the sum of their
-/// radiance (rgb) and the sum of their squared luminance (w), for
-/// [`accumulate`].
+/// Next-event estimation at a diffuse point `x` (outward normal `n`, `nl`
+/// facing the incoming ray) of primitive `prim`: one light chosen by power,
+/// one direction to it, a shadow ray, weighted by the power heuristic
+/// against the cosine-weighted bounce. Radiance per unit throughput (the
+/// surface's reflectance is already in the throughput).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn sample_direct<T: ClosestHit, const F: u32, const S: usize>(
+    x: Vec3,
+    n: Vec3,
+    nl: Vec3,
+    prim: u32,
+    rng: &BounceRng,
+    params: &RenderParams,
+    scene: &SceneRefs<T>,
+    lights: &[Light],
+    stack: &mut [u32; S],
+    lane: u32,
+) -> Vec3 {
+    let light = lights[select_light(lights, params.light_count, rng.uniform(4)) as usize];
+    if light.prim == prim {
+        return Vec3::ZERO; // A surface does not light itself.
+    }
+    let s = sample_light(&scene.prims, light.prim, x, rng.uniform(5), rng.uniform(6));
+    let cos = nl.dot(s.dir);
+    if !(s.pdf > 0.0) || !(cos > 0.0) {
+        return Vec3::ZERO;
+    }
+    let o = x + nl * surface_offset(x);
+    let from = Origin { prim, into: s.dir.dot(n) < 0.0 };
+    let shadow = closest_hit::<T, F, S>(o, s.dir, from, scene, stack, lane);
+    if shadow.prim != light.prim {
+        return Vec3::ZERO; // Occluded (glass too: its paths come by the bounce).
+    }
+    let light_pdf = light.pmf * s.pdf;
+    let bsdf_pdf = cos * core::f32::consts::FRAC_1_PI;
+    let emission = Vec3::from_array(scene.materials[light.prim as usize].emission);
+    emission * (bsdf_pdf / light_pdf * power_heuristic(light_pdf, bsdf_pdf))
+}
+
 /// The outward normal of primitive `prim` at its point `x` (hit along `d`):
 /// a sphere's radial direction, a triangle's geometric normal (its winding
 /// decides "into" for glass).
@@ -292,6 +355,7 @@ pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
     id: u32,
     params: &RenderParams,
     scene: &SceneRefs<T>,
+    lights: &[Light],
     stack: &mut [u32; S],
     lane: u32,
 ) -> [f32; 4] {
@@ -304,7 +368,7 @@ pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
         let sample = params.first_sample + s;
         let rng = BounceRng::new(params.seed, id, sample, 0);
         let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
-        let l = radiance::<T, F, S>(o, d, params, id, sample, scene, stack, lane);
+        let l = radiance::<T, F, S>(o, d, params, id, sample, scene, lights, stack, lane);
         sum += l;
         let lum = luminance(l);
         sum_sq += lum * lum;

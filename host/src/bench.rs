@@ -7,7 +7,7 @@ use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::layout::Layout;
 use treelet::lbvh;
-use treelet::render::{render, Accel, RenderSettings};
+use treelet::render::{render, Accel, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::trbvh::{self, TreeletConfig};
 use treelet::variant::KernelChoice;
@@ -231,7 +231,7 @@ pub(crate) fn bench_render_kernel<B: Backend>(
     layout: Layout,
     kernel: KernelChoice,
 ) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel };
+    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
     Ok(RenderRow {

@@ -15,6 +15,7 @@ use treelet_core::aabb::Aabb;
 use treelet_core::bvh2::Bvh2Tree;
 use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
 use treelet_core::features::VARIANTS;
+use treelet_core::lights::Light;
 use treelet_core::render::{accumulate, render_pixel, SceneRefs};
 use treelet_core::traverse::{ClassicTree, ClosestHit, Scan};
 use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
@@ -70,16 +71,22 @@ fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
 }
 
 /// `render_pixel` compiled for `VARIANTS[v]`, as the shader's entry points are.
-fn render_variant<T: ClosestHit>(v: u8, id: u32, p: &treelet_core::RenderParams, scene: &SceneRefs<T>) -> [f32; 4] {
+fn render_variant<T: ClosestHit>(
+    v: u8,
+    id: u32,
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    lights: &[Light],
+) -> [f32; 4] {
     const _: () = assert!(VARIANTS.len() == 6, "one arm per variant");
     let stack = &mut [0u32; 1];
     match v {
-        0 => render_pixel::<T, { VARIANTS[0].0 }, 1>(id, p, scene, stack, 0),
-        1 => render_pixel::<T, { VARIANTS[1].0 }, 1>(id, p, scene, stack, 0),
-        2 => render_pixel::<T, { VARIANTS[2].0 }, 1>(id, p, scene, stack, 0),
-        3 => render_pixel::<T, { VARIANTS[3].0 }, 1>(id, p, scene, stack, 0),
-        4 => render_pixel::<T, { VARIANTS[4].0 }, 1>(id, p, scene, stack, 0),
-        _ => render_pixel::<T, { VARIANTS[5].0 }, 1>(id, p, scene, stack, 0),
+        0 => render_pixel::<T, { VARIANTS[0].0 }, 1>(id, p, scene, lights, stack, 0),
+        1 => render_pixel::<T, { VARIANTS[1].0 }, 1>(id, p, scene, lights, stack, 0),
+        2 => render_pixel::<T, { VARIANTS[2].0 }, 1>(id, p, scene, lights, stack, 0),
+        3 => render_pixel::<T, { VARIANTS[3].0 }, 1>(id, p, scene, lights, stack, 0),
+        4 => render_pixel::<T, { VARIANTS[4].0 }, 1>(id, p, scene, lights, stack, 0),
+        _ => render_pixel::<T, { VARIANTS[5].0 }, 1>(id, p, scene, lights, stack, 0),
     }
 }
 
@@ -90,6 +97,7 @@ fn render_all<T: ClosestHit + Sync>(
     v: u8,
     p: &treelet_core::RenderParams,
     scene: &SceneRefs<T>,
+    lights: &[Light],
     accum: &mut [[f32; 4]],
     groups: u32,
 ) {
@@ -97,7 +105,7 @@ fn render_all<T: ClosestHit + Sync>(
     accum[..pixels]
         .par_iter_mut()
         .enumerate()
-        .for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene)));
+        .for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene, lights)));
 }
 
 /// A sort pass kernel's workgroups, one after another: every earlier
@@ -534,26 +542,27 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 _ => panic!("{kernel:?}: no such cast kernel"),
             }
         }
-        (Kernel::Render(method, v), [p, spheres, materials, nodes, prims, accum, triangles]) => {
+        (Kernel::Render(method, v), [p, spheres, materials, nodes, prims, accum, triangles, lights]) => {
             let p: treelet_core::RenderParams = params(p);
+            let lights: &[Light] = view(lights);
             let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
             let accum: &mut [[f32; 4]] = view(accum);
             match method {
                 Method::Scan => {
                     let tree = Scan::new(&[], &[]);
-                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Classic => {
                     let tree = ClassicTree::new(view(nodes), view(prims));
-                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Bvh2 => {
                     let tree = Bvh2Tree::new(view(nodes), view(prims));
-                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Cwbvh => {
                     let tree = WideTree::new(view(nodes), view(prims));
-                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), accum, groups)
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
             }
         }

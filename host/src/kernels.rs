@@ -259,9 +259,8 @@ impl Kernel {
             Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => {
-                &[Read, Read, Read, Read, Read, ReadWrite, Read]
-            }
+            Kernel::Render(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
+            Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
         }
     }
 }

@@ -10,7 +10,7 @@ use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::image_io;
 use treelet::layout::Layout;
 use treelet::plot::Series;
-use treelet::render::{render, Accel, PassRow, RenderSettings};
+use treelet::render::{render, Accel, Integrator, PassRow, RenderSettings};
 use treelet::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::trbvh::TreeletConfig;
@@ -102,6 +102,10 @@ struct RenderArgs {
     /// Print the scene's features and the accel and kernel chosen, and why.
     #[arg(long)]
     explain: bool,
+    /// smallpt: emitters count where paths hit them; nee: also a light
+    /// sampled at every diffuse bounce, with multiple importance sampling.
+    #[arg(long, value_enum, default_value = "smallpt")]
+    integrator: Integrator,
     #[arg(long, value_enum, default_value = "gpu")]
     device: Device,
     #[arg(long, default_value_t = 0)]
@@ -128,6 +132,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         accel: args.accel,
         layout: args.layout,
         kernel: args.kernel,
+        integrator: args.integrator,
     };
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
@@ -142,7 +147,13 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     let explain = |b: &dyn Fn() -> treelet::backend::DeviceClass| {
         if args.explain {
-            bar.suspend(|| eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain()));
+            bar.suspend(|| {
+                eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain());
+                eprintln!("integrator: {}", match args.integrator {
+                    Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
+                    Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
+                });
+            });
         }
     };
     let (result, device, adapter) = match args.device {
@@ -162,7 +173,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
     image_io::write(&args.out, &result.image)?;
     let paths = args.width as f64 * args.height as f64 * args.spp as f64;
     eprintln!(
-        "{}: {}x{} at {} spp on {adapter} (accel {}, layout {}, kernel {}), {:.3} s ({:.1} M camera paths/s), wrote {}",
+        "{}: {}x{} at {} spp on {adapter} (accel {}, layout {}, kernel {}, integrator {}), {:.3} s ({:.1} M camera paths/s), wrote {}",
         scene.name,
         args.width,
         args.height,
@@ -170,6 +181,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         format!("{:?}", result.plan.accel).to_lowercase(),
         if result.plan.accel == Accel::None { "-" } else { result.plan.layout.name() },
         result.plan.kernel,
+        format!("{:?}", args.integrator).to_lowercase(),
         result.total_s,
         paths / result.total_s / 1e6,
         args.out.display()
@@ -182,6 +194,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
             "spp": args.spp,
             "seed": args.seed,
             "accel": result.plan.accel,
+            "integrator": args.integrator,
             "plan": result.plan,
             "device": device,
             "adapter": adapter,

@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::layout::{Node, RenderParams};
+use treelet_core::lights::{light_power, Light};
 use treelet_core::render::{luminance, tiled_invocations};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
@@ -36,6 +37,56 @@ pub enum Accel {
     Sweep,
 }
 
+/// How radiance is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// smallpt's: emitters count only where a path hits them.
+    Smallpt,
+    /// Next-event estimation: a light sampled at every diffuse bounce, with
+    /// multiple importance sampling (`treelet_core::lights`).
+    Nee,
+}
+
+impl Integrator {
+    fn code(self) -> u32 {
+        match self {
+            Integrator::Smallpt => treelet_core::layout::SMALLPT,
+            Integrator::Nee => treelet_core::layout::NEE,
+        }
+    }
+}
+
+/// The light table of `prims` (spheres then triangles, one material each):
+/// every emitter, chosen in proportion to its power
+/// (`treelet_core::lights::light_power`), in primitive order. Empty
+/// without emitters.
+pub fn light_table(prims: Primitives, materials: &[treelet_core::layout::Material]) -> Vec<Light> {
+    let p = treelet_core::traverse::Prims {
+        spheres: prims.spheres,
+        sphere_count: prims.spheres.len() as u32,
+        triangles: prims.triangles,
+        triangle_count: prims.triangles.len() as u32,
+    };
+    let powers: Vec<(u32, f64)> = (0..p.count())
+        .map(|i| (i, light_power(&p, materials, i) as f64))
+        .filter(|&(_, w)| w > 0.0 && w.is_finite())
+        .collect();
+    let total: f64 = powers.iter().map(|&(_, w)| w).sum();
+    let mut cumulative = 0.0;
+    let mut table: Vec<Light> = powers
+        .iter()
+        .map(|&(prim, w)| {
+            cumulative += w;
+            Light { prim, pmf: (w / total) as f32, cdf: (cumulative / total) as f32, _pad: 0 }
+        })
+        .collect();
+    if let Some(last) = table.last_mut() {
+        last.cdf = 1.0; // Whatever rounding did, the last light takes the rest.
+    }
+    table
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct RenderSettings {
     pub width: u32,
@@ -48,11 +99,19 @@ pub struct RenderSettings {
     pub layout: Layout,
     /// The render kernel: the smallest variant for the scene, or the general one.
     pub kernel: KernelChoice,
+    pub integrator: Integrator,
 }
 
 /// Camera paths per dispatch at most, so that no dispatch runs long enough
 /// for a driver to time it out, whatever the sample count.
 pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;
+
+/// Samples per pixel per dispatch at most. lavapipe (Mesa 22.3) returned a
+/// far too dark image when one dispatch took 512 samples of each pixel of a
+/// small image (cornell at 64x48 and 32x24; 256 were right, and the CPU
+/// runner right at any count); the cause is not known. Small images take
+/// more dispatches instead.
+pub const MAX_SAMPLES_PER_DISPATCH: u32 = 64;
 
 /// The error of the image after one pass.
 #[derive(Clone, Debug, Serialize)]
@@ -106,7 +165,7 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel, layout, kernel } = *settings;
+    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator } = *settings;
     if width == 0 || height == 0 || spp == 0 {
         bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
     }
@@ -131,10 +190,12 @@ pub fn render<B: Backend>(
 
     let (tree, buffers, build_ms) = scene_tree(b, all, plan.accel, plan.layout)?;
     let materials = b.upload("materials", &scene.materials)?;
+    let table = light_table(all, &scene.materials);
+    let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
     let accum = b.zeroed("accumulation", pixels * 16)?;
     let camera = scene.camera.camera(width, height);
     let kernel = Kernel::Render(plan.method(), plan.variant as u8);
-    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, u32::MAX as u64) as u32;
+    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, MAX_SAMPLES_PER_DISPATCH as u64) as u32;
 
     let mut rows = Vec::new();
     let mut render_ms = 0.0;
@@ -154,12 +215,14 @@ pub fn render<B: Backend>(
                 prims,
                 triangles: triangles_n,
                 camera,
+                integrator: integrator.code(),
+                light_count: table.len() as u32,
                 ..Default::default()
             };
             let p = b.upload("render params", &[params])?;
             b.dispatch(
                 kernel,
-                &[&p, &buffers.spheres, &materials, &tree.nodes, &tree.prims, &accum, &buffers.triangles],
+                &[&p, &buffers.spheres, &materials, &tree.nodes, &tree.prims, &accum, &buffers.triangles, &lights],
                 groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
             );
             done += samples;

@@ -12,7 +12,7 @@ use treelet::cpu_runner::CpuBackend;
 use treelet::gpu::{GpuBackend, GpuContext};
 use treelet::layout::Layout;
 use treelet::plot::{chart, Chart, Series};
-use treelet::render::{render, Accel, RenderSettings};
+use treelet::render::{render, Accel, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::trbvh::TreeletConfig;
 use treelet::variant::KernelChoice;
@@ -521,7 +521,16 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             with_backend!(runner, |b| {
                 for a in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
                     let layout = Layout::Auto;
-                    let settings = RenderSettings { width: w, height: h, spp, seed: 1, accel: a, layout, kernel: KernelChoice::Auto };
+                    let settings = RenderSettings {
+                        width: w,
+                        height: h,
+                        spp,
+                        seed: 1,
+                        accel: a,
+                        layout,
+                        kernel: KernelChoice::Auto,
+                        integrator: Integrator::Smallpt,
+                    };
                     let res = render(b, &scene, &settings, None, |_| {})?;
                     for row in &res.rows {
                         if let Some(e) = row.mean_std_error {

@@ -4,6 +4,7 @@ use treelet_core::bvh2::Bvh2Tree;
 use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
 use treelet_core::features::{ALL, TRIANGLES, VARIANTS};
 use treelet_core::layout::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
+use treelet_core::lights::Light;
 use treelet_core::render::{accumulate, render_pixel, tiled_pixel, SceneRefs};
 use treelet_core::traverse::{ClassicTree, Scan};
 use treelet_core::triangle::Triangle;
@@ -26,11 +27,12 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
         ) {
             let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
             if pixel != u32::MAX {
                 let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
-                let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, &mut [0u32; 1], 0);
+                let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, lights, &mut [0u32; 1], 0);
                 accumulate(&mut accum[pixel as usize], sums);
             }
         }
