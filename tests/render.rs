@@ -37,6 +37,7 @@ fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> Rende
         layout: Layout::Auto,
         kernel: KernelChoice::Auto,
         integrator: Integrator::Smallpt,
+        error_each_pass: true,
     }
 }
 

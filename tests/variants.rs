@@ -64,6 +64,7 @@ fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel,
         layout: Layout::Auto,
         kernel,
         integrator: treelet::render::Integrator::Smallpt,
+        error_each_pass: true,
     };
     render(b, scene, &s, None, |_| {}).unwrap()
 }

@@ -100,6 +100,10 @@ pub struct RenderSettings {
     /// The render kernel: the smallest variant for the scene, or the general one.
     pub kernel: KernelChoice,
     pub integrator: Integrator,
+    /// Read the image back and measure its error after every pass (for a
+    /// report or a reference); else only after the last, which saves a
+    /// readback of the whole image per pass.
+    pub error_each_pass: bool,
 }
 
 /// Camera paths per dispatch at most, so that no dispatch runs long enough
@@ -165,7 +169,7 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator } = *settings;
+    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, error_each_pass } = *settings;
     if width == 0 || height == 0 || spp == 0 {
         bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
     }
@@ -201,7 +205,8 @@ pub fn render<B: Backend>(
     let mut render_ms = 0.0;
     let mut done = 0u32;
     let mut sums: Vec<[f32; 4]> = Vec::new();
-    for (pass, target) in pass_schedule(spp).into_iter().enumerate() {
+    let schedule = pass_schedule(spp);
+    for (pass, target) in schedule.iter().copied().enumerate() {
         b.stage("render");
         while done < target {
             let samples = (target - done).min(per_dispatch);
@@ -227,11 +232,19 @@ pub fn render<B: Backend>(
             );
             done += samples;
         }
-        sums = b.read(&accum, pixels as usize)?;
-        render_ms += b.take_times()?.get("render");
-        let row = error_row(pass as u32, done, start.elapsed().as_secs_f64(), &sums, reference);
-        on_pass(&row);
-        rows.push(row);
+        let last = pass + 1 == schedule.len();
+        if error_each_pass || last {
+            sums = b.read(&accum, pixels as usize)?;
+            render_ms += b.take_times()?.get("render");
+            let row = error_row(pass as u32, done, start.elapsed().as_secs_f64(), &sums, reference);
+            on_pass(&row);
+            rows.push(row);
+        } else {
+            // Waits for the pass (its timestamps), without reading the image.
+            render_ms += b.take_times()?.get("render");
+            let elapsed_s = start.elapsed().as_secs_f64();
+            on_pass(&PassRow { pass: pass as u32, spp: done, elapsed_s, rmse: None, rel_mse: None, mean_std_error: None });
+        }
     }
     let image =
         HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };

@@ -530,6 +530,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                         layout,
                         kernel: KernelChoice::Auto,
                         integrator: Integrator::Smallpt,
+                        error_each_pass: true,
                     };
                     let res = render(b, &scene, &settings, None, |_| {})?;
                     for row in &res.rows {
