@@ -174,8 +174,31 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     // hit emitter then counts in full), and where that bounce was.
     let mut bsdf_pdf = 0.0f32;
     let mut last_x = o;
-    while depth < MAX_BOUNCES {
+    // A shadow ray is traced by the same call as the path's rays, in the
+    // iteration after its diffuse bounce: one traversal inlined in the
+    // kernel, not two (which doubled its registers and slowed every tree
+    // layout on the GPU). While one is pending, `(o, d, from)` is the shadow
+    // ray, `next` the path's bounce, and `shadow_value` what the light adds
+    // if the ray reaches `shadow_light` first.
+    let mut shadow_light = NO_LIGHT;
+    let mut shadow_value = Vec3::ZERO;
+    let mut shadow_d = Vec3::Z;
+    let mut next = (o, d, from);
+    loop {
+        if depth >= MAX_BOUNCES && shadow_light == NO_LIGHT {
+            break;
+        }
         let hit = closest_hit::<T, F, S>(o, d, from, scene, stack, lane);
+        if shadow_light != NO_LIGHT {
+            // Anything else first, glass too, occludes it: paths through
+            // glass reach a light by their bounces, at full weight.
+            if hit.prim == shadow_light {
+                result += shadow_value;
+            }
+            shadow_light = NO_LIGHT;
+            (o, d, from) = next;
+            continue;
+        }
         if !hit.is_hit() {
             break;
         }
@@ -210,7 +233,10 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
         // never runs such a kernel on a scene that has them).
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
             if nee {
-                result += throughput * sample_direct::<T, F, S>(x, n, nl, hit.prim, &rng, params, scene, lights, stack, lane);
+                let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
+                if s.light != NO_LIGHT {
+                    (shadow_light, shadow_d, shadow_value) = (s.light, s.dir, throughput * s.value);
+                }
             }
             d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
             o = x + nl * eps;
@@ -253,48 +279,56 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
         // The next ray leaves this sphere: into it when it heads against the
         // outward normal.
         from = Origin { prim: hit.prim, into: d.dot(n) < 0.0 };
+        if shadow_light != NO_LIGHT {
+            // The shadow ray first, from the same point (see above).
+            next = (o, d, from);
+            (o, d, from) = (x + nl * eps, shadow_d, Origin { prim: hit.prim, into: shadow_d.dot(n) < 0.0 });
+        }
     }
     result
 }
 
-/// Next-event estimation at a diffuse point `x` (outward normal `n`, `nl`
-/// facing the incoming ray) of primitive `prim`: one light chosen by power,
-/// one direction to it, a shadow ray, weighted by the power heuristic
-/// against the cosine-weighted bounce. Radiance per unit throughput (the
-/// surface's reflectance is already in the throughput).
+/// No light: no shadow ray pending.
+const NO_LIGHT: u32 = u32::MAX;
+
+/// A light sample at a diffuse point: the light, the shadow ray's
+/// direction, and the radiance the light adds (per unit throughput) if that
+/// ray reaches it first; `light == NO_LIGHT` where there is nothing to trace.
+struct DirectSample {
+    light: u32,
+    dir: Vec3,
+    value: Vec3,
+}
+
+/// Next-event estimation at a diffuse point `x` (`nl` facing the incoming
+/// ray) of primitive `prim`: one light chosen by power, one direction to
+/// it, weighted by the power heuristic against the cosine-weighted bounce.
+/// The caller traces the shadow ray (see [`radiance`]).
 #[inline]
-#[allow(clippy::too_many_arguments)]
-fn sample_direct<T: ClosestHit, const F: u32, const S: usize>(
+fn sample_direct<T: ClosestHit>(
     x: Vec3,
-    n: Vec3,
     nl: Vec3,
     prim: u32,
     rng: &BounceRng,
     params: &RenderParams,
     scene: &SceneRefs<T>,
     lights: &[Light],
-    stack: &mut [u32; S],
-    lane: u32,
-) -> Vec3 {
+) -> DirectSample {
+    let none = DirectSample { light: NO_LIGHT, dir: Vec3::Z, value: Vec3::ZERO };
     let light = lights[select_light(lights, params.light_count, rng.uniform(4)) as usize];
     if light.prim == prim {
-        return Vec3::ZERO; // A surface does not light itself.
+        return none; // A surface does not light itself.
     }
     let s = sample_light(&scene.prims, light.prim, x, rng.uniform(5), rng.uniform(6));
     let cos = nl.dot(s.dir);
     if !(s.pdf > 0.0) || !(cos > 0.0) {
-        return Vec3::ZERO;
-    }
-    let o = x + nl * surface_offset(x);
-    let from = Origin { prim, into: s.dir.dot(n) < 0.0 };
-    let shadow = closest_hit::<T, F, S>(o, s.dir, from, scene, stack, lane);
-    if shadow.prim != light.prim {
-        return Vec3::ZERO; // Occluded (glass too: its paths come by the bounce).
+        return none;
     }
     let light_pdf = light.pmf * s.pdf;
     let bsdf_pdf = cos * core::f32::consts::FRAC_1_PI;
     let emission = Vec3::from_array(scene.materials[light.prim as usize].emission);
-    emission * (bsdf_pdf / light_pdf * power_heuristic(light_pdf, bsdf_pdf))
+    let value = emission * (bsdf_pdf / light_pdf * power_heuristic(light_pdf, bsdf_pdf));
+    DirectSample { light: light.prim, dir: s.dir, value }
 }
 
 /// The outward normal of primitive `prim` at its point `x` (hit along `d`):
