@@ -69,6 +69,13 @@ enum Command {
     },
     /// Path-trace a scene (smallpt) and write the image, with an error report.
     Render(RenderArgs),
+    /// Score an image (.exr or .pfm, linear) against a reference with the
+    /// render's own error measure; prints one JSON object (`rmse`, `rel_mse`).
+    Compare {
+        image: std::path::PathBuf,
+        #[arg(long)]
+        reference: std::path::PathBuf,
+    },
     /// Benchmarks (medians over repeats; GPU stage times from timestamp queries).
     Bench {
         #[command(subcommand)]
@@ -282,6 +289,23 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(report.valid)
         }
         Command::Render(args) => run_render(args).map(|_| true),
+        Command::Compare { image, reference } => {
+            let (img, r) = (image_io::read_hdr(&image)?, image_io::read_hdr(&reference)?);
+            if (img.width, img.height) != (r.width, r.height) {
+                anyhow::bail!(
+                    "{} is {}x{}, the reference {} is {}x{}",
+                    image.display(),
+                    img.width,
+                    img.height,
+                    reference.display(),
+                    r.width,
+                    r.height
+                );
+            }
+            let (rmse, rel_mse) = treelet::render::image_error(img.pixels.iter().map(|p| p.map(f64::from)), &r);
+            println!("{}", serde_json::json!({ "image": image, "reference": reference, "rmse": rmse, "rel_mse": rel_mse }));
+            Ok(true)
+        }
         Command::Bench { what } => bench::run(what).map(|_| true),
     }
 }

@@ -251,23 +251,30 @@ pub fn render<B: Backend>(
     Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
 }
 
+/// Root mean square error (per channel) of `image` against `reference`,
+/// and the mean of `(x - ref)² / (ref² + 0.01)`: how every render and
+/// `treelet compare` score an image. Images must have the same size.
+pub fn image_error(image: impl Iterator<Item = [f64; 3]>, reference: &HdrImage) -> (f64, f64) {
+    let (mut se, mut rel, mut count) = (0.0f64, 0.0f64, 0usize);
+    for (x, rp) in image.zip(&reference.pixels) {
+        for k in 0..3 {
+            let y = rp[k] as f64;
+            se += (x[k] - y) * (x[k] - y);
+            rel += (x[k] - y) * (x[k] - y) / (y * y + 0.01);
+        }
+        count += 3;
+    }
+    ((se / count.max(1) as f64).sqrt(), rel / count.max(1) as f64)
+}
+
 fn error_row(pass: u32, spp: u32, elapsed_s: f64, sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
     let n = spp as f64;
     let mut row = PassRow { pass, spp, elapsed_s, rmse: None, rel_mse: None, mean_std_error: None };
     match reference {
         Some(r) => {
-            let (mut se, mut rel) = (0.0f64, 0.0f64);
-            for (s, rp) in sums.iter().zip(&r.pixels) {
-                for k in 0..3 {
-                    let x = s[k] as f64 / n;
-                    let y = rp[k] as f64;
-                    se += (x - y) * (x - y);
-                    rel += (x - y) * (x - y) / (y * y + 0.01);
-                }
-            }
-            let count = 3.0 * sums.len() as f64;
-            row.rmse = Some((se / count).sqrt());
-            row.rel_mse = Some(rel / count);
+            let (rmse, rel) = image_error(sums.iter().map(|s| [0, 1, 2].map(|k| s[k] as f64 / n)), r);
+            row.rmse = Some(rmse);
+            row.rel_mse = Some(rel);
         }
         None if spp >= 2 => {
             let mut total = 0.0f64;
