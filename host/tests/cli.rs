@@ -210,3 +210,32 @@ fn figure_writes_json_png_and_results() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no figure files"));
 }
+
+/// `compare` scores an image against a reference: 0 against itself, more
+/// against a noisier render of the same scene, and a clear error for images
+/// of different sizes or a missing file.
+#[test]
+fn compare_scores_images_and_names_bad_input() {
+    let dir = std::env::temp_dir().join(format!("treelet-compare-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let render = |name: &str, w: &str, spp: &str| {
+        let path = dir.join(name);
+        let args = ["render", "--device", "cpu", "--width", w, "--height", "12", "--spp", spp, "--out"];
+        let out = treelet(&[&args[..], &[path.to_str().unwrap()]].concat());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        path.to_str().unwrap().to_string()
+    };
+    let (fine, coarse, wide) = (render("fine.pfm", "16", "64"), render("coarse.pfm", "16", "4"), render("wide.pfm", "20", "4"));
+    let score = |image: &str| {
+        let out = treelet(&["compare", image, "--reference", &fine]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+        v["rmse"].as_f64().unwrap()
+    };
+    assert_eq!(score(&fine), 0.0);
+    assert!(score(&coarse) > 0.0);
+    let e = stderr_of(&["compare", &wide, "--reference", &fine]);
+    assert!(e.contains("20x12") && e.contains("16x12"), "{e}");
+    let e = stderr_of(&["compare", "nowhere.exr", "--reference", &fine]);
+    assert!(e.contains("nowhere.exr"), "{e}");
+}
