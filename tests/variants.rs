@@ -9,7 +9,7 @@ use treelet::gpu::GpuBackend;
 use treelet::layout::Layout;
 use treelet::render::{render, Accel, RenderResult, RenderSettings};
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
-use treelet::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU};
+use treelet::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU, TRIANGLE_SCAN_WEIGHT};
 use treelet_core::features::{self, VARIANTS};
 use treelet_core::triangle::Triangle;
 use treelet_tests::gpu;
@@ -117,8 +117,8 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
                 assert!(compiled & features::GLASS != 0, "{}: glass without refraction", scene.name);
             }
-            let n = scene.spheres.len() + scene.triangles.len();
-            assert_eq!(p.accel == Accel::None, n <= LINEAR_MAX_CPU, "{}: {n} primitives, {:?}", scene.name, p.accel);
+            let cost = scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len();
+            assert_eq!(p.accel == Accel::None, cost <= LINEAR_MAX_CPU, "{}: scan cost {cost}, {:?}", scene.name, p.accel);
         }
         // Forced choices stay as asked.
         use treelet::backend::DeviceClass::Gpu;

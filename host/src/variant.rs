@@ -45,6 +45,11 @@ impl SceneFeatures {
         self.spheres + self.triangles
     }
 
+    /// The scan's cost in spheres: a triangle counts [`TRIANGLE_SCAN_WEIGHT`].
+    pub fn scan_cost(&self) -> usize {
+        self.spheres + TRIANGLE_SCAN_WEIGHT * self.triangles
+    }
+
     /// The kernel features (`treelet_core::features`) these need.
     pub fn bits(&self) -> u32 {
         let mut bits = 0;
@@ -120,6 +125,13 @@ pub fn full_variant() -> usize {
 /// the scan 40.4 ms against 45.5 ms for the treelet-optimized BVH at 265
 /// primitives, 158 ms against 66 ms at 1009.
 pub const LINEAR_MAX_GPU: usize = 256;
+/// What a triangle costs a linear scan, in spheres, against the crossovers
+/// above. Measured on the H100 with terrain:N in smallpt's room (7 spheres;
+/// 1024x768, 64 spp, each integrator): the scan is as fast as the
+/// treelet-optimized BVH at 32 triangles (0.168 s against 0.164), half as
+/// fast at 64 (0.333 against 0.166), faster at 16 (0.113 against 0.167).
+/// CPU devices use the same weight (not measured there).
+pub const TRIANGLE_SCAN_WEIGHT: usize = 8;
 /// As [`LINEAR_MAX_GPU`] on CPU devices (lavapipe, 256x192): the scan wins
 /// at 521 primitives (5.0 s against 7.5 s), loses at 1009 (11.7 s against
 /// 4.5 s). The CPU runner uses it too (not measured separately).
@@ -149,17 +161,21 @@ pub struct Plan {
 /// BVH; `Layout::Auto` the fastest measured layout.
 pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
     let features = SceneFeatures::of(scene);
-    let n = features.primitives();
+    let (n, cost) = (features.primitives(), features.scan_cost());
     let runs_on_cpu = class != DeviceClass::Gpu;
     let (linear_max, device) = if runs_on_cpu { (LINEAR_MAX_CPU, "a CPU device") } else { (LINEAR_MAX_GPU, "a GPU") };
     let (accel, accel_reason) = match accel {
-        Accel::Auto if n <= linear_max => (
+        Accel::Auto if cost <= linear_max => (
             Accel::None,
-            format!("{n} primitives: a linear scan is faster than a BVH up to {linear_max} on {device}"),
+            format!(
+                "{n} primitives, scan cost {cost} (a triangle counts {TRIANGLE_SCAN_WEIGHT} spheres): a linear scan is faster than a BVH up to {linear_max} on {device}"
+            ),
         ),
         Accel::Auto => (
             Accel::Trbvh,
-            format!("{n} primitives: above {linear_max} a BVH is faster on {device}; treelet-optimized"),
+            format!(
+                "{n} primitives, scan cost {cost} (a triangle counts {TRIANGLE_SCAN_WEIGHT} spheres): above {linear_max} a BVH is faster on {device}; treelet-optimized"
+            ),
         ),
         other => (other, "as asked (--accel)".to_string()),
     };
