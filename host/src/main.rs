@@ -110,10 +110,10 @@ struct RenderArgs {
     #[arg(long)]
     explain: bool,
     /// nee: a light sampled at every diffuse bounce, with multiple
-    /// importance sampling (the default: on the H100, as little error as
-    /// smallpt's estimator at equal time on cornell, 1.8 times less RMSE on
-    /// scenes/room_disk.json); smallpt: emitters count only where paths hit
-    /// them.
+    /// importance sampling (the default: on the H100, about as little error
+    /// as smallpt's estimator at equal time on cornell, 1.4 times less RMSE
+    /// on scenes/room_disk.json); smallpt: emitters count only where paths
+    /// hit them.
     #[arg(long, value_enum, default_value = "nee")]
     integrator: Integrator,
     #[arg(long, value_enum, default_value = "gpu")]

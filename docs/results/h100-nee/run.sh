@@ -1,5 +1,5 @@
 #!/bin/bash
-# One H100 lease, the final binary: error against wall time on cornell and scenes/room_disk.json for
+# One H100 lease, the final binary (--accel auto: the room gets the treelet BVH): error against wall time on cornell and scenes/room_disk.json for
 # Treelet's two integrators (RMSE against a Treelet reference of 8192 spp) and Mitsuba 3 on the room
 # (RMSE against Treelet's reference, and against Mitsuba's own 4096-spp image).
 for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
