@@ -18,6 +18,10 @@
 //! surfaces. Paths stop after [`MAX_BOUNCES`] (a bias no render
 //! has shown: Russian roulette ends them long before).
 //! Random numbers are counter-based ([`crate::rng`]).
+//!
+//! `RenderParams::integrator` selects smallpt's estimator or next-event
+//! estimation with multiple importance sampling (see [`radiance`] and
+//! [`crate::lights`]); both converge to the same image.
 use glam::Vec3;
 
 use crate::layout::{Camera, Material, RenderParams, Sphere, DIFFUSE, MIRROR, NEE};
@@ -176,10 +180,11 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     let mut last_x = o;
     // A shadow ray is traced by the same call as the path's rays, in the
     // iteration after its diffuse bounce: one traversal inlined in the
-    // kernel, not two (which doubled its registers and slowed every tree
-    // layout on the GPU). While one is pending, `(o, d, from)` is the shadow
-    // ray, `next` the path's bounce, and `shadow_value` what the light adds
-    // if the ray reaches `shadow_light` first.
+    // kernel, not two (with two, NEE through the treelet BVH ran 6.7 times
+    // as long as smallpt's estimator on the H100; with one, 3 times). While
+    // one is pending, `(o, d, from)` is the shadow ray, `next` the path's
+    // bounce, and `shadow_value` what the light adds if the ray reaches
+    // `shadow_light` first.
     let mut shadow_light = NO_LIGHT;
     let mut shadow_value = Vec3::ZERO;
     let mut shadow_d = Vec3::Z;
