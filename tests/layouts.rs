@@ -255,12 +255,7 @@ fn gpu_layouts_equal_cpu() {
     let spheres = random_spheres(20_000, seed as u64);
     let tris = terrain(20_000);
     for (what, prims) in [("random spheres", Primitives::spheres(&spheres)), ("terrain", Primitives::triangles(&tris))] {
-        let scene = Prims {
-            spheres: prims.spheres,
-            sphere_count: prims.spheres.len() as u32,
-            triangles: prims.triangles,
-            triangle_count: prims.triangles.len() as u32,
-        };
+        let scene = prims.as_core();
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 300);
         for layout in [Layout::Bvh2, Layout::Cwbvh] {

@@ -45,6 +45,12 @@ fn pixels<B: Backend>(b: &mut B, scene: &Scene, s: &RenderSettings) -> Vec<[f32;
     render(b, scene, s, None, |_| {}).unwrap().image.pixels
 }
 
+/// Mean absolute difference of two images, over pixels and channels.
+fn mean_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>()).sum::<f64>()
+        / (3 * a.len()) as f64
+}
+
 /// Fraction of pixels whose channels differ by more than `tol` (relative to 1 + value).
 fn mismatch_fraction(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> f64 {
     let bad = a.iter().zip(b).filter(|(x, y)| (0..3).any(|k| (x[k] - y[k]).abs() > tol * (1.0 + y[k].abs()))).count();
@@ -69,10 +75,6 @@ fn gpu_render_matches_cpu() {
         // A few diverge where the GPU rounds differently (fused multiply-adds,
         // its square root) and a path then takes another branch.
         let same = 1.0 - mismatch_fraction(&g, &c, 1e-4);
-        let mean_abs = |a: &[[f32; 3]], b: &[[f32; 3]]| {
-            a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>()).sum::<f64>()
-                / (3 * a.len()) as f64
-        };
         let (gpu_cpu, noise) = (mean_abs(&g, &c), mean_abs(&c, &other));
         eprintln!(
             "{} {accel:?}: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}",
@@ -356,10 +358,6 @@ fn nee_gpu_matches_cpu() {
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
         let c = pixels(&mut CpuBackend::new(), &scene, &s);
         let other = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { seed: seed.wrapping_add(1), ..s });
-        let mean_abs = |a: &[[f32; 3]], b: &[[f32; 3]]| {
-            a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>()).sum::<f64>()
-                / (3 * a.len()) as f64
-        };
         let (gpu_cpu, noise) = (mean_abs(&g, &c), mean_abs(&c, &other));
         let same = 1.0 - mismatch_fraction(&g, &c, 1e-4);
         eprintln!("{} nee: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}", scene.name, 100.0 * same);

@@ -19,8 +19,8 @@
 //! fit, from one dispatch instead of two and with half the box reads of the
 //! fit (the sibling's box only; the climber keeps its own).
 use crate::aabb::Aabb;
-use crate::fit::{load_box, store_box};
-use crate::layout::{Node, INVALID, LEAF_BIT};
+use crate::fit::{load_box, store_box, write_leaf};
+use crate::layout::{Node, INVALID};
 use crate::radix_tree::{delta, leaf_node};
 
 /// Whether the node covering `[l, r]` of `n` sorted keys is its parent's
@@ -70,16 +70,11 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
     if i >= n {
         return;
     }
-    let leaf = leaf_node(n, i);
-    let mut own = prim_boxes[sorted_prims[i as usize] as usize];
-    nodes[leaf as usize].left = i;
-    nodes[leaf as usize].right = LEAF_BIT | 1;
-    store_box(&mut nodes[leaf as usize], &own);
+    let mut own = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
     if n == 1 {
-        parents[0] = INVALID;
         return;
     }
-    let (mut l, mut r, mut current) = (i, i, leaf);
+    let (mut l, mut r, mut current) = (i, i, leaf_node(n, i));
     let mut left_child = parent_side(keys, n, l, r);
     loop {
         let split = if left_child { r } else { l - 1 };

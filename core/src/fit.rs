@@ -40,6 +40,22 @@ pub fn second_arrival<const ORDERED: bool>(counter: &mut u32) -> bool {
     previous != 0
 }
 
+/// Writes leaf `i` (sorted position) of `n` and its box, which it returns;
+/// for a one-leaf tree, also its parent link (none). The start of every
+/// bottom-up climb ([`fit_kernel`], [`crate::agglomerate`]).
+#[inline]
+pub(crate) fn write_leaf(i: u32, n: u32, sorted_prims: &[u32], prim_boxes: &[Aabb], nodes: &mut [Node], parents: &mut [u32]) -> Aabb {
+    let leaf = leaf_node(n, i);
+    let b = prim_boxes[sorted_prims[i as usize] as usize];
+    nodes[leaf as usize].left = i;
+    nodes[leaf as usize].right = LEAF_BIT | 1;
+    store_box(&mut nodes[leaf as usize], &b);
+    if n == 1 {
+        parents[0] = INVALID;
+    }
+    b
+}
+
 /// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
 /// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
 /// `ORDERED` gives the counter acquire-release semantics (see
@@ -56,17 +72,12 @@ pub fn fit_kernel<const ORDERED: bool>(
     if i >= n {
         return;
     }
-    let leaf = leaf_node(n, i);
-    let b = prim_boxes[sorted_prims[i as usize] as usize];
-    nodes[leaf as usize].left = i;
-    nodes[leaf as usize].right = LEAF_BIT | 1;
-    store_box(&mut nodes[leaf as usize], &b);
+    let b = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
     if n == 1 {
-        parents[0] = INVALID;
         return;
     }
     // The climber keeps its subtree's box and reads only the sibling's.
-    let (mut current, mut own) = (leaf, b);
+    let (mut current, mut own) = (leaf_node(n, i), b);
     while current != 0 {
         let parent = parents[current as usize];
         if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {

@@ -21,6 +21,16 @@ impl<'a> Primitives<'a> {
         Primitives { spheres: &[], triangles }
     }
 
+    /// The same primitives as the kernels' view of them.
+    pub fn as_core(&self) -> treelet_core::traverse::Prims<'a> {
+        treelet_core::traverse::Prims {
+            spheres: self.spheres,
+            sphere_count: self.spheres.len() as u32,
+            triangles: self.triangles,
+            triangle_count: self.triangles.len() as u32,
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.spheres.len() + self.triangles.len()
     }

@@ -62,12 +62,7 @@ impl Integrator {
 /// (`treelet_core::lights::light_power`), in primitive order. Empty
 /// without emitters.
 pub fn light_table(prims: Primitives, materials: &[treelet_core::layout::Material]) -> Vec<Light> {
-    let p = treelet_core::traverse::Prims {
-        spheres: prims.spheres,
-        sphere_count: prims.spheres.len() as u32,
-        triangles: prims.triangles,
-        triangle_count: prims.triangles.len() as u32,
-    };
+    let p = prims.as_core();
     let powers: Vec<(u32, f64)> = (0..p.count())
         .map(|i| (i, light_power(&p, materials, i) as f64))
         .filter(|&(_, w)| w > 0.0 && w.is_finite())
