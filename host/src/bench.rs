@@ -49,8 +49,16 @@ pub enum BenchCommand {
     /// Figure: treelet-optimization time against size (Graph 3.5).
     #[command(name = "graph3.5")]
     Graph35(FigureArgs),
-    /// Figure: error against time for each closest-hit method.
-    Error(FigureArgs),
+    /// Figures: RMSE against wall and kernel time for each integrator on
+    /// cornell and the disk-lit room, Mitsuba 3 beside (`--mitsuba`).
+    Error {
+        #[command(flatten)]
+        figure: FigureArgs,
+        /// Folder of `peers/mitsuba/room_disk.py`'s output (`mitsuba.jsonl` and
+        /// its images): Mitsuba 3's renders of the room, scored beside Treelet's.
+        #[arg(long)]
+        mitsuba: Option<std::path::PathBuf>,
+    },
     /// Figure: SAH cost against build time for every builder and peer.
     Pareto(FigureArgs),
     /// Figure: primary and diffuse rays per second through each tree.
@@ -162,7 +170,11 @@ pub enum BenchCommand {
 }
 
 fn figure(f: Figure, a: FigureArgs) -> Result<()> {
-    let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats: a.repeats.max(1) };
+    figure_with(f, a, None)
+}
+
+fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) -> Result<()> {
+    let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats: a.repeats.max(1), mitsuba };
     crate::suite::run(f, &suite)
 }
 
@@ -651,7 +663,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Graph25(a) => figure(Figure::Graph25, a),
         BenchCommand::Graph3(a) => figure(Figure::Graph3, a),
         BenchCommand::Graph35(a) => figure(Figure::Graph35, a),
-        BenchCommand::Error(a) => figure(Figure::Error, a),
+        BenchCommand::Error { figure: a, mitsuba } => figure_with(Figure::Error, a, mitsuba),
         BenchCommand::Pareto(a) => figure(Figure::Pareto, a),
         BenchCommand::RaysFigure(a) => figure(Figure::Rays, a),
         BenchCommand::All(a) => figure(Figure::All, a),

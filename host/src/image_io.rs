@@ -30,10 +30,13 @@ pub fn write(path: &Path, image: &HdrImage) -> Result<()> {
     let (w, h) = (image.width, image.height);
     match extension(path).as_str() {
         "png" => {
+            use image::codecs::png::{CompressionType, FilterType, PngEncoder};
             let bytes: Vec<u8> = image.pixels.iter().flat_map(|p| p.map(to_srgb8)).collect();
-            image::RgbImage::from_raw(w, h, bytes)
-                .context("image size mismatch")?
-                .save(path)
+            // Fast compression: a render's PNG is written on every run, and the
+            // default level takes several times longer for a few percent of size.
+            let file = std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+            let encoder = PngEncoder::new_with_quality(std::io::BufWriter::new(file), CompressionType::Fast, FilterType::Adaptive);
+            image::ImageEncoder::write_image(encoder, &bytes, w, h, image::ExtendedColorType::Rgb8)
                 .with_context(|| format!("cannot write {}", path.display()))
         }
         "exr" => {

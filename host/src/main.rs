@@ -167,21 +167,42 @@ fn run_render(args: RenderArgs) -> Result<()> {
             });
         }
     };
-    let (result, device, adapter) = match args.device {
+    let (result, device, adapter, startup) = match args.device {
         Device::Gpu => {
-            let mut b = GpuBackend::new(GpuContext::new()?);
+            let ctx = GpuContext::new()?;
+            let mut b = GpuBackend::new(ctx.clone());
             explain(&|| b.class());
             let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
-            (r, "gpu", b.adapter())
+            let (pipelines, pipelines_s) = ctx.pipelines_built();
+            let startup = serde_json::json!({
+                "device_s": ctx.startup.device_s,
+                "module_s": ctx.startup.module_s,
+                "pipelines": pipelines,
+                "pipelines_s": pipelines_s,
+                "pipeline_cache": if !ctx.has_pipeline_cache() { "none" } else if ctx.startup.cache_loaded { "loaded" } else { "new" },
+            });
+            (r, "gpu", b.adapter(), startup)
         }
         Device::Cpu => {
             let mut b = CpuBackend::new();
             explain(&|| b.class());
-            (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into())
+            (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into(), serde_json::Value::Null)
         }
     };
     bar.finish_and_clear();
+    let write_start = std::time::Instant::now();
     image_io::write(&args.out, &result.image)?;
+    let write_s = write_start.elapsed().as_secs_f64();
+    if args.explain && !startup.is_null() {
+        eprintln!(
+            "start-up   device {:.3} s, shader module {:.3} s, {} pipelines {:.3} s (pipeline cache: {}); image written in {write_s:.3} s",
+            startup["device_s"].as_f64().unwrap_or(0.0),
+            startup["module_s"].as_f64().unwrap_or(0.0),
+            startup["pipelines"],
+            startup["pipelines_s"].as_f64().unwrap_or(0.0),
+            startup["pipeline_cache"].as_str().unwrap_or("none"),
+        );
+    }
     // Wall time of the whole run so far: start-up, device, pipelines, render, image.
     let process_s = PROCESS_START.get().map_or(0.0, |t| t.elapsed().as_secs_f64());
     let paths = args.width as f64 * args.height as f64 * args.spp as f64;
@@ -218,6 +239,8 @@ fn run_render(args: RenderArgs) -> Result<()> {
             "total_s": result.total_s,
             "kernel_s": (result.build_ms + result.render_ms) / 1e3,
             "process_s": process_s,
+            "startup": startup,
+            "write_s": write_s,
             "samples_per_s": paths / result.total_s,
             "rows": result.rows,
         });

@@ -10,7 +10,7 @@ use treelet_core::lights::{light_power, Light};
 use treelet_core::render::{luminance, tiled_invocations};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::{Backend, StageTimes};
+use crate::backend::{Backend, DeviceClass, StageTimes};
 use crate::image_io::HdrImage;
 use crate::kernels::{Kernel, Method};
 use crate::layout::{lay_out, Layout, PrimBuffers, TracedTree};
@@ -53,6 +53,22 @@ impl Integrator {
         match self {
             Integrator::Smallpt => treelet_core::layout::SMALLPT,
             Integrator::Nee => treelet_core::layout::NEE,
+        }
+    }
+
+    /// The word the command line takes (`--integrator`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Smallpt => "smallpt",
+            Integrator::Nee => "nee",
+        }
+    }
+
+    /// What it is, for figures.
+    pub fn label(self) -> &'static str {
+        match self {
+            Integrator::Smallpt => "smallpt's estimator",
+            Integrator::Nee => "next-event estimation",
         }
     }
 }
@@ -105,12 +121,23 @@ pub struct RenderSettings {
 /// for a driver to time it out, whatever the sample count.
 pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;
 
-/// Samples per pixel per dispatch at most. lavapipe (Mesa 22.3) returned a
-/// far too dark image when one dispatch took 512 samples of each pixel of a
-/// small image (cornell at 64x48 and 32x24; 256 were right, and the CPU
-/// runner right at any count); the cause is not known. Small images take
-/// more dispatches instead.
-pub const MAX_SAMPLES_PER_DISPATCH: u32 = 64;
+/// Samples per pixel per dispatch at most: each invocation loops over
+/// that many camera paths of its pixel.
+///
+/// lavapipe (Mesa 22.3, LLVM 15) gets the image wrong when that loop is
+/// long, and the CPU runner, which runs the same code, never does; the
+/// cause is not known. Seen twice: far too dark at 512 samples a dispatch
+/// with smallpt's estimator (cornell at 64x48 and 32x24; 256 were right),
+/// and, with next-event estimation in the disk-lit room, most of the light
+/// lost from the second dispatch on at 32 and 64 samples a dispatch (16x12
+/// to 128x96; 24 and fewer were right at every size tried). CPU adapters
+/// therefore take 16; more dispatches cost them little.
+pub fn max_samples_per_dispatch(class: DeviceClass) -> u32 {
+    match class {
+        DeviceClass::CpuAdapter => 16,
+        DeviceClass::Gpu | DeviceClass::CpuRunner => 64,
+    }
+}
 
 /// The error of the image after one pass.
 #[derive(Clone, Debug, Serialize)]
@@ -120,6 +147,13 @@ pub struct PassRow {
     pub spp: u32,
     /// Seconds since the render started (BVH build included).
     pub elapsed_s: f64,
+    /// The wall time a render that stopped after this pass would have taken:
+    /// `elapsed_s` less the readbacks and scoring of earlier passes, which
+    /// only the error measurement needs.
+    pub wall_s: f64,
+    /// Kernel time so far (BVH build and render kernels; GPU timestamps
+    /// where available).
+    pub kernel_s: f64,
     /// Root mean square error against the reference (per channel).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rmse: Option<f64>,
@@ -194,12 +228,14 @@ pub fn render<B: Backend>(
     let accum = b.zeroed("accumulation", pixels * 16)?;
     let camera = scene.camera.camera(width, height);
     let kernel = Kernel::Render(plan.method(), plan.variant as u8);
-    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, MAX_SAMPLES_PER_DISPATCH as u64) as u32;
+    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, max_samples_per_dispatch(b.class()) as u64) as u32;
 
     let mut rows = Vec::new();
     let mut render_ms = 0.0;
     let mut done = 0u32;
     let mut sums: Vec<[f32; 4]> = Vec::new();
+    // Seconds spent reading back and scoring images that only the error rows need.
+    let mut measuring_s = 0.0;
     let schedule = pass_schedule(spp);
     for (pass, target) in schedule.iter().copied().enumerate() {
         b.stage("render");
@@ -229,16 +265,25 @@ pub fn render<B: Backend>(
         }
         let last = pass + 1 == schedule.len();
         if error_each_pass || last {
-            sums = b.read(&accum, pixels as usize)?;
+            // Waits for the pass (its timestamps) first, so that the readback is timed alone.
             render_ms += b.take_times()?.get("render");
-            let row = error_row(pass as u32, done, start.elapsed().as_secs_f64(), &sums, reference);
+            let read_start = start.elapsed().as_secs_f64();
+            sums = b.read(&accum, pixels as usize)?;
+            let elapsed_s = start.elapsed().as_secs_f64();
+            let times = (elapsed_s, elapsed_s - measuring_s, (build_ms + render_ms) / 1e3);
+            let row = error_row(pass as u32, done, times, &sums, reference);
+            if !last {
+                measuring_s += start.elapsed().as_secs_f64() - read_start;
+            }
             on_pass(&row);
             rows.push(row);
         } else {
             // Waits for the pass (its timestamps), without reading the image.
             render_ms += b.take_times()?.get("render");
             let elapsed_s = start.elapsed().as_secs_f64();
-            on_pass(&PassRow { pass: pass as u32, spp: done, elapsed_s, rmse: None, rel_mse: None, mean_std_error: None });
+            let kernel_s = (build_ms + render_ms) / 1e3;
+            let wall_s = elapsed_s - measuring_s;
+            on_pass(&PassRow { pass: pass as u32, spp: done, elapsed_s, wall_s, kernel_s, rmse: None, rel_mse: None, mean_std_error: None });
         }
     }
     let image =
@@ -262,9 +307,11 @@ pub fn image_error(image: impl Iterator<Item = [f64; 3]>, reference: &HdrImage) 
     ((se / count.max(1) as f64).sqrt(), rel / count.max(1) as f64)
 }
 
-fn error_row(pass: u32, spp: u32, elapsed_s: f64, sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
+/// `times`: elapsed, wall and kernel seconds (see [`PassRow`]).
+fn error_row(pass: u32, spp: u32, times: (f64, f64, f64), sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
     let n = spp as f64;
-    let mut row = PassRow { pass, spp, elapsed_s, rmse: None, rel_mse: None, mean_std_error: None };
+    let (elapsed_s, wall_s, kernel_s) = times;
+    let mut row = PassRow { pass, spp, elapsed_s, wall_s, kernel_s, rmse: None, rel_mse: None, mean_std_error: None };
     match reference {
         Some(r) => {
             let (rmse, rel) = image_error(sums.iter().map(|s| [0, 1, 2].map(|k| s[k] as f64 / n)), r);

@@ -42,7 +42,7 @@ pub enum Figure {
     /// Graph 3.5: treelet-optimization time against size.
     #[value(name = "graph3.5")]
     Graph35,
-    /// Error against time for each closest-hit method.
+    /// RMSE against wall and kernel time for each integrator (and Mitsuba 3).
     #[value(name = "error")]
     Error,
     /// SAH cost against build time for every builder (Pareto plot).
@@ -68,9 +68,12 @@ impl Figure {
         Figure::Rays,
     ];
 
-    /// File names of the figures, in order.
+    /// File names of the figures, in order (`error` makes two).
     pub fn names() -> impl Iterator<Item = &'static str> {
-        Self::EACH.into_iter().map(Figure::name)
+        Self::EACH.into_iter().flat_map(|f| match f {
+            Figure::Error => vec![f.name(), error_curves::ERROR_KERNEL],
+            _ => vec![f.name()],
+        })
     }
 
     fn name(self) -> &'static str {
@@ -142,6 +145,8 @@ pub struct Suite {
     pub quick: bool,
     pub out: PathBuf,
     pub repeats: usize,
+    /// Mitsuba 3's images of the disk-lit room (`bench error --mitsuba`).
+    pub mitsuba: Option<PathBuf>,
 }
 
 /// A backend for the suite's device (the GPU context is made once).
@@ -165,6 +170,8 @@ macro_rules! with_backend {
     };
 }
 
+mod error_curves;
+
 pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
     std::fs::create_dir_all(&suite.out).with_context(|| format!("creating {}", suite.out.display()))?;
     let runner = match suite.device {
@@ -180,21 +187,27 @@ pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
     for f in figures {
         eprintln!("== {} ({adapter})", f.name());
         let start = std::time::Instant::now();
-        let mut doc = measure(f, suite, &runner)?;
-        doc.adapter = adapter.clone();
-        doc.device = format!("{:?}", suite.device).to_lowercase();
-        doc.date = chrono::Utc::now().format("%Y-%m-%d").to_string();
-        doc.quick = suite.quick;
-        doc.command = format!(
-            "treelet bench {}{} --device {} --out DIR",
-            if f == Figure::Rays { "rays-figure" } else { f.name() },
-            if suite.quick { " --quick" } else { "" },
-            doc.device
-        );
-        write_figure(&suite.out, &doc)?;
-        print_table(&doc);
+        let measured = match f {
+            Figure::Error => error_curves::measure(suite, &runner)?,
+            _ => vec![measure(f, suite, &runner)?],
+        };
+        for mut doc in measured {
+            doc.adapter = adapter.clone();
+            doc.device = format!("{:?}", suite.device).to_lowercase();
+            doc.date = chrono::Utc::now().format("%Y-%m-%d").to_string();
+            doc.quick = suite.quick;
+            doc.command = format!(
+                "treelet bench {}{} --device {}{} --out DIR",
+                if f == Figure::Rays { "rays-figure" } else { f.name() },
+                if suite.quick { " --quick" } else { "" },
+                doc.device,
+                if f == Figure::Error && suite.mitsuba.is_some() { " --mitsuba MITSUBA_DIR" } else { "" }
+            );
+            write_figure(&suite.out, &doc)?;
+            print_table(&doc);
+            docs.push(doc);
+        }
         eprintln!("   {:.1} s", start.elapsed().as_secs_f64());
-        docs.push(doc);
     }
     if figure == Figure::All {
         let md = crate::results::markdown(&docs, "");
@@ -512,37 +525,6 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             }
             Ok(d)
         }
-        Figure::Error => {
-            let (w, h, spp) = if q { (128, 96, 64) } else { (1024, 768, 128) };
-            let spec = if q { "random:300" } else { "random:4000" };
-            let mut d = doc(figure, &format!("{spec}: error against time for each closest-hit method"), "time (s)", "mean standard error of pixel luminance", (true, true));
-            d.parameters = serde_json::json!({ "scene": spec, "width": w, "height": h, "spp": spp });
-            let scene = Scene::from_spec(spec)?;
-            with_backend!(runner, |b| {
-                for a in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
-                    let layout = Layout::Auto;
-                    let settings = RenderSettings {
-                        width: w,
-                        height: h,
-                        spp,
-                        seed: 1,
-                        accel: a,
-                        layout,
-                        kernel: KernelChoice::Auto,
-                        integrator: Integrator::Smallpt,
-                        error_each_pass: true,
-                    };
-                    let res = render(b, &scene, &settings, None, |_| {})?;
-                    for row in &res.rows {
-                        if let Some(e) = row.mean_std_error {
-                            d.points.push(Point::once(accel_name(a), row.elapsed_s, e));
-                        }
-                    }
-                }
-            });
-            d.notes.push("time is wall clock since the render began, BVH build included; error from per-pixel sample variance".into());
-            Ok(d)
-        }
         Figure::Pareto => {
             let specs: Vec<&str> = if q { vec!["random:10000", "terrain:10000"] } else { vec!["random:1000000", "terrain:1002528"] };
             let mut d = doc(
@@ -616,6 +598,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             Ok(d)
         }
         Figure::All => unreachable!("all is expanded by run"),
+        Figure::Error => unreachable!("error makes two figures: error_curves::measure"),
     }
 }
 

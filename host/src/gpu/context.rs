@@ -6,7 +6,9 @@
 //! passthrough (naga cannot read the Vulkan memory model capability the
 //! device-scope atomics need), so Treelet runs on Vulkan adapters only.
 use std::collections::HashMap;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
+use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 
@@ -30,6 +32,69 @@ pub struct GpuContext {
     pub timestamps: bool,
     module: wgpu::ShaderModule,
     pipelines: Mutex<HashMap<Kernel, Arc<Pipeline>>>,
+    /// The driver's compiled pipelines, kept on disk between runs.
+    cache: Option<DiskCache>,
+    /// Where the start-up time went.
+    pub startup: Startup,
+    /// Pipelines built so far, and their seconds (the cache is saved on drop only when some were).
+    built: Mutex<(u32, f64)>,
+}
+
+/// Seconds spent opening the device and building pipelines.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct Startup {
+    /// Vulkan instance, adapter and device.
+    pub device_s: f64,
+    /// The SPIR-V module (passed through to the driver).
+    pub module_s: f64,
+    /// Whether a pipeline cache from an earlier run was found.
+    pub cache_loaded: bool,
+}
+
+/// A pipeline cache and the file it is loaded from and saved to.
+struct DiskCache {
+    cache: wgpu::PipelineCache,
+    path: PathBuf,
+}
+
+/// The folder of the pipeline cache: `TREELET_PIPELINE_CACHE` (a folder, or
+/// `off`), else `$XDG_CACHE_HOME/treelet`, else `$HOME/.cache/treelet`.
+fn cache_dir() -> Option<PathBuf> {
+    match std::env::var_os("TREELET_PIPELINE_CACHE") {
+        Some(v) if v == "off" => None,
+        Some(v) => Some(PathBuf::from(v)),
+        None => std::env::var_os("XDG_CACHE_HOME")
+            .map(PathBuf::from)
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+            .map(|d| d.join("treelet")),
+    }
+}
+
+/// The file of this adapter's and this shader's cache (a shader of another
+/// build gets its own file, so that caches do not grow without end).
+fn cache_file(info: &wgpu::AdapterInfo) -> Option<PathBuf> {
+    let key = wgpu::util::pipeline_cache_key(info)?;
+    let hash = SHADER_SPV.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3));
+    Some(cache_dir()?.join(format!("{key}_{hash:016x}.bin")))
+}
+
+impl Drop for GpuContext {
+    /// Saves the pipeline cache when this run built pipelines. A cache that
+    /// cannot be written only costs the next run its compile time: ignored.
+    fn drop(&mut self) {
+        let Some(c) = &self.cache else { return };
+        if self.pipelines_built().0 == 0 {
+            return;
+        }
+        if let (Some(data), Some(dir)) = (c.cache.get_data(), c.path.parent()) {
+            // A temporary name of this process and context alone, renamed into place
+            // whole: runs that save at once never leave a mixed file.
+            let temp = c.path.with_extension(format!("{}-{:p}.tmp", std::process::id(), self));
+            let _ = std::fs::create_dir_all(dir)
+                .and_then(|()| std::fs::write(&temp, &data))
+                .and_then(|()| std::fs::rename(&temp, &c.path));
+        }
+    }
 }
 
 impl GpuContext {
@@ -40,6 +105,7 @@ impl GpuContext {
     }
 
     async fn new_async() -> Result<Arc<Self>> {
+        let start = Instant::now();
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         desc.backends = wgpu::Backends::VULKAN;
         let instance = wgpu::Instance::new(desc);
@@ -61,7 +127,9 @@ impl GpuContext {
             bail!("adapter `{}` lacks features Treelet needs: {missing:?}", info.name);
         }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let features = needed | if timestamps { wgpu::Features::TIMESTAMP_QUERY } else { wgpu::Features::empty() };
+        let cache_path = cache_file(&info).filter(|_| adapter.features().contains(wgpu::Features::PIPELINE_CACHE));
+        let optional = [(timestamps, wgpu::Features::TIMESTAMP_QUERY), (cache_path.is_some(), wgpu::Features::PIPELINE_CACHE)];
+        let features = optional.iter().filter(|o| o.0).fold(needed, |f, o| f | o.1);
         // Ask for everything the adapter offers: large scenes need large buffers.
         let limits = adapter.limits();
         let (device, queue) = adapter
@@ -75,14 +143,47 @@ impl GpuContext {
             })
             .await
             .with_context(|| format!("could not open adapter `{}`", info.name))?;
+        let device_s = start.elapsed().as_secs_f64();
         let module = shader_module(&device);
-        Ok(Arc::new(Self { device, queue, info, limits, timestamps, module, pipelines: Mutex::default() }))
+        let module_s = start.elapsed().as_secs_f64() - device_s;
+        let mut startup = Startup { device_s, module_s, cache_loaded: false };
+        let cache = cache_path.map(|path| {
+            let data = std::fs::read(&path).ok();
+            startup.cache_loaded = data.is_some();
+            // SAFETY: the data is what `get_data` saved for an adapter of the same
+            // pipeline_cache_key (the file name); the driver checks it and, with
+            // `fallback`, starts an empty cache when it does not match.
+            let cache = unsafe {
+                device.create_pipeline_cache(&wgpu::PipelineCacheDescriptor { label: Some("treelet"), data: data.as_deref(), fallback: true })
+            };
+            DiskCache { cache, path }
+        });
+        Ok(Arc::new(Self { device, queue, info, limits, timestamps, module, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
     }
 
     /// The pipeline of `kernel`, built the first time it is asked for.
     pub fn pipeline(&self, kernel: Kernel) -> Arc<Pipeline> {
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
-        pipelines.entry(kernel).or_insert_with(|| Arc::new(build_pipeline(&self.device, &self.module, kernel))).clone()
+        pipelines
+            .entry(kernel)
+            .or_insert_with(|| {
+                let start = Instant::now();
+                let p = build_pipeline(&self.device, &self.module, kernel, self.cache.as_ref().map(|c| &c.cache));
+                let mut built = self.built.lock().unwrap_or_else(|e| e.into_inner());
+                *built = (built.0 + 1, built.1 + start.elapsed().as_secs_f64());
+                Arc::new(p)
+            })
+            .clone()
+    }
+
+    /// Pipelines built so far and the seconds they took.
+    pub fn pipelines_built(&self) -> (u32, f64) {
+        *self.built.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Whether compiled pipelines are kept on disk between runs.
+    pub fn has_pipeline_cache(&self) -> bool {
+        self.cache.is_some()
     }
 
     /// Largest buffer usable as one storage binding.
@@ -108,7 +209,7 @@ fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {
     }
 }
 
-fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Kernel) -> Pipeline {
+fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Kernel, cache: Option<&wgpu::PipelineCache>) -> Pipeline {
             let entries: Vec<_> = kernel
                 .bindings()
                 .iter()
@@ -139,7 +240,7 @@ fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Ke
                 module,
                 entry_point: Some(kernel.entry_point()),
                 compilation_options: Default::default(),
-                cache: None,
+                cache,
             });
             Pipeline { pipeline, layout }
 }

@@ -1,0 +1,202 @@
+//! `treelet bench error`: how fast each integrator's error falls, as RMSE
+//! against a reference that Treelet renders long (next-event estimation,
+//! another seed), after each pass of one render, against the render's wall
+//! time (`error`) and its kernel time (`error-kernel`). Mitsuba 3's images
+//! of the same room (`peers/mitsuba/room_disk.py`, run on the same GPU) are
+//! scored beside them with the same error code when `--mitsuba DIR` names
+//! its output.
+use super::*;
+use treelet::image_io::{self, HdrImage};
+use anyhow::bail;
+use treelet::render::{image_error, PassRow};
+
+/// The scenes: smallpt's room with its big sphere light, and the room lit by
+/// a small disk of triangles (as Mitsuba sees it).
+const SCENES: [(&str, &str); 2] = [("cornell", "cornell"), ("room_disk", "scenes/room_disk.json")];
+
+/// Both figures: against wall time, then against kernel time.
+pub(super) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
+    let (w, h, spp, reference_spp) = if s.quick { (128, 96, 256, 2048) } else { (1024, 768, 1024, 4096) };
+    let mut wall = doc(Figure::Error, &format!("RMSE against wall time, {w}x{h}"), "wall time (s)", "RMSE against the reference", (true, true));
+    let mut kernel = doc(Figure::Error, &format!("RMSE against kernel time, {w}x{h}"), "kernel time (s)", "RMSE against the reference", (true, true));
+    kernel.figure = ERROR_KERNEL.into();
+    let parameters = serde_json::json!({ "scenes": SCENES.map(|s| s.1), "width": w, "height": h, "spp": spp, "reference_spp": reference_spp });
+    wall.parameters = parameters.clone();
+    kernel.parameters = parameters;
+    let pb = bar(SCENES.len() * (1 + 2 * s.repeats), "renders");
+    for (name, spec) in SCENES {
+        let scene = Scene::from_spec(spec)?;
+        let settings = |integrator, spp, seed, error_each_pass| RenderSettings {
+            width: w,
+            height: h,
+            spp,
+            seed,
+            accel: Accel::Auto,
+            layout: Layout::Auto,
+            kernel: KernelChoice::Auto,
+            integrator,
+            error_each_pass,
+        };
+        with_backend!(runner, |b| {
+            pb.set_message(format!("{name}: reference, {reference_spp} spp"));
+            let reference = render(b, &scene, &settings(Integrator::Nee, reference_spp, 99, false), None, |_| {})?.image;
+            let path = s.out.join(format!("error_reference_{name}.exr"));
+            image_io::write(&path, &reference)?;
+            pb.inc(1);
+            for integrator in [Integrator::Smallpt, Integrator::Nee] {
+                pb.set_message(format!("{name}: {}", integrator.name()));
+                // Warm-up: the first render compiles the kernel (Mitsuba's times also leave that out).
+                render(b, &scene, &settings(integrator, 4, 1, false), None, |_| {})?;
+                let mut runs = Vec::new();
+                for _ in 0..s.repeats {
+                    runs.push(render(b, &scene, &settings(integrator, spp, 1, true), Some(&reference), |_| {})?.rows);
+                    pb.inc(1);
+                }
+                let series = format!("{name}: Treelet, {}", integrator.label());
+                for (i, row) in runs[0].iter().enumerate() {
+                    let rmse = row.rmse.context("a render against a reference has an RMSE")?;
+                    let at = |time: fn(&PassRow) -> f64| median(runs.iter().map(|r| time(&r[i])).collect());
+                    wall.points.push(Point { x: at(|r| r.wall_s), ..Point::once(&series, 0.0, rmse) });
+                    kernel.points.push(Point { x: at(|r| r.kernel_s), ..Point::once(&series, 0.0, rmse) });
+                }
+                let spps: Vec<String> = runs[0].iter().map(|r| r.spp.to_string()).collect();
+                wall.notes.push(format!("{series}: {} spp at its points", spps.join(", ")));
+            }
+        });
+        if let (Some(dir), "room_disk") = (&s.mitsuba, name) {
+            let reference = image_io::read_hdr(&s.out.join(format!("error_reference_{name}.exr")))?;
+            for (label, time, rmse) in mitsuba_points(dir, &reference)? {
+                let series = format!("{name}: Mitsuba 3, {label}");
+                wall.points.push(Point::once(&series, time.0, rmse));
+                kernel.points.push(Point::once(&series, time.1, rmse));
+            }
+        }
+    }
+    pb.finish_and_clear();
+    for d in [&mut wall, &mut kernel] {
+        d.notes.extend(equal_time_notes(d));
+        d.notes.push(format!(
+            "Treelet: one render per integrator and scene ({} repeats, median times), its error after each pass against \
+             Treelet's reference (next-event estimation, {reference_spp} spp, seed 99); `--accel auto`; time from the start of \
+             the render (BVH build included, kernel compilation left out by a warm-up render; wall time leaves out the \
+             readbacks and scoring of earlier passes, which only this measurement needs)",
+            s.repeats
+        ));
+    }
+    if s.mitsuba.is_some() {
+        wall.notes.push(
+            "Mitsuba 3: `peers/mitsuba/room_disk.py` (a fresh render per sample count, its wall time from the render call to \
+             its image in device memory, its kernel time from Dr.Jit's kernel history), scored by Treelet's error code \
+             against its own largest sample count (its noise) and against Treelet's reference (which also shows where \
+             the two renderers' rooms differ)"
+                .into(),
+        );
+    }
+    Ok(vec![wall, kernel])
+}
+
+/// The file name of the kernel-time figure.
+pub(super) const ERROR_KERNEL: &str = "error-kernel";
+
+/// Mitsuba's images listed in `dir/mitsuba.jsonl` (one JSON object a line:
+/// `spp`, `wall_s`, `kernel_ms`, `image`), each scored against its own
+/// largest sample count and against Treelet's `reference`: (series label,
+/// (wall s, kernel s), RMSE).
+fn mitsuba_points(dir: &Path, reference: &HdrImage) -> Result<Vec<(String, (f64, f64), f64)>> {
+    let list = dir.join("mitsuba.jsonl");
+    let text = std::fs::read_to_string(&list).with_context(|| format!("reading {}", list.display()))?;
+    let mut runs = Vec::new();
+    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let where_ = || format!("{}:{}", list.display(), i + 1);
+        let v: serde_json::Value = serde_json::from_str(line).with_context(where_)?;
+        let field = |k: &str| v[k].as_f64().with_context(|| format!("{}: no number `{k}`", where_()));
+        let image = v["image"].as_str().with_context(|| format!("{}: no string `image`", where_()))?;
+        // The script wrote the path on the device; the image lies beside the list.
+        let file = Path::new(image).file_name().with_context(|| format!("{}: `{image}` names no file", where_()))?;
+        let hdr = image_io::read_hdr(&dir.join(file))?;
+        if (hdr.width, hdr.height) != (reference.width, reference.height) {
+            bail!(
+                "{}: {} is {}x{}, the figure's images {}x{} (Mitsuba's script renders 1024x768: leave out --quick)",
+                where_(),
+                file.to_string_lossy(),
+                hdr.width,
+                hdr.height,
+                reference.width,
+                reference.height
+            );
+        }
+        runs.push((field("spp")?, (field("wall_s")?, field("kernel_ms")? / 1e3), hdr));
+    }
+    let Some(top) = runs.iter().map(|r| r.0).reduce(f64::max) else { bail!("{}: no images listed", list.display()) };
+    let own = &runs.iter().find(|r| r.0 == top).expect("the largest is in the list").2;
+    let pixels = |img: &HdrImage| img.pixels.iter().map(|p| p.map(f64::from)).collect::<Vec<_>>().into_iter();
+    let mut points = Vec::new();
+    for (spp, time, image) in &runs {
+        if *spp < top {
+            points.push((format!("against its own {top} spp"), *time, image_error(pixels(image), own).0));
+        }
+        points.push(("against Treelet's reference".to_string(), *time, image_error(pixels(image), reference).0));
+    }
+    points.sort_by(|a, b| a.0.cmp(&b.0).then(a.1 .0.total_cmp(&b.1 .0)));
+    Ok(points)
+}
+
+/// For each scene: every series' RMSE at the time of next-event
+/// estimation's last point, interpolated on the log-log curve (beyond a
+/// series' ends, extended with slope -1/2, as Monte Carlo error falls).
+fn equal_time_notes(d: &FigureDoc) -> Vec<String> {
+    let mut notes = Vec::new();
+    for (name, _) in SCENES {
+        let nee = format!("{name}: Treelet, {}", Integrator::Nee.label());
+        let Some(t) = d.points.iter().filter(|p| p.series == nee).map(|p| p.x).reduce(f64::max) else { continue };
+        let mut names: Vec<&str> = Vec::new();
+        for p in d.points.iter().filter(|p| p.series.starts_with(&format!("{name}: "))) {
+            if !names.contains(&p.series.as_str()) {
+                names.push(&p.series);
+            }
+        }
+        let at = |series: &str| {
+            let pts: Vec<(f64, f64)> = d.points.iter().filter(|p| p.series == series && p.x > 0.0 && p.median > 0.0).map(|p| (p.x, p.median)).collect();
+            rmse_at(&pts, t)
+        };
+        let Some(base) = at(&nee) else { continue };
+        let parts: Vec<String> = names
+            .iter()
+            .filter_map(|n| at(n).map(|e| format!("{} {:.4} ({:.2}x next-event estimation's)", n.trim_start_matches(&format!("{name}: ")), e, e / base)))
+            .collect();
+        notes.push(format!("{name} at {t:.3} s ({}): {}", d.x_label, parts.join("; ")));
+    }
+    notes
+}
+
+/// The error of a curve at time `t`: log-log interpolation between the
+/// points around it, or slope -1/2 from the nearest end.
+pub(crate) fn rmse_at(points: &[(f64, f64)], t: f64) -> Option<f64> {
+    let mut pts = points.to_vec();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (first, last) = (*pts.first()?, *pts.last()?);
+    if t <= first.0 {
+        return Some(first.1 * (t / first.0).powf(-0.5));
+    }
+    if t >= last.0 {
+        return Some(last.1 * (t / last.0).powf(-0.5));
+    }
+    let i = pts.iter().position(|p| p.0 >= t)?;
+    let (a, b) = (pts[i - 1], pts[i]);
+    let f = (t / a.0).ln() / (b.0 / a.0).ln();
+    Some((a.1.ln() + f * (b.1 / a.1).ln()).exp())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rmse_at;
+
+    #[test]
+    fn interpolates_on_the_log_log_curve_and_extends_with_slope_minus_half() {
+        let pts = [(1.0, 1.0), (4.0, 0.5)];
+        assert!((rmse_at(&pts, 2.0).unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+        assert!((rmse_at(&pts, 16.0).unwrap() - 0.25).abs() < 1e-12);
+        assert!((rmse_at(&pts, 0.25).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(rmse_at(&[], 1.0), None);
+    }
+}
