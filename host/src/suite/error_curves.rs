@@ -189,7 +189,36 @@ pub(crate) fn rmse_at(points: &[(f64, f64)], t: f64) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
-    use super::rmse_at;
+    use super::{mitsuba_points, rmse_at};
+    use treelet::image_io::{write, HdrImage};
+
+    /// Mitsuba's list with a bad line or a missing image: an error that names
+    /// the file and line; a good list: scores against both references.
+    #[test]
+    fn mitsuba_lists_are_read_with_clear_errors() {
+        let dir = std::env::temp_dir().join(format!("treelet-mitsuba-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let image = |v: f32| HdrImage { width: 4, height: 2, pixels: vec![[v; 3]; 8] };
+        write(&dir.join("a_16spp.pfm"), &image(1.5)).unwrap();
+        write(&dir.join("a_64spp.pfm"), &image(1.25)).unwrap();
+        let line = |spp: u32, file: &str| format!("{{\"spp\": {spp}, \"wall_s\": 0.5, \"kernel_ms\": 400, \"image\": \"/elsewhere/{file}\"}}\n");
+        let list = dir.join("mitsuba.jsonl");
+        std::fs::write(&list, line(16, "a_16spp.pfm") + &line(64, "a_64spp.pfm")).unwrap();
+        let points = mitsuba_points(&dir, &image(1.0)).unwrap();
+        assert_eq!(points.len(), 3);
+        assert!(points.iter().any(|p| p.0 == "against its own 64 spp" && (p.2 - 0.25).abs() < 1e-6));
+        assert!(points.iter().any(|p| p.0 == "against Treelet's reference" && (p.2 - 0.5).abs() < 1e-6));
+        std::fs::write(&list, line(16, "a_16spp.pfm") + "{\"spp\": 64}\n").unwrap();
+        let e = format!("{:#}", mitsuba_points(&dir, &image(1.0)).unwrap_err());
+        assert!(e.contains("mitsuba.jsonl:2") && e.contains("no string `image`"), "{e}");
+        std::fs::write(&list, line(16, "missing.pfm")).unwrap();
+        let e = format!("{:#}", mitsuba_points(&dir, &image(1.0)).unwrap_err());
+        assert!(e.contains("missing.pfm"), "{e}");
+        std::fs::write(&list, line(16, "a_16spp.pfm")).unwrap();
+        let e = format!("{:#}", mitsuba_points(&dir, &HdrImage { width: 2, height: 2, pixels: vec![[1.0; 3]; 4] }).unwrap_err());
+        assert!(e.contains("is 4x2, the figure's images 2x2"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn interpolates_on_the_log_log_curve_and_extends_with_slope_minus_half() {
