@@ -37,6 +37,19 @@ pub enum Accel {
     Sweep,
 }
 
+impl Accel {
+    /// The word the command line takes (`--accel`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Auto => "auto",
+            Accel::None => "none",
+            Accel::Lbvh => "lbvh",
+            Accel::Trbvh => "trbvh",
+            Accel::Sweep => "sweep",
+        }
+    }
+}
+
 /// How radiance is estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]

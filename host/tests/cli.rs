@@ -239,3 +239,51 @@ fn compare_scores_images_and_names_bad_input() {
     let e = stderr_of(&["compare", "nowhere.exr", "--reference", &fine]);
     assert!(e.contains("nowhere.exr"), "{e}");
 }
+
+/// A first run on a machine without a Vulkan driver renders on the CPU
+/// runner with one note; `--device gpu` there is an error that says what to
+/// install; and no run prints Mesa's XDG_RUNTIME_DIR complaint.
+#[test]
+fn first_run_without_vulkan_renders_on_the_cpu_runner() {
+    let dir = std::env::temp_dir().join(format!("treelet-novulkan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let image = dir.join("a.png");
+    let run = |device: &str| {
+        Command::new(env!("CARGO_BIN_EXE_treelet"))
+            .args(["render", "--width", "16", "--height", "12", "--spp", "4", "--device", device, "--out"])
+            .arg(&image)
+            .env("VK_DRIVER_FILES", "/nonexistent")
+            .env("VK_ICD_FILENAMES", "/nonexistent")
+            .env_remove("XDG_RUNTIME_DIR")
+            .output()
+            .expect("run treelet")
+    };
+    let out = run("auto");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(image.exists(), "no image written: {err}");
+    assert_eq!(err.matches("note:").count(), 1, "{err}");
+    assert!(err.contains("no Vulkan adapter") && err.contains("CPU runner") && err.contains("on cpu"), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    let out = run("gpu");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("mesa-vulkan-drivers") && !err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// With Vulkan present (lavapipe in CI) and no runtime directory set, Mesa
+/// stays quiet.
+#[test]
+fn no_xdg_runtime_dir_message() {
+    let image = std::env::temp_dir().join(format!("treelet-xdg-{}.png", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["render", "--width", "16", "--height", "12", "--spp", "4", "--out"])
+        .arg(&image)
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .expect("run treelet");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    std::fs::remove_file(&image).ok();
+}

@@ -116,9 +116,8 @@ impl GpuContext {
             })
             .await
             .context(
-                "no Vulkan adapter found: install a Vulkan driver \
-                 (on a machine without a GPU: `apt-get install mesa-vulkan-drivers` for lavapipe), \
-                 or use --device cpu",
+                "no Vulkan adapter found (install a Vulkan driver; without a GPU, \
+                 `apt-get install mesa-vulkan-drivers` gives lavapipe)",
             )?;
         let info = adapter.get_info();
         let needed = wgpu::Features::PASSTHROUGH_SHADERS | wgpu::Features::SHADER_INT64;
