@@ -5,10 +5,10 @@
 //!
 //!     cargo run --release -p treelet --example embed
 use glam::Vec3;
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::layout::{wide_nodes, Layout};
-use treelet::primitives::Primitives;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::build::layout::{wide_nodes, Layout};
+use treelet::scene::primitives::Primitives;
 use treelet::render::{scene_tree, Accel};
 use treelet_core::bvh2::closest_hit_bvh2;
 use treelet_core::cwbvh::closest_hit_cwbvh;

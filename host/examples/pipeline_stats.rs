@@ -7,7 +7,7 @@
 //!     cargo run --release -p treelet --example pipeline_stats [ENTRY_POINT ...]
 //!
 //! Entry points are named as in the shader crate (`render::cast_cwbvh_cs`);
-//! without names, every kernel of `treelet::kernels::Kernel::all()`.
+//! without names, every kernel of `treelet::runtime::kernels::Kernel::all()`.
 use std::ffi::CString;
 
 use anyhow::{bail, Context, Result};
@@ -16,7 +16,7 @@ use ash::vk;
 fn main() -> Result<()> {
     let mut names: Vec<String> = std::env::args().skip(1).collect();
     if names.is_empty() {
-        names = treelet::kernels::Kernel::all().iter().map(|k| k.entry_point().to_string()).collect();
+        names = treelet::runtime::kernels::Kernel::all().iter().map(|k| k.entry_point().to_string()).collect();
     }
     // SAFETY: plain Vulkan calls on objects created here, destroyed at exit.
     unsafe {
@@ -52,7 +52,7 @@ fn main() -> Result<()> {
             .push_next(&mut v12);
         let device = instance.create_device(pdev, &info, None).context("device without pipeline statistics")?;
         let stats = ash::khr::pipeline_executable_properties::Device::new(&instance, &device);
-        let words = ash::util::read_spv(&mut std::io::Cursor::new(treelet::gpu::context::SHADER_SPV))?;
+        let words = ash::util::read_spv(&mut std::io::Cursor::new(treelet::runtime::gpu::context::SHADER_SPV))?;
         let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
         // One layout that covers every kernel's bindings: storage buffers 0..16.
         let bindings: Vec<_> = (0..16)

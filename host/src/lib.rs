@@ -1,34 +1,30 @@
 //! # treelet
 //!
-//! The host side of Treelet: a wgpu runtime for the SPIR-V kernels of
-//! `treelet-shader`, a CPU runner for the same kernel functions, the stage
-//! order of each build, scenes, an independent tree validator, and the
-//! `treelet` command.
+//! The host side of Treelet, in the order of its pipeline; each folder
+//! depends only on the ones above it:
+//!
+//! - [`runtime`]: where kernels run: the [`Backend`](runtime::backend::Backend)
+//!   trait, the GPU through wgpu, and the CPU runner that calls the same
+//!   kernel functions over every invocation id;
+//! - [`scene`]: what is built and rendered: spheres and triangles, meshes,
+//!   scene files, and the checks that reject bad input;
+//! - [`build`]: the BVH builders (LBVH, treelet restructuring, full-sweep
+//!   SAH), the traversal layouts and the independent validators;
+//! - [`render`]: the path tracer's passes, the kernel variant a scene needs,
+//!   images in and out;
+//! - [`plot`]: charts for reports and benchmarks.
+//!
+//! The `treelet` command (`main.rs`, `bench/`) sits on top.
 //!
 //! ```no_run
-//! use treelet::{backend::Backend, cpu_runner::CpuBackend, lbvh, scene};
+//! use treelet::{build::lbvh, runtime::cpu_runner::CpuBackend, scene};
 //! let spheres = scene::random_spheres(1000, 7);
 //! let (bvh, times) = lbvh::build(&mut CpuBackend::new(), &spheres).unwrap();
 //! assert_eq!(bvh.nodes.len(), 1999);
 //! println!("{} ms", times.total());
 //! ```
-pub mod backend;
-pub mod cpu_runner;
-pub mod gpu;
-pub mod image_io;
-pub mod kernels;
-pub mod layout;
-pub mod lbvh;
-pub mod mesh;
-pub mod primitives;
+pub mod build;
 pub mod plot;
 pub mod render;
-pub mod report;
+pub mod runtime;
 pub mod scene;
-pub mod scene_file;
-pub mod sort;
-pub mod sweep;
-pub mod trbvh;
-pub mod validate;
-pub mod validate_layout;
-pub mod variant;

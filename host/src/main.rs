@@ -4,21 +4,19 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::{GpuBackend, GpuContext};
-use treelet::image_io;
-use treelet::layout::Layout;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::render::image_io;
+use treelet::build::layout::Layout;
 use treelet::plot::Series;
 use treelet::render::{render, Accel, Integrator, PassRow, RenderSettings};
-use treelet::report::{run_build, run_build_sweep, BuildReport};
+use treelet::build::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
-use treelet::trbvh::TreeletConfig;
-use treelet::variant::{self, KernelChoice};
+use treelet::build::trbvh::TreeletConfig;
+use treelet::render::variant::{self, KernelChoice};
 
 mod bench;
-mod results;
-mod suite;
 
 #[derive(Parser)]
 #[command(name = "treelet", version, about = "GPU BVH construction (Karras 2012) and a smallpt path tracer, in Rust")]
@@ -27,11 +25,6 @@ struct Cli {
     command: Command,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Device {
-    Gpu,
-    Cpu,
-}
 
 /// Where `render` and `build` run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -185,7 +178,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         };
         bar.set_message(err);
     };
-    let explain = |b: &dyn Fn() -> treelet::backend::DeviceClass| {
+    let explain = |b: &dyn Fn() -> treelet::runtime::backend::DeviceClass| {
         if args.explain {
             bar.suspend(|| {
                 eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain());

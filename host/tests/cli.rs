@@ -107,7 +107,7 @@ fn render_writes_image_report_and_plot() {
         report.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let image = treelet::image_io::read_hdr(&img).unwrap();
+    let image = treelet::render::image_io::read_hdr(&img).unwrap();
     assert_eq!((image.width, image.height), (24, 18));
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert_eq!(v["spp"], 16);

@@ -1,12 +1,13 @@
-//! Scenes: parsing a scene name, generating random scenes, checking input.
-use anyhow::{bail, Context as _, Result};
+//! What a scene is (spheres and triangles, a material each, a camera) and
+//! the built-in ones: smallpt's cornell, random spheres, terrains.
+use anyhow::{bail, Result};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
 use treelet_core::render::SMALLPT_FOV;
 use treelet_core::triangle::Triangle;
 
-use crate::primitives::Primitives;
+use crate::scene::primitives::Primitives;
 
 /// Where random scenes place sphere centres: smallpt's room, short of the
 /// plane (z about 155) where its camera rays start, so that no sphere
@@ -177,54 +178,6 @@ impl Scene {
     pub fn primitives(&self) -> Primitives<'_> {
         Primitives { spheres: self.objects(), triangles: &self.triangles }
     }
-
-    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON
-    /// scene file or an `.obj` / `.ply` mesh.
-    pub fn from_spec(spec: &str) -> Result<Scene> {
-        if spec == "cornell" {
-            return Ok(cornell());
-        }
-        if spec.ends_with(".json") {
-            return crate::scene_file::load(std::path::Path::new(spec));
-        }
-        let lower = spec.to_ascii_lowercase();
-        if lower.ends_with(".obj") || lower.ends_with(".ply") {
-            let triangles = crate::mesh::load(std::path::Path::new(spec))?;
-            return Ok(mesh_scene(spec, &triangles));
-        }
-        let mut parts = spec.split(':');
-        match parts.next() {
-            Some("random") => {
-                let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
-                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
-                let seed = match parts.next() {
-                    Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
-                    None => 1,
-                };
-                if parts.next().is_some() {
-                    bail!("scene `{spec}`: expected random:N[:SEED]");
-                }
-                if n > crate::lbvh::MAX_PRIMITIVES as usize {
-                    bail!("scene `{spec}`: {n} primitives, at most {} are supported", crate::lbvh::MAX_PRIMITIVES);
-                }
-                Ok(random_scene(spec, n, seed))
-            }
-            Some("terrain") => {
-                let n = parts.next().with_context(|| format!("scene `{spec}`: expected terrain:N"))?;
-                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a triangle count"))?;
-                if parts.next().is_some() || n == 0 {
-                    bail!("scene `{spec}`: expected terrain:N with N > 0 triangles");
-                }
-                if n > crate::lbvh::MAX_PRIMITIVES as usize {
-                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", crate::lbvh::MAX_PRIMITIVES);
-                }
-                Ok(mesh_scene(spec, &terrain(n)))
-            }
-            _ => bail!(
-                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file or an .obj/.ply mesh"
-            ),
-        }
-    }
 }
 
 /// `random:N`: N spheres of mixed materials inside smallpt's room: 70%
@@ -272,24 +225,3 @@ pub fn random_spheres(n: usize, seed: u64) -> Vec<Sphere> {
         .collect()
 }
 
-/// Rejects spheres a build or render cannot use, naming the first bad one:
-/// non-finite centre or radius, or a negative radius.
-pub fn validate_spheres(spheres: &[Sphere]) -> Result<()> {
-    for (i, s) in spheres.iter().enumerate() {
-        if let Some(k) = s.center.iter().position(|c| !c.is_finite()) {
-            bail!(
-                "sphere {i}: centre coordinate {} is {} (every coordinate must be finite)",
-                "xyz".as_bytes()[k] as char,
-                s.center[k]
-            );
-        }
-        if !s.radius.is_finite() || s.radius < 0.0 {
-            bail!("sphere {i}: radius is {} (must be finite and non-negative)", s.radius);
-        }
-        // A box corner (centre ± radius) must stay finite too.
-        if s.center.iter().any(|c| !(c.abs() + s.radius).is_finite()) {
-            bail!("sphere {i}: its bounding box overflows f32 (centre {:?}, radius {})", s.center, s.radius);
-        }
-    }
-    Ok(())
-}

@@ -4,7 +4,7 @@
 use treelet_core::layout::{Node, Sphere};
 use treelet_core::triangle::Triangle;
 
-use crate::primitives::Primitives;
+use crate::scene::primitives::Primitives;
 
 /// The result of [`validate`]: empty `errors` means valid.
 #[derive(Clone, Debug, Default)]

@@ -17,9 +17,9 @@ use treelet_core::sah::SahCosts;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::{Aabb, Node};
 
-use crate::backend::{Backend, StageTimes};
-use crate::kernels::Kernel;
-use crate::lbvh::DeviceBvh;
+use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernels::Kernel;
+use crate::build::lbvh::DeviceBvh;
 
 /// How the optimization runs; defaults after Karras & Aila 2013.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
@@ -83,7 +83,7 @@ pub fn optimize<B: Backend>(
 
 /// The restructuring rounds of [`optimize`] alone: the tree keeps one
 /// primitive per leaf and the LBVH layout, for layouts that collapse
-/// leaves their own way ([`crate::layout::Layout::Cwbvh`]).
+/// leaves their own way ([`crate::build::layout::Layout::Cwbvh`]).
 pub fn restructure<B: Backend>(
     b: &mut B,
     bvh: DeviceBvh<B>,

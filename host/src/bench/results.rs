@@ -1,7 +1,7 @@
 //! `RESULTS.md` from the figures of one `treelet bench all` run: a section
 //! per figure with its device, date and command, its table and its plot.
 //! Generated, never typed: `docs/RESULTS.md` concatenates such runs.
-use crate::suite::{table, FigureDoc};
+use super::figure::{plot_figure, table, Figure, FigureDoc};
 
 /// The section of one run; plots are linked as `<image_prefix><figure>.png`.
 pub fn markdown(docs: &[FigureDoc], image_prefix: &str) -> String {
@@ -64,7 +64,7 @@ pub fn collect(runs: &[std::path::PathBuf], out: &std::path::Path) -> anyhow::Re
     );
     for dir in runs {
         let mut docs: Vec<FigureDoc> = Vec::new();
-        for f in crate::suite::Figure::names() {
+        for f in Figure::names() {
             let path = dir.join(format!("{f}.json"));
             if !path.exists() {
                 continue;
@@ -74,7 +74,7 @@ pub fn collect(runs: &[std::path::PathBuf], out: &std::path::Path) -> anyhow::Re
         }
         // Plots anew from the JSON, with the current plotting code.
         for d in &docs {
-            crate::suite::plot_figure(dir, d)?;
+            plot_figure(dir, d)?;
         }
         anyhow::ensure!(!docs.is_empty(), "{}: no figure files (run `treelet bench all --out {}` first)", dir.display(), dir.display());
         let rel = pathdiff(dir, base);

@@ -5,8 +5,19 @@
 //! of the same room (`peers/mitsuba/room_disk.py`, run on the same GPU) are
 //! scored beside them with the same error code when `--mitsuba DIR` names
 //! its output.
-use super::*;
-use treelet::image_io::{self, HdrImage};
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use treelet::build::layout::Layout;
+use treelet::render::variant::KernelChoice;
+use treelet::render::{render, Accel, Integrator, RenderSettings};
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::scene::Scene;
+
+use super::figure::{bar, doc, with_backend, Figure, FigureDoc, Point, Runner, Suite, ERROR_KERNEL};
+use super::measure::median;
+use treelet::render::image_io::{self, HdrImage};
 use anyhow::bail;
 use treelet::render::{image_error, PassRow};
 
@@ -15,7 +26,7 @@ use treelet::render::{image_error, PassRow};
 const SCENES: [(&str, &str); 2] = [("cornell", "cornell"), ("room_disk", "scenes/room_disk.json")];
 
 /// Both figures: against wall time, then against kernel time.
-pub(super) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
+pub(crate) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
     let (w, h, spp, reference_spp) = if s.quick { (128, 96, 256, 2048) } else { (1024, 768, 1024, 4096) };
     let mut wall = doc(Figure::Error, &format!("RMSE against wall time, {w}x{h}"), "wall time (s)", "RMSE against the reference", (true, true));
     let mut kernel = doc(Figure::Error, &format!("RMSE against kernel time, {w}x{h}"), "kernel time (s)", "RMSE against the reference", (true, true));
@@ -94,9 +105,6 @@ pub(super) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
     }
     Ok(vec![wall, kernel])
 }
-
-/// The file name of the kernel-time figure.
-pub(super) const ERROR_KERNEL: &str = "error-kernel";
 
 /// Mitsuba's images listed in `dir/mitsuba.jsonl` (one JSON object a line:
 /// `spp`, `wall_s`, `kernel_ms`, `image`), each scored against its own
@@ -190,7 +198,7 @@ pub(crate) fn rmse_at(points: &[(f64, f64)], t: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::{mitsuba_points, rmse_at};
-    use treelet::image_io::{write, HdrImage};
+    use treelet::render::image_io::{write, HdrImage};
 
     /// Mitsuba's list with a bad line or a missing image: an error that names
     /// the file and line; a good list: scores against both references.

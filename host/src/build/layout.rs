@@ -10,11 +10,11 @@ use treelet_core::layout::{Bvh2Node, LayoutParams, LeafPrim, Node, WideNode};
 use treelet_core::traverse::STACK_DEPTH;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::{check_fits, Backend, DeviceClass};
-use crate::kernels::{Kernel, Method};
-use crate::lbvh::{upload_or_placeholder, DeviceBvh};
-use crate::primitives::Primitives;
-use crate::trbvh;
+use crate::runtime::backend::{check_fits, Backend, DeviceClass};
+use crate::runtime::kernels::{Kernel, Method};
+use crate::build::lbvh::{upload_or_placeholder, DeviceBvh};
+use crate::scene::primitives::Primitives;
+use crate::build::trbvh;
 
 /// How a tree is stored for traversal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -272,8 +272,8 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
         groups,
     );
     b.stage("wide scans");
-    crate::sort::exclusive_scan(b, &child_offsets, internal)?;
-    crate::sort::exclusive_scan(b, &prim_offsets, internal)?;
+    crate::build::sort::exclusive_scan(b, &child_offsets, internal)?;
+    crate::build::sort::exclusive_scan(b, &prim_offsets, internal)?;
     let positions = b.scratch("wide node positions", internal as u64 * 4)?;
     let slots = b.scratch("wide node slots", internal as u64 * 32)?;
     b.stage("wide place");

@@ -4,6 +4,9 @@ use anyhow::{bail, Result};
 use treelet_core::triangle::Triangle;
 use treelet_core::{Aabb, Sphere};
 
+/// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.
+pub const MAX_PRIMITIVES: u32 = 1 << 30;
+
 /// The primitives of one build: primitive `i` is sphere `i` below
 /// `spheres.len()`, else triangle `i - spheres.len()`.
 #[derive(Clone, Copy, Debug)]
@@ -53,7 +56,7 @@ impl<'a> Primitives<'a> {
     /// or overflowing radii, boxes whose extent overflows f32. Names the
     /// first bad primitive.
     pub fn check(&self) -> Result<()> {
-        crate::scene::validate_spheres(self.spheres)?;
+        validate_spheres(self.spheres)?;
         for (i, t) in self.triangles.iter().enumerate() {
             for (k, v) in [t.v0, t.v1, t.v2].iter().enumerate() {
                 if v.iter().any(|x| !x.is_finite()) {
@@ -66,4 +69,26 @@ impl<'a> Primitives<'a> {
         }
         Ok(())
     }
+}
+
+/// Rejects spheres a build or render cannot use, naming the first bad one:
+/// non-finite centre or radius, or a negative radius.
+pub fn validate_spheres(spheres: &[Sphere]) -> Result<()> {
+    for (i, s) in spheres.iter().enumerate() {
+        if let Some(k) = s.center.iter().position(|c| !c.is_finite()) {
+            bail!(
+                "sphere {i}: centre coordinate {} is {} (every coordinate must be finite)",
+                "xyz".as_bytes()[k] as char,
+                s.center[k]
+            );
+        }
+        if !s.radius.is_finite() || s.radius < 0.0 {
+            bail!("sphere {i}: radius is {} (must be finite and non-negative)", s.radius);
+        }
+        // A box corner (centre ± radius) must stay finite too.
+        if s.center.iter().any(|c| !(c.abs() + s.radius).is_finite()) {
+            bail!("sphere {i}: its bounding box overflows f32 (centre {:?}, radius {})", s.center, s.radius);
+        }
+    }
+    Ok(())
 }

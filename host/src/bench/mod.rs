@@ -1,20 +1,26 @@
-//! `treelet bench ...`: sweeps of build sizes, reporting per-stage medians.
+//! `treelet bench ...`: the benchmark commands. [`measure`] times builds,
+//! renders and ray casts; [`suite`] turns them into figures ([`figure`]:
+//! JSON, table, plot), [`error_curves`] makes `bench error`, and [`results`]
+//! gathers figure files into `RESULTS.md`.
 use anyhow::Result;
 use clap::Subcommand;
-use indicatif::{ProgressBar, ProgressStyle};
-use treelet::backend::{Backend, StageTimes};
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::{GpuBackend, GpuContext};
-use treelet::layout::Layout;
-use treelet::lbvh;
-use treelet::render::{render, Accel, Integrator, RenderSettings};
-use treelet::scene::{random_spheres, Scene};
-use treelet::trbvh::{self, TreeletConfig};
-use treelet::variant::KernelChoice;
-use treelet_core::Sphere;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::build::layout::Layout;
+use treelet::render::Accel;
+use treelet::scene::Scene;
+use treelet::build::trbvh::TreeletConfig;
 
-use crate::suite::{Figure, Suite};
-use crate::Device;
+use figure::{Figure, Suite};
+pub use measure::Device;
+use measure::*;
+
+mod error_curves;
+mod figure;
+mod measure;
+pub mod results;
+mod suite;
 
 /// Options of every figure command.
 #[derive(clap::Args, Clone)]
@@ -175,7 +181,7 @@ fn figure(f: Figure, a: FigureArgs) -> Result<()> {
 
 fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) -> Result<()> {
     let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats: a.repeats.max(1), mitsuba };
-    crate::suite::run(f, &suite)
+    suite::run(f, &suite)
 }
 
 /// Scenes `bench variants` compares by default: each exercises a different
@@ -189,421 +195,6 @@ const VARIANT_SCENES: [&str; 5] =
 pub enum TreeBuilder {
     Lbvh,
     Trbvh,
-}
-
-/// One build on the device, the tree left there (as in a renderer).
-fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&TreeletConfig>) -> Result<StageTimes> {
-    let (bvh, mut times) = lbvh::build_on_device(b, spheres)?;
-    if let Some(config) = builder {
-        let root = trbvh::root_box(b, &bvh)?;
-        let (_, rounds) = trbvh::optimize(b, bvh, &root, config)?;
-        for s in &rounds.order {
-            times.add(s, rounds.get(s));
-        }
-    }
-    Ok(times)
-}
-
-/// Paths per second of a render, by wall clock and by render-kernel time.
-#[derive(serde::Serialize)]
-pub(crate) struct RenderRow {
-    pub(crate) scene: String,
-    pub(crate) accel: Accel,
-    pub(crate) layout: Layout,
-    /// The render kernel variant that ran.
-    pub(crate) kernel: &'static str,
-    pub(crate) width: u32,
-    pub(crate) height: u32,
-    pub(crate) spp: u32,
-    /// Whole render, BVH build and readbacks included (s).
-    pub(crate) total_s: f64,
-    /// Render kernels alone (GPU timestamps on a GPU) (s).
-    pub(crate) kernel_s: f64,
-    pub(crate) build_ms: f64,
-    /// Camera paths per second of kernel time.
-    pub(crate) paths_per_s: f64,
-}
-
-pub(crate) fn bench_render<B: Backend>(
-    b: &mut B,
-    scene: &Scene,
-    width: u32,
-    height: u32,
-    spp: u32,
-    accel: Accel,
-) -> Result<RenderRow> {
-    bench_render_kernel(b, scene, (width, height, spp), accel, Layout::Auto, KernelChoice::Auto)
-}
-
-pub(crate) fn bench_render_kernel<B: Backend>(
-    b: &mut B,
-    scene: &Scene,
-    (width, height, spp): (u32, u32, u32),
-    accel: Accel,
-    layout: Layout,
-    kernel: KernelChoice,
-) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt, error_each_pass: true };
-    let r = render(b, scene, &settings, None, |_| {})?;
-    let kernel_s = r.render_ms / 1e3;
-    Ok(RenderRow {
-        scene: scene.name.clone(),
-        accel: r.plan.accel,
-        layout: r.plan.layout,
-        kernel: r.plan.kernel,
-        width,
-        height,
-        spp,
-        total_s: r.total_s,
-        kernel_s,
-        build_ms: r.build_ms,
-        paths_per_s: width as f64 * height as f64 * spp as f64 / kernel_s,
-    })
-}
-
-/// One scene of `bench variants`: the chosen variant against the general kernel.
-#[derive(serde::Serialize)]
-struct VariantRow {
-    scene: String,
-    accel: Accel,
-    kernel: &'static str,
-    /// SPIR-V words of the entry points that ran (None on the CPU runner).
-    kernel_words: Option<usize>,
-    full_words: Option<usize>,
-    /// Median render-kernel seconds.
-    kernel_s: f64,
-    full_s: f64,
-    speedup: f64,
-}
-
-fn bench_variants<B: Backend>(
-    b: &mut B,
-    scenes: &[String],
-    (width, height, spp): (u32, u32, u32),
-    repeats: usize,
-) -> Result<Vec<VariantRow>> {
-    let bar = ProgressBar::new((scenes.len() * 2 * (repeats + 1)) as u64);
-    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} renders {msg}").unwrap());
-    let mut rows = Vec::new();
-    for spec in scenes {
-        bar.set_message(spec.clone());
-        let scene = Scene::from_spec(spec)?;
-        let (mut auto, mut full) = (Vec::new(), Vec::new());
-        let (mut accel, mut kernel) = (Accel::Auto, "");
-        // Alternate the two so that clock drift hits both alike; the first
-        // of each warms pipelines and clocks.
-        for r in 0..=repeats {
-            for (choice, times) in [(KernelChoice::Auto, &mut auto), (KernelChoice::Full, &mut full)] {
-                let row = bench_render_kernel(b, &scene, (width, height, spp), Accel::Auto, Layout::Auto, choice)?;
-                if choice == KernelChoice::Auto {
-                    (accel, kernel) = (row.accel, row.kernel);
-                }
-                if r > 0 {
-                    times.push(row.kernel_s);
-                }
-                bar.inc(1);
-            }
-        }
-        let entry = |name: &str| {
-            let method = if accel == Accel::None { "linear" } else { Layout::Auto.resolve(b.class()).method().name() };
-            (b.device_kind() == "gpu")
-                .then(|| treelet::gpu::context::entry_point_words(&format!("render::render_{method}_{name}_cs")))
-                .flatten()
-        };
-        let (kernel_s, full_s) = (median(auto), median(full));
-        rows.push(VariantRow {
-            scene: scene.name.clone(),
-            accel,
-            kernel,
-            kernel_words: entry(kernel),
-            full_words: entry("full"),
-            kernel_s,
-            full_s,
-            speedup: full_s / kernel_s,
-        });
-    }
-    bar.finish_and_clear();
-    Ok(rows)
-}
-
-fn print_render_rows(title: &str, rows: &[RenderRow]) {
-    println!("{title}");
-    println!(
-        "{:>14}{:>6}{:>11}{:>6}{:>10}{:>11}{:>10}{:>14}",
-        "scene", "accel", "size", "spp", "total s", "kernel s", "build ms", "Mpaths/s"
-    );
-    for r in rows {
-        println!(
-            "{:>14}{:>6}{:>11}{:>6}{:>10.3}{:>11.4}{:>10.3}{:>14.3}",
-            r.scene,
-            format!("{:?}", r.accel).to_lowercase(),
-            format!("{}x{}", r.width, r.height),
-            r.spp,
-            r.total_s,
-            r.kernel_s,
-            r.build_ms,
-            r.paths_per_s / 1e6
-        );
-    }
-}
-
-/// What `bench render` sweeps.
-struct RenderSweep {
-    quick: bool,
-    spps: Vec<u32>,
-    sizes: Vec<usize>,
-    accels: Vec<Accel>,
-}
-
-fn render_sweeps<B: Backend>(b: &mut B, sweep: &RenderSweep) -> Result<(Vec<RenderRow>, Vec<RenderRow>)> {
-    // Graph 1 of the seed: cornell, time against samples per pixel.
-    let (w, h) = if sweep.quick { (256, 192) } else { (1024, 768) };
-    let (spps, sizes) = (&sweep.spps, &sweep.sizes);
-    let bar = ProgressBar::new((spps.len() + sweep.accels.len() * sizes.len()) as u64);
-    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} renders {msg}").unwrap());
-    let cornell = Scene::from_spec("cornell")?;
-    // Warm up pipelines and clocks.
-    bench_render(b, &cornell, 64, 48, 4, Accel::None)?;
-    let mut graph1 = Vec::new();
-    for &spp in spps.iter() {
-        bar.set_message(format!("cornell {spp} spp"));
-        graph1.push(bench_render(b, &cornell, w, h, spp, Accel::None)?);
-        bar.inc(1);
-    }
-    // Graph 2: random:N at 4 spp, linear scan against the trees.
-    let mut graph2 = Vec::new();
-    for &n in sizes.iter() {
-        let scene = Scene::from_spec(&format!("random:{n}"))?;
-        for &accel in &sweep.accels {
-            bar.set_message(format!("random:{n} {accel:?}"));
-            graph2.push(bench_render(b, &scene, w, h, 4, accel)?);
-            bar.inc(1);
-        }
-    }
-    bar.finish_and_clear();
-    Ok((graph1, graph2))
-}
-
-#[derive(serde::Serialize)]
-pub(crate) struct Row {
-    pub(crate) primitives: usize,
-    /// Median per stage (or per kernel, with --per-kernel), in the order run.
-    pub(crate) median_ms: Vec<(&'static str, f64)>,
-    pub(crate) total_median_ms: f64,
-    pub(crate) total_min_ms: f64,
-    pub(crate) total_max_ms: f64,
-    pub(crate) mprims_per_s: f64,
-}
-
-pub(crate) fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    }
-}
-
-pub(crate) fn bench_sizes<B: Backend>(
-    b: &mut B,
-    sizes: &[usize],
-    repeats: usize,
-    builder: Option<&TreeletConfig>,
-) -> Result<Vec<Row>> {
-    let bar = ProgressBar::new((sizes.len() * (repeats + 1)) as u64);
-    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} builds {msg}").unwrap());
-    let mut rows = Vec::new();
-    for &n in sizes {
-        bar.set_message(format!("N = {n}"));
-        let spheres = random_spheres(n, 1);
-        let mut names: Vec<&'static str> = Vec::new();
-        let mut samples: std::collections::BTreeMap<&'static str, Vec<f64>> = Default::default();
-        let mut totals = Vec::new();
-        // Warm up (pipelines, buffer pool, GPU clocks) for at least half a second.
-        let warm = std::time::Instant::now();
-        while warm.elapsed().as_secs_f64() < 0.5 {
-            build_once(b, &spheres, builder)?;
-        }
-        bar.inc(1);
-        for _ in 0..repeats {
-            // The tree stays on the device, as in a renderer: no readback.
-            let times = build_once(b, &spheres, builder)?;
-            bar.inc(1);
-            for s in &times.order {
-                if !names.contains(s) {
-                    names.push(s);
-                }
-                samples.entry(s).or_default().push(times.get(s));
-            }
-            totals.push(times.total());
-        }
-        let total_median_ms = median(totals.clone());
-        rows.push(Row {
-            primitives: n,
-            median_ms: names.iter().map(|s| (*s, median(samples[s].clone()))).collect(),
-            total_median_ms,
-            total_min_ms: totals.iter().copied().fold(f64::MAX, f64::min),
-            total_max_ms: totals.iter().copied().fold(0.0, f64::max),
-            mprims_per_s: n as f64 / total_median_ms / 1e3,
-        });
-    }
-    bar.finish_and_clear();
-    Ok(rows)
-}
-
-/// Primary and diffuse rays per second through one tree.
-#[derive(serde::Serialize)]
-pub(crate) struct RaysRow {
-    pub(crate) scene: String,
-    pub(crate) accel: Accel,
-    pub(crate) layout: Layout,
-    /// Where the traversal stack lives: "private" or "workgroup".
-    pub(crate) stack: &'static str,
-    pub(crate) primitives: usize,
-    /// The binary tree's build (ms).
-    pub(crate) build_ms: f64,
-    /// Its layout for traversal (ms, collapse included).
-    pub(crate) layout_ms: f64,
-    /// The layout's stages (ms).
-    pub(crate) layout_stages: Vec<(&'static str, f64)>,
-    pub(crate) primary_rays: u64,
-    pub(crate) diffuse_rays: u64,
-    pub(crate) primary_median_ms: f64,
-    pub(crate) diffuse_median_ms: f64,
-    pub(crate) primary_mrays_per_s: f64,
-    pub(crate) diffuse_mrays_per_s: f64,
-}
-
-/// What `bench rays` times through one tree: its layouts, each with its
-/// stacks (the workgroup-memory stack exists for cwbvh only).
-pub(crate) struct RaysPlan {
-    pub(crate) layouts: Vec<Layout>,
-    pub(crate) workgroup_stack: bool,
-}
-
-/// Rays per second through the tree `accel` builds, in each layout of `plan`.
-pub(crate) fn bench_rays<B: Backend>(
-    b: &mut B,
-    scene: &Scene,
-    accel: Accel,
-    plan: &RaysPlan,
-    (width, height): (u32, u32),
-    repeats: usize,
-) -> Result<Vec<RaysRow>> {
-    use treelet::kernels::Kernel;
-    use treelet::layout::PrimBuffers;
-    use treelet::primitives::Primitives;
-    anyhow::ensure!(
-        !matches!(accel, Accel::None | Accel::Auto),
-        "bench rays traces trees: pick lbvh, trbvh or sweep (not {accel:?})"
-    );
-    let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
-    all.check()?;
-    let pixels = width as u64 * height as u64;
-    anyhow::ensure!(pixels > 0 && pixels <= u32::MAX as u64 / 4, "image size {width}x{height} out of range");
-    let Some(built) = treelet::render::binary_tree(b, all, accel)? else { unreachable!("a tree was asked for") };
-    let buffers = PrimBuffers::upload(b, all)?;
-    let materials = b.upload("materials", &scene.materials)?;
-    let rays = b.zeroed("rays", pixels * 32)?;
-    b.take_times()?;
-    let mut rows = Vec::new();
-    for &layout in &plan.layouts {
-        let layout = layout.resolve(b.class());
-        let (tree, stages) = built.lay_out_timed(b, layout, &buffers)?;
-        let layout_ms = stages.total();
-        let layout_stages: Vec<_> = stages.order.iter().map(|&s| (s, stages.get(s))).collect();
-        // Meshes get the kernels compiled for triangles alone.
-        let triangles_only = scene.spheres.is_empty();
-        let mut kernels = vec![("private", Kernel::Cast(layout.method(), triangles_only))];
-        if plan.workgroup_stack && layout == Layout::Cwbvh {
-            kernels.push(("workgroup", Kernel::CastWideWorkgroupStack));
-        }
-        for (stack, kernel) in kernels {
-            let bindings = [&buffers.spheres, &materials, &tree.nodes, &tree.prims, &rays, &buffers.triangles];
-            let (primary_ms, diffuse_ms, diffuse_rays) = time_casts(b, scene, kernel, &bindings, (width, height), repeats)?;
-            rows.push(RaysRow {
-                scene: scene.name.clone(),
-                accel,
-                layout,
-                stack,
-                primitives: all.len(),
-                build_ms: built.build_ms,
-                layout_ms,
-                layout_stages: layout_stages.clone(),
-                primary_rays: pixels,
-                diffuse_rays,
-                primary_median_ms: primary_ms,
-                diffuse_median_ms: diffuse_ms,
-                primary_mrays_per_s: pixels as f64 / primary_ms / 1e3,
-                diffuse_mrays_per_s: diffuse_rays as f64 / diffuse_ms / 1e3,
-            });
-        }
-    }
-    Ok(rows)
-}
-
-/// Median kernel times (ms) of the primary and the diffuse pass of `kernel`
-/// (bindings 1.. as the cast kernels take them), and the number of diffuse
-/// rays (pixels whose camera ray hit).
-fn time_casts<B: Backend>(
-    b: &mut B,
-    scene: &Scene,
-    kernel: treelet::kernels::Kernel,
-    bindings: &[&B::Buffer; 6],
-    (width, height): (u32, u32),
-    repeats: usize,
-) -> Result<(f64, f64, u64)> {
-    use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
-    use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
-    let pixels = width * height;
-    let base = treelet_core::RenderParams {
-        width,
-        height,
-        samples: 1,
-        prims: scene.spheres.len() as u32,
-        triangles: scene.triangles.len() as u32,
-        camera: scene.camera.camera(width, height),
-        ..Default::default()
-    };
-    let groups = groups_for(treelet_core::render::tiled_invocations(width, height), WORKGROUP_SIZE);
-    let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
-    let mut diffuse_rays = 0;
-    // Warm-up passes for half a second first (pipelines, and GPU clocks,
-    // which drop while a CPU-built tree is being made), then the timed ones.
-    // The first casts of a process warm up for two seconds (GPUs were seen
-    // to run their first seconds of work at a fraction of their speed),
-    // later ones for half a second.
-    static WARMED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-    let warm_s = if WARMED.swap(true, std::sync::atomic::Ordering::Relaxed) { 0.5 } else { 2.0 };
-    let warm = std::time::Instant::now();
-    let mut warm_passes = 0;
-    for r in 0.. {
-        if r > warm_passes + repeats {
-            break;
-        }
-        // The bounce rays are made between the two timed passes.
-        for (stage, mode) in [("primary", CAST_PRIMARY), ("bounce", CAST_BOUNCE), ("diffuse", CAST_DIFFUSE)] {
-            b.stage(stage);
-            let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
-            let [spheres, materials, nodes, prims, rays, triangles] = *bindings;
-            b.dispatch(kernel, &[&p, spheres, materials, nodes, prims, rays, triangles], groups);
-        }
-        let t = b.take_times()?;
-        if r == 0 {
-            let rays: Vec<[f32; 4]> = b.read(bindings[4], 2 * pixels as usize)?;
-            diffuse_rays = rays.iter().step_by(2).filter(|x| x[3] != 0.0).count() as u64;
-        }
-        if r == warm_passes {
-            if warm.elapsed().as_secs_f64() < warm_s {
-                warm_passes += 1;
-            }
-            continue;
-        }
-        primary.push(t.get("primary"));
-        diffuse.push(t.get("diffuse"));
-    }
-    Ok((median(primary), median(diffuse), diffuse_rays))
 }
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
@@ -668,7 +259,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::RaysFigure(a) => figure(Figure::Rays, a),
         BenchCommand::All(a) => figure(Figure::All, a),
         BenchCommand::Results { runs, out } => {
-            crate::results::collect(&runs, &out)?;
+            results::collect(&runs, &out)?;
             eprintln!("wrote {}", out.display());
             Ok(())
         }

@@ -6,8 +6,8 @@ use treelet_core::scan::SCAN_TILE;
 use treelet_core::sort::{histogram_tile, passes_for, state, MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE};
 use treelet_core::workgroup::groups_for;
 
-use crate::backend::Backend;
-use crate::kernels::Kernel;
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::Kernel;
 
 /// Exclusive prefix sum of the first `len` u32s of `data`, in place.
 pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Result<()> {

@@ -9,9 +9,9 @@ use treelet_core::layout::{BuildParams, Node, Sphere};
 use treelet_core::morton::{MortonFrame, KEY_BITS, SORTED_KEY_BITS};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::{check_fits, Backend, StageTimes};
-use crate::kernels::Kernel;
-use crate::primitives::Primitives;
+use crate::runtime::backend::{check_fits, Backend, StageTimes};
+use crate::runtime::kernels::Kernel;
+use crate::scene::primitives::Primitives;
 
 /// The stages of a build, in order, as named in timings and reports.
 pub const STAGES: [&str; 5] = ["bounds", "morton", "sort", "tree", "fit"];
@@ -181,7 +181,7 @@ pub fn build_primitives_with<B: Backend>(
     b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
-    let (keys, values) = crate::sort::radix_sort(b, &keys, &values, n, key_bits)?;
+    let (keys, values) = crate::build::sort::radix_sort(b, &keys, &values, n, key_bits)?;
 
     let nodes = b.scratch("nodes", node_count * 32)?;
     let parents = b.scratch("parents", node_count * 4)?;
@@ -247,5 +247,4 @@ pub fn upload_or_placeholder<B: Backend, T: bytemuck::Pod>(
     }
 }
 
-/// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.
-pub const MAX_PRIMITIVES: u32 = 1 << 30;
+pub use crate::scene::primitives::MAX_PRIMITIVES;

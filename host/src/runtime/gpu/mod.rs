@@ -1,7 +1,7 @@
 //! The wgpu runtime: device set-up ([`context`]) and the [`Backend`]
 //! implementation that records, times and submits dispatches ([`backend`]).
 //!
-//! [`Backend`]: crate::backend::Backend
+//! [`Backend`]: crate::runtime::backend::Backend
 pub mod backend;
 pub mod context;
 

@@ -1,5 +1,5 @@
 //! An independent validator of the traversal layouts (`bvh2`, `cwbvh`):
-//! like [`crate::validate`], it shares no code with the kernels that make
+//! like [`crate::build::validate`], it shares no code with the kernels that make
 //! them. It decodes every node itself, recomputes each subtree's exact box
 //! from its primitives, and checks, in exact arithmetic, that the box a
 //! node stores for each child (for cwbvh, the dequantized bytes) contains
@@ -7,8 +7,8 @@
 //! has it; and that every node is reached exactly once from the root.
 use treelet_core::layout::{Bvh2Node, LeafPrim, WideNode};
 
-use crate::primitives::Primitives;
-use crate::validate::{primitive_box, Validation};
+use crate::scene::primitives::Primitives;
+use crate::build::validate::{primitive_box, Validation};
 
 /// Stop collecting after this many errors.
 const MAX_ERRORS: usize = 20;

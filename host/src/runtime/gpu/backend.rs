@@ -10,8 +10,8 @@ use bytemuck::Pod;
 use treelet_core::workgroup::dispatch_grid;
 
 use super::context::GpuContext;
-use crate::backend::{Backend, StageTimes};
-use crate::kernels::Kernel;
+use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernels::Kernel;
 
 /// Readbacks are copied in pieces no larger than this.
 const READBACK_CHUNK: u64 = 64 << 20;
@@ -201,7 +201,7 @@ impl Backend for GpuBackend {
 
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        crate::backend::check_fits(self, label, bytes.len() as u64)?;
+        crate::runtime::backend::check_fits(self, label, bytes.len() as u64)?;
         let size = (bytes.len() as u64).max(MIN_BUFFER).next_multiple_of(4);
         let buffer = self.take_buffer(label, size);
         // Staged by the queue and copied before the next submission, which
@@ -217,7 +217,7 @@ impl Backend for GpuBackend {
     }
 
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
-        crate::backend::check_fits(self, label, bytes)?;
+        crate::runtime::backend::check_fits(self, label, bytes)?;
         Ok(self.take_buffer(label, bytes.max(MIN_BUFFER).next_multiple_of(4)))
     }
 

@@ -12,7 +12,7 @@ use treelet_core::features::VARIANTS;
 use Access::{Read, ReadWrite};
 
 /// How a render or cast kernel finds closest hits: the scan, or a tree in
-/// one of the traversal layouts (see [`crate::layout::Layout`]).
+/// one of the traversal layouts (see [`crate::build::layout::Layout`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Method {
     Scan,

@@ -22,8 +22,8 @@ use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::{agglomerate, bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
 use treelet_core::{bvh2, cwbvh_build};
 
-use crate::backend::{Backend, StageTimes};
-use crate::kernels::{Kernel, Method};
+use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernels::{Kernel, Method};
 
 /// A CPU buffer: 8-byte words, so that any Pod type of alignment ≤ 8 views it.
 pub type CpuBuffer = Rc<RefCell<Vec<u64>>>;

@@ -5,13 +5,13 @@ use anyhow::Result;
 use serde::Serialize;
 use treelet_core::sah::{sah_cost, SahCosts};
 
-use crate::backend::Backend;
+use crate::runtime::backend::Backend;
 use treelet_core::{Aabb, Node};
 
-use crate::lbvh::{self, Bvh, STAGES};
+use crate::build::lbvh::{self, Bvh, STAGES};
 use crate::scene::Scene;
-use crate::trbvh::{self, TreeletConfig};
-use crate::validate::validate_primitives;
+use crate::build::trbvh::{self, TreeletConfig};
+use crate::build::validate::validate_primitives;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct BuildReport {
@@ -60,7 +60,7 @@ pub fn run_build_sweep(scene: &Scene, max_leaf: u32) -> Result<(Bvh, BuildReport
     let prims = scene.primitives();
     prims.check()?;
     let start = Instant::now();
-    let bvh = crate::sweep::build_collapsed_boxes(&prims.boxes(), max_leaf)?;
+    let bvh = crate::build::sweep::build_collapsed_boxes(&prims.boxes(), max_leaf)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let mut ms = serde_json::Map::new();

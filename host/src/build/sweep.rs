@@ -7,13 +7,13 @@
 //! The tree has the LBVH's layout (`2n - 1` nodes, internal nodes first with
 //! the root at 0, the leaf of sorted position `j` at `n - 1 + j`, parent
 //! links), so the validator, the SAH, the renderer and the leaf collapse of
-//! [`crate::trbvh::collapse`] take it as they are: [`build_collapsed`]
+//! [`crate::build::trbvh::collapse`] take it as they are: [`build_collapsed`]
 //! collapses leaves by the same rule as the TRBVH.
 use treelet_core::layout::{Node, Sphere, INVALID, LEAF_BIT};
 use treelet_core::Aabb;
 
-use crate::cpu_runner::CpuBackend;
-use crate::lbvh::{Bvh, DeviceBvh};
+use crate::runtime::cpu_runner::CpuBackend;
+use crate::build::lbvh::{Bvh, DeviceBvh};
 
 /// The sweep tree with the SAH leaf collapse (leaves of up to `max_leaf`
 /// primitives), run by the CPU runner over the same kernels as the TRBVH's.
@@ -31,7 +31,7 @@ pub fn build_collapsed_boxes(boxes: &[Aabb], max_leaf: u32) -> anyhow::Result<Bv
     }
     let b = &mut CpuBackend::new();
     let device = DeviceBvh::upload(b, &tree)?;
-    crate::trbvh::collapse(b, device, max_leaf)?.read(b).map(|t| Bvh { sorted_keys: Vec::new(), ..t })
+    crate::build::trbvh::collapse(b, device, max_leaf)?.read(b).map(|t| Bvh { sorted_keys: Vec::new(), ..t })
 }
 
 /// Builds the full-sweep SAH tree over `spheres`, one primitive per leaf.
@@ -135,7 +135,7 @@ pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::validate::validate;
+    use crate::build::validate::validate;
     use treelet_core::sah::{sah_cost, SahCosts};
 
     #[test]
@@ -152,7 +152,7 @@ mod tests {
                 (sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA), sah_cost(&collapsed.nodes, SahCosts::KARRAS_AILA));
             assert!(c <= s * (1.0 + 1e-6), "n = {n}: collapse raised the SAH from {s} to {c}");
             if n >= 1000 {
-                let (lbvh, _) = crate::lbvh::build(&mut crate::cpu_runner::CpuBackend::new(), &spheres).unwrap();
+                let (lbvh, _) = crate::build::lbvh::build(&mut crate::runtime::cpu_runner::CpuBackend::new(), &spheres).unwrap();
                 let (s, l) =
                     (sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA), sah_cost(&lbvh.nodes, SahCosts::KARRAS_AILA));
                 assert!(s < 0.9 * l, "n = {n}: sweep SAH {s} is not well below the LBVH's {l}");

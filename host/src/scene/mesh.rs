@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context as _, Result};
 use treelet_core::triangle::Triangle;
 
-use crate::primitives::Primitives;
+use crate::scene::primitives::Primitives;
 
 /// Loads the triangles of an `.obj` or `.ply` file and checks them
 /// (finite coordinates, at least one triangle).

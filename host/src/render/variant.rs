@@ -6,9 +6,8 @@ use serde::Serialize;
 use treelet_core::features::{self, VARIANTS};
 use treelet_core::layout::{DIFFUSE, GLASS, MIRROR};
 
-use crate::backend::DeviceClass;
-use crate::layout::Layout;
-use crate::render::Accel;
+use crate::runtime::backend::DeviceClass;
+use crate::build::layout::Layout;
 use crate::scene::Scene;
 
 /// What a scene contains.
@@ -192,7 +191,7 @@ pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, c
         }
         other => (other, "as asked (--layout)".to_string()),
     };
-    let method = if accel == Accel::None { crate::kernels::Method::Scan } else { layout.method() };
+    let method = if accel == Accel::None { crate::runtime::kernels::Method::Scan } else { layout.method() };
     let bits = features.bits();
     let (variant, kernel_reason) = match kernel {
         KernelChoice::Full => (full_variant(), "as asked (--kernel full)".to_string()),
@@ -274,6 +273,36 @@ mod tests {
             if bits & features::GLASS != 0 {
                 assert!(VARIANTS[smallest_variant(bits)].0 & features::GLASS != 0);
             }
+        }
+    }
+}
+
+/// How closest hits are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Accel {
+    /// A linear scan for scenes below the measured crossover, else trbvh
+    /// (see `treelet::variant`).
+    Auto,
+    /// Test every primitive.
+    None,
+    /// Traverse the LBVH (Karras 2012).
+    Lbvh,
+    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
+    Trbvh,
+    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
+    Sweep,
+}
+
+impl Accel {
+    /// The word the command line takes (`--accel`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Auto => "auto",
+            Accel::None => "none",
+            Accel::Lbvh => "lbvh",
+            Accel::Trbvh => "trbvh",
+            Accel::Sweep => "sweep",
         }
     }
 }

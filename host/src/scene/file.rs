@@ -28,7 +28,8 @@ use anyhow::{bail, Context as _, Result};
 use serde::Deserialize;
 use treelet_core::layout::{Material, Sphere, DIFFUSE, GLASS, MIRROR};
 
-use crate::scene::{CameraSpec, Scene};
+use super::model::{CameraSpec, Scene};
+use super::primitives::{validate_spheres, Primitives};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -148,7 +149,7 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         spheres.push(Sphere::new(s.center, s.radius));
         sphere_materials.push(*m);
     }
-    crate::scene::validate_spheres(&spheres).with_context(|| format!("scene file {name}"))?;
+    validate_spheres(&spheres).with_context(|| format!("scene file {name}"))?;
     let mut triangles = Vec::new();
     let mut triangle_materials = Vec::new();
     for (i, mesh) in file.meshes.iter().enumerate() {
@@ -158,13 +159,13 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         if mesh.scale.iter().chain(&mesh.rotate).chain(&mesh.translate).any(|v| !v.is_finite()) {
             bail!("scene file {name}: mesh {i} has a non-finite transform");
         }
-        let loaded = crate::mesh::load(&dir.join(&mesh.path)).with_context(|| format!("scene file {name}: mesh {i}"))?;
+        let loaded = super::mesh::load(&dir.join(&mesh.path)).with_context(|| format!("scene file {name}: mesh {i}"))?;
         let xf = mesh.transform();
         let place = |v: [f32; 3]| xf.transform_point3(v.into()).to_array();
         triangle_materials.extend(std::iter::repeat_n(*m, loaded.len()));
         triangles.extend(loaded.iter().map(|t| treelet_core::triangle::Triangle::new(place(t.v0), place(t.v1), place(t.v2))));
     }
-    crate::primitives::Primitives::triangles(&triangles)
+    Primitives::triangles(&triangles)
         .check()
         .with_context(|| format!("scene file {name}: after the mesh transforms"))?;
     let c = &file.camera;
@@ -187,7 +188,7 @@ mod tests {
     fn the_shipped_cornell_file_is_smallpts_scene() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.json");
         let file = load(Path::new(path)).unwrap();
-        let builtin = crate::scene::cornell();
+        let builtin = super::super::model::cornell();
         assert_eq!(file.spheres, builtin.spheres);
         assert_eq!(file.materials, builtin.materials);
         assert_eq!(file.camera, builtin.camera);

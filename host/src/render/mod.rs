@@ -1,6 +1,9 @@
 //! A render, pass by pass, over any [`Backend`]: the BVH (if any) is built
 //! on the device, then each pass adds samples to every pixel and the error
 //! is measured, against a reference image or from the per-pixel variance.
+pub mod image_io;
+pub mod variant;
+
 use std::time::Instant;
 
 use anyhow::{bail, Result};
@@ -10,45 +13,16 @@ use treelet_core::lights::{light_power, Light};
 use treelet_core::render::{luminance, tiled_invocations};
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::backend::{Backend, DeviceClass, StageTimes};
-use crate::image_io::HdrImage;
-use crate::kernels::{Kernel, Method};
-use crate::layout::{lay_out, Layout, PrimBuffers, TracedTree};
-use crate::lbvh;
+use crate::build::layout::{lay_out, Layout, PrimBuffers, TracedTree};
+use crate::build::lbvh;
+use crate::build::trbvh::{self, TreeletConfig};
+use crate::runtime::backend::{Backend, DeviceClass, StageTimes};
+use crate::runtime::kernels::{Kernel, Method};
+use crate::scene::primitives::Primitives;
 use crate::scene::Scene;
-use crate::primitives::Primitives;
-use crate::trbvh::{self, TreeletConfig};
-use crate::variant::{self, KernelChoice, Plan};
-
-/// How closest hits are found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Accel {
-    /// A linear scan for scenes below the measured crossover, else trbvh
-    /// (see `treelet::variant`).
-    Auto,
-    /// Test every primitive.
-    None,
-    /// Traverse the LBVH (Karras 2012).
-    Lbvh,
-    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
-    Trbvh,
-    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
-    Sweep,
-}
-
-impl Accel {
-    /// The word the command line takes (`--accel`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Lbvh => "lbvh",
-            Accel::Trbvh => "trbvh",
-            Accel::Sweep => "sweep",
-        }
-    }
-}
+use image_io::HdrImage;
+pub use variant::Accel;
+use variant::{KernelChoice, Plan};
 
 /// How radiance is estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -434,7 +408,7 @@ pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Resu
         }
         Accel::Sweep => {
             let build = std::time::Instant::now();
-            let tree = crate::sweep::build_boxes(&all.boxes());
+            let tree = crate::build::sweep::build_boxes(&all.boxes());
             let build_ms = build.elapsed().as_secs_f64() * 1e3;
             b.begin_build();
             BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }

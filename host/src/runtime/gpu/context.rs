@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 
-use crate::kernels::{Access, Kernel};
+use crate::runtime::kernels::{Access, Kernel};
 
 /// The SPIR-V module compiled from the `shader` crate by `build.rs`.
 pub const SHADER_SPV: &[u8] = include_bytes!(env!("treelet_shader.spv"));

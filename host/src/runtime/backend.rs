@@ -1,7 +1,7 @@
 //! What a build needs from a device: buffers, dispatches, readback and
-//! per-stage times. The GPU ([`crate::gpu::GpuBackend`]) and the CPU
-//! ([`crate::cpu_runner::CpuBackend`]) implement it, so the order of stages
-//! of a build is written once ([`crate::lbvh`]).
+//! per-stage times. The GPU ([`crate::runtime::gpu::GpuBackend`]) and the CPU
+//! ([`crate::runtime::cpu_runner::CpuBackend`]) implement it, so the order of stages
+//! of a build is written once ([`crate::build::lbvh`]).
 use std::collections::BTreeMap;
 
 use anyhow::Result;
@@ -10,7 +10,7 @@ use bytemuck::Pod;
 use treelet_core::layout::FillParams;
 use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use crate::kernels::Kernel;
+use crate::runtime::kernels::Kernel;
 
 /// Milliseconds per named stage, in the order the stages first ran.
 #[derive(Clone, Debug, Default, serde::Serialize)]

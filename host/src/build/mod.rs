@@ -1,0 +1,20 @@
+//! BVH builders, each written once as a sequence of kernel dispatches on a
+//! [`Backend`](crate::runtime::backend::Backend), so that the GPU and the CPU
+//! runner run the same stages:
+//!
+//! - [`lbvh`]: Karras 2012 (Morton codes, [`sort`], radix tree or
+//!   agglomerative hierarchy, bottom-up boxes);
+//! - [`trbvh`]: Karras & Aila 2013 treelet restructuring and SAH leaf collapse;
+//! - [`sweep`]: the full-sweep SAH tree on the CPU, the quality reference;
+//! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
+//! - [`validate`], [`validate_layout`]: independent checks that share no
+//!   code with the kernels;
+//! - [`report`]: one build, timed and checked (the `treelet build` command).
+pub mod layout;
+pub mod lbvh;
+pub mod report;
+pub mod sort;
+pub mod sweep;
+pub mod trbvh;
+pub mod validate;
+pub mod validate_layout;

@@ -1,0 +1,9 @@
+//! Where kernels run: the [`backend::Backend`] trait (buffers, dispatches,
+//! stage times), its two implementations, the GPU through wgpu ([`gpu`]) and
+//! the CPU runner that calls the same kernel functions over every
+//! invocation id ([`cpu_runner`]), and the table of kernels with their
+//! bindings ([`kernels`]). Nothing here knows what a BVH or a scene is.
+pub mod backend;
+pub mod cpu_runner;
+pub mod gpu;
+pub mod kernels;

@@ -1,0 +1,15 @@
+//! Scenes: what a build or render runs over, where it comes from, and the
+//! checks that turn bad input into an error naming the problem.
+//!
+//! [`model`] is the scene itself and the built-in ones, [`primitives`] the
+//! spheres-then-triangles view a build takes (and its checks), [`mesh`]
+//! reads `.obj` / `.ply`, [`file`] reads JSON scene files, and [`spec`]
+//! parses the names the command line takes ([`Scene::from_spec`]).
+pub mod file;
+pub mod mesh;
+pub mod model;
+pub mod primitives;
+pub mod spec;
+
+pub use model::*;
+pub use primitives::{validate_spheres, Primitives};

@@ -1,0 +1,56 @@
+//! Scene names as the command line takes them: `cornell`, `random:N[:SEED]`,
+//! `terrain:N`, a JSON scene file, or an `.obj` / `.ply` mesh.
+use anyhow::{bail, Context as _, Result};
+
+use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
+use super::primitives::MAX_PRIMITIVES;
+
+impl Scene {
+    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON
+    /// scene file or an `.obj` / `.ply` mesh.
+    pub fn from_spec(spec: &str) -> Result<Scene> {
+        if spec == "cornell" {
+            return Ok(cornell());
+        }
+        if spec.ends_with(".json") {
+            return super::file::load(std::path::Path::new(spec));
+        }
+        let lower = spec.to_ascii_lowercase();
+        if lower.ends_with(".obj") || lower.ends_with(".ply") {
+            let triangles = super::mesh::load(std::path::Path::new(spec))?;
+            return Ok(mesh_scene(spec, &triangles));
+        }
+        let mut parts = spec.split(':');
+        match parts.next() {
+            Some("random") => {
+                let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
+                let seed = match parts.next() {
+                    Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
+                    None => 1,
+                };
+                if parts.next().is_some() {
+                    bail!("scene `{spec}`: expected random:N[:SEED]");
+                }
+                if n > MAX_PRIMITIVES as usize {
+                    bail!("scene `{spec}`: {n} primitives, at most {} are supported", MAX_PRIMITIVES);
+                }
+                Ok(random_scene(spec, n, seed))
+            }
+            Some("terrain") => {
+                let n = parts.next().with_context(|| format!("scene `{spec}`: expected terrain:N"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a triangle count"))?;
+                if parts.next().is_some() || n == 0 {
+                    bail!("scene `{spec}`: expected terrain:N with N > 0 triangles");
+                }
+                if n > MAX_PRIMITIVES as usize {
+                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
+                }
+                Ok(mesh_scene(spec, &terrain(n)))
+            }
+            _ => bail!(
+                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file or an .obj/.ply mesh"
+            ),
+        }
+    }
+}
