@@ -6,14 +6,14 @@
 //! boxes contain their children's exact boxes); and the GPU builds the
 //! layouts the CPU runner builds.
 use glam::Vec3;
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::GpuBackend;
-use treelet::layout::{wide_nodes, Layout, TracedTree};
-use treelet::primitives::Primitives;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::build::layout::{wide_nodes, Layout, TracedTree};
+use treelet::scene::primitives::Primitives;
 use treelet::render::{scene_tree, Accel};
 use treelet::scene::{random_spheres, Scene};
-use treelet::validate_layout::{validate_bvh2, validate_wide};
+use treelet::build::validate_layout::{validate_bvh2, validate_wide};
 use treelet_core::bvh2::closest_hit_bvh2;
 use treelet_core::cwbvh::closest_hit_cwbvh;
 use treelet_core::features::ALL;

@@ -1,12 +1,12 @@
 //! Triangle meshes through the builders: GPU against the CPU run of the same
 //! kernels, the independent validator, and the SAH ordering of the builders.
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::GpuBackend;
-use treelet::lbvh::{build_primitives_on_device, Bvh};
-use treelet::primitives::Primitives;
-use treelet::trbvh::{optimize, root_box, TreeletConfig};
-use treelet::validate::validate_primitives;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::build::lbvh::{build_primitives_on_device, Bvh};
+use treelet::scene::primitives::Primitives;
+use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
+use treelet::build::validate::validate_primitives;
 use treelet_core::sah::{sah_cost, SahCosts};
 use treelet_core::triangle::Triangle;
 
@@ -73,7 +73,7 @@ fn mesh_trbvh_lowers_sah_on_both_devices() {
     let v = validate_primitives(prims, &c.nodes, &c.parents, &c.prim_indices);
     assert!(v.is_valid(), "{:?}", v.errors);
     let trbvh = sah_cost(&c.nodes, SahCosts::KARRAS_AILA);
-    let sweep = treelet::sweep::build_collapsed_boxes(&prims.boxes(), config.max_leaf).unwrap();
+    let sweep = treelet::build::sweep::build_collapsed_boxes(&prims.boxes(), config.max_leaf).unwrap();
     let sweep = sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA);
     eprintln!("terrain of {} triangles: SAH lbvh {lbvh:.3}, trbvh {trbvh:.3}, sweep {sweep:.3}", tris.len());
     assert!(
@@ -147,7 +147,7 @@ mod fuzz {
             std::fs::create_dir_all(&dir).unwrap();
             let path = dir.join(format!("m-{name}"));
             std::fs::write(&path, mutate(bytes.clone(), &edits)).unwrap();
-            let result = std::panic::catch_unwind(|| treelet::mesh::load(&path));
+            let result = std::panic::catch_unwind(|| treelet::scene::mesh::load(&path));
             prop_assert!(result.is_ok(), "the loader panicked on a mutation of {}", name);
             if let Ok(Err(e)) = result {
                 prop_assert!(format!("{e:#}").contains(&format!("m-{name}")), "error `{e:#}` does not name the file");
@@ -218,7 +218,7 @@ mod stiff {
         let b = &mut CpuBackend::new();
         let lbvh = build(b, tris, None);
         let trbvh = build(b, tris, Some(&TreeletConfig::default()));
-        let sweep = treelet::sweep::build_collapsed_boxes(&prims.boxes(), 8).unwrap();
+        let sweep = treelet::build::sweep::build_collapsed_boxes(&prims.boxes(), 8).unwrap();
         let scene = Prims { spheres: &[], sphere_count: 0, triangles: tris, triangle_count: tris.len() as u32 };
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let (center, size) = (bounds.centroid(), bounds.extent().max_element());

@@ -1,11 +1,11 @@
 //! The path tracer: GPU against the CPU run of the same kernel, BVH against
 //! linear scan, and the picture's sanity (no NaN, no black speckles).
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::GpuBackend;
-use treelet::layout::Layout;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::build::layout::Layout;
 use treelet::render::{render, Accel, Integrator, RenderSettings};
-use treelet::variant::KernelChoice;
+use treelet::render::variant::KernelChoice;
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet_core::triangle::Triangle;
 use treelet_tests::gpu;
@@ -155,7 +155,7 @@ fn render_rejects_bad_settings() {
         let e = render(&mut b, &scene, &settings(w, h, spp, 0, Accel::None), None, |_| {}).err().unwrap();
         assert!(e.to_string().contains("must be positive"), "{e}");
     }
-    let reference = treelet::image_io::HdrImage { width: 3, height: 3, pixels: vec![[0.0; 3]; 9] };
+    let reference = treelet::render::image_io::HdrImage { width: 3, height: 3, pixels: vec![[0.0; 3]; 9] };
     let e = render(&mut b, &scene, &settings(4, 4, 4, 0, Accel::None), Some(&reference), |_| {}).err().unwrap();
     assert!(e.to_string().contains("reference image is 3x3"), "{e}");
 }
@@ -165,8 +165,8 @@ fn render_rejects_bad_settings() {
 /// workgroup memory), GPU against the CPU run of the same kernel.
 #[test]
 fn cast_kernels_match_cpu() {
-    use treelet::kernels::Kernel;
-    use treelet::primitives::Primitives;
+    use treelet::runtime::kernels::Kernel;
+    use treelet::scene::primitives::Primitives;
     use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     fn cast<B: Backend>(b: &mut B, scene: &Scene, layout: Layout, kernel: Kernel, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
         let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
@@ -190,7 +190,7 @@ fn cast_kernels_match_cpu() {
         }
         b.read(&rays, (2 * w * h) as usize).unwrap()
     }
-    use treelet::kernels::Method;
+    use treelet::runtime::kernels::Method;
     let room = mesh();
     // A height field alone: its bounce rays meet its own hills.
     let alone = Scene::from_spec("terrain:3000").unwrap().mesh_only().unwrap();

@@ -1,7 +1,7 @@
 //! Treelet restructuring (Karras & Aila 2013) on CPU-built LBVHs: one
 //! sequential bottom-up round keeps every invariant and never raises the SAH;
 //! the device pass (rounds, then the SAH leaf collapse) equals its CPU run.
-use treelet::validate::validate;
+use treelet::build::validate::validate;
 use treelet_core::sah::{sah_cost, SahCosts};
 use treelet_core::treelet::{node_cost, restructure, TreeletCosts};
 use treelet_core::{Aabb, Node, INVALID};
@@ -89,9 +89,9 @@ fn one_round_keeps_invariants_and_lowers_sah() {
 /// primitives, by their height before the round, bottom up.
 #[test]
 fn kernel_round_equals_the_one_invocation_reference() {
-    use treelet::cpu_runner::CpuBackend;
-    use treelet::lbvh::{build_on_device, DeviceBvh};
-    use treelet::trbvh::{collapse, optimize, root_box, TreeletConfig};
+    use treelet::runtime::cpu_runner::CpuBackend;
+    use treelet::build::lbvh::{build_on_device, DeviceBvh};
+    use treelet::build::trbvh::{collapse, optimize, root_box, TreeletConfig};
 
     let seed = treelet_tests::fresh_seed();
     for (n, gamma, max_leaf) in [(3000usize, 3, 8), (20_000, 7, 1), (5000, 1, 8)] {
@@ -130,11 +130,11 @@ fn kernel_round_equals_the_one_invocation_reference() {
 /// same kernels.
 #[test]
 fn device_optimization_matches_cpu_and_lowers_sah() {
-    use treelet::backend::Backend;
-    use treelet::cpu_runner::CpuBackend;
-    use treelet::gpu::GpuBackend;
-    use treelet::lbvh::{build_on_device, Bvh};
-    use treelet::trbvh::{optimize, root_box, TreeletConfig};
+    use treelet::runtime::backend::Backend;
+    use treelet::runtime::cpu_runner::CpuBackend;
+    use treelet::runtime::gpu::GpuBackend;
+    use treelet::build::lbvh::{build_on_device, Bvh};
+    use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
 
     fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], config: &TreeletConfig) -> (Bvh, f64) {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
@@ -212,11 +212,11 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
 /// on the GPU where it fuses Fma), with five rounds so that skips pile up.
 #[test]
 fn skipping_kept_treelets_changes_nothing() {
-    use treelet::backend::Backend;
-    use treelet::cpu_runner::CpuBackend;
-    use treelet::gpu::GpuBackend;
-    use treelet::lbvh::{build_on_device, Bvh};
-    use treelet::trbvh::{optimize, root_box, TreeletConfig};
+    use treelet::runtime::backend::Backend;
+    use treelet::runtime::cpu_runner::CpuBackend;
+    use treelet::runtime::gpu::GpuBackend;
+    use treelet::build::lbvh::{build_on_device, Bvh};
+    use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
 
     fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], gamma: u32, skip_kept: bool) -> Bvh {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
@@ -245,7 +245,7 @@ fn skipping_kept_treelets_changes_nothing() {
 /// full leaves; with `max_leaf` 1 a tree is only reordered (same SAH).
 #[test]
 fn collapse_by_sah() {
-    use treelet::sweep::{build, build_collapsed};
+    use treelet::build::sweep::{build, build_collapsed};
     let same: Vec<treelet_core::Sphere> = (0..100).map(|_| treelet_core::Sphere::new([1.0, 2.0, 3.0], 0.5)).collect();
     let t = build_collapsed(&same, 8).unwrap();
     assert!(validate(&same, &t.nodes, &t.parents, &t.prim_indices).is_valid());

@@ -3,13 +3,13 @@
 //! runner and on the GPU; the choice never drops a feature the scene has.
 use std::collections::BTreeSet;
 
-use treelet::backend::Backend;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::GpuBackend;
-use treelet::layout::Layout;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::build::layout::Layout;
 use treelet::render::{render, Accel, RenderResult, RenderSettings};
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
-use treelet::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU, TRIANGLE_SCAN_WEIGHT};
+use treelet::render::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU, TRIANGLE_SCAN_WEIGHT};
 use treelet_core::features::{self, VARIANTS};
 use treelet_core::triangle::Triangle;
 use treelet_tests::gpu;
@@ -111,7 +111,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, treelet::backend::DeviceClass::CpuRunner);
+            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
             if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
@@ -121,7 +121,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             assert_eq!(p.accel == Accel::None, cost <= LINEAR_MAX_CPU, "{}: scan cost {cost}, {:?}", scene.name, p.accel);
         }
         // Forced choices stay as asked.
-        use treelet::backend::DeviceClass::Gpu;
+        use treelet::runtime::backend::DeviceClass::Gpu;
         assert_eq!(plan(&scene, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu).accel, Accel::Sweep);
         assert_eq!(plan(&scene, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu).layout, Layout::Cwbvh);
     }

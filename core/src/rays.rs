@@ -19,6 +19,12 @@ pub const CAST_DIFFUSE: u32 = 1;
 /// [`RenderParams::cast_mode`]: a diffuse bounce ray from each camera hit
 /// (no tracing).
 pub const CAST_BOUNCE: u32 = 2;
+/// [`RenderParams::cast_mode`]: the caller's own rays (an engine's batch):
+/// `rays[2 id]` = (origin, farthest hit distance), `rays[2 id + 1]` =
+/// (direction, 1 to trace or 0 to skip); the closest hit replaces the
+/// first: (distance along the normalized direction, bits of the primitive,
+/// 0, 0), the primitive `u32::MAX` for none.
+pub const CAST_RAYS: u32 = 3;
 
 /// Kernel (one invocation per pixel, in tiles: see
 /// [`crate::render::tiled_pixel`]), for pixel `id` of invocation
@@ -47,7 +53,19 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         return;
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);
-    if params.cast_mode == CAST_PRIMARY {
+    if params.cast_mode == CAST_RAYS {
+        if rays[j][3] != 0.0 {
+            let (o, d) = (Vec3::new(rays[i][0], rays[i][1], rays[i][2]), Vec3::new(rays[j][0], rays[j][1], rays[j][2]));
+            let len = d.length();
+            let hit = if len > 0.0 && len.is_finite() {
+                closest_hit::<T, F, S>(o, d / len, Origin::NONE, scene, stack, lane)
+            } else {
+                crate::traverse::Hit::NONE
+            };
+            let found = hit.is_hit() && hit.t <= rays[i][3];
+            rays[i] = if found { [hit.t, f32::from_bits(hit.prim), 0.0, 0.0] } else { [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0] };
+        }
+    } else if params.cast_mode == CAST_PRIMARY {
         let (o, d) = camera_ray(params, id);
         let hit = closest_hit::<T, F, S>(o, d, Origin::NONE, scene, stack, lane);
         rays[i] = [hit.t, f32::from_bits(hit.prim), 0.0, 0.0];

@@ -12,6 +12,8 @@
 //!   SAH), the traversal layouts and the independent validators;
 //! - [`render`]: the path tracer's passes, the kernel variant a scene needs,
 //!   images in and out;
+//! - [`tracer`]: the engine API: a tree over your spheres and triangles on
+//!   a device, refit after they move, closest hits for batches of rays;
 //! - [`plot`]: charts for reports and benchmarks.
 //!
 //! The `treelet` command (`main.rs`, `bench/`) sits on top.
@@ -28,3 +30,4 @@ pub mod plot;
 pub mod render;
 pub mod runtime;
 pub mod scene;
+pub mod tracer;

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 use std::sync::{Arc, OnceLock};
 
-use treelet::gpu::GpuContext;
+use treelet::runtime::gpu::GpuContext;
 
 /// The GPU context for tests. With `CI` set, a missing adapter fails the
 /// test; elsewhere the test is skipped with a printed reason (never silently).
@@ -18,10 +18,10 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
 }
 
 use rand::Rng;
-use treelet::cpu_runner::CpuBackend;
-use treelet::gpu::GpuBackend;
-use treelet::lbvh::{self, Bvh};
-use treelet::validate::validate;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::build::lbvh::{self, Bvh};
+use treelet::build::validate::validate;
 use treelet_core::Sphere;
 
 /// A fresh random seed, printed so that a failure can be replayed.

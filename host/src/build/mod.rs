@@ -5,6 +5,7 @@
 //! - [`lbvh`]: Karras 2012 (Morton codes, [`sort`], radix tree or
 //!   agglomerative hierarchy, bottom-up boxes);
 //! - [`trbvh`]: Karras & Aila 2013 treelet restructuring and SAH leaf collapse;
+//! - [`refit`]: new boxes for a tree whose primitives moved;
 //! - [`sweep`]: the full-sweep SAH tree on the CPU, the quality reference;
 //! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
 //! - [`validate`], [`validate_layout`]: independent checks that share no
@@ -12,6 +13,7 @@
 //! - [`report`]: one build, timed and checked (the `treelet build` command).
 pub mod layout;
 pub mod lbvh;
+pub mod refit;
 pub mod report;
 pub mod sort;
 pub mod sweep;

@@ -1,0 +1,160 @@
+//! Treelet inside an engine: a tree over the engine's own triangles and
+//! spheres on a device, closest hits for a batch of rays, then the geometry
+//! moves, the tree is refit and the rays traced again. Every hit is checked
+//! against a scan of every primitive (`treelet_core`'s reference).
+//!
+//!     cargo run --release -p treelet --example tracer            # the first Vulkan adapter
+//!     cargo run --release -p treelet --example tracer -- cpu     # the CPU runner
+//!
+//! `cargo test` runs it on both (it is also the example's test).
+use anyhow::{ensure, Result};
+use glam::Vec3;
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::tracer::{Quality, Ray, RayHit, Tracer};
+use treelet_core::layout::Sphere;
+use treelet_core::traverse::{closest_hit_linear, Origin, Prims};
+use treelet_core::triangle::Triangle;
+
+/// The engine's geometry: a wavy 64 x 64 grid of quads (8 192 triangles)
+/// and a row of balls above it; `phase` moves the waves.
+fn geometry(phase: f32) -> (Vec<Sphere>, Vec<Triangle>) {
+    let height = |x: f32, z: f32| 2.0 * ((x * 0.15 + phase).sin() + (z * 0.11 - phase).cos());
+    let mut triangles = Vec::new();
+    for i in 0..64 {
+        for j in 0..64 {
+            let p = |di: i32, dj: i32| {
+                let (x, z) = ((i + di) as f32, (j + dj) as f32);
+                [x, height(x, z), z]
+            };
+            triangles.push(Triangle::new(p(0, 0), p(1, 0), p(1, 1)));
+            triangles.push(Triangle::new(p(0, 0), p(1, 1), p(0, 1)));
+        }
+    }
+    let spheres = (0..8).map(|k| Sphere::new([8.0 * k as f32 + 4.0, 8.0 + phase, 32.0], 3.0)).collect();
+    (spheres, triangles)
+}
+
+/// A batch of rays from above, looking down and a little sideways.
+fn rays() -> Vec<Ray> {
+    (0..4096)
+        .map(|k| {
+            let (x, z) = ((k % 64) as f32 + 0.37, (k / 64) as f32 + 0.61);
+            Ray::new([x, 20.0, z], [0.1, -1.0, 0.05])
+        })
+        .collect()
+}
+
+/// Traces `rays` through `tracer` and checks every hit against the scan.
+fn trace_and_check<B: Backend>(b: &mut B, tracer: &Tracer<B>, scene: &(Vec<Sphere>, Vec<Triangle>), rays: &[Ray]) -> Result<Vec<RayHit>> {
+    let hits = tracer.closest_hits(b, rays)?;
+    let (spheres, triangles) = scene;
+    let prims = Prims {
+        spheres,
+        sphere_count: spheres.len() as u32,
+        triangles,
+        triangle_count: triangles.len() as u32,
+    };
+    for (r, h) in rays.iter().zip(&hits) {
+        let d = Vec3::from(r.dir).normalize();
+        let scan = closest_hit_linear(Vec3::from(r.origin), d, Origin::NONE, &prims);
+        ensure!(h.prim == scan.prim, "ray {r:?}: the tree hit {h:?}, the scan {} at {}", scan.prim, scan.t);
+        ensure!(!h.is_hit() || (h.t - scan.t).abs() <= 1e-4 * scan.t.max(1.0), "ray {r:?}: {} against {}", h.t, scan.t);
+    }
+    Ok(hits)
+}
+
+/// The whole job on one device.
+fn run<B: Backend>(b: &mut B) -> Result<()> {
+    let rays = rays();
+    let scene = geometry(0.0);
+    let tracer = &mut Tracer::build(b, &scene.0, &scene.1, Quality::High)?;
+    let hits = trace_and_check(b, tracer, &scene, &rays)?;
+    let on_balls = hits.iter().filter(|h| h.is_hit() && h.prim < 8).count();
+    println!(
+        "{}: {} of {} rays hit ({on_balls} a ball), all equal to the scan",
+        b.adapter(),
+        hits.iter().filter(|h| h.is_hit()).count(),
+        rays.len()
+    );
+    // The waves move and the balls rise: refit, trace again.
+    let moved = geometry(1.3);
+    tracer.refit(b, &moved.0, &moved.1)?;
+    let moved_hits = trace_and_check(b, tracer, &moved, &rays)?;
+    let changed = hits.iter().zip(&moved_hits).filter(|(a, b)| a != b).count();
+    println!("after the refit: {changed} rays hit something else or elsewhere, all equal to the scan");
+    ensure!(changed > rays.len() / 2, "moving the geometry should move most hits");
+    Ok(())
+}
+
+/// Rays that live on the GPU already (an engine's own `wgpu::Buffer`):
+/// traced in place, without a round trip through host memory.
+fn on_device(ctx: std::sync::Arc<GpuContext>) -> Result<()> {
+    let b = &mut GpuBackend::new(ctx.clone());
+    let scene = geometry(0.0);
+    let tracer = Tracer::build(b, &scene.0, &scene.1, Quality::Fast)?;
+    let rays = rays();
+    // The engine's buffer: ray k is (origin, t_max), (direction, 1), padded
+    // with zeros to `batch_slots` pairs.
+    let mut data = vec![[0f32; 4]; 2 * treelet::tracer::batch_slots(rays.len())?];
+    for (k, r) in rays.iter().enumerate() {
+        data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
+        data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
+    }
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("engine rays"),
+        size: (data.len() * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    ctx.queue.write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
+    tracer.closest_hits_on_device(b, &buffer, rays.len())?;
+    // Here an engine would bind `buffer` to its next pass; the example reads it back to check.
+    let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
+    let from_host = tracer.closest_hits(b, &rays)?;
+    for (k, h) in from_host.iter().enumerate() {
+        ensure!(out[2 * k][1].to_bits() == h.prim && (out[2 * k][0] == h.t), "ray {k}: on the device {:?}, from the host {h:?}", out[2 * k]);
+    }
+    println!("{} rays traced in a wgpu buffer: the same hits as from host slices", rays.len());
+    Ok(())
+}
+
+fn main() -> Result<()> {
+    if std::env::args().nth(1).as_deref() == Some("cpu") {
+        return run(&mut CpuBackend::new());
+    }
+    match GpuContext::new() {
+        Ok(ctx) => {
+            run(&mut GpuBackend::new(ctx.clone()))?;
+            on_device(ctx)
+        }
+        Err(e) => {
+            eprintln!("note: {e}: running on the CPU runner instead");
+            run(&mut CpuBackend::new())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_on_the_cpu_runner() {
+        run(&mut CpuBackend::new()).unwrap();
+    }
+
+    /// With `CI` set, a machine without a usable adapter fails this test.
+    #[test]
+    fn runs_on_the_gpu() {
+        match GpuContext::new() {
+            Ok(ctx) => {
+                run(&mut GpuBackend::new(ctx.clone())).unwrap();
+                on_device(ctx).unwrap();
+            }
+            Err(e) if std::env::var_os("CI").is_some() => panic!("CI is set and no GPU adapter is usable: {e:#}"),
+            Err(e) => eprintln!("SKIPPED (no GPU adapter, CI not set): {e:#}"),
+        }
+    }
+}

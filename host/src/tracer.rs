@@ -1,0 +1,191 @@
+//! Closest hits for an engine's own geometry: build a tree over its spheres
+//! and triangles on a device (the GPU, or the CPU runner with the same
+//! kernels), refit the tree after they move, and trace batches of rays,
+//! from host slices or from a buffer that stays on the device.
+//!
+//! ```
+//! use treelet::runtime::cpu_runner::CpuBackend;
+//! use treelet::tracer::{Quality, Ray, Tracer};
+//! use treelet_core::triangle::Triangle;
+//! let triangles = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
+//! let b = &mut CpuBackend::new();
+//! let tracer = Tracer::build(b, &[], &triangles, Quality::Fast)?;
+//! let hits = tracer.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0])])?;
+//! assert_eq!((hits[0].prim, hits[0].t), (0, 5.0));
+//! # anyhow::Ok(())
+//! ```
+use anyhow::{bail, Result};
+use treelet_core::layout::{RenderParams, Sphere};
+use treelet_core::rays::CAST_RAYS;
+use treelet_core::render::tiled_invocations;
+use treelet_core::triangle::Triangle;
+use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+
+use crate::build::layout::{Layout, PrimBuffers, TracedTree};
+use crate::build::refit::refit;
+use crate::render::{binary_tree, Accel, BuiltTree};
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::{Kernel, Method};
+use crate::scene::primitives::Primitives;
+
+/// A ray of a batch: from `origin` along `dir` (any length but zero), hits
+/// up to distance `t_max` (along the normalized direction). A ray that
+/// leaves a surface should start a little off it: nothing is excluded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: [f32; 3],
+    pub dir: [f32; 3],
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// A ray with no limit on its hit distance.
+    pub fn new(origin: [f32; 3], dir: [f32; 3]) -> Ray {
+        Ray { origin, dir, t_max: f32::INFINITY }
+    }
+}
+
+/// The closest hit of a ray: the primitive (spheres first, then triangles,
+/// in the order given to [`Tracer::build`]) and the distance along the
+/// normalized direction; `prim == u32::MAX` and `t` infinite for none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    pub t: f32,
+    pub prim: u32,
+}
+
+impl RayHit {
+    pub fn is_hit(&self) -> bool {
+        self.prim != u32::MAX
+    }
+}
+
+/// How much build time to spend for faster rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    /// The LBVH (Karras 2012): the fastest build.
+    Fast,
+    /// The LBVH after treelet restructuring (Karras & Aila 2013): about ten
+    /// times the build time, faster rays.
+    High,
+}
+
+/// Rays a device batch holds per row (the cast kernels walk an image).
+const BATCH_WIDTH: u32 = 1024;
+
+/// A tree over an engine's primitives on one device, laid out for tracing.
+pub struct Tracer<B: Backend> {
+    built: Option<BuiltTree<B>>,
+    prims: PrimBuffers<B>,
+    tree: Option<TracedTree<B>>,
+    counts: (usize, usize),
+}
+
+impl<B: Backend> Tracer<B> {
+    /// Builds the tree over `spheres` and `triangles` on `b` and lays it out
+    /// for tracing. Rejects non-finite or degenerate input, naming it.
+    pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> Result<Self> {
+        let all = Primitives { spheres, triangles };
+        all.check()?;
+        let accel = match quality {
+            Quality::Fast => Accel::Lbvh,
+            Quality::High => Accel::Trbvh,
+        };
+        let built = if all.len() == 0 { None } else { binary_tree(b, all, accel)? };
+        let mut tracer = Tracer { built, prims: PrimBuffers::upload(b, all)?, tree: None, counts: (spheres.len(), triangles.len()) };
+        tracer.lay_out(b)?;
+        Ok(tracer)
+    }
+
+    /// Moves the primitives: the same counts, in the same order, at new
+    /// places. The tree keeps its shape and gets new boxes (bottom-up, the
+    /// build's own fit kernel), then a new layout. A refit tree stays
+    /// correct however far things move, but its rays slow down as it drifts
+    /// from what a new build would make: rebuild after large changes.
+    pub fn refit(&mut self, b: &mut B, spheres: &[Sphere], triangles: &[Triangle]) -> Result<()> {
+        if (spheres.len(), triangles.len()) != self.counts {
+            bail!(
+                "refit with {} spheres and {} triangles: the tree was built over {} and {} (build a new one)",
+                spheres.len(),
+                triangles.len(),
+                self.counts.0,
+                self.counts.1
+            );
+        }
+        let all = Primitives { spheres, triangles };
+        all.check()?;
+        if let Some(built) = &self.built {
+            refit(b, &built.bvh, all)?;
+        }
+        self.prims = PrimBuffers::upload(b, all)?;
+        self.lay_out(b)
+    }
+
+    /// The two-box binary layout: the fastest to trace in our measurements.
+    fn lay_out(&mut self, b: &mut B) -> Result<()> {
+        self.tree = match &self.built {
+            Some(built) => Some(built.lay_out(b, Layout::Bvh2, &self.prims)?.0),
+            None => None,
+        };
+        Ok(())
+    }
+
+    /// The closest hit of each ray.
+    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
+        if self.tree.is_none() {
+            return Ok(vec![RayHit { t: f32::INFINITY, prim: u32::MAX }; rays.len()]);
+        }
+        let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
+        for (k, r) in rays.iter().enumerate() {
+            data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
+            data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
+        }
+        let buffer = b.upload("rays", &data)?;
+        self.closest_hits_on_device(b, &buffer, rays.len())?;
+        let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
+        Ok((0..rays.len()).map(|k| RayHit { t: out[2 * k][0], prim: out[2 * k][1].to_bits() }).collect())
+    }
+
+    /// Traces `count` rays that are already on the device (for callers that
+    /// hold their rays in a GPU buffer, e.g. a `wgpu::Buffer` through
+    /// [`GpuBackend`](crate::runtime::gpu::GpuBackend)), in place: ray `k` is
+    /// `rays[2k]` = (origin, t_max) and `rays[2k + 1]` = (direction, 1), as
+    /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, 0,
+    /// 0). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// `count` must be zero. Submitted, not waited for.
+    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        let slots = batch_slots(count)? as u32;
+        let (width, height) = (BATCH_WIDTH.min(slots.max(1)), slots.div_ceil(BATCH_WIDTH).max(1));
+        let params = RenderParams {
+            width,
+            height,
+            prims: self.prims.sphere_count,
+            triangles: self.prims.triangle_count,
+            cast_mode: CAST_RAYS,
+            ..Default::default()
+        };
+        let p = b.upload("trace params", &[params])?;
+        let materials = b.upload("no materials", &[treelet_core::layout::Material::default()])?;
+        let Some(tree) = &self.tree else {
+            bail!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)");
+        };
+        let kernel = Kernel::Cast(Method::Bvh2, self.counts.0 == 0);
+        b.stage("trace");
+        b.dispatch(
+            kernel,
+            &[&p, &self.prims.spheres, &materials, &tree.nodes, &tree.prims, rays, &self.prims.triangles],
+            groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
+        );
+        Ok(())
+    }
+}
+
+/// Ray pairs a device batch of `count` rays holds (rows of whole width).
+pub fn batch_slots(count: usize) -> Result<usize> {
+    let width = BATCH_WIDTH as usize;
+    let slots = if count <= width { count.max(1) } else { count.div_ceil(width) * width };
+    if slots > u32::MAX as usize / 4 {
+        bail!("{count} rays in one batch: at most {} are supported", u32::MAX / 4);
+    }
+    Ok(slots)
+}

@@ -1,0 +1,136 @@
+//! The engine API (`treelet::tracer`): closest hits of random rays through
+//! trees over random spheres and triangles, on the GPU and the CPU runner,
+//! each against the scan of every primitive (`treelet_core`, no tree), before
+//! and after a refit; and its errors.
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::tracer::{Quality, Ray, RayHit, Tracer};
+use treelet_core::layout::Sphere;
+use treelet_core::traverse::{closest_hit_linear, Origin, Prims};
+use treelet_core::triangle::Triangle;
+use treelet_tests::{fresh_seed, gpu};
+
+type Geometry = (Vec<Sphere>, Vec<Triangle>);
+
+fn geometry(rng: &mut impl Rng, spheres: usize, triangles: usize) -> Geometry {
+    let mut p = || [rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32)];
+    let s = (0..spheres).map(|_| Sphere::new(p(), 1.5)).collect();
+    let t = (0..triangles)
+        .map(|_| {
+            let a = p();
+            Triangle::new(a, [a[0] + 4.0, a[1] + 1.0, a[2]], [a[0], a[1] + 3.0, a[2] + 4.0])
+        })
+        .collect();
+    (s, t)
+}
+
+/// Every primitive moved by its own random offset.
+fn moved(g: &Geometry, rng: &mut impl Rng) -> Geometry {
+    let mut off = || Vec3::new(rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0));
+    let s = g.0.iter().map(|s| Sphere::new((Vec3::from(s.center) + off()).into(), s.radius)).collect();
+    let t = g.1.iter().map(|t| {
+        let o = off();
+        Triangle::new((Vec3::from(t.v0) + o).into(), (Vec3::from(t.v1) + o).into(), (Vec3::from(t.v2) + o).into())
+    });
+    (s, t.collect())
+}
+
+fn rays(rng: &mut impl Rng, n: usize) -> Vec<Ray> {
+    (0..n)
+        .map(|k| {
+            let o = [rng.random_range(-10.0..110.0), rng.random_range(-10.0..110.0), rng.random_range(-10.0..110.0)];
+            let d = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+            // Every fourth ray stops at 30 units.
+            Ray { origin: o, dir: d, t_max: if k % 4 == 0 { 30.0 } else { f32::INFINITY } }
+        })
+        .collect()
+}
+
+fn scan(g: &Geometry, r: &Ray) -> RayHit {
+    let prims = Prims { spheres: &g.0, sphere_count: g.0.len() as u32, triangles: &g.1, triangle_count: g.1.len() as u32 };
+    let d = Vec3::from(r.dir);
+    if d.length() == 0.0 {
+        return RayHit { t: f32::INFINITY, prim: u32::MAX };
+    }
+    let h = closest_hit_linear(Vec3::from(r.origin), d.normalize(), Origin::NONE, &prims);
+    if h.is_hit() && h.t <= r.t_max {
+        RayHit { t: h.t, prim: h.prim }
+    } else {
+        RayHit { t: f32::INFINITY, prim: u32::MAX }
+    }
+}
+
+/// The tracer's hits equal the scan's: same primitive, same distance within
+/// rounding (a ray grazing two primitives at one distance may name either).
+fn check(what: &str, hits: &[RayHit], g: &Geometry, rays: &[Ray]) {
+    assert_eq!(hits.len(), rays.len());
+    let mut hit = 0;
+    for (r, h) in rays.iter().zip(hits) {
+        let s = scan(g, r);
+        assert_eq!(h.is_hit(), s.is_hit(), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
+        if s.is_hit() {
+            hit += 1;
+            assert!((h.t - s.t).abs() <= 1e-4 * s.t.max(1.0), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
+            assert!(h.prim == s.prim || (h.t - s.t).abs() <= 1e-5 * s.t.max(1.0), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
+        }
+    }
+    assert!(hit > rays.len() / 20, "{what}: only {hit} of {} rays hit: the test would prove little", rays.len());
+}
+
+fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> (Vec<RayHit>, Vec<RayHit>) {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let g = geometry(&mut rng, 300, 1700);
+    let rays = rays(&mut rng, 3000);
+    let what = format!("{} {quality:?} seed {seed}", b.adapter());
+    let mut t = Tracer::build(b, &g.0, &g.1, quality).unwrap();
+    let first = t.closest_hits(b, &rays).unwrap();
+    check(&what, &first, &g, &rays);
+    let m = moved(&g, &mut rng);
+    t.refit(b, &m.0, &m.1).unwrap();
+    let second = t.closest_hits(b, &rays).unwrap();
+    check(&format!("{what}, refit"), &second, &m, &rays);
+    (first, second)
+}
+
+#[test]
+fn tracer_finds_the_scans_hits_before_and_after_a_refit() {
+    let seed = fresh_seed();
+    for quality in [Quality::Fast, Quality::High] {
+        let cpu = round_trip(&mut CpuBackend::new(), seed, quality);
+        if let Some(ctx) = gpu() {
+            let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);
+            // Same kernels, same tree: the same primitives, distances within rounding.
+            let same = cpu.0.iter().chain(&cpu.1).zip(gpu.0.iter().chain(&gpu.1)).filter(|(c, g)| c.prim == g.prim).count();
+            assert!(same as f64 >= 0.999 * 2.0 * cpu.0.len() as f64, "{quality:?}: GPU and CPU agree on {same} hits of {}", 2 * cpu.0.len());
+        }
+    }
+}
+
+#[test]
+fn tracer_small_and_empty_scenes() {
+    let b = &mut CpuBackend::new();
+    let one = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
+    let t = Tracer::build(b, &[], &one, Quality::Fast).unwrap();
+    let hits = t.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 2.0]), Ray::new([3.0, 3.0, 0.0], [0.0, 0.0, 1.0])]).unwrap();
+    assert_eq!((hits[0].prim, hits[0].t), (0, 5.0));
+    assert!(!hits[1].is_hit());
+    let empty = Tracer::build(b, &[], &[], Quality::High).unwrap();
+    assert!(!empty.closest_hits(b, &[Ray::new([0.0; 3], [1.0, 0.0, 0.0])]).unwrap()[0].is_hit());
+    // A zero direction hits nothing.
+    assert!(!t.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0; 3])]).unwrap()[0].is_hit());
+}
+
+#[test]
+fn tracer_rejects_bad_input_by_name() {
+    let b = &mut CpuBackend::new();
+    let bad = [Triangle::new([0.0, f32::NAN, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
+    let e = format!("{:#}", Tracer::build(b, &[], &bad, Quality::Fast).err().expect("NaN accepted"));
+    assert!(e.contains("triangle 0") || e.contains("NaN"), "{e}");
+    let good = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
+    let mut t = Tracer::build(b, &[], &good, Quality::Fast).unwrap();
+    let e = format!("{:#}", t.refit(b, &[], &[good[0], good[0]]).unwrap_err());
+    assert!(e.contains("2 triangles") && e.contains("built over"), "{e}");
+}
