@@ -96,12 +96,8 @@ fn on_device(ctx: std::sync::Arc<GpuContext>) -> Result<()> {
     let tracer = Tracer::build(b, &scene.0, &scene.1, Quality::Fast)?;
     let rays = rays();
     // The engine's buffer: ray k is (origin, t_max), (direction, 1), padded
-    // with zeros to `batch_slots` pairs.
-    let mut data = vec![[0f32; 4]; 2 * treelet::tracer::batch_slots(rays.len())?];
-    for (k, r) in rays.iter().enumerate() {
-        data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
-        data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
-    }
+    // with zeros (an engine would write these from its own shaders).
+    let data = treelet::tracer::device_rays(&rays)?;
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("engine rays"),
         size: (data.len() * 16) as u64,

@@ -135,12 +135,7 @@ impl<B: Backend> Tracer<B> {
         if self.tree.is_none() {
             return Ok(vec![RayHit { t: f32::INFINITY, prim: u32::MAX }; rays.len()]);
         }
-        let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
-        for (k, r) in rays.iter().enumerate() {
-            data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
-            data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
-        }
-        let buffer = b.upload("rays", &data)?;
+        let buffer = b.upload("rays", &device_rays(rays)?)?;
         self.closest_hits_on_device(b, &buffer, rays.len())?;
         let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
         Ok((0..rays.len()).map(|k| RayHit { t: out[2 * k][0], prim: out[2 * k][1].to_bits() }).collect())
@@ -178,6 +173,17 @@ impl<B: Backend> Tracer<B> {
         );
         Ok(())
     }
+}
+
+/// `rays` as [`Tracer::closest_hits_on_device`] reads them from a device
+/// buffer: two `[f32; 4]` a ray, padded with zeros to [`batch_slots`] pairs.
+pub fn device_rays(rays: &[Ray]) -> Result<Vec<[f32; 4]>> {
+    let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
+    for (k, r) in rays.iter().enumerate() {
+        data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
+        data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
+    }
+    Ok(data)
 }
 
 /// Ray pairs a device batch of `count` rays holds (rows of whole width).
