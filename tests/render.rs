@@ -38,6 +38,7 @@ fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> Rende
         kernel: KernelChoice::Auto,
         integrator: Integrator::Smallpt,
         error_each_pass: true,
+        first_sample: 0,
     }
 }
 

@@ -65,6 +65,7 @@ fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel,
         kernel,
         integrator: treelet::render::Integrator::Smallpt,
         error_each_pass: true,
+        first_sample: 0,
     };
     render(b, scene, &s, None, |_| {}).unwrap()
 }

@@ -91,6 +91,17 @@ enum Command {
     },
     /// Path-trace a scene (smallpt) and write the image, with an error report.
     Render(RenderArgs),
+    /// Add the parts of a render (`render --samples A..B --out part.exr`,
+    /// from other processes or machines) into one image; checks that they
+    /// share scene, size, seed and integrator, and that their sample ranges
+    /// neither overlap nor leave gaps.
+    Merge {
+        #[arg(required = true)]
+        parts: Vec<std::path::PathBuf>,
+        /// The image: .png (gamma 2.2), .exr or .pfm (linear means).
+        #[arg(long, default_value = "treelet.png")]
+        out: std::path::PathBuf,
+    },
     /// Score an image (.exr or .pfm, linear) against a reference with the
     /// render's own error measure; prints one JSON object (`rmse`, `rel_mse`).
     Compare {
@@ -115,8 +126,13 @@ struct RenderArgs {
     #[arg(long, default_value_t = 384)]
     height: u32,
     /// Samples per pixel (taken in turn by the 2x2 subpixels).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, conflicts_with = "samples")]
     spp: u32,
+    /// Render only samples FIRST..LAST (LAST excluded) and write them to
+    /// --out (.exr) as a part: per-pixel sums and the range in its header,
+    /// for `treelet merge` to add to the other parts.
+    #[arg(long, value_name = "FIRST..LAST", value_parser = parse_range)]
+    samples: Option<std::ops::Range<u32>>,
     /// How closest hits are found; auto: a linear scan below the measured
     /// crossover in primitive count, else the treelet-optimized BVH.
     #[arg(long, value_enum, default_value = "auto")]
@@ -153,7 +169,24 @@ struct RenderArgs {
     report: Option<std::path::PathBuf>,
 }
 
-fn run_render(args: RenderArgs) -> Result<()> {
+/// `A..B` (B excluded) with A < B.
+fn parse_range(s: &str) -> std::result::Result<std::ops::Range<u32>, String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("`{s}`: expected FIRST..LAST, e.g. 0..256"))?;
+    let (a, b): (u32, u32) = (a.parse().map_err(|_| format!("`{a}` is not a sample index"))?, b.parse().map_err(|_| format!("`{b}` is not a sample index"))?);
+    if a >= b {
+        return Err(format!("`{s}`: the range is empty (FIRST must be below LAST)"));
+    }
+    Ok(a..b)
+}
+
+fn run_render(mut args: RenderArgs) -> Result<()> {
+    let part = args.samples.clone();
+    if let Some(range) = &part {
+        if image_io::extension(&args.out) != "exr" {
+            anyhow::bail!("--samples writes a part of a render: --out must name an .exr file (not {})", args.out.display());
+        }
+        args.spp = range.end - range.start;
+    }
     let scene = Scene::from_spec(&args.scene)?;
     let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
     let settings = RenderSettings {
@@ -166,6 +199,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         kernel: args.kernel,
         integrator: args.integrator,
         error_each_pass: args.report.is_some() || args.reference.is_some(),
+        first_sample: part.as_ref().map_or(0, |r| r.start),
     };
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
@@ -212,7 +246,20 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
     bar.finish_and_clear();
     let write_start = std::time::Instant::now();
-    image_io::write(&args.out, &result.image)?;
+    match &part {
+        Some(range) => {
+            let info = treelet::render::parts::PartInfo {
+                scene: scene.name.clone(),
+                width: args.width,
+                height: args.height,
+                seed: args.seed,
+                integrator: args.integrator.name().into(),
+                samples: range.clone(),
+            };
+            treelet::render::parts::write_part(&args.out, &info, &result.sums)?;
+        }
+        None => image_io::write(&args.out, &result.image)?,
+    }
     let write_s = write_start.elapsed().as_secs_f64();
     if args.explain && !startup.is_null() {
         eprintln!(
@@ -330,6 +377,21 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(report.valid)
         }
         Command::Render(args) => run_render(args).map(|_| true),
+        Command::Merge { parts, out } => {
+            let (info, image) = treelet::render::parts::merge(&parts)?;
+            image_io::write(&out, &image)?;
+            eprintln!(
+                "{}: {}x{}, samples {}..{} from {} parts, wrote {}",
+                info.scene,
+                info.width,
+                info.height,
+                info.samples.start,
+                info.samples.end,
+                parts.len(),
+                out.display()
+            );
+            Ok(true)
+        }
         Command::Compare { image, reference } => {
             let (img, r) = (image_io::read_hdr(&image)?, image_io::read_hdr(&reference)?);
             if (img.width, img.height) != (r.width, r.height) {

@@ -287,3 +287,84 @@ fn no_xdg_runtime_dir_message() {
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
     std::fs::remove_file(&image).ok();
 }
+
+/// A render split into sample ranges in separate processes, then merged,
+/// is the render made in one go (up to float rounding of the sums); merge
+/// names the file of every mismatch, gap and overlap.
+#[test]
+fn parts_rendered_apart_merge_into_the_whole() {
+    let dir = std::env::temp_dir().join(format!("treelet-parts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_string_lossy().to_string();
+    let render = |extra: &[&str], out: &str| {
+        let mut args = vec!["render", "--device", "cpu", "--scene", "cornell", "--width", "32", "--height", "24"];
+        if !extra.contains(&"--seed") {
+            args.extend_from_slice(&["--seed", "5"]);
+        }
+        args.extend_from_slice(extra);
+        let o = path(out);
+        args.extend_from_slice(&["--out", &o]);
+        let out = treelet(&args);
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    };
+    for (range, file) in [("0..10", "a.exr"), ("10..33", "b.exr"), ("33..48", "c.exr")] {
+        render(&["--samples", range], file);
+    }
+    render(&["--spp", "48"], "whole.pfm");
+    let out = treelet(&["merge", &path("c.exr"), &path("a.exr"), &path("b.exr"), "--out", &path("merged.pfm")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = treelet(&["compare", &path("merged.pfm"), "--reference", &path("whole.pfm")]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    assert!(v["rmse"].as_f64().unwrap() < 1e-5, "merged against whole: {v}");
+
+    let merge_error = |files: &[&str]| {
+        let mut args = vec!["merge".to_string()];
+        args.extend(files.iter().map(|f| path(f)));
+        args.extend(["--out".to_string(), path("x.png")]);
+        stderr_of(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let e = merge_error(&["a.exr", "c.exr"]);
+    assert!(e.contains("samples 10..33 are missing") && e.contains("a.exr") && e.contains("c.exr"), "{e}");
+    let e = merge_error(&["a.exr", "b.exr", "a.exr"]);
+    assert!(e.contains("overlap") && e.contains("a.exr"), "{e}");
+    render(&["--samples", "10..33", "--seed", "6"], "other_seed.exr");
+    let e = merge_error(&["a.exr", "other_seed.exr"]);
+    assert!(e.contains("other_seed.exr") && e.contains("seed 6"), "{e}");
+    let e = merge_error(&["a.exr", "whole.pfm"]);
+    assert!(e.contains("whole.pfm"), "{e}");
+    let e = stderr_of(&["render", "--samples", "0..4", "--out", &path("part.png")]);
+    assert!(e.contains(".exr"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `deploy/slurm-array.sh` as a job array would run it: every task's range,
+/// then the merge, equal to one render of all the samples.
+#[test]
+fn slurm_array_script_splits_and_merges() {
+    let dir = std::env::temp_dir().join(format!("treelet-slurm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy/slurm-array.sh");
+    let run = |step: &str, task: Option<u32>| {
+        let mut c = Command::new("bash");
+        c.arg(script).arg(step).current_dir(&dir);
+        c.env("TREELET", env!("CARGO_BIN_EXE_treelet")).env("DEVICE", "cpu").env("WIDTH", "24").env("HEIGHT", "16");
+        c.env("SPP", "30").env("TASKS", "4").env("SEED", "2").env("OUT", dir.join("merged.pfm"));
+        if let Some(t) = task {
+            c.env("SLURM_ARRAY_TASK_ID", t.to_string());
+        }
+        let out = c.output().expect("run bash");
+        assert!(out.status.success(), "{step} {task:?}: {}", String::from_utf8_lossy(&out.stderr));
+    };
+    for task in 0..4 {
+        run("render", Some(task));
+    }
+    run("merge", None);
+    let whole = dir.join("whole.pfm").to_string_lossy().to_string();
+    let args = ["render", "--device", "cpu", "--width", "24", "--height", "16", "--spp", "30", "--seed", "2", "--out", &whole];
+    assert!(treelet(&args).status.success());
+    let merged = dir.join("merged.pfm").to_string_lossy().to_string();
+    let out = treelet(&["compare", &merged, "--reference", &whole]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    assert!(v["rmse"].as_f64().unwrap() < 1e-5, "{v}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -47,6 +47,7 @@ pub(crate) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
             kernel: KernelChoice::Auto,
             integrator,
             error_each_pass,
+            first_sample: 0,
         };
         with_backend!(runner, |b| {
             pb.set_message(format!("{name}: reference, {reference_spp} spp"));

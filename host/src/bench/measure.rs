@@ -71,7 +71,7 @@ pub(crate) fn bench_render_kernel<B: Backend>(
     layout: Layout,
     kernel: KernelChoice,
 ) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt, error_each_pass: true };
+    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt, error_each_pass: true, first_sample: 0 };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
     Ok(RenderRow {

@@ -2,6 +2,7 @@
 //! on the device, then each pass adds samples to every pixel and the error
 //! is measured, against a reference image or from the per-pixel variance.
 pub mod image_io;
+pub mod parts;
 pub mod variant;
 
 use std::time::Instant;
@@ -102,6 +103,11 @@ pub struct RenderSettings {
     /// report or a reference); else only after the last, which saves a
     /// readback of the whole image per pass.
     pub error_each_pass: bool,
+    /// The index of the first sample: a render of samples `first_sample ..
+    /// first_sample + spp` is that part of a longer render (the random
+    /// numbers are counted from (seed, pixel, sample)), so parts rendered
+    /// apart add up to it (`treelet render --samples`, `treelet merge`).
+    pub first_sample: u32,
 }
 
 /// Camera paths per dispatch at most, so that no dispatch runs long enough
@@ -155,6 +161,9 @@ pub struct PassRow {
 
 pub struct RenderResult {
     pub image: HdrImage,
+    /// Per pixel, the sums of radiance (r, g, b) and of squared luminance
+    /// over the samples rendered: what parts of a render add up.
+    pub sums: Vec<[f32; 4]>,
     pub rows: Vec<PassRow>,
     /// BVH build time on the device (ms; 0 without a BVH).
     pub build_ms: f64,
@@ -185,13 +194,16 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, error_each_pass } = *settings;
+    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, error_each_pass, first_sample } = *settings;
     if width == 0 || height == 0 || spp == 0 {
         bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
     }
     let pixels = width as u64 * height as u64;
     if pixels > u32::MAX as u64 / 2 {
         bail!("image size {width}x{height} is too large ({pixels} pixels)");
+    }
+    if first_sample.checked_add(spp).is_none() {
+        bail!("samples {first_sample}.. plus {spp}: the sample index must stay below 2^32");
     }
     if let Some(r) = reference {
         if (r.width, r.height) != (width, height) {
@@ -233,7 +245,7 @@ pub fn render<B: Backend>(
                 width,
                 height,
                 samples,
-                first_sample: done,
+                first_sample: first_sample + done,
                 seed,
                 prims,
                 triangles: triangles_n,
@@ -275,7 +287,7 @@ pub fn render<B: Backend>(
     }
     let image =
         HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
-    Ok(RenderResult { image, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
+    Ok(RenderResult { image, sums, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
 }
 
 /// Root mean square error (per channel) of `image` against `reference`,

@@ -1,0 +1,159 @@
+//! Parts of a render made apart (other processes, other machines): each is a
+//! linear EXR of per-pixel sums (radiance in r, g, b; squared luminance in
+//! a) whose header names the scene, seed, integrator and sample range.
+//! Because Treelet's random numbers are counted from (seed, pixel, sample),
+//! parts whose ranges tile `first..last` add up to the render of that range
+//! in one go, up to float rounding. `treelet render --samples` writes a
+//! part, `treelet merge` adds parts after checking that they belong together.
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use exr::prelude::*;
+
+use super::image_io::HdrImage;
+
+/// What a part is of.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PartInfo {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub seed: u32,
+    pub integrator: String,
+    /// The samples rendered: `first..last`.
+    pub samples: Range<u32>,
+}
+
+const PREFIX: &str = "treelet.";
+
+/// Writes `sums` (one per pixel, image order) as a part.
+pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()> {
+    let (w, h) = (info.width as usize, info.height as usize);
+    if sums.len() != w * h {
+        bail!("{}: {} pixel sums for a {w}x{h} image", path.display(), sums.len());
+    }
+    let text = |what: &str, v: &str| {
+        Text::new_or_none(v).map(AttributeValue::Text).with_context(|| format!("{}: the {what} `{v}` is not Latin-1 text, which EXR headers need", path.display()))
+    };
+    let mut attributes = LayerAttributes::named("treelet render part");
+    let mut put = |key: &str, value: AttributeValue| {
+        attributes.other.insert(Text::from(format!("{PREFIX}{key}").as_str()), value);
+    };
+    put("scene", text("scene name", &info.scene)?);
+    put("integrator", text("integrator", &info.integrator)?);
+    put("seed", AttributeValue::Text(Text::from(info.seed.to_string().as_str())));
+    put("first_sample", AttributeValue::Text(Text::from(info.samples.start.to_string().as_str())));
+    put("last_sample", AttributeValue::Text(Text::from(info.samples.end.to_string().as_str())));
+    let layer = Layer::new(
+        (w, h),
+        attributes,
+        Encoding::FAST_LOSSLESS,
+        SpecificChannels::rgba(|p: Vec2<usize>| {
+            let s = sums[p.y() * w + p.x()];
+            (s[0], s[1], s[2], s[3])
+        }),
+    );
+    Image::from_layer(layer).write().to_file(path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Reads a part: what it is of, and its sums.
+pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |size, _| (size.width(), vec![[0f32; 4]; size.width() * size.height()]),
+        |(w, pixels), p, (r, g, b, a): (f32, f32, f32, f32)| pixels[p.y() * *w + p.x()] = [r, g, b, a],
+    )
+    .with_context(|| format!("cannot read {} as an EXR image", path.display()))?;
+    let size = image.layer_data.size;
+    let other = &image.layer_data.attributes.other;
+    let field = |key: &str| -> Result<String> {
+        match other.get(&Text::from(format!("{PREFIX}{key}").as_str())) {
+            Some(AttributeValue::Text(t)) => Ok(t.to_string()),
+            _ => bail!("{}: no `{PREFIX}{key}` in its header: not a part written by `treelet render --samples`", path.display()),
+        }
+    };
+    let number = |key: &str| -> Result<u32> {
+        let v = field(key)?;
+        v.parse().with_context(|| format!("{}: `{PREFIX}{key}` is `{v}`, not a number", path.display()))
+    };
+    let info = PartInfo {
+        scene: field("scene")?,
+        width: size.width() as u32,
+        height: size.height() as u32,
+        seed: number("seed")?,
+        integrator: field("integrator")?,
+        samples: number("first_sample")?..number("last_sample")?,
+    };
+    if info.samples.is_empty() {
+        bail!("{}: its sample range {}..{} is empty", path.display(), info.samples.start, info.samples.end);
+    }
+    Ok((info, image.layer_data.channel_data.pixels.1))
+}
+
+/// Adds parts: they must be of one scene, size, seed and integrator, and
+/// their sample ranges must neither overlap nor leave gaps. Returns what
+/// the sum is of (its range: the union), and the image of mean radiance.
+pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
+    let Some(first) = paths.first() else { bail!("no parts to merge") };
+    let mut parts = Vec::new();
+    for p in paths {
+        let (info, sums) = read_part(p)?;
+        parts.push((p, info, sums));
+    }
+    let reference = parts[0].1.clone();
+    for (p, info, _) in &parts[1..] {
+        let same = |what: &str, a: &dyn std::fmt::Display, b: &dyn std::fmt::Display| -> Result<()> {
+            if a.to_string() != b.to_string() {
+                bail!("{} is of {what} {a}, {} of {b}: parts of one render only", p.display(), first.display());
+            }
+            Ok(())
+        };
+        same("scene", &info.scene, &reference.scene)?;
+        same("size", &format!("{}x{}", info.width, info.height), &format!("{}x{}", reference.width, reference.height))?;
+        same("seed", &info.seed, &reference.seed)?;
+        same("integrator", &info.integrator, &reference.integrator)?;
+    }
+    parts.sort_by_key(|(_, info, _)| info.samples.start);
+    for pair in parts.windows(2) {
+        let ((a, ia, _), (b, ib, _)) = (&pair[0], &pair[1]);
+        if ib.samples.start < ia.samples.end {
+            bail!(
+                "{} (samples {}..{}) and {} (samples {}..{}) overlap",
+                a.display(),
+                ia.samples.start,
+                ia.samples.end,
+                b.display(),
+                ib.samples.start,
+                ib.samples.end
+            );
+        }
+        if ib.samples.start > ia.samples.end {
+            bail!(
+                "samples {}..{} are missing: between {} (..{}) and {} ({}..)",
+                ia.samples.end,
+                ib.samples.start,
+                a.display(),
+                ia.samples.end,
+                b.display(),
+                ib.samples.start
+            );
+        }
+    }
+    let samples = parts[0].1.samples.start..parts[parts.len() - 1].1.samples.end;
+    let count = (samples.end - samples.start) as f64;
+    let mut sums = vec![[0f64; 3]; parts[0].2.len()];
+    for (_, _, part) in &parts {
+        for (acc, s) in sums.iter_mut().zip(part) {
+            for k in 0..3 {
+                acc[k] += s[k] as f64;
+            }
+        }
+    }
+    let image = HdrImage {
+        width: reference.width,
+        height: reference.height,
+        pixels: sums.iter().map(|s| s.map(|v| (v / count) as f32)).collect(),
+    };
+    Ok((PartInfo { samples, ..reference }, image))
+}
