@@ -156,6 +156,12 @@ struct RenderArgs {
     integrator: Integrator,
     #[arg(long, value_enum, default_value = "auto")]
     device: RunOn,
+    /// Render on several devices at once, each taking chunks of samples as
+    /// it finishes the last: all (every Vulkan adapter and the CPU runner),
+    /// gpu (every adapter), or a list of adapter indices or names and cpu
+    /// (`--devices list` prints the adapters).
+    #[arg(long, value_name = "all|gpu|LIST", conflicts_with_all = ["device", "reference"])]
+    devices: Option<String>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
     /// Output image: .png (gamma 2.2, clamped), .exr or .pfm (linear).
@@ -187,6 +193,13 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
         args.spp = range.end - range.start;
     }
+    if args.devices.as_deref() == Some("list") {
+        for (i, name) in GpuContext::adapters().iter().enumerate() {
+            println!("{i}: {name}");
+        }
+        println!("cpu: the CPU runner");
+        return Ok(());
+    }
     let scene = Scene::from_spec(&args.scene)?;
     let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
     let settings = RenderSettings {
@@ -201,6 +214,9 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         error_each_pass: args.report.is_some() || args.reference.is_some(),
         first_sample: part.as_ref().map_or(0, |r| r.start),
     };
+    if let Some(spec) = &args.devices {
+        return render_on_devices(&args, spec, &scene, &settings);
+    }
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -246,20 +262,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     };
     bar.finish_and_clear();
     let write_start = std::time::Instant::now();
-    match &part {
-        Some(range) => {
-            let info = treelet::render::parts::PartInfo {
-                scene: scene.name.clone(),
-                width: args.width,
-                height: args.height,
-                seed: args.seed,
-                integrator: args.integrator.name().into(),
-                samples: range.clone(),
-            };
-            treelet::render::parts::write_part(&args.out, &info, &result.sums)?;
-        }
-        None => image_io::write(&args.out, &result.image)?,
-    }
+    write_output(&args, &scene, &result.image, &result.sums)?;
     let write_s = write_start.elapsed().as_secs_f64();
     if args.explain && !startup.is_null() {
         eprintln!(
@@ -336,6 +339,67 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             Ok(()) => eprintln!("wrote {} and {}", path.display(), plot_path.display()),
             Err(e) => eprintln!("wrote {}; no plot: {e:#}", path.display()),
         }
+    }
+    Ok(())
+}
+
+/// The image, or with `--samples` the part (sums and their range).
+fn write_output(args: &RenderArgs, scene: &Scene, image: &image_io::HdrImage, sums: &[[f32; 4]]) -> Result<()> {
+    match &args.samples {
+        Some(range) => {
+            let info = treelet::render::parts::PartInfo {
+                scene: scene.name.clone(),
+                width: args.width,
+                height: args.height,
+                seed: args.seed,
+                integrator: args.integrator.name().into(),
+                samples: range.clone(),
+            };
+            treelet::render::parts::write_part(&args.out, &info, sums)
+        }
+        None => image_io::write(&args.out, image),
+    }
+}
+
+/// `render --devices`: one image from several devices (see `treelet::render::devices`).
+fn render_on_devices(args: &RenderArgs, spec: &str, scene: &Scene, settings: &RenderSettings) -> Result<()> {
+    use treelet::render::devices;
+    let list = devices::open(spec)?;
+    let start = std::time::Instant::now();
+    let (image, sums, shares) = devices::render_on_devices(&list, scene, settings, None)?;
+    let seconds = start.elapsed().as_secs_f64();
+    write_output(args, scene, &image, &sums)?;
+    let paths = args.width as f64 * args.height as f64 * args.spp as f64;
+    eprintln!(
+        "{}: {}x{} at {} spp on {} devices, {seconds:.3} s ({:.1} M camera paths/s), wrote {}",
+        scene.name,
+        args.width,
+        args.height,
+        args.spp,
+        shares.len(),
+        paths / seconds / 1e6,
+        args.out.display()
+    );
+    for s in &shares {
+        eprintln!(
+            "  {}: {} spp ({:.1}%) in {} chunks, {:.1} M paths/s{}",
+            s.device,
+            s.samples,
+            100.0 * s.samples as f64 / args.spp as f64,
+            s.chunks,
+            s.paths_per_s / 1e6,
+            s.failed.as_ref().map(|f| format!(", stopped: {f}")).unwrap_or_default()
+        );
+        if s.failed.is_some() {
+            eprintln!("warning: {} failed; the other devices rendered its unfinished samples", s.device);
+        }
+    }
+    if let Some(path) = &args.report {
+        let doc = serde_json::json!({
+            "scene": scene.name, "width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed,
+            "integrator": args.integrator, "total_s": seconds, "samples_per_s": paths / seconds, "devices": shares,
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&doc)?)?;
     }
     Ok(())
 }

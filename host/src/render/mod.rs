@@ -1,6 +1,7 @@
 //! A render, pass by pass, over any [`Backend`]: the BVH (if any) is built
 //! on the device, then each pass adds samples to every pixel and the error
 //! is measured, against a reference image or from the per-pixel variance.
+pub mod devices;
 pub mod image_io;
 pub mod parts;
 pub mod variant;
@@ -186,6 +187,108 @@ pub fn pass_schedule(spp: u32) -> Vec<u32> {
     out
 }
 
+/// Everything a render needs on one device before its first sample: the
+/// tree and buffers, the kernel, and an accumulation buffer of per-pixel
+/// sums. A render is samples dispatched into it, in any ranges, on any
+/// number of devices ([`render`], [`devices`]).
+pub struct Prepared<B: Backend> {
+    tree: TracedTree<B>,
+    buffers: PrimBuffers<B>,
+    materials: B::Buffer,
+    lights: B::Buffer,
+    accum: B::Buffer,
+    kernel: Kernel,
+    /// Render parameters but for the samples of a dispatch.
+    params: RenderParams,
+    per_dispatch: u32,
+    pixels: u64,
+    pub build_ms: f64,
+    pub plan: Plan,
+}
+
+impl<B: Backend> Prepared<B> {
+    /// Checks the settings and the scene, builds the tree on `b` and uploads
+    /// the scene.
+    pub fn new(b: &mut B, scene: &Scene, settings: &RenderSettings) -> Result<Self> {
+        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, first_sample, .. } = *settings;
+        if width == 0 || height == 0 || spp == 0 {
+            bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
+        }
+        let pixels = width as u64 * height as u64;
+        if pixels > u32::MAX as u64 / 2 {
+            bail!("image size {width}x{height} is too large ({pixels} pixels)");
+        }
+        if first_sample.checked_add(spp).is_none() {
+            bail!("samples {first_sample}.. plus {spp}: the sample index must stay below 2^32");
+        }
+        // Everything the render traces: spheres (the room included), then triangles.
+        let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+        all.check()?;
+        if scene.materials.len() != all.len() {
+            bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
+        }
+        let plan = variant::plan(scene, accel, layout, kernel, b.class());
+        let (tree, buffers, build_ms) = scene_tree(b, all, plan.accel, plan.layout)?;
+        let materials = b.upload("materials", &scene.materials)?;
+        let table = light_table(all, &scene.materials);
+        let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
+        let accum = b.zeroed("accumulation", pixels * 16)?;
+        let params = RenderParams {
+            width,
+            height,
+            seed,
+            prims: scene.spheres.len() as u32,
+            triangles: scene.triangles.len() as u32,
+            camera: scene.camera.camera(width, height),
+            integrator: integrator.code(),
+            light_count: table.len() as u32,
+            ..Default::default()
+        };
+        Ok(Prepared {
+            tree,
+            buffers,
+            materials,
+            lights,
+            accum,
+            kernel: Kernel::Render(plan.method(), plan.variant as u8),
+            params,
+            per_dispatch: (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, max_samples_per_dispatch(b.class()) as u64) as u32,
+            pixels,
+            build_ms,
+            plan,
+        })
+    }
+
+    /// Dispatches samples `first .. first + count` of every pixel, adding
+    /// to the accumulation (recorded, not waited for).
+    pub fn dispatch_samples(&self, b: &mut B, first: u32, count: u32) -> Result<()> {
+        b.stage("render");
+        let mut done = 0;
+        while done < count {
+            let samples = (count - done).min(self.per_dispatch);
+            let p = b.upload("render params", &[RenderParams { samples, first_sample: first + done, ..self.params }])?;
+            let t = &self.tree;
+            b.dispatch(
+                self.kernel,
+                &[&p, &self.buffers.spheres, &self.materials, &t.nodes, &t.prims, &self.accum, &self.buffers.triangles, &self.lights],
+                groups_for(tiled_invocations(self.params.width, self.params.height), WORKGROUP_SIZE),
+            );
+            done += samples;
+        }
+        Ok(())
+    }
+
+    /// The per-pixel sums so far (waits for the dispatches).
+    pub fn read_sums(&self, b: &mut B) -> Result<Vec<[f32; 4]>> {
+        b.read(&self.accum, self.pixels as usize)
+    }
+
+    /// Empties the accumulation.
+    pub fn clear(&self, b: &mut B) -> Result<()> {
+        b.zero_words(&self.accum, (self.pixels * 4) as u32)
+    }
+}
+
 /// Renders `scene`; `on_pass` sees each pass's row as it completes.
 pub fn render<B: Backend>(
     b: &mut B,
@@ -194,40 +297,15 @@ pub fn render<B: Backend>(
     reference: Option<&HdrImage>,
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, error_each_pass, first_sample } = *settings;
-    if width == 0 || height == 0 || spp == 0 {
-        bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
-    }
-    let pixels = width as u64 * height as u64;
-    if pixels > u32::MAX as u64 / 2 {
-        bail!("image size {width}x{height} is too large ({pixels} pixels)");
-    }
-    if first_sample.checked_add(spp).is_none() {
-        bail!("samples {first_sample}.. plus {spp}: the sample index must stay below 2^32");
-    }
+    let RenderSettings { width, height, spp, error_each_pass, first_sample, .. } = *settings;
     if let Some(r) = reference {
         if (r.width, r.height) != (width, height) {
             bail!("reference image is {}x{}, the render {width}x{height}", r.width, r.height);
         }
     }
-    // Everything the render traces: spheres (the room included), then triangles.
-    let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
-    all.check()?;
-    if scene.materials.len() != all.len() {
-        bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
-    }
-    let plan = variant::plan(scene, accel, layout, kernel, b.class());
     let start = Instant::now();
-    let prims = scene.spheres.len() as u32;
-
-    let (tree, buffers, build_ms) = scene_tree(b, all, plan.accel, plan.layout)?;
-    let materials = b.upload("materials", &scene.materials)?;
-    let table = light_table(all, &scene.materials);
-    let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
-    let accum = b.zeroed("accumulation", pixels * 16)?;
-    let camera = scene.camera.camera(width, height);
-    let kernel = Kernel::Render(plan.method(), plan.variant as u8);
-    let per_dispatch = (MAX_PATHS_PER_DISPATCH / pixels).clamp(1, max_samples_per_dispatch(b.class()) as u64) as u32;
+    let prepared = Prepared::new(b, scene, settings)?;
+    let build_ms = prepared.build_ms;
 
     let mut rows = Vec::new();
     let mut render_ms = 0.0;
@@ -237,37 +315,14 @@ pub fn render<B: Backend>(
     let mut measuring_s = 0.0;
     let schedule = pass_schedule(spp);
     for (pass, target) in schedule.iter().copied().enumerate() {
-        b.stage("render");
-        while done < target {
-            let samples = (target - done).min(per_dispatch);
-            let triangles_n = scene.triangles.len() as u32;
-            let params = RenderParams {
-                width,
-                height,
-                samples,
-                first_sample: first_sample + done,
-                seed,
-                prims,
-                triangles: triangles_n,
-                camera,
-                integrator: integrator.code(),
-                light_count: table.len() as u32,
-                ..Default::default()
-            };
-            let p = b.upload("render params", &[params])?;
-            b.dispatch(
-                kernel,
-                &[&p, &buffers.spheres, &materials, &tree.nodes, &tree.prims, &accum, &buffers.triangles, &lights],
-                groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
-            );
-            done += samples;
-        }
+        prepared.dispatch_samples(b, first_sample + done, target - done)?;
+        done = target;
         let last = pass + 1 == schedule.len();
         if error_each_pass || last {
             // Waits for the pass (its timestamps) first, so that the readback is timed alone.
             render_ms += b.take_times()?.get("render");
             let read_start = start.elapsed().as_secs_f64();
-            sums = b.read(&accum, pixels as usize)?;
+            sums = prepared.read_sums(b)?;
             let elapsed_s = start.elapsed().as_secs_f64();
             let times = (elapsed_s, elapsed_s - measuring_s, (build_ms + render_ms) / 1e3);
             let row = error_row(pass as u32, done, times, &sums, reference);
@@ -287,6 +342,7 @@ pub fn render<B: Backend>(
     }
     let image =
         HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
+    let plan = prepared.plan;
     Ok(RenderResult { image, sums, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
 }
 

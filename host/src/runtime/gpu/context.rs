@@ -101,20 +101,34 @@ impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred) and
     /// loads the shader module. Fails with a clear message when there is none.
     pub fn new() -> Result<Arc<Self>> {
-        pollster::block_on(Self::new_async())
+        pollster::block_on(Self::new_async(None))
     }
 
-    async fn new_async() -> Result<Arc<Self>> {
+    /// Opens the Vulkan adapter of index `index` in [`GpuContext::adapters`].
+    pub fn with_adapter(index: usize) -> Result<Arc<Self>> {
+        pollster::block_on(Self::new_async(Some(index)))
+    }
+
+    /// The names of the machine's Vulkan adapters, in index order.
+    pub fn adapters() -> Vec<String> {
+        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN));
+        adapters.iter().map(|a| a.get_info().name).collect()
+    }
+
+    async fn new_async(index: Option<usize>) -> Result<Arc<Self>> {
         let start = Instant::now();
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.backends = wgpu::Backends::VULKAN;
-        let instance = wgpu::Instance::new(desc);
-        let adapter = instance
-            .request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                ..Default::default()
-            })
-            .await
+        let instance = instance();
+        let adapter = match index {
+            Some(i) => instance.enumerate_adapters(wgpu::Backends::VULKAN).await.into_iter().nth(i),
+            None => instance
+                .request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    ..Default::default()
+                })
+                .await
+                .ok(),
+        };
+        let adapter = adapter
             .context(
                 "no Vulkan adapter found (install a Vulkan driver; without a GPU, \
                  `apt-get install mesa-vulkan-drivers` gives lavapipe)",
@@ -189,6 +203,13 @@ impl GpuContext {
     pub fn max_binding_bytes(&self) -> u64 {
         self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size)
     }
+}
+
+/// A Vulkan instance (the backend Treelet's SPIR-V passthrough needs).
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::VULKAN;
+    wgpu::Instance::new(desc)
 }
 
 fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {

@@ -1,0 +1,263 @@
+//! One render on several devices at once: every Vulkan adapter of the
+//! machine and the CPU runner. Each device prepares its own copy of the
+//! scene ([`Prepared`]), then takes chunks of samples from a shared queue
+//! as it finishes the last, so a fast GPU takes most and a slow device still
+//! helps. A device reads back its sums after each chunk; one that fails
+//! loses only its unfinished chunk, which goes back to the queue for the
+//! others. The host adds the devices' sums. Treelet's random numbers are
+//! counted from (seed, pixel, sample), so the image is the one-device image
+//! up to the devices' rounding.
+use std::ops::Range;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+
+use super::image_io::HdrImage;
+use super::{Prepared, RenderSettings};
+use crate::runtime::backend::Backend;
+use crate::runtime::cpu_runner::CpuBackend;
+use crate::runtime::gpu::{GpuBackend, GpuContext};
+use crate::scene::Scene;
+
+/// A device of `--devices`.
+#[derive(Clone)]
+pub enum Device {
+    Gpu(Arc<GpuContext>),
+    Cpu,
+}
+
+impl Device {
+    fn name(&self) -> String {
+        match self {
+            Device::Gpu(ctx) => ctx.info.name.clone(),
+            Device::Cpu => "cpu".into(),
+        }
+    }
+}
+
+/// The devices `spec` names: `all` (every Vulkan adapter and the CPU
+/// runner), `gpu` (every Vulkan adapter), or a comma list of adapter
+/// indices (as `treelet render --devices list` prints them), adapter names
+/// (or a part of one) and `cpu`.
+pub fn open(spec: &str) -> Result<Vec<Device>> {
+    let adapters = GpuContext::adapters();
+    let gpu = |i: usize| -> Result<Device> { Ok(Device::Gpu(GpuContext::with_adapter(i)?)) };
+    let mut out = Vec::new();
+    for item in spec.split(',').map(str::trim) {
+        match item {
+            "all" | "gpu" => {
+                for i in 0..adapters.len() {
+                    out.push(gpu(i)?);
+                }
+                if item == "all" {
+                    out.push(Device::Cpu);
+                }
+            }
+            "cpu" => out.push(Device::Cpu),
+            _ => {
+                let index = match item.parse::<usize>() {
+                    Ok(i) if i < adapters.len() => i,
+                    Ok(i) => bail!("--devices: no adapter {i}; this machine has {}: {}", adapters.len(), adapters.join(", ")),
+                    Err(_) => adapters.iter().position(|a| a.to_lowercase().contains(&item.to_lowercase())).with_context(|| {
+                        format!("--devices: `{item}` names no adapter (this machine has: {}; or use cpu, gpu, all)", adapters.join(", "))
+                    })?,
+                };
+                out.push(gpu(index)?);
+            }
+        }
+    }
+    if out.is_empty() {
+        bail!("--devices `{spec}`: no device (no Vulkan adapter found; `cpu` is the CPU runner)");
+    }
+    Ok(out)
+}
+
+/// Sample ranges handed out to devices as they ask; ranges a failed
+/// device gave back go out first. A device leaves only when no range is
+/// left and none is being rendered (one may yet come back).
+pub struct SampleQueue {
+    /// Next sample, ranges given back, ranges out.
+    state: Mutex<(u32, Vec<Range<u32>>, u32)>,
+    end: u32,
+    chunk: u32,
+}
+
+/// What a device asking the queue gets.
+pub enum Take {
+    Range(Range<u32>),
+    /// Nothing now, but a range out may come back: ask again.
+    Wait,
+    Done,
+}
+
+impl SampleQueue {
+    pub fn new(samples: Range<u32>, chunk: u32) -> Self {
+        SampleQueue { state: Mutex::new((samples.start, Vec::new(), 0)), end: samples.end, chunk: chunk.max(1) }
+    }
+
+    pub fn take(&self) -> Take {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(r) = s.1.pop() {
+            s.2 += 1;
+            return Take::Range(r);
+        }
+        let start = s.0;
+        if start >= self.end {
+            return if s.2 > 0 { Take::Wait } else { Take::Done };
+        }
+        s.0 = start.saturating_add(self.chunk).min(self.end);
+        s.2 += 1;
+        Take::Range(start..s.0)
+    }
+
+    /// A range taken is rendered.
+    pub fn finished(&self) {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).2 -= 1;
+    }
+
+    /// A range taken is not rendered: another device takes it.
+    pub fn give_back(&self, r: Range<u32>) {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        s.1.push(r);
+        s.2 -= 1;
+    }
+}
+
+/// What one device did.
+#[derive(Clone, Debug, Serialize)]
+pub struct Share {
+    pub device: String,
+    /// Samples per pixel it rendered.
+    pub samples: u32,
+    pub chunks: u32,
+    /// Wall seconds from its start to its last chunk.
+    pub seconds: f64,
+    /// Its rate: camera paths per second.
+    pub paths_per_s: f64,
+    /// Why it stopped early, if it did (its unfinished chunk went to the others).
+    pub failed: Option<String>,
+}
+
+/// A failure injected for tests: device `device` fails when it takes its
+/// chunk number `chunk` (from 0).
+#[derive(Clone, Copy, Debug)]
+pub struct InjectedFailure {
+    pub device: usize,
+    pub chunk: u32,
+}
+
+/// Renders `settings.first_sample ..+ settings.spp` of `scene` on `devices`;
+/// returns the image, the sums and each device's share.
+pub fn render_on_devices(
+    devices: &[Device],
+    scene: &Scene,
+    settings: &RenderSettings,
+    inject: Option<InjectedFailure>,
+) -> Result<(HdrImage, Vec<[f32; 4]>, Vec<Share>)> {
+    let first = settings.first_sample;
+    let end = first.checked_add(settings.spp).context("the sample index must stay below 2^32")?;
+    // Chunks small enough that every device gets several, large enough that
+    // a chunk's readback is small against its work.
+    let chunk = (settings.spp / (8 * devices.len() as u32)).clamp(1, 256);
+    let queue = SampleQueue::new(first..end, chunk);
+    let pixels = (settings.width * settings.height) as usize;
+    let results: Vec<(Share, Vec<[f64; 4]>)> = std::thread::scope(|s| {
+        let handles: Vec<_> = devices
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let (queue, inject) = (&queue, inject.filter(|f| f.device == i));
+                s.spawn(move || match d {
+                    Device::Gpu(ctx) => share(&mut GpuBackend::new(ctx.clone()), d.name(), scene, settings, queue, inject, pixels),
+                    Device::Cpu => share(&mut CpuBackend::new(), d.name(), scene, settings, queue, inject, pixels),
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().expect("a device thread panicked")).collect()
+    });
+    let done: u32 = results.iter().map(|r| r.0.samples).sum();
+    if done != settings.spp {
+        let why: Vec<String> = results.iter().filter_map(|r| r.0.failed.as_ref().map(|f| format!("{}: {f}", r.0.device))).collect();
+        bail!("{done} of {} samples rendered: every device failed ({})", settings.spp, why.join("; "));
+    }
+    let mut total = vec![[0f64; 4]; pixels];
+    for (_, sums) in &results {
+        for (t, s) in total.iter_mut().zip(sums) {
+            for k in 0..4 {
+                t[k] += s[k];
+            }
+        }
+    }
+    let sums: Vec<[f32; 4]> = total.iter().map(|t| t.map(|v| v as f32)).collect();
+    let n = settings.spp as f64;
+    let image = HdrImage {
+        width: settings.width,
+        height: settings.height,
+        pixels: total.iter().map(|t| [t[0], t[1], t[2]].map(|v| (v / n) as f32)).collect(),
+    };
+    Ok((image, sums, results.into_iter().map(|r| r.0).collect()))
+}
+
+/// One device's loop: prepare, then chunks until the queue is empty.
+fn share<B: Backend>(
+    b: &mut B,
+    device: String,
+    scene: &Scene,
+    settings: &RenderSettings,
+    queue: &SampleQueue,
+    inject: Option<InjectedFailure>,
+    pixels: usize,
+) -> (Share, Vec<[f64; 4]>) {
+    let start = Instant::now();
+    let mut sums = vec![[0f64; 4]; pixels];
+    let mut share = Share { device, samples: 0, chunks: 0, seconds: 0.0, paths_per_s: 0.0, failed: None };
+    let prepared = match Prepared::new(b, scene, settings) {
+        Ok(p) => p,
+        Err(e) => {
+            share.failed = Some(format!("{e:#}"));
+            return (share, sums);
+        }
+    };
+    loop {
+        let range = match queue.take() {
+            Take::Range(r) => r,
+            Take::Wait => {
+                std::thread::sleep(std::time::Duration::from_millis(2));
+                continue;
+            }
+            Take::Done => break,
+        };
+        if inject.is_some_and(|f| f.chunk == share.chunks) {
+            queue.give_back(range);
+            share.failed = Some("injected failure".into());
+            break;
+        }
+        let chunk = (|| -> Result<Vec<[f32; 4]>> {
+            prepared.clear(b)?;
+            prepared.dispatch_samples(b, range.start, range.end - range.start)?;
+            prepared.read_sums(b)
+        })();
+        match chunk {
+            Ok(s) => {
+                for (t, v) in sums.iter_mut().zip(&s) {
+                    for k in 0..4 {
+                        t[k] += v[k] as f64;
+                    }
+                }
+                queue.finished();
+                share.samples += range.end - range.start;
+                share.chunks += 1;
+            }
+            Err(e) => {
+                queue.give_back(range);
+                share.failed = Some(format!("{e:#}"));
+                break;
+            }
+        }
+    }
+    share.seconds = start.elapsed().as_secs_f64();
+    share.paths_per_s = share.samples as f64 * pixels as f64 / share.seconds.max(1e-9);
+    (share, sums)
+}

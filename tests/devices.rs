@@ -1,0 +1,109 @@
+//! One render on several devices (`treelet::render::devices`): the image is
+//! the one-device image (exactly, up to float rounding, when every device
+//! is a CPU runner; within the GPU-vs-CPU tolerance with a GPU among them),
+//! every sample is rendered once, and a device that fails leaves its
+//! unfinished chunk to the others.
+use treelet::build::layout::Layout;
+use treelet::render::devices::{render_on_devices, Device, InjectedFailure, SampleQueue, Take};
+use treelet::render::variant::KernelChoice;
+use treelet::render::{render, Accel, Integrator, RenderSettings};
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::scene::{cornell, Scene};
+use treelet_tests::{fresh_seed, gpu};
+
+fn settings(spp: u32, seed: u32) -> RenderSettings {
+    RenderSettings {
+        width: 32,
+        height: 24,
+        spp,
+        seed,
+        accel: Accel::Auto,
+        layout: Layout::Auto,
+        kernel: KernelChoice::Auto,
+        integrator: Integrator::Nee,
+        error_each_pass: false,
+        first_sample: 0,
+    }
+}
+
+fn max_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
+    a.iter().zip(b).flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs())).fold(0.0, f32::max)
+}
+
+fn mean_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let s: f64 = a.iter().zip(b).flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs() as f64)).sum();
+    s / (3 * a.len()) as f64
+}
+
+fn one_device(scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {
+    render(&mut CpuBackend::new(), scene, s, None, |_| {}).unwrap().image.pixels
+}
+
+#[test]
+fn the_queue_hands_out_every_sample_once() {
+    let q = SampleQueue::new(5..47, 4);
+    let mut seen = vec![0u32; 47];
+    let mut taken = Vec::new();
+    while let Take::Range(r) = q.take() {
+        taken.push(r);
+    }
+    // Everything is out: a device asking now waits (a range may come back).
+    assert!(matches!(q.take(), Take::Wait));
+    let back = taken.remove(3);
+    q.give_back(back.clone());
+    match q.take() {
+        Take::Range(r) => assert_eq!(r, back),
+        _ => panic!("a range given back goes out again"),
+    }
+    taken.push(back);
+    for r in &taken {
+        q.finished();
+        for i in r.clone() {
+            seen[i as usize] += 1;
+        }
+    }
+    assert!(matches!(q.take(), Take::Done));
+    assert!(seen[..5].iter().all(|&c| c == 0) && seen[5..].iter().all(|&c| c == 1), "{seen:?}");
+}
+
+#[test]
+fn cpu_runners_together_make_the_one_device_image() {
+    let scene = cornell();
+    let s = settings(37, fresh_seed() as u32);
+    let (image, _, shares) = render_on_devices(&[Device::Cpu, Device::Cpu, Device::Cpu], &scene, &s, None).unwrap();
+    assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 37);
+    let d = max_abs(&image.pixels, &one_device(&scene, &s));
+    assert!(d < 1e-4, "three CPU runners against one: {d}");
+}
+
+#[test]
+fn a_failed_device_leaves_its_chunk_to_the_others() {
+    let scene = cornell();
+    let s = settings(48, 11);
+    let inject = InjectedFailure { device: 0, chunk: 1 };
+    let (image, _, shares) = render_on_devices(&[Device::Cpu, Device::Cpu], &scene, &s, Some(inject)).unwrap();
+    assert!(shares[0].failed.as_deref() == Some("injected failure"), "{shares:?}");
+    assert_eq!(shares[0].chunks, 1);
+    assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 48);
+    let d = max_abs(&image.pixels, &one_device(&scene, &s));
+    assert!(d < 1e-4, "with a failed device, against one device: {d}");
+    // When every device fails, the render fails and says why.
+    let e = render_on_devices(&[Device::Cpu], &scene, &s, Some(InjectedFailure { device: 0, chunk: 0 })).unwrap_err();
+    assert!(format!("{e:#}").contains("injected failure"), "{e:#}");
+}
+
+#[test]
+fn a_gpu_and_the_cpu_runner_make_the_gpu_image() {
+    let Some(ctx) = gpu() else { return };
+    let scene = cornell();
+    let s = settings(64, 3);
+    let (both, _, shares) = render_on_devices(&[Device::Gpu(ctx.clone()), Device::Cpu], &scene, &s, None).unwrap();
+    assert!(shares.iter().all(|s| s.failed.is_none()), "{shares:?}");
+    assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 64);
+    let alone = render(&mut GpuBackend::new(ctx), &scene, &s, None, |_| {}).unwrap().image.pixels;
+    let other_seed = render(&mut CpuBackend::new(), &scene, &settings(64, 4), None, |_| {}).unwrap().image.pixels;
+    let (diff, noise) = (mean_abs(&both.pixels, &alone), mean_abs(&alone, &other_seed));
+    eprintln!("GPU + CPU runner against the GPU alone: mean |diff| {diff:.2e}, noise {noise:.2e}; shares {shares:?}");
+    assert!(diff < 0.25 * noise, "GPU + CPU against GPU: {diff}, noise {noise}");
+}
