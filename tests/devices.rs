@@ -14,8 +14,8 @@ use treelet_tests::{fresh_seed, gpu};
 
 fn settings(spp: u32, seed: u32) -> RenderSettings {
     RenderSettings {
-        width: 32,
-        height: 24,
+        width: 64,
+        height: 48,
         spp,
         seed,
         accel: Accel::Auto,
@@ -42,17 +42,17 @@ fn one_device(scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {
 
 #[test]
 fn the_queue_hands_out_every_sample_once() {
-    let q = SampleQueue::new(5..47, 4);
+    let q = SampleQueue::new(5..47, 1);
     let mut seen = vec![0u32; 47];
     let mut taken = Vec::new();
-    while let Take::Range(r) = q.take() {
+    while let Take::Range(r) = q.take(4) {
         taken.push(r);
     }
     // Everything is out: a device asking now waits (a range may come back).
-    assert!(matches!(q.take(), Take::Wait));
+    assert!(matches!(q.take(4), Take::Wait));
     let back = taken.remove(3);
     q.give_back(back.clone());
-    match q.take() {
+    match q.take(1) {
         Take::Range(r) => assert_eq!(r, back),
         _ => panic!("a range given back goes out again"),
     }
@@ -63,7 +63,7 @@ fn the_queue_hands_out_every_sample_once() {
             seen[i as usize] += 1;
         }
     }
-    assert!(matches!(q.take(), Take::Done));
+    assert!(matches!(q.take(4), Take::Done));
     assert!(seen[..5].iter().all(|&c| c == 0) && seen[5..].iter().all(|&c| c == 1), "{seen:?}");
 }
 
@@ -81,10 +81,13 @@ fn cpu_runners_together_make_the_one_device_image() {
 fn a_failed_device_leaves_its_chunk_to_the_others() {
     let scene = cornell();
     let s = settings(48, 11);
-    let inject = InjectedFailure { device: 0, chunk: 1 };
+    // Device 0 fails on its first chunk (both start with a one-sample chunk,
+    // and no device may take more than a quarter of what is left).
+    let inject = InjectedFailure { device: 0, chunk: 0 };
     let (image, _, shares) = render_on_devices(&[Device::Cpu, Device::Cpu], &scene, &s, Some(inject)).unwrap();
     assert!(shares[0].failed.as_deref() == Some("injected failure"), "{shares:?}");
-    assert_eq!(shares[0].chunks, 1);
+    assert_eq!((shares[0].chunks, shares[0].samples), (0, 0));
+    assert!(shares[1].chunks >= 2, "{shares:?}");
     assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 48);
     let d = max_abs(&image.pixels, &one_device(&scene, &s));
     assert!(d < 1e-4, "with a failed device, against one device: {d}");

@@ -81,7 +81,7 @@ pub struct SampleQueue {
     /// Next sample, ranges given back, ranges out.
     state: Mutex<(u32, Vec<Range<u32>>, u32)>,
     end: u32,
-    chunk: u32,
+    devices: u32,
 }
 
 /// What a device asking the queue gets.
@@ -93,11 +93,15 @@ pub enum Take {
 }
 
 impl SampleQueue {
-    pub fn new(samples: Range<u32>, chunk: u32) -> Self {
-        SampleQueue { state: Mutex::new((samples.start, Vec::new(), 0)), end: samples.end, chunk: chunk.max(1) }
+    /// The queue of `samples` for `devices` devices.
+    pub fn new(samples: Range<u32>, devices: u32) -> Self {
+        SampleQueue { state: Mutex::new((samples.start, Vec::new(), 0)), end: samples.end, devices: devices.max(1) }
     }
 
-    pub fn take(&self) -> Take {
+    /// Up to `want` samples (at least one; at most half of a fair share of
+    /// what is left, so that the end is shared too), or a range given back
+    /// whole.
+    pub fn take(&self, want: u32) -> Take {
         let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(r) = s.1.pop() {
             s.2 += 1;
@@ -107,7 +111,8 @@ impl SampleQueue {
         if start >= self.end {
             return if s.2 > 0 { Take::Wait } else { Take::Done };
         }
-        s.0 = start.saturating_add(self.chunk).min(self.end);
+        let fair = ((self.end - start) / (2 * self.devices)).max(1);
+        s.0 = start.saturating_add(want.clamp(1, fair)).min(self.end);
         s.2 += 1;
         Take::Range(start..s.0)
     }
@@ -124,6 +129,9 @@ impl SampleQueue {
         s.2 -= 1;
     }
 }
+
+/// Seconds of work a device takes at a time.
+const CHUNK_S: f64 = 0.25;
 
 /// What one device did.
 #[derive(Clone, Debug, Serialize)]
@@ -158,10 +166,7 @@ pub fn render_on_devices(
 ) -> Result<(HdrImage, Vec<[f32; 4]>, Vec<Share>)> {
     let first = settings.first_sample;
     let end = first.checked_add(settings.spp).context("the sample index must stay below 2^32")?;
-    // Chunks small enough that every device gets several, large enough that
-    // a chunk's readback is small against its work.
-    let chunk = (settings.spp / (8 * devices.len() as u32)).clamp(1, 256);
-    let queue = SampleQueue::new(first..end, chunk);
+    let queue = SampleQueue::new(first..end, devices.len() as u32);
     let pixels = (settings.width * settings.height) as usize;
     let results: Vec<(Share, Vec<[f64; 4]>)> = std::thread::scope(|s| {
         let handles: Vec<_> = devices
@@ -220,8 +225,12 @@ fn share<B: Backend>(
             return (share, sums);
         }
     };
+    // Chunks are sized by the device's own rate, to take about CHUNK_S
+    // each: a slow device never holds a large chunk at the end, and a fast
+    // one reads back seldom. The first chunk, one sample, measures the rate.
+    let mut want = 1u32;
     loop {
-        let range = match queue.take() {
+        let range = match queue.take(want) {
             Take::Range(r) => r,
             Take::Wait => {
                 std::thread::sleep(std::time::Duration::from_millis(2));
@@ -234,6 +243,7 @@ fn share<B: Backend>(
             share.failed = Some("injected failure".into());
             break;
         }
+        let chunk_start = Instant::now();
         let chunk = (|| -> Result<Vec<[f32; 4]>> {
             prepared.clear(b)?;
             prepared.dispatch_samples(b, range.start, range.end - range.start)?;
@@ -249,6 +259,8 @@ fn share<B: Backend>(
                 queue.finished();
                 share.samples += range.end - range.start;
                 share.chunks += 1;
+                let rate = (range.end - range.start) as f64 / chunk_start.elapsed().as_secs_f64().max(1e-6);
+                want = (rate * CHUNK_S).clamp(1.0, 4096.0) as u32;
             }
             Err(e) => {
                 queue.give_back(range);
