@@ -37,8 +37,8 @@ impl Device {
     }
 }
 
-/// The devices `spec` names: `all` (every Vulkan adapter and the CPU
-/// runner), `gpu` (every Vulkan adapter), or a comma list of adapter
+/// The devices `spec` names: `all` (every Vulkan adapter, and the CPU
+/// runner unless an adapter runs on the CPU already), `gpu` (every Vulkan adapter), or a comma list of adapter
 /// indices (as `treelet render --devices list` prints them), adapter names
 /// (or a part of one) and `cpu`.
 pub fn open(spec: &str) -> Result<Vec<Device>> {
@@ -51,7 +51,10 @@ pub fn open(spec: &str) -> Result<Vec<Device>> {
                 for i in 0..adapters.len() {
                     out.push(gpu(i)?);
                 }
-                if item == "all" {
+                // The CPU runner too, unless an adapter already runs on the CPU
+                // cores (lavapipe): two devices on the same cores only slow each other.
+                let cpu_adapter = out.iter().any(|d| matches!(d, Device::Gpu(c) if c.info.device_type == wgpu::DeviceType::Cpu));
+                if item == "all" && !cpu_adapter {
                     out.push(Device::Cpu);
                 }
             }
