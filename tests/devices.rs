@@ -96,15 +96,22 @@ fn a_failed_device_leaves_its_chunk_to_the_others() {
     assert!(format!("{e:#}").contains("injected failure"), "{e:#}");
 }
 
+/// The chunked path on a GPU (clear, dispatch, read back, add) is the
+/// plain render on that GPU; with the CPU runner beside it, the image stays
+/// the GPU's within the GPU-vs-CPU tolerance, whichever device took what.
 #[test]
 fn a_gpu_and_the_cpu_runner_make_the_gpu_image() {
     let Some(ctx) = gpu() else { return };
     let scene = cornell();
     let s = settings(64, 3);
-    let (both, _, shares) = render_on_devices(&[Device::Gpu(ctx.clone()), Device::Cpu], &scene, &s, None).unwrap();
+    let alone = render(&mut GpuBackend::new(ctx.clone()), &scene, &s, None, |_| {}).unwrap().image.pixels;
+    let (chunked, _, shares) = render_on_devices(&[Device::Gpu(ctx.clone())], &scene, &s, None).unwrap();
+    assert!(shares[0].chunks >= 2, "{shares:?}");
+    let d = max_abs(&chunked.pixels, &alone);
+    assert!(d < 1e-4, "the GPU in chunks against the GPU in one render: {d}");
+    let (both, _, shares) = render_on_devices(&[Device::Gpu(ctx), Device::Cpu], &scene, &s, None).unwrap();
     assert!(shares.iter().all(|s| s.failed.is_none()), "{shares:?}");
     assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 64);
-    let alone = render(&mut GpuBackend::new(ctx), &scene, &s, None, |_| {}).unwrap().image.pixels;
     let other_seed = render(&mut CpuBackend::new(), &scene, &settings(64, 4), None, |_| {}).unwrap().image.pixels;
     let (diff, noise) = (mean_abs(&both.pixels, &alone), mean_abs(&alone, &other_seed));
     eprintln!("GPU + CPU runner against the GPU alone: mean |diff| {diff:.2e}, noise {noise:.2e}; shares {shares:?}");
