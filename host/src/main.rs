@@ -157,8 +157,8 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "auto")]
     device: RunOn,
     /// Render on several devices at once, each taking chunks of samples as
-    /// it finishes the last: all (every Vulkan adapter, and the CPU runner
-    /// unless an adapter already runs on the CPU cores, as lavapipe does),
+    /// it finishes the last: all (every Vulkan adapter; the CPU runner where
+    /// there is none: beside a GPU or lavapipe it slowed renders, measured),
     /// gpu (every adapter), or a list of adapter indices or names and cpu
     /// (`--devices list` prints the adapters).
     #[arg(long, value_name = "all|gpu|LIST", conflicts_with_all = ["device", "reference"])]
