@@ -368,3 +368,24 @@ fn slurm_array_script_splits_and_merges() {
     assert!(v["rmse"].as_f64().unwrap() < 1e-5, "{v}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `render --devices`: a list of devices renders the image that one device
+/// renders; a name that matches no adapter is an error that lists them.
+#[test]
+fn render_on_a_list_of_devices() {
+    let dir = std::env::temp_dir().join(format!("treelet-devices-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |n: &str| dir.join(n).to_string_lossy().to_string();
+    let base = ["render", "--width", "24", "--height", "16", "--spp", "12", "--seed", "9"];
+    let (two, one) = (path("two.pfm"), path("one.pfm"));
+    let out = treelet(&[&base[..], &["--devices", "cpu,cpu", "--out", &two]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("on 2 devices"), "{err}");
+    assert!(treelet(&[&base[..], &["--device", "cpu", "--out", &one]].concat()).status.success());
+    let out = treelet(&["compare", &two, "--reference", &one]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    assert!(v["rmse"].as_f64().unwrap() < 1e-5, "{v}");
+    let e = stderr_of(&[&base[..], &["--devices", "no-such-gpu", "--out", &one]].concat());
+    assert!(e.contains("no-such-gpu") && e.contains("names no adapter"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
