@@ -151,6 +151,214 @@ pub fn closest_hit<T: ClosestHit, const F: u32, const S: usize>(
     scene.tree.closest_hit::<F, S>(o, d, from, &scene.prims, stack, lane)
 }
 
+/// One path in flight: what the loop of [`radiance`] carries from one
+/// traced ray to the next. [`render_pixel`] steps a pixel's paths one ray at
+/// a time and starts the next sample's path as soon as one ends (path
+/// regeneration: the lanes of a subgroup then wait for each other once per
+/// dispatch, not once per sample), which changes no pixel's value.
+pub struct Path {
+    /// The ray to trace next.
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    /// Radiance gathered so far: the path's value once it has ended.
+    pub result: Vec3,
+    throughput: Vec3,
+    depth: u32,
+    sample: u32,
+    /// Density of the last bounce's direction if it was diffuse (else 0: a
+    /// hit emitter then counts in full), and where that bounce was.
+    bsdf_pdf: f32,
+    last_x: Vec3,
+    /// A shadow ray is traced by the same call as the path's rays, in the
+    /// step after its diffuse bounce: one traversal inlined in the kernel,
+    /// not two (with two, NEE through the treelet BVH ran 6.7 times as long
+    /// as smallpt's estimator on the H100; with one, 3 times; with pbrt-v4's
+    /// roulette as well, 1.8 times). While one is pending, `(o, d, from)` is
+    /// the shadow ray, `next_*` the path's bounce, and `shadow_value` what
+    /// the light adds if the ray reaches `shadow_light` first.
+    shadow_light: u32,
+    shadow_value: Vec3,
+    shadow_d: Vec3,
+    next_o: Vec3,
+    next_d: Vec3,
+    next_from: Origin,
+    /// Roulette ended the path; a pending shadow ray is still traced.
+    ended: bool,
+}
+
+impl Path {
+    /// A path starting with the ray `(o, d)`, as sample `sample` of its pixel.
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3, sample: u32) -> Path {
+        Path {
+            o,
+            d,
+            from: Origin::NONE,
+            result: Vec3::ZERO,
+            throughput: Vec3::ONE,
+            depth: 0,
+            sample,
+            bsdf_pdf: 0.0,
+            last_x: o,
+            shadow_light: NO_LIGHT,
+            shadow_value: Vec3::ZERO,
+            shadow_d: Vec3::Z,
+            next_o: o,
+            next_d: d,
+            next_from: Origin::NONE,
+            ended: false,
+        }
+    }
+
+    /// The camera path of sample `sample` of pixel `pixel`.
+    #[inline]
+    pub fn camera(params: &RenderParams, pixel: u32, sample: u32) -> Path {
+        let (w, h) = (params.width, params.height);
+        let (x, y) = (pixel % w, h - 1 - pixel / w);
+        let rng = BounceRng::new(params.seed, pixel, sample, 0);
+        let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
+        Path::new(o, d, sample)
+    }
+
+    /// Traces the path's next ray and follows what it hits (see
+    /// [`radiance`]); false once the path has ended, its radiance then
+    /// being `result`.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn step<T: ClosestHit, const F: u32, const S: usize>(
+        &mut self,
+        params: &RenderParams,
+        pixel: u32,
+        scene: &SceneRefs<T>,
+        lights: &[Light],
+        stack: &mut [u32; S],
+        lane: u32,
+    ) -> bool {
+        if (self.depth >= MAX_BOUNCES || self.ended) && self.shadow_light == NO_LIGHT {
+            return false;
+        }
+        let nee = params.integrator == NEE && params.light_count > 0;
+        let hit = closest_hit::<T, F, S>(self.o, self.d, self.from, scene, stack, lane);
+        if self.shadow_light != NO_LIGHT {
+            // Anything else first, glass too, occludes it: paths through
+            // glass reach a light by their bounces, at full weight.
+            if hit.prim == self.shadow_light {
+                self.result += self.shadow_value;
+            }
+            self.shadow_light = NO_LIGHT;
+            (self.o, self.d, self.from) = (self.next_o, self.next_d, self.next_from);
+            return true;
+        }
+        if !hit.is_hit() {
+            return false;
+        }
+        let m = scene.materials[hit.prim as usize];
+        let x = self.o + self.d * hit.t;
+        let n = hit_normal_for::<F>(&scene.prims, hit.prim, x, self.d);
+        let nl = if n.dot(self.d) < 0.0 { n } else { -n };
+        let mut f = Vec3::from_array(m.color);
+        let emission = Vec3::from_array(m.emission);
+        if nee && self.bsdf_pdf > 0.0 && emission != Vec3::ZERO {
+            let light = light_pmf(lights, params.light_count, hit.prim)
+                * light_pdf(&scene.prims, hit.prim, self.last_x, self.d, hit.t);
+            self.result += self.throughput * emission * power_heuristic(self.bsdf_pdf, light);
+        } else {
+            self.result += self.throughput * emission;
+        }
+        self.bsdf_pdf = 0.0;
+        self.depth += 1;
+        // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
+        let rng = BounceRng::new(params.seed, pixel, self.sample, self.depth);
+        if self.depth > 5 && !nee {
+            let p = f.max_element();
+            if rng.uniform(0) < p {
+                f /= p;
+            } else {
+                return false;
+            }
+        }
+        self.throughput *= f;
+        // A black surface (a lamp, smallpt's front wall) ends the path:
+        // nothing after it can add light, and smallpt's way (on to Russian
+        // roulette after depth 5) only spends rays. No pixel changes.
+        if self.throughput == Vec3::ZERO {
+            return false;
+        }
+        let eps = surface_offset(x);
+        // Branches for materials outside `F` are not compiled (the host
+        // never runs such a kernel on a scene that has them).
+        if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
+            if nee {
+                let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
+                if s.light != NO_LIGHT {
+                    (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                }
+            }
+            self.d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
+            self.o = x + nl * eps;
+            self.bsdf_pdf = nl.dot(self.d).max(0.0) * core::f32::consts::FRAC_1_PI;
+            self.last_x = x;
+        } else if !has(F, features::GLASS) || (has(F, features::MIRROR) && m.kind == MIRROR) {
+            self.d = self.d - n * 2.0 * n.dot(self.d);
+            self.o = x + nl * eps;
+        } else {
+            let reflected = self.d - n * 2.0 * n.dot(self.d);
+            let into = n.dot(nl) > 0.0;
+            let (nc, nt) = (1.0, m.ior);
+            let nnt = if into { nc / nt } else { nt / nc };
+            let ddn = self.d.dot(nl);
+            let cos2t = 1.0 - nnt * nnt * (1.0 - ddn * ddn);
+            if cos2t < 0.0 {
+                // Total internal reflection.
+                self.d = reflected;
+                self.o = x + nl * eps;
+            } else {
+                let sign = if into { 1.0 } else { -1.0 };
+                let tdir = (self.d * nnt - n * (sign * (ddn * nnt + libm::sqrtf(cos2t)))).normalize();
+                let (a, b) = (nt - nc, nt + nc);
+                let r0 = a * a / (b * b);
+                let c = 1.0 - if into { -ddn } else { tdir.dot(n) };
+                let re = r0 + (1.0 - r0) * c * c * c * c * c;
+                let tr = 1.0 - re;
+                let p = 0.25 + 0.5 * re;
+                if rng.uniform(3) < p {
+                    self.throughput *= re / p;
+                    self.d = reflected;
+                    self.o = x + nl * eps;
+                } else {
+                    self.throughput *= tr / (1.0 - p);
+                    self.d = tdir;
+                    self.o = x - nl * eps;
+                }
+            }
+        }
+        // The next ray leaves this sphere: into it when it heads against the
+        // outward normal.
+        self.from = Origin { prim: hit.prim, into: self.d.dot(n) < 0.0 };
+        // NEE's roulette on the path's throughput (see NEE_ROULETTE_DEPTH),
+        // after this vertex's light sample, which it leaves to be traced.
+        if nee && self.depth >= NEE_ROULETTE_DEPTH {
+            let p = self.throughput.max_element();
+            if p < 1.0 {
+                if rng.uniform(0) < p {
+                    self.throughput /= p;
+                } else if self.shadow_light == NO_LIGHT {
+                    return false;
+                } else {
+                    self.ended = true;
+                }
+            }
+        }
+        if self.shadow_light != NO_LIGHT {
+            // The shadow ray first, from the same point (see above).
+            (self.next_o, self.next_d, self.next_from) = (self.o, self.d, self.from);
+            (self.o, self.d, self.from) = (x + nl * eps, self.shadow_d, Origin { prim: hit.prim, into: self.shadow_d.dot(n) < 0.0 });
+        }
+        true
+    }
+}
+
 /// Radiance along one path (smallpt's `radiance`, as a loop), with the
 /// code for the features `F` only (see [`crate::features`]).
 ///
@@ -163,8 +371,8 @@ pub fn closest_hit<T: ClosestHit, const F: u32, const S: usize>(
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
-    mut o: Vec3,
-    mut d: Vec3,
+    o: Vec3,
+    d: Vec3,
     params: &RenderParams,
     pixel: u32,
     sample: u32,
@@ -173,151 +381,9 @@ pub fn radiance<T: ClosestHit, const F: u32, const S: usize>(
     stack: &mut [u32; S],
     lane: u32,
 ) -> Vec3 {
-    let mut result = Vec3::ZERO;
-    let mut throughput = Vec3::ONE;
-    let mut depth = 0u32;
-    let mut from = Origin::NONE;
-    let nee = params.integrator == NEE && params.light_count > 0;
-    // Density of the last bounce's direction if it was diffuse (else 0: a
-    // hit emitter then counts in full), and where that bounce was.
-    let mut bsdf_pdf = 0.0f32;
-    let mut last_x = o;
-    // A shadow ray is traced by the same call as the path's rays, in the
-    // iteration after its diffuse bounce: one traversal inlined in the
-    // kernel, not two (with two, NEE through the treelet BVH ran 6.7 times
-    // as long as smallpt's estimator on the H100; with one, 3 times; with
-    // pbrt-v4's roulette as well, 1.8 times). While
-    // one is pending, `(o, d, from)` is the shadow ray, `next` the path's
-    // bounce, and `shadow_value` what the light adds if the ray reaches
-    // `shadow_light` first.
-    let mut shadow_light = NO_LIGHT;
-    let mut shadow_value = Vec3::ZERO;
-    let mut shadow_d = Vec3::Z;
-    let mut next = (o, d, from);
-    // Roulette ended the path; a pending shadow ray is still traced.
-    let mut ended = false;
-    loop {
-        if (depth >= MAX_BOUNCES || ended) && shadow_light == NO_LIGHT {
-            break;
-        }
-        let hit = closest_hit::<T, F, S>(o, d, from, scene, stack, lane);
-        if shadow_light != NO_LIGHT {
-            // Anything else first, glass too, occludes it: paths through
-            // glass reach a light by their bounces, at full weight.
-            if hit.prim == shadow_light {
-                result += shadow_value;
-            }
-            shadow_light = NO_LIGHT;
-            (o, d, from) = next;
-            continue;
-        }
-        if !hit.is_hit() {
-            break;
-        }
-        let m = scene.materials[hit.prim as usize];
-        let x = o + d * hit.t;
-        let n = hit_normal_for::<F>(&scene.prims, hit.prim, x, d);
-        let nl = if n.dot(d) < 0.0 { n } else { -n };
-        let mut f = Vec3::from_array(m.color);
-        let emission = Vec3::from_array(m.emission);
-        if nee && bsdf_pdf > 0.0 && emission != Vec3::ZERO {
-            let light = light_pmf(lights, params.light_count, hit.prim)
-                * light_pdf(&scene.prims, hit.prim, last_x, d, hit.t);
-            result += throughput * emission * power_heuristic(bsdf_pdf, light);
-        } else {
-            result += throughput * emission;
-        }
-        bsdf_pdf = 0.0;
-        depth += 1;
-        // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
-        let rng = BounceRng::new(params.seed, pixel, sample, depth);
-        if depth > 5 && !nee {
-            let p = f.max_element();
-            if rng.uniform(0) < p {
-                f /= p;
-            } else {
-                break;
-            }
-        }
-        throughput *= f;
-        // A black surface (a lamp, smallpt's front wall) ends the path:
-        // nothing after it can add light, and smallpt's way (on to Russian
-        // roulette after depth 5) only spends rays. No pixel changes.
-        if throughput == Vec3::ZERO {
-            break;
-        }
-        let eps = surface_offset(x);
-        // Branches for materials outside `F` are not compiled (the host
-        // never runs such a kernel on a scene that has them).
-        if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
-            if nee {
-                let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
-                if s.light != NO_LIGHT {
-                    (shadow_light, shadow_d, shadow_value) = (s.light, s.dir, throughput * s.value);
-                }
-            }
-            d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
-            o = x + nl * eps;
-            bsdf_pdf = nl.dot(d).max(0.0) * core::f32::consts::FRAC_1_PI;
-            last_x = x;
-        } else if !has(F, features::GLASS) || (has(F, features::MIRROR) && m.kind == MIRROR) {
-            d = d - n * 2.0 * n.dot(d);
-            o = x + nl * eps;
-        } else {
-            let reflected = d - n * 2.0 * n.dot(d);
-            let into = n.dot(nl) > 0.0;
-            let (nc, nt) = (1.0, m.ior);
-            let nnt = if into { nc / nt } else { nt / nc };
-            let ddn = d.dot(nl);
-            let cos2t = 1.0 - nnt * nnt * (1.0 - ddn * ddn);
-            if cos2t < 0.0 {
-                // Total internal reflection.
-                d = reflected;
-                o = x + nl * eps;
-            } else {
-                let sign = if into { 1.0 } else { -1.0 };
-                let tdir = (d * nnt - n * (sign * (ddn * nnt + libm::sqrtf(cos2t)))).normalize();
-                let (a, b) = (nt - nc, nt + nc);
-                let r0 = a * a / (b * b);
-                let c = 1.0 - if into { -ddn } else { tdir.dot(n) };
-                let re = r0 + (1.0 - r0) * c * c * c * c * c;
-                let tr = 1.0 - re;
-                let p = 0.25 + 0.5 * re;
-                if rng.uniform(3) < p {
-                    throughput *= re / p;
-                    d = reflected;
-                    o = x + nl * eps;
-                } else {
-                    throughput *= tr / (1.0 - p);
-                    d = tdir;
-                    o = x - nl * eps;
-                }
-            }
-        }
-        // The next ray leaves this sphere: into it when it heads against the
-        // outward normal.
-        from = Origin { prim: hit.prim, into: d.dot(n) < 0.0 };
-        // NEE's roulette on the path's throughput (see NEE_ROULETTE_DEPTH),
-        // after this vertex's light sample, which it leaves to be traced.
-        if nee && depth >= NEE_ROULETTE_DEPTH {
-            let p = throughput.max_element();
-            if p < 1.0 {
-                if rng.uniform(0) < p {
-                    throughput /= p;
-                } else if shadow_light == NO_LIGHT {
-                    break;
-                } else {
-                    ended = true;
-                }
-            }
-        }
-        if shadow_light != NO_LIGHT {
-            // The shadow ray first, from the same point (see above).
-            next = (o, d, from);
-            (o, d, from) = (x + nl * eps, shadow_d, Origin { prim: hit.prim, into: shadow_d.dot(n) < 0.0 });
-        }
-    }
-    result
+    let mut path = Path::new(o, d, sample);
+    while path.step::<T, F, S>(params, pixel, scene, lights, stack, lane) {}
+    path.result
 }
 
 /// With next-event estimation, Russian roulette starts at the third hit
@@ -438,20 +504,22 @@ pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
     stack: &mut [u32; S],
     lane: u32,
 ) -> [f32; 4] {
-    let (w, h) = (params.width, params.height);
-    let (x, y) = (id % w, h - 1 - id / w);
     let mut sum = Vec3::ZERO;
     let mut sum_sq = 0.0;
     let mut s = 0;
+    // One loop over every ray of the pixel's paths (see [`Path`]).
+    let mut path = Path::camera(params, id, params.first_sample);
     while s < params.samples {
-        let sample = params.first_sample + s;
-        let rng = BounceRng::new(params.seed, id, sample, 0);
-        let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
-        let l = radiance::<T, F, S>(o, d, params, id, sample, scene, lights, stack, lane);
-        sum += l;
-        let lum = luminance(l);
-        sum_sq += lum * lum;
-        s += 1;
+        if !path.step::<T, F, S>(params, id, scene, lights, stack, lane) {
+            let l = path.result;
+            sum += l;
+            let lum = luminance(l);
+            sum_sq += lum * lum;
+            s += 1;
+            if s < params.samples {
+                path = Path::camera(params, id, params.first_sample + s);
+            }
+        }
     }
     [sum.x, sum.y, sum.z, sum_sq]
 }
