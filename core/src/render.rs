@@ -558,6 +558,74 @@ mod tests {
         }
     }
 
+    /// render_pixel's one loop over a pixel's paths (path regeneration) adds
+    /// up the same paths as tracing each sample alone with `radiance`, in
+    /// order, with both integrators: sample indices, restarts and sums kept.
+    #[test]
+    fn path_regeneration_sums_the_same_paths() {
+        use crate::layout::{GLASS, SMALLPT};
+        use crate::traverse::Scan;
+        // smallpt's room: walls (the front one black), a mirror ball, a
+        // glass ball and the lamp through the ceiling.
+        let spheres = [
+            Sphere::new([1e5 + 1.0, 40.8, 81.6], 1e5),
+            Sphere::new([-1e5 + 99.0, 40.8, 81.6], 1e5),
+            Sphere::new([50.0, 40.8, 1e5], 1e5),
+            Sphere::new([50.0, 40.8, -1e5 + 170.0], 1e5),
+            Sphere::new([50.0, 1e5, 81.6], 1e5),
+            Sphere::new([50.0, -1e5 + 81.6, 81.6], 1e5),
+            Sphere::new([27.0, 16.5, 47.0], 16.5),
+            Sphere::new([73.0, 16.5, 78.0], 16.5),
+            Sphere::new([50.0, 681.6 - 0.27, 81.6], 600.0),
+        ];
+        let diffuse = |c: f32, k: f32| Material { kind: DIFFUSE, color: [c, k, k], ..Default::default() };
+        let materials = [
+            diffuse(0.75, 0.25),
+            diffuse(0.25, 0.75),
+            diffuse(0.75, 0.75),
+            diffuse(0.0, 0.0),
+            diffuse(0.75, 0.75),
+            diffuse(0.75, 0.75),
+            Material { kind: MIRROR, color: [0.999; 3], ..Default::default() },
+            Material { kind: GLASS, color: [0.999; 3], ior: 1.5, ..Default::default() },
+            Material { emission: [12.0; 3], ..diffuse(0.0, 0.0) },
+        ];
+        let lights = [Light { prim: 8, pmf: 1.0, cdf: 1.0, _pad: 0 }];
+        let (w, h) = (8u32, 6u32);
+        let camera = Camera::look(Vec3::new(50.0, 52.0, 295.6), Vec3::new(0.0, -0.042612, -1.0), 140.0, SMALLPT_FOV, w, h);
+        let mut total = 0.0;
+        for integrator in [SMALLPT, NEE] {
+            let params = RenderParams {
+                width: w,
+                height: h,
+                samples: 9,
+                first_sample: 5,
+                seed: 3,
+                prims: spheres.len() as u32,
+                camera,
+                integrator,
+                light_count: 1,
+                ..Default::default()
+            };
+            let scene = SceneRefs::new(&params, &spheres, &[], &materials, Scan::new(&[], &[]));
+            for pixel in 0..w * h {
+                let got = render_pixel::<_, { features::ALL }, 1>(pixel, &params, &scene, &lights, &mut [0; 1], 0);
+                let (x, y) = (pixel % w, h - 1 - pixel / w);
+                let (mut sum, mut sum_sq) = (Vec3::ZERO, 0.0f32);
+                for sample in params.first_sample..params.first_sample + params.samples {
+                    let rng = BounceRng::new(params.seed, pixel, sample, 0);
+                    let (o, d) = camera.primary_ray(x, y, sample % 4, w, h, &rng);
+                    let l = radiance::<_, { features::ALL }, 1>(o, d, &params, pixel, sample, &scene, &lights, &mut [0; 1], 0);
+                    sum += l;
+                    sum_sq += luminance(l) * luminance(l);
+                }
+                assert_eq!(got, [sum.x, sum.y, sum.z, sum_sq], "integrator {integrator}, pixel {pixel}");
+                total += sum_sq;
+            }
+        }
+        assert!(total > 0.0, "the room rendered black: the test compared nothing");
+    }
+
     #[test]
     fn sin_cos_turns_is_accurate() {
         for i in 0..10_000 {
