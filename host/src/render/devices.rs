@@ -15,7 +15,7 @@ use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
 use super::image_io::HdrImage;
-use super::{Prepared, RenderSettings};
+use super::{add_sums, mean_image, Prepared, RenderSettings};
 use crate::runtime::backend::Backend;
 use crate::runtime::cpu_runner::CpuBackend;
 use crate::runtime::gpu::{GpuBackend, GpuContext};
@@ -209,12 +209,7 @@ pub fn render_on_devices(
         }
     }
     let sums: Vec<[f32; 4]> = total.iter().map(|t| t.map(|v| v as f32)).collect();
-    let n = settings.spp as f64;
-    let image = HdrImage {
-        width: settings.width,
-        height: settings.height,
-        pixels: total.iter().map(|t| [t[0], t[1], t[2]].map(|v| (v / n) as f32)).collect(),
-    };
+    let image = mean_image(settings.width, settings.height, &total, settings.spp);
     Ok((image, sums, results.into_iter().map(|r| r.0).collect()))
 }
 
@@ -264,11 +259,7 @@ fn share<B: Backend>(
         })();
         match chunk {
             Ok(s) => {
-                for (t, v) in sums.iter_mut().zip(&s) {
-                    for k in 0..4 {
-                        t[k] += v[k] as f64;
-                    }
-                }
+                add_sums(&mut sums, &s);
                 queue.finished();
                 share.samples += range.end - range.start;
                 share.chunks += 1;

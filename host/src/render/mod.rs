@@ -175,6 +175,23 @@ pub struct RenderResult {
     pub plan: Plan,
 }
 
+/// Adds per-pixel sums (radiance r, g, b and squared luminance) of one
+/// part of a render into `total`, in f64 so that many parts add without
+/// loss (devices, `treelet merge`).
+pub fn add_sums(total: &mut [[f64; 4]], part: &[[f32; 4]]) {
+    for (t, p) in total.iter_mut().zip(part) {
+        for k in 0..4 {
+            t[k] += p[k] as f64;
+        }
+    }
+}
+
+/// The image of mean radiance from per-pixel sums over `samples` samples.
+pub fn mean_image<T: Copy + Into<f64>>(width: u32, height: u32, sums: &[[T; 4]], samples: u32) -> HdrImage {
+    let n = samples as f64;
+    HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| (v.into() / n) as f32)).collect() }
+}
+
 /// Cumulative sample counts after each pass: 4, 8, 16, ... then `spp`.
 pub fn pass_schedule(spp: u32) -> Vec<u32> {
     let mut out = Vec::new();
@@ -340,8 +357,7 @@ pub fn render<B: Backend>(
             on_pass(&PassRow { pass: pass as u32, spp: done, elapsed_s, wall_s, kernel_s, rmse: None, rel_mse: None, mean_std_error: None });
         }
     }
-    let image =
-        HdrImage { width, height, pixels: sums.iter().map(|s| [s[0], s[1], s[2]].map(|v| v / spp as f32)).collect() };
+    let image = mean_image(width, height, &sums, spp);
     let plan = prepared.plan;
     Ok(RenderResult { image, sums, rows, build_ms, render_ms, total_s: start.elapsed().as_secs_f64(), plan })
 }

@@ -141,19 +141,10 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
         }
     }
     let samples = parts[0].1.samples.start..parts[parts.len() - 1].1.samples.end;
-    let count = (samples.end - samples.start) as f64;
-    let mut sums = vec![[0f64; 3]; parts[0].2.len()];
+    let mut sums = vec![[0f64; 4]; parts[0].2.len()];
     for (_, _, part) in &parts {
-        for (acc, s) in sums.iter_mut().zip(part) {
-            for k in 0..3 {
-                acc[k] += s[k] as f64;
-            }
-        }
+        super::add_sums(&mut sums, part);
     }
-    let image = HdrImage {
-        width: reference.width,
-        height: reference.height,
-        pixels: sums.iter().map(|s| s.map(|v| (v / count) as f32)).collect(),
-    };
+    let image = super::mean_image(reference.width, reference.height, &sums, samples.end - samples.start);
     Ok((PartInfo { samples, ..reference }, image))
 }
