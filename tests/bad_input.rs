@@ -23,7 +23,7 @@ fn non_finite_input_names_the_primitive() {
 fn run_build_rejects_nan_before_building() {
     let mut scene = treelet::scene::random_scene("test", 10, 1);
     scene.spheres[3].center[0] = f32::NEG_INFINITY;
-    let e = treelet::build::report::run_build(&mut treelet::runtime::cpu_runner::CpuBackend::new(), &scene, None).unwrap_err();
+    let e = treelet::bvh::report::run_build(&mut treelet::runtime::cpu_runner::CpuBackend::new(), &scene, None).unwrap_err();
     assert!(e.to_string().contains("sphere 3"), "{e}");
 }
 

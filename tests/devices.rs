@@ -3,7 +3,7 @@
 //! is a CPU runner; within the GPU-vs-CPU tolerance with a GPU among them),
 //! every sample is rendered once, and a device that fails leaves its
 //! unfinished chunk to the others.
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::devices::{render_on_devices, Device, InjectedFailure, SampleQueue, Take};
 use treelet::render::variant::KernelChoice;
 use treelet::render::{render, Accel, Integrator, RenderSettings};

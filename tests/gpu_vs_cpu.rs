@@ -6,7 +6,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::scene::random_spheres;
-use treelet::build::sort::SortTiles;
+use treelet::bvh::sort::SortTiles;
 use treelet_tests::{compare_builds, gpu};
 
 #[test]
@@ -22,7 +22,7 @@ fn lbvh_matches_cpu_on_random_scenes() {
 /// where many Morton keys are equal.
 #[test]
 fn agglomerative_build_equals_radix_tree_and_fit() {
-    use treelet::build::lbvh::{build_with, Hierarchy};
+    use treelet::bvh::lbvh::{build_with, Hierarchy};
     let seed = treelet_tests::fresh_seed();
     let mut scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 5, 1000, 40_000]
         .iter()
@@ -54,7 +54,7 @@ fn agglomerative_build_equals_radix_tree_and_fit() {
             }
             assert_eq!(t.parents, reference.parents, "{what}, {how}: parents");
         }
-        let v = treelet::build::validate::validate(spheres, &trees[0].1.nodes, &trees[0].1.parents, &trees[0].1.prim_indices);
+        let v = treelet::bvh::validate::validate(spheres, &trees[0].1.nodes, &trees[0].1.parents, &trees[0].1.prim_indices);
         assert!(v.is_valid(), "{what}: agglomerative tree invalid: {:?}", v.errors);
     }
 }
@@ -158,7 +158,7 @@ fn run_sort<B: Backend>(
     let n = keys.len() as u32;
     let kb = b.upload("keys", keys).unwrap();
     let vb = b.upload("values", values).unwrap();
-    let (k, v) = treelet::build::sort::radix_sort_tiled(b, &kb, &vb, n, key_bits, tiles).unwrap();
+    let (k, v) = treelet::bvh::sort::radix_sort_tiled(b, &kb, &vb, n, key_bits, tiles).unwrap();
     (b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap())
 }
 
@@ -171,7 +171,7 @@ fn repeated_builds_on_one_backend_stay_correct() {
     let mut backend = GpuBackend::new(ctx);
     for (k, n) in [5000usize, 5000, 5000, 777, 5000].into_iter().enumerate() {
         let spheres = random_spheres(n, seed.wrapping_add(k as u64));
-        let (g, _) = treelet::build::lbvh::build(&mut backend, &spheres).unwrap();
+        let (g, _) = treelet::bvh::lbvh::build(&mut backend, &spheres).unwrap();
         let c = treelet_tests::build_cpu_checked(&spheres, "reuse");
         assert_eq!(g.nodes, c.nodes, "build {k} (n = {n}) on a reused backend differs from the CPU");
         assert_eq!(g.prim_indices, c.prim_indices, "build {k}");

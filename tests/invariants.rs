@@ -68,10 +68,10 @@ fn flat_scene() {
 /// The validator itself must catch broken trees, or the checks above prove nothing.
 #[test]
 fn validator_catches_corruption() {
-    use treelet::build::validate::validate;
+    use treelet::bvh::validate::validate;
     let spheres = random_spheres(500, 9);
     let good = treelet_tests::build_cpu_checked(&spheres, "base");
-    let check = |mutate: &dyn Fn(&mut treelet::build::lbvh::Bvh), needle: &str| {
+    let check = |mutate: &dyn Fn(&mut treelet::bvh::lbvh::Bvh), needle: &str| {
         let mut bad = good.clone();
         mutate(&mut bad);
         let v = validate(&spheres, &bad.nodes, &bad.parents, &bad.prim_indices);

@@ -9,18 +9,20 @@ use glam::Vec3;
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
-use treelet::build::layout::{wide_nodes, Layout, TracedTree};
+use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
 use treelet::render::{scene_tree, Accel};
 use treelet::scene::{random_spheres, Scene};
-use treelet::build::validate_layout::{validate_bvh2, validate_wide};
-use treelet_core::bvh2::closest_hit_bvh2;
-use treelet_core::cwbvh::closest_hit_cwbvh;
-use treelet_core::features::ALL;
-use treelet_core::layout::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
-use treelet_core::rng::BounceRng;
-use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Hit, Origin, Prims};
-use treelet_core::triangle::Triangle;
+use treelet::bvh::validate_layout::{validate_bvh2, validate_wide};
+use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
+use treelet_core::geometry::features::ALL;
+use treelet_core::geometry::prims::{Origin, Prims};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::rng::BounceRng;
+use treelet_core::trace::bvh2::closest_hit_bvh2;
+use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
+use treelet_core::trace::cwbvh::closest_hit_cwbvh;
+use treelet_core::trace::hit::Hit;
 
 /// A laid-out tree, read back.
 enum HostTree {
@@ -110,11 +112,11 @@ fn rays(prims: &Prims, lo: Vec3, hi: Vec3, seed: u32, count: u32) -> Vec<(Vec3, 
         if hit.is_hit() {
             // Leave the surface hit, outwards, as a bounce does.
             let x = o + d * hit.t;
-            let n = treelet_core::render::hit_normal(prims, hit.prim, x, d);
+            let n = treelet_core::render::integrator::hit_normal(prims, hit.prim, x, d);
             let nl = if n.dot(d) < 0.0 { n } else { -n };
-            let d2 = treelet_core::render::cosine_direction(nl, r.uniform(11), r.uniform(12));
+            let d2 = treelet_core::render::sampling::cosine_direction(nl, r.uniform(11), r.uniform(12));
             let from = Origin { prim: hit.prim, into: d2.dot(n) < 0.0 };
-            let o2 = x + nl * treelet_core::render::surface_offset(x);
+            let o2 = x + nl * treelet_core::geometry::intersect::surface_offset(x);
             out.push((o2, d2, from, closest_hit_linear(o2, d2, from, prims)));
         }
     }

@@ -3,12 +3,12 @@
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
-use treelet::build::lbvh::{build_primitives_on_device, Bvh};
+use treelet::bvh::lbvh::{build_primitives_on_device, Bvh};
 use treelet::scene::primitives::Primitives;
-use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
-use treelet::build::validate::validate_primitives;
-use treelet_core::sah::{sah_cost, SahCosts};
-use treelet_core::triangle::Triangle;
+use treelet::bvh::trbvh::{optimize, root_box, TreeletConfig};
+use treelet::bvh::validate::validate_primitives;
+use treelet_core::construct::sah::{SahCosts, sah_cost};
+use treelet_core::geometry::triangle::Triangle;
 
 /// A height field over an n x n grid, two triangles per cell, with a
 /// seed-dependent phase: a terrain-like mesh.
@@ -73,7 +73,7 @@ fn mesh_trbvh_lowers_sah_on_both_devices() {
     let v = validate_primitives(prims, &c.nodes, &c.parents, &c.prim_indices);
     assert!(v.is_valid(), "{:?}", v.errors);
     let trbvh = sah_cost(&c.nodes, SahCosts::KARRAS_AILA);
-    let sweep = treelet::build::sweep::build_collapsed_boxes(&prims.boxes(), config.max_leaf).unwrap();
+    let sweep = treelet::bvh::sweep::build_collapsed_boxes(&prims.boxes(), config.max_leaf).unwrap();
     let sweep = sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA);
     eprintln!("terrain of {} triangles: SAH lbvh {lbvh:.3}, trbvh {trbvh:.3}, sweep {sweep:.3}", tris.len());
     assert!(
@@ -162,7 +162,8 @@ mod fuzz {
 mod stiff {
     use super::*;
     use glam::Vec3;
-    use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
+    use treelet_core::geometry::prims::{Origin, Prims};
+    use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
 
     /// Triangles spanning the same unit cube at `c` (three corners each, in
     /// varying order): identical boxes and centroids.
@@ -218,13 +219,13 @@ mod stiff {
         let b = &mut CpuBackend::new();
         let lbvh = build(b, tris, None);
         let trbvh = build(b, tris, Some(&TreeletConfig::default()));
-        let sweep = treelet::build::sweep::build_collapsed_boxes(&prims.boxes(), 8).unwrap();
+        let sweep = treelet::bvh::sweep::build_collapsed_boxes(&prims.boxes(), 8).unwrap();
         let scene = Prims { spheres: &[], sphere_count: 0, triangles: tris, triangle_count: tris.len() as u32 };
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let (center, size) = (bounds.centroid(), bounds.extent().max_element());
         let mut hits = 0;
         for i in 0..2000u32 {
-            let r = treelet_core::rng::BounceRng::new(17, i, 0, 0);
+            let r = treelet_core::gpu::rng::BounceRng::new(17, i, 0, 0);
             let dir = Vec3::new(r.uniform(0) - 0.5, r.uniform(1) - 0.5, r.uniform(2) - 0.5).normalize_or(Vec3::X);
             let target = center + Vec3::new(r.uniform(3) - 0.5, r.uniform(4) - 0.5, r.uniform(5) - 0.5) * size;
             let o = target - dir * (2.0 * size);

@@ -3,11 +3,11 @@
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::{render, Accel, Integrator, RenderSettings};
 use treelet::render::variant::KernelChoice;
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::triangle::Triangle;
 use treelet_tests::gpu;
 
 /// A small closed mesh (an octahedron with each face split into four),
@@ -135,14 +135,14 @@ fn cornell_has_no_nan_and_no_black_speckles() {
         let d =
             v(camera.cx) * ((x + 0.5) / w as f32 - 0.5) + v(camera.cy) * ((y + 0.5) / h as f32 - 0.5) + v(camera.dir);
         let o = v(camera.origin) + d * camera.near;
-        let hit = treelet_core::traverse::closest_hit_linear(
+        let hit = treelet_core::trace::classic::closest_hit_linear(
             o,
             d.normalize(),
-            treelet_core::traverse::Origin::NONE,
-            &treelet_core::traverse::Prims::spheres(&scene.spheres),
+            treelet_core::geometry::prims::Origin::NONE,
+            &treelet_core::geometry::prims::Prims::spheres(&scene.spheres),
         );
         let kind = scene.materials[hit.prim as usize].kind;
-        assert_ne!(kind, treelet_core::layout::DIFFUSE, "black pixel {i} on diffuse sphere {}", hit.prim);
+        assert_ne!(kind, treelet_core::geometry::buffers::DIFFUSE, "black pixel {i} on diffuse sphere {}", hit.prim);
     }
     let mean = p.iter().flatten().sum::<f32>() / (3 * p.len()) as f32;
     assert!((0.3..1.2).contains(&mean), "mean {mean}");
@@ -168,7 +168,7 @@ fn render_rejects_bad_settings() {
 fn cast_kernels_match_cpu() {
     use treelet::runtime::kernels::Kernel;
     use treelet::scene::primitives::Primitives;
-    use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     fn cast<B: Backend>(b: &mut B, scene: &Scene, layout: Layout, kernel: Kernel, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
         let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
         let (tree, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh, layout).unwrap();
@@ -187,7 +187,7 @@ fn cast_kernels_match_cpu() {
         for mode in [CAST_PRIMARY, CAST_BOUNCE, CAST_DIFFUSE] {
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, ..base }]).unwrap();
             let bindings = [&p, &prims.spheres, &materials, &tree.nodes, &tree.prims, &rays, &prims.triangles];
-            b.dispatch(kernel, &bindings, treelet_core::render::tiled_invocations(w, h).div_ceil(256));
+            b.dispatch(kernel, &bindings, treelet_core::render::integrator::tiled_invocations(w, h).div_ceil(256));
         }
         b.read(&rays, (2 * w * h) as usize).unwrap()
     }
@@ -240,7 +240,7 @@ fn cast_kernels_match_cpu() {
 // --- Next-event estimation (`--integrator nee`) ---
 
 use treelet::scene::{cornell_room, diffuse, CameraSpec};
-use treelet_core::layout::{Material, Sphere, GLASS};
+use treelet_core::geometry::buffers::{GLASS, Material, Sphere};
 
 /// smallpt's room without its light, plus `extra` spheres and `triangles`.
 fn room_with(name: &str, extra: Vec<(Sphere, Material)>, triangles: Vec<(Triangle, Material)>) -> Scene {

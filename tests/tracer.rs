@@ -8,9 +8,10 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::tracer::{Quality, Ray, RayHit, Tracer};
-use treelet_core::layout::Sphere;
-use treelet_core::traverse::{closest_hit_linear, Origin, Prims};
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::buffers::Sphere;
+use treelet_core::geometry::prims::{Origin, Prims};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::trace::classic::closest_hit_linear;
 use treelet_tests::{fresh_seed, gpu};
 
 type Geometry = (Vec<Sphere>, Vec<Triangle>);

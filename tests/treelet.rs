@@ -1,9 +1,9 @@
 //! Treelet restructuring (Karras & Aila 2013) on CPU-built LBVHs: one
 //! sequential bottom-up round keeps every invariant and never raises the SAH;
 //! the device pass (rounds, then the SAH leaf collapse) equals its CPU run.
-use treelet::build::validate::validate;
-use treelet_core::sah::{sah_cost, SahCosts};
-use treelet_core::treelet::{node_cost, restructure, TreeletCosts};
+use treelet::bvh::validate::validate;
+use treelet_core::construct::sah::{SahCosts, sah_cost};
+use treelet_core::construct::treelet::{TreeletCosts, node_cost, restructure};
 use treelet_core::{Aabb, Node, INVALID};
 
 /// Internal nodes in post-order (children before parents).
@@ -90,8 +90,8 @@ fn one_round_keeps_invariants_and_lowers_sah() {
 #[test]
 fn kernel_round_equals_the_one_invocation_reference() {
     use treelet::runtime::cpu_runner::CpuBackend;
-    use treelet::build::lbvh::{build_on_device, DeviceBvh};
-    use treelet::build::trbvh::{collapse, optimize, root_box, TreeletConfig};
+    use treelet::bvh::lbvh::{build_on_device, DeviceBvh};
+    use treelet::bvh::trbvh::{collapse, optimize, root_box, TreeletConfig};
 
     let seed = treelet_tests::fresh_seed();
     for (n, gamma, max_leaf) in [(3000usize, 3, 8), (20_000, 7, 1), (5000, 1, 8)] {
@@ -133,8 +133,8 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
     use treelet::runtime::backend::Backend;
     use treelet::runtime::cpu_runner::CpuBackend;
     use treelet::runtime::gpu::GpuBackend;
-    use treelet::build::lbvh::{build_on_device, Bvh};
-    use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
+    use treelet::bvh::lbvh::{build_on_device, Bvh};
+    use treelet::bvh::trbvh::{optimize, root_box, TreeletConfig};
 
     fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], config: &TreeletConfig) -> (Bvh, f64) {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
@@ -215,8 +215,8 @@ fn skipping_kept_treelets_changes_nothing() {
     use treelet::runtime::backend::Backend;
     use treelet::runtime::cpu_runner::CpuBackend;
     use treelet::runtime::gpu::GpuBackend;
-    use treelet::build::lbvh::{build_on_device, Bvh};
-    use treelet::build::trbvh::{optimize, root_box, TreeletConfig};
+    use treelet::bvh::lbvh::{build_on_device, Bvh};
+    use treelet::bvh::trbvh::{optimize, root_box, TreeletConfig};
 
     fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], gamma: u32, skip_kept: bool) -> Bvh {
         let (dbvh, _) = build_on_device(b, spheres).unwrap();
@@ -245,7 +245,7 @@ fn skipping_kept_treelets_changes_nothing() {
 /// full leaves; with `max_leaf` 1 a tree is only reordered (same SAH).
 #[test]
 fn collapse_by_sah() {
-    use treelet::build::sweep::{build, build_collapsed};
+    use treelet::bvh::sweep::{build, build_collapsed};
     let same: Vec<treelet_core::Sphere> = (0..100).map(|_| treelet_core::Sphere::new([1.0, 2.0, 3.0], 0.5)).collect();
     let t = build_collapsed(&same, 8).unwrap();
     assert!(validate(&same, &t.nodes, &t.parents, &t.prim_indices).is_valid());

@@ -6,12 +6,13 @@ use std::collections::BTreeSet;
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::{render, Accel, RenderResult, RenderSettings};
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet::render::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU, TRIANGLE_SCAN_WEIGHT};
-use treelet_core::features::{self, VARIANTS};
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::features;
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::render::variants::VARIANTS;
 use treelet_tests::gpu;
 
 /// A tetrahedron-studded patch of triangles.
@@ -115,7 +116,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
-            if scene.materials.iter().any(|m| m.kind == treelet_core::layout::GLASS) {
+            if scene.materials.iter().any(|m| m.kind == treelet_core::geometry::buffers::GLASS) {
                 assert!(compiled & features::GLASS != 0, "{}: glass without refraction", scene.name);
             }
             let cost = scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len();

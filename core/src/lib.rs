@@ -5,72 +5,52 @@
 //! ordinary host code, which the CPU runner, the tests and embedding engines
 //! call. Nothing here allocates; every buffer is a slice owned by the caller.
 //!
-//! ## The LBVH build (Karras 2012), stage by stage
+//! ## The folders, bottom to top
 //!
-//! | stage | file | reads | writes |
-//! |---|---|---|---|
-//! | primitive boxes | [`scene`] | spheres | one [`Aabb`] per primitive |
-//! | centroid bounds | [`bounds`] | boxes | one box per workgroup, reduced again until one remains |
-//! | Morton codes | [`morton`] | boxes, centroid bounds | 63-bit keys, identity values |
-//! | sort | [`sort`], [`scan`] | keys, values | keys, values sorted (stable LSD radix sort) |
-//! | radix tree | [`radix_tree`] | sorted keys | internal nodes' children, parent links |
-//! | fit | [`fit`] | tree, boxes | leaf and internal boxes, bottom-up with atomic flags |
+//! Each folder is a stage of the pipeline and imports only the folders
+//! below it (`tests/layering.rs` checks this):
 //!
-//! Treelet restructuring (Karras & Aila 2013) then rewrites the tree in
-//! place, round by round ([`treelet`]), and [`collapse`] compacts it into
-//! depth-first order with SAH-collapsed leaves of several primitives.
+//! | folder | what | papers |
+//! |---|---|---|
+//! | [`gpu`] | atomics, workgroup phases, unchecked access, fills: the one GPU/CPU split | |
+//! | [`geometry`] | buffer types, boxes, spheres, triangles, ray intersection, feature bits | Ize 2013; Woop, Benthin & Wald 2013 |
+//! | [`construct`] | Morton codes, radix sort, radix tree, bottom-up fit, agglomerative build, treelet restructuring, leaf collapse, SAH | Karras 2012; Apetrei 2014; Karras & Aila 2013; Adinets & Merrill 2022 |
+//! | [`layouts`] | two-box binary nodes and compressed 8-wide nodes, made from a built tree | Aila & Laine 2009; Ylitie, Karras & Laine 2017 |
+//! | [`trace`] | one closest-hit traversal per layout | the same |
+//! | [`render`] | the path tracer (smallpt's estimator, NEE with MIS), lights, sampling, ray casts | Veach 1997; pbrt-v4 |
 //!
-//! Node layout: `n` leaves and `n - 1` internal nodes in one array of
-//! `2n - 1` [`Node`]s. Internal node `i` sits at index `i` (so the root is 0),
-//! leaf `j` (the `j`-th primitive in Morton order) at index `n - 1 + j`.
+//! Every kernel is a plain function of its invocation id (or of its
+//! workgroup, for kernels that share workgroup memory: see
+//! [`gpu::workgroup`]). The shader crate's entry points only map ids and
+//! bindings to these functions.
 //!
-//! Every kernel is a plain function of its invocation id (or of its workgroup,
-//! for kernels that share workgroup memory: see [`workgroup`]). The shader
-//! crate's entry points only map ids and bindings to these functions.
-//!
-//! ## Example: build a BVH over spheres on the CPU
+//! ## Example: a sphere's box, and a closest hit by the scan
 //! ```
-//! use treelet_core::{Sphere, Node};
-//! // The host crate (`treelet`) wraps these stages; see `treelet::bvh::build_cpu`.
-//! let s = Sphere::new([0.0, 0.0, 0.0], 1.0);
-//! assert_eq!(s.aabb().surface_area(), 24.0);
+//! use glam::Vec3;
+//! use treelet_core::geometry::prims::{Origin, Prims};
+//! use treelet_core::trace::classic::closest_hit_linear;
+//! use treelet_core::{Node, Sphere};
+//! let spheres = [Sphere::new([0.0, 0.0, 0.0], 1.0), Sphere::new([4.0, 0.0, 0.0], 1.0)];
+//! assert_eq!(spheres[0].aabb().surface_area(), 24.0);
 //! assert_eq!(core::mem::size_of::<Node>(), 32);
+//! let hit = closest_hit_linear(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, Origin::NONE, &Prims::spheres(&spheres));
+//! assert_eq!((hit.prim, hit.t), (0, 4.0));
 //! ```
+//! The host crate (`treelet`) runs these stages on a device: see its
+//! `Tracer` for building a tree and finding closest hits from an engine.
 #![no_std]
 
-pub mod aabb;
-pub mod agglomerate;
-pub mod atomics;
-pub mod bounds;
-pub mod bvh2;
-pub mod collapse;
-pub mod cwbvh;
-pub mod cwbvh_build;
-pub mod features;
-pub mod fill;
-pub mod fit;
-pub mod intersect;
-pub mod layout;
-pub mod lights;
-pub mod morton;
-pub mod radix_tree;
-pub mod rays;
+pub mod construct;
+pub mod geometry;
+pub mod gpu;
+pub mod layouts;
 pub mod render;
-pub mod rng;
-pub mod sah;
-pub mod scan;
-pub mod scene;
-pub mod sort;
-pub mod traverse;
-pub mod treelet;
-pub mod treelet_kernels;
-pub mod triangle;
-pub mod unchecked;
-pub mod workgroup;
+pub mod trace;
 
-pub use aabb::Aabb;
-pub use layout::{
+pub use geometry::aabb::Aabb;
+pub use geometry::buffers::{
     BuildParams, Bvh2Node, Camera, FillParams, LayoutParams, LeafPrim, Material, Node, RenderParams, ScanParams,
     SortParams, Sphere, WideNode, INVALID, LEAF_BIT,
 };
-pub use workgroup::WORKGROUP_SIZE;
+pub use geometry::triangle::Triangle;
+pub use gpu::workgroup::WORKGROUP_SIZE;

@@ -7,14 +7,15 @@
 use glam::Vec3;
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
-use treelet::build::layout::{wide_nodes, Layout};
+use treelet::bvh::layout::{wide_nodes, Layout};
 use treelet::scene::primitives::Primitives;
 use treelet::render::{scene_tree, Accel};
-use treelet_core::bvh2::closest_hit_bvh2;
-use treelet_core::cwbvh::closest_hit_cwbvh;
-use treelet_core::features::ALL;
-use treelet_core::layout::{Bvh2Node, LeafPrim};
-use treelet_core::traverse::{closest_hit_bvh, closest_hit_linear, Origin, Prims};
+use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim};
+use treelet_core::geometry::features::ALL;
+use treelet_core::geometry::prims::{Origin, Prims};
+use treelet_core::trace::bvh2::closest_hit_bvh2;
+use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
+use treelet_core::trace::cwbvh::closest_hit_cwbvh;
 use treelet_core::{Node, Sphere};
 
 fn main() -> anyhow::Result<()> {
@@ -39,7 +40,7 @@ fn main() -> anyhow::Result<()> {
         let (tree, _, build_ms) = scene_tree(b, prims, Accel::Trbvh, layout)?;
         println!("{}: built and laid out over {} spheres in {build_ms:.2} ms", layout.name(), spheres.len());
         // Read the layout back and trace with its traversal function.
-        let trace: Box<dyn Fn(Vec3, Vec3) -> treelet_core::traverse::Hit> = match layout {
+        let trace: Box<dyn Fn(Vec3, Vec3) -> treelet_core::trace::hit::Hit> = match layout {
             Layout::Classic => {
                 let nodes: Vec<Node> = b.read(&tree.nodes, tree.node_count as usize)?;
                 let indices: Vec<u32> = b.read(&tree.prims, spheres.len())?;

@@ -8,7 +8,7 @@
 //!   kernel functions over every invocation id;
 //! - [`scene`]: what is built and rendered: spheres and triangles, meshes,
 //!   scene files, and the checks that reject bad input;
-//! - [`build`]: the BVH builders (LBVH, treelet restructuring, full-sweep
+//! - [`bvh`]: the BVH builders (LBVH, treelet restructuring, full-sweep
 //!   SAH), the traversal layouts and the independent validators;
 //! - [`render`]: the path tracer's passes, the kernel variant a scene needs,
 //!   images in and out;
@@ -19,13 +19,13 @@
 //! The `treelet` command (`main.rs`, `bench/`) sits on top.
 //!
 //! ```no_run
-//! use treelet::{build::lbvh, runtime::cpu_runner::CpuBackend, scene};
+//! use treelet::{bvh::lbvh, runtime::cpu_runner::CpuBackend, scene};
 //! let spheres = scene::random_spheres(1000, 7);
 //! let (bvh, times) = lbvh::build(&mut CpuBackend::new(), &spheres).unwrap();
 //! assert_eq!(bvh.nodes.len(), 1999);
 //! println!("{} ms", times.total());
 //! ```
-pub mod build;
+pub mod bvh;
 pub mod plot;
 pub mod render;
 pub mod runtime;

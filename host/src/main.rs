@@ -8,12 +8,12 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::render::image_io;
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::plot::Series;
 use treelet::render::{render, Accel, Integrator, PassRow, RenderSettings};
-use treelet::build::report::{run_build, run_build_sweep, BuildReport};
+use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
-use treelet::build::trbvh::TreeletConfig;
+use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
 
 mod bench;

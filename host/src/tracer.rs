@@ -6,7 +6,7 @@
 //! ```
 //! use treelet::runtime::cpu_runner::CpuBackend;
 //! use treelet::tracer::{Quality, Ray, Tracer};
-//! use treelet_core::triangle::Triangle;
+//! use treelet_core::geometry::triangle::Triangle;
 //! let triangles = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
 //! let b = &mut CpuBackend::new();
 //! let tracer = Tracer::build(b, &[], &triangles, Quality::Fast)?;
@@ -15,14 +15,14 @@
 //! # anyhow::Ok(())
 //! ```
 use anyhow::{bail, Result};
-use treelet_core::layout::{RenderParams, Sphere};
-use treelet_core::rays::CAST_RAYS;
-use treelet_core::render::tiled_invocations;
-use treelet_core::triangle::Triangle;
-use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+use treelet_core::geometry::buffers::{RenderParams, Sphere};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::render::integrator::tiled_invocations;
+use treelet_core::render::rays::CAST_RAYS;
 
-use crate::build::layout::{Layout, PrimBuffers, TracedTree};
-use crate::build::refit::refit;
+use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
+use crate::bvh::refit::refit;
 use crate::render::{binary_tree, Accel, BuiltTree};
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::{Kernel, Method};
@@ -160,7 +160,7 @@ impl<B: Backend> Tracer<B> {
             ..Default::default()
         };
         let p = b.upload("trace params", &[params])?;
-        let materials = b.upload("no materials", &[treelet_core::layout::Material::default()])?;
+        let materials = b.upload("no materials", &[treelet_core::geometry::buffers::Material::default()])?;
         let Some(tree) = &self.tree else {
             bail!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)");
         };

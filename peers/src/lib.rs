@@ -1,6 +1,6 @@
 //! Peer BVH builders from crates.io, run over Treelet's own boxes and
 //! converted to Treelet's node layout, so that the benchmark suite scores
-//! them with the same SAH function and constants (`treelet_core::sah`).
+//! them with the same SAH function and constants (`treelet_core::construct::sah`).
 //! Only the suite uses this crate (`treelet` feature `peers`): the release
 //! binary does not depend on them.
 //!
@@ -10,8 +10,8 @@
 //!   collapse (`BvhBuildParams::medium_build`, leaves of up to 8), single-threaded.
 use std::time::Instant;
 
-use treelet_core::layout::{Node, LEAF_BIT};
 use treelet_core::Aabb;
+use treelet_core::geometry::buffers::{LEAF_BIT, Node};
 
 /// A peer's tree in Treelet's layout (root at 0) and its build time.
 pub struct PeerTree {
@@ -141,7 +141,7 @@ pub fn obvhs_ploc(boxes: &[Aabb]) -> PeerTree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use treelet_core::sah::{sah_cost, SahCosts};
+    use treelet_core::construct::sah::{SahCosts, sah_cost};
 
     fn boxes(n: usize) -> Vec<Aabb> {
         let mut x = 12345u32;

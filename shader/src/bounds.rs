@@ -1,9 +1,9 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::bounds;
-use treelet_core::layout::BuildParams;
-use treelet_core::workgroup::{barrier, linear_group, WG};
 use treelet_core::Aabb;
+use treelet_core::construct::bounds;
+use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
 #[spirv(compute(threads(256)))]
 pub fn reduce_bounds_cs(

@@ -1,8 +1,8 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::{Bvh2Node, LayoutParams, LeafPrim, Node, Sphere};
-use treelet_core::triangle::Triangle;
-use treelet_core::workgroup::linear_id;
+use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, Node, Sphere};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::linear_id;
 
 /// One node of a collapsed tree into the two-box layout.
 #[spirv(compute(threads(256)))]
@@ -15,7 +15,7 @@ pub fn bvh2_nodes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Bvh2Node],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::bvh2::bvh2_node_kernel(id, params.nodes, nodes, parents, out);
+    treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, nodes, parents, out);
 }
 
 /// One primitive, in leaf order, as its leaf stores it.
@@ -30,5 +30,5 @@ pub fn leaf_prims_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [LeafPrim],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
+    treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
 }

@@ -1,9 +1,9 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::cwbvh_build::{wide_count_kernel, wide_dp_kernel, wide_emit_kernel, wide_place_kernel};
-use treelet_core::layout::{LayoutParams, LeafPrim, Node, Sphere, WideNode};
-use treelet_core::triangle::Triangle;
-use treelet_core::workgroup::linear_id;
+use treelet_core::geometry::buffers::{LayoutParams, LeafPrim, Node, Sphere, WideNode};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::linear_id;
+use treelet_core::layouts::cwbvh_build::{wide_count_kernel, wide_dp_kernel, wide_emit_kernel, wide_place_kernel};
 
 /// The wide DP, bottom up; acquire-release counters (GPUs).
 #[spirv(compute(threads(256)))]

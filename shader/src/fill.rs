@@ -1,7 +1,7 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::FillParams;
-use treelet_core::workgroup::linear_id;
+use treelet_core::geometry::buffers::FillParams;
+use treelet_core::gpu::workgroup::linear_id;
 
 #[spirv(compute(threads(256)))]
 pub fn fill_cs(
@@ -10,5 +10,5 @@ pub fn fill_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &FillParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] data: &mut [u32],
 ) {
-    treelet_core::fill::fill_kernel(linear_id(gid.x, gid.y, groups.x), params, data);
+    treelet_core::construct::fill::fill_kernel(linear_id(gid.x, gid.y, groups.x), params, data);
 }

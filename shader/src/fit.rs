@@ -1,12 +1,12 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::BuildParams;
-use treelet_core::workgroup::linear_id;
+use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::{Aabb, Node};
 
 /// A bottom-up fit entry point; `$ordered` as in
-/// `treelet_core::fit::fit_kernel` (acquire-release counters for GPUs,
-/// relaxed for CPU adapters: see `treelet_core::atomics::add_device_acq_rel`).
+/// `treelet_core::construct::fit::fit_kernel` (acquire-release counters for GPUs,
+/// relaxed for CPU adapters: see `treelet_core::gpu::atomics::add_device_acq_rel`).
 macro_rules! fit_kernel {
     ($name:ident, $ordered:literal) => {
         #[spirv(compute(threads(256)))]
@@ -21,7 +21,7 @@ macro_rules! fit_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
-            treelet_core::fit::fit_kernel::<$ordered>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
+            treelet_core::construct::fit::fit_kernel::<$ordered>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
         }
     };
 }
@@ -44,7 +44,7 @@ macro_rules! agglomerate_kernel {
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let n = params.n;
-            treelet_core::agglomerate::agglomerate_kernel::<$ordered>(
+            treelet_core::construct::agglomerate::agglomerate_kernel::<$ordered>(
                 id,
                 n,
                 keys,

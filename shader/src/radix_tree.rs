@@ -1,8 +1,8 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::BuildParams;
-use treelet_core::workgroup::linear_id;
 use treelet_core::Node;
+use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::gpu::workgroup::linear_id;
 
 #[spirv(compute(threads(256)))]
 pub fn radix_tree_cs(
@@ -14,5 +14,5 @@ pub fn radix_tree_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::radix_tree::radix_tree_kernel(id, params.n, keys, nodes, parents);
+    treelet_core::construct::radix_tree::radix_tree_kernel(id, params.n, keys, nodes, parents);
 }

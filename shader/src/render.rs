@@ -1,18 +1,19 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::bvh2::Bvh2Tree;
-use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
-use treelet_core::features::{ALL, TRIANGLES, VARIANTS};
-use treelet_core::layout::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
-use treelet_core::lights::Light;
-use treelet_core::render::{accumulate, render_pixel, tiled_pixel, SceneRefs};
-use treelet_core::traverse::{ClassicTree, Scan};
-use treelet_core::triangle::Triangle;
-use treelet_core::workgroup::linear_id;
+use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
+use treelet_core::geometry::features::{ALL, TRIANGLES};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::linear_id;
+use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
+use treelet_core::render::lights::Light;
+use treelet_core::render::variants::VARIANTS;
+use treelet_core::trace::bvh2::Bvh2Tree;
+use treelet_core::trace::classic::{ClassicTree, Scan};
+use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
-/// `treelet_core::features::VARIANTS`, whose names these must match: the
+/// `treelet_core::render::variants::VARIANTS`, whose names these must match: the
 /// feature sets come from it by index). The stack stays private.
 macro_rules! render_kernel {
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
@@ -83,7 +84,7 @@ macro_rules! cast_kernel {
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
-            treelet_core::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
+            treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
 }
@@ -113,5 +114,5 @@ pub fn cast_cwbvh_workgroup_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     let scene = SceneRefs::new(params, spheres, triangles, materials, WideTree::new(nodes, prims));
-    treelet_core::rays::cast_kernel::<_, ALL, WORKGROUP_STACK_WORDS>(id, params, &scene, rays, stack, lane);
+    treelet_core::render::rays::cast_kernel::<_, ALL, WORKGROUP_STACK_WORDS>(id, params, &scene, rays, stack, lane);
 }

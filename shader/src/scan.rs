@@ -1,8 +1,8 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::ScanParams;
-use treelet_core::scan;
-use treelet_core::workgroup::{barrier, linear_group, WG};
+use treelet_core::construct::scan;
+use treelet_core::geometry::buffers::ScanParams;
+use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
 #[spirv(compute(threads(256)))]
 pub fn scan_reduce_cs(

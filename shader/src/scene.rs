@@ -1,8 +1,8 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::BuildParams;
-use treelet_core::workgroup::linear_id;
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::{Aabb, Sphere};
 
 #[spirv(compute(threads(256)))]
@@ -15,5 +15,5 @@ pub fn primitive_boxes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] boxes: &mut [Aabb],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::scene::primitive_boxes_kernel(id, params.n, params.spheres, spheres, triangles, boxes);
+    treelet_core::construct::primitive_boxes::primitive_boxes_kernel(id, params.n, params.spheres, spheres, triangles, boxes);
 }

@@ -1,8 +1,8 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::SortParams;
-use treelet_core::sort;
-use treelet_core::workgroup::{barrier, linear_group, WG};
+use treelet_core::construct::sort;
+use treelet_core::geometry::buffers::SortParams;
+use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
 #[spirv(compute(threads(256)))]
 pub fn sort_histogram_cs(
@@ -38,7 +38,7 @@ pub fn sort_offsets_cs(
 }
 
 /// A sort pass's entry point; `$look_back` and `$items` as in
-/// `treelet_core::sort::onesweep_phase` (entry points cannot be generic).
+/// `treelet_core::construct::sort::onesweep_phase` (entry points cannot be generic).
 macro_rules! onesweep_kernel {
     ($name:ident, $look_back:literal, $items:expr) => {
         #[spirv(compute(threads(256)))]

@@ -1,13 +1,10 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::layout::{Node, TreeletParams};
-use treelet_core::collapse::collapse_kernel;
-use treelet_core::treelet_kernels::{
-    treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase, HISTOGRAM_PHASES,
-    RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES,
-};
-use treelet_core::treelet::SUBSETS;
-use treelet_core::workgroup::{barrier, linear_group, linear_id, WG};
+use treelet_core::construct::collapse::collapse_kernel;
+use treelet_core::construct::treelet::SUBSETS;
+use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase};
+use treelet_core::geometry::buffers::{Node, TreeletParams};
+use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
 
 /// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
 #[spirv(compute(threads(256)))]

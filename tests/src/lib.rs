@@ -20,8 +20,8 @@ pub fn gpu() -> Option<Arc<GpuContext>> {
 use rand::Rng;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
-use treelet::build::lbvh::{self, Bvh};
-use treelet::build::validate::validate;
+use treelet::bvh::lbvh::{self, Bvh};
+use treelet::bvh::validate::validate;
 use treelet_core::Sphere;
 
 /// A fresh random seed, printed so that a failure can be replayed.

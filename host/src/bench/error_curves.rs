@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::variant::KernelChoice;
 use treelet::render::{render, Accel, Integrator, RenderSettings};
 use treelet::runtime::cpu_runner::CpuBackend;

@@ -4,11 +4,11 @@
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::{Backend, StageTimes};
-use treelet::build::layout::Layout;
-use treelet::build::lbvh;
+use treelet::bvh::layout::Layout;
+use treelet::bvh::lbvh;
 use treelet::render::{render, Accel, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
-use treelet::build::trbvh::{self, TreeletConfig};
+use treelet::bvh::trbvh::{self, TreeletConfig};
 use treelet::render::variant::KernelChoice;
 use treelet_core::Sphere;
 
@@ -320,7 +320,7 @@ pub(crate) fn bench_rays<B: Backend>(
     repeats: usize,
 ) -> Result<Vec<RaysRow>> {
     use treelet::runtime::kernels::Kernel;
-    use treelet::build::layout::PrimBuffers;
+    use treelet::bvh::layout::PrimBuffers;
     use treelet::scene::primitives::Primitives;
     anyhow::ensure!(
         !matches!(accel, Accel::None | Accel::Auto),
@@ -382,8 +382,8 @@ pub(crate) fn time_casts<B: Backend>(
     (width, height): (u32, u32),
     repeats: usize,
 ) -> Result<(f64, f64, u64)> {
-    use treelet_core::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
-    use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+    use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+    use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     let pixels = width * height;
     let base = treelet_core::RenderParams {
         width,
@@ -394,7 +394,7 @@ pub(crate) fn time_casts<B: Backend>(
         camera: scene.camera.camera(width, height),
         ..Default::default()
     };
-    let groups = groups_for(treelet_core::render::tiled_invocations(width, height), WORKGROUP_SIZE);
+    let groups = groups_for(treelet_core::render::integrator::tiled_invocations(width, height), WORKGROUP_SIZE);
     let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,

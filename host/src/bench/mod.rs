@@ -7,10 +7,10 @@ use clap::Subcommand;
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::Accel;
 use treelet::scene::Scene;
-use treelet::build::trbvh::TreeletConfig;
+use treelet::bvh::trbvh::TreeletConfig;
 
 use figure::{Figure, Suite};
 pub use measure::Device;

@@ -6,10 +6,10 @@ use anyhow::{Context, Result};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
-use treelet::build::layout::Layout;
+use treelet::bvh::layout::Layout;
 use treelet::render::Accel;
 use treelet::scene::{random_spheres, Scene};
-use treelet::build::trbvh::TreeletConfig;
+use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;
 
 use super::error_curves;
@@ -325,8 +325,8 @@ fn random_boxes(n: usize) -> Vec<treelet_core::Aabb> {
 /// SAH and build time (ms, GPU timestamps: median of 3 after half a second
 /// of warm-up builds, as `bench build`) of a device build.
 fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
-    use treelet::build::{lbvh, trbvh};
-    use treelet_core::sah::{sah_cost, SahCosts};
+    use treelet::bvh::{lbvh, trbvh};
+    use treelet_core::construct::sah::{SahCosts, sah_cost};
     let all = scene.primitives();
     let once = |b: &mut B| -> Result<(lbvh::DeviceBvh<B>, f64)> {
         b.begin_build();
@@ -364,8 +364,8 @@ fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletCon
 /// compressed wide BVH: the LBVH, the treelet rounds if `config`, the wide
 /// layout (which does its own leaf collapse).
 fn device_build_wide<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<f64> {
-    use treelet::build::layout::{lay_out, PrimBuffers};
-    use treelet::build::{lbvh, trbvh};
+    use treelet::bvh::layout::{lay_out, PrimBuffers};
+    use treelet::bvh::{lbvh, trbvh};
     let all = scene.primitives();
     let once = |b: &mut B| -> Result<f64> {
         b.begin_build();
@@ -396,10 +396,10 @@ fn cpu_builds(boxes: &[treelet_core::Aabb]) -> Result<Vec<(String, f64)>> {
 
 /// The CPU builders over `boxes`: (name, build ms, SAH with Treelet's function).
 fn cpu_builds_scored(boxes: &[treelet_core::Aabb]) -> Result<Vec<(String, f64, f64)>> {
-    use treelet_core::sah::{sah_cost, SahCosts};
+    use treelet_core::construct::sah::{SahCosts, sah_cost};
     let mut out = Vec::new();
     let start = std::time::Instant::now();
-    let sweep = treelet::build::sweep::build_collapsed_boxes(boxes, TreeletConfig::default().max_leaf)?;
+    let sweep = treelet::bvh::sweep::build_collapsed_boxes(boxes, TreeletConfig::default().max_leaf)?;
     out.push(("full-sweep SAH (Treelet, CPU)".to_string(), start.elapsed().as_secs_f64() * 1e3, sah_cost(&sweep.nodes, SahCosts::KARRAS_AILA)));
     #[cfg(feature = "peers")]
     for t in [treelet_peers::bvh_crate(boxes), treelet_peers::obvhs_ploc(boxes)] {

@@ -10,18 +10,19 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use treelet_core::layout::{Node, RenderParams};
-use treelet_core::lights::{light_power, Light};
-use treelet_core::render::{luminance, tiled_invocations};
-use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+use treelet_core::geometry::buffers::{Node, RenderParams};
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::render::integrator::tiled_invocations;
+use treelet_core::render::lights::{Light, light_power};
+use treelet_core::render::sampling::luminance;
 
-use crate::build::layout::{lay_out, Layout, PrimBuffers, TracedTree};
-use crate::build::lbvh;
-use crate::build::trbvh::{self, TreeletConfig};
+use crate::bvh::layout::{lay_out, Layout, PrimBuffers, TracedTree};
+use crate::bvh::lbvh;
+use crate::bvh::trbvh::{self, TreeletConfig};
 use crate::runtime::backend::{Backend, DeviceClass, StageTimes};
 use crate::runtime::kernels::{Kernel, Method};
-use crate::scene::primitives::Primitives;
 use crate::scene::Scene;
+use crate::scene::primitives::Primitives;
 use image_io::HdrImage;
 pub use variant::Accel;
 use variant::{KernelChoice, Plan};
@@ -33,15 +34,15 @@ pub enum Integrator {
     /// smallpt's: emitters count only where a path hits them.
     Smallpt,
     /// Next-event estimation: a light sampled at every diffuse bounce, with
-    /// multiple importance sampling (`treelet_core::lights`).
+    /// multiple importance sampling (`treelet_core::render::lights`).
     Nee,
 }
 
 impl Integrator {
     fn code(self) -> u32 {
         match self {
-            Integrator::Smallpt => treelet_core::layout::SMALLPT,
-            Integrator::Nee => treelet_core::layout::NEE,
+            Integrator::Smallpt => treelet_core::geometry::buffers::SMALLPT,
+            Integrator::Nee => treelet_core::geometry::buffers::NEE,
         }
     }
 
@@ -64,9 +65,9 @@ impl Integrator {
 
 /// The light table of `prims` (spheres then triangles, one material each):
 /// every emitter, chosen in proportion to its power
-/// (`treelet_core::lights::light_power`), in primitive order. Empty
+/// (`treelet_core::render::lights::light_power`), in primitive order. Empty
 /// without emitters.
-pub fn light_table(prims: Primitives, materials: &[treelet_core::layout::Material]) -> Vec<Light> {
+pub fn light_table(prims: Primitives, materials: &[treelet_core::geometry::buffers::Material]) -> Vec<Light> {
     let p = prims.as_core();
     let powers: Vec<(u32, f64)> = (0..p.count())
         .map(|i| (i, light_power(&p, materials, i) as f64))
@@ -492,7 +493,7 @@ pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Resu
         }
         Accel::Sweep => {
             let build = std::time::Instant::now();
-            let tree = crate::build::sweep::build_boxes(&all.boxes());
+            let tree = crate::bvh::sweep::build_boxes(&all.boxes());
             let build_ms = build.elapsed().as_secs_f64() * 1e3;
             b.begin_build();
             BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }

@@ -1,13 +1,14 @@
 //! Leaving out what a scene does not need: from the scene's features, the
-//! render kernel compiled without the rest (`treelet_core::features`), and
+//! render kernel compiled without the rest (`treelet_core::geometry::features`), and
 //! whether a BVH pays at all. The same choice on every backend, recorded
 //! with its reasons for `treelet render --explain` and the report.
 use serde::Serialize;
-use treelet_core::features::{self, VARIANTS};
-use treelet_core::layout::{DIFFUSE, GLASS, MIRROR};
+use treelet_core::geometry::buffers::{DIFFUSE, GLASS, MIRROR};
+use treelet_core::geometry::features;
+use treelet_core::render::variants::VARIANTS;
 
+use crate::bvh::layout::Layout;
 use crate::runtime::backend::DeviceClass;
-use crate::build::layout::Layout;
 use crate::scene::Scene;
 
 /// What a scene contains.
@@ -49,7 +50,7 @@ impl SceneFeatures {
         self.spheres + TRIANGLE_SCAN_WEIGHT * self.triangles
     }
 
-    /// The kernel features (`treelet_core::features`) these need.
+    /// The kernel features (`treelet_core::geometry::features`) these need.
     pub fn bits(&self) -> u32 {
         let mut bits = 0;
         for (count, bit) in [

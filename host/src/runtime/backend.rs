@@ -1,14 +1,14 @@
 //! What a build needs from a device: buffers, dispatches, readback and
 //! per-stage times. The GPU ([`crate::runtime::gpu::GpuBackend`]) and the CPU
 //! ([`crate::runtime::cpu_runner::CpuBackend`]) implement it, so the order of stages
-//! of a build is written once ([`crate::build::lbvh`]).
+//! of a build is written once ([`crate::bvh::lbvh`]).
 use std::collections::BTreeMap;
 
 use anyhow::Result;
 use bytemuck::Pod;
 
-use treelet_core::layout::FillParams;
-use treelet_core::workgroup::{groups_for, WORKGROUP_SIZE};
+use treelet_core::geometry::buffers::FillParams;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
 use crate::runtime::kernels::Kernel;
 
@@ -74,7 +74,7 @@ pub trait Backend {
         true
     }
     /// False where the radix sort's decoupled look-back was seen to give
-    /// wrong offsets (lavapipe: see `treelet_core::sort`); the sort runs
+    /// wrong offsets (lavapipe: see `treelet_core::construct::sort`); the sort runs
     /// without it there.
     fn look_back_works(&self) -> bool {
         true

@@ -1,7 +1,7 @@
 //! The CPU runner: the same kernel functions of `treelet-core` the shaders
 //! call, run over every invocation id (and, for workgroup kernels, every
 //! workgroup phase by phase, each phase over all local ids: see
-//! `treelet_core::workgroup`). Invocations run
+//! `treelet_core::gpu::workgroup`). Invocations run
 //! one after another, so results are deterministic and equal the GPU's
 //! wherever the kernels are (the sort is stable, the tree unique).
 use std::cell::RefCell;
@@ -11,16 +11,19 @@ use std::time::Instant;
 use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
-use treelet_core::aabb::Aabb;
-use treelet_core::bvh2::Bvh2Tree;
-use treelet_core::cwbvh::{WideTree, WORKGROUP_STACK_WORDS};
-use treelet_core::features::VARIANTS;
-use treelet_core::lights::Light;
-use treelet_core::render::{accumulate, render_pixel, SceneRefs};
-use treelet_core::traverse::{ClassicTree, ClosestHit, Scan};
-use treelet_core::workgroup::{WG, WORKGROUP_SIZE};
-use treelet_core::{agglomerate, bounds, collapse, fill, fit, morton, radix_tree, scan, scene, sort, treelet_kernels};
-use treelet_core::{bvh2, cwbvh_build};
+use treelet_core::geometry::aabb::Aabb;
+use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE};
+use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
+use treelet_core::render::lights::Light;
+use treelet_core::render::variants::VARIANTS;
+use treelet_core::trace::bvh2::Bvh2Tree;
+use treelet_core::trace::classic::{ClassicTree, Scan};
+use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
+use treelet_core::trace::hit::ClosestHit;
+use treelet_core::construct::{
+    agglomerate, bounds, collapse, fill, fit, morton, primitive_boxes, radix_tree, scan, sort, treelet_kernels,
+};
+use treelet_core::layouts::{bvh2, cwbvh_build};
 
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::{Kernel, Method};
@@ -92,7 +95,7 @@ fn render_variant<T: ClosestHit>(
 
 /// Every pixel of a render dispatch (pixels are independent: the one
 /// kernel the CPU runs in parallel; the GPU's tiling of pixels, see
-/// `treelet_core::render::tiled_pixel`, only orders them).
+/// `treelet_core::render::integrator::tiled_pixel`, only orders them).
 fn render_all<T: ClosestHit + Sync>(
     v: u8,
     p: &treelet_core::RenderParams,
@@ -158,7 +161,7 @@ fn cast_all<T: ClosestHit, const F: u32, const S: usize>(
     let mut stack = vec![0u32; S];
     let stack: &mut [u32; S] = stack.as_mut_slice().try_into().unwrap();
     for id in ids(groups) {
-        treelet_core::rays::cast_kernel::<T, F, S>(id, p, scene, rays, stack, id % WORKGROUP_SIZE);
+        treelet_core::render::rays::cast_kernel::<T, F, S>(id, p, scene, rays, stack, id % WORKGROUP_SIZE);
     }
 }
 
@@ -170,7 +173,7 @@ fn cast_variant<T: ClosestHit>(
     rays: &mut [[f32; 4]],
     groups: u32,
 ) {
-    use treelet_core::features::{ALL, TRIANGLES};
+    use treelet_core::geometry::features::{ALL, TRIANGLES};
     if triangles {
         cast_all::<T, TRIANGLES, 1>(p, scene, rays, groups)
     } else {
@@ -249,7 +252,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let p: treelet_core::BuildParams = params(p);
             let (spheres, triangles, boxes) = (view(spheres), view(triangles), view(boxes));
             for id in ids(groups) {
-                scene::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
+                primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
             }
         }
         (Kernel::ReduceBounds, [p, input, output]) => {
@@ -358,7 +361,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed,
             [p, nodes, parents, flags, counts, costs, heights, tree_leaves],
         ) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
             let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
             for id in ids(groups) {
@@ -376,7 +379,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (nodes, parents, counts, tree_leaves) = (view(nodes), view(parents), view(counts), view(tree_leaves));
             let (prims, out_nodes, out_parents, out_prims) =
                 (view(prims), view(out_nodes), view(out_parents), view(out_prims));
@@ -396,7 +399,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             }
         }
         (Kernel::TreeletHistogram, [p, counts, heights, level_counts]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (counts, heights, level_counts) = (view(counts), view(heights), view(level_counts));
             let mut local = [0u32; WG];
             workgroups(groups, treelet_kernels::HISTOGRAM_PHASES, |group, phase, lid| {
@@ -413,7 +416,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             });
         }
         (Kernel::TreeletScatter, [p, counts, heights, cursors, roots]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (counts, heights, cursors, roots) = (view(counts), view(heights), view(cursors), view(roots));
             let (mut local, mut ranks) = ([0u32; WG], [0u32; WG]);
             workgroups(groups, treelet_kernels::SCATTER_PHASES, |group, phase, lid| {
@@ -423,13 +426,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             });
         }
         (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights, marks]) => {
-            let p: treelet_core::layout::TreeletParams = params(p);
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (roots, subsets, nodes, parents) = (view(roots), view(subsets), view(nodes), view(parents));
             let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
             let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
             let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
             let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
-            let mut order = [0u32; treelet_core::treelet::SUBSETS];
+            let mut order = [0u32; treelet_core::construct::treelet::SUBSETS];
             let mut votes = [0u32; treelet_kernels::TEAM_VOTES];
             workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
@@ -537,7 +540,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
                 Kernel::CastWideWorkgroupStack => {
                     let scene =
                         SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
-                    cast_all::<_, { treelet_core::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
+                    cast_all::<_, { treelet_core::geometry::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
                 }
                 _ => panic!("{kernel:?}: no such cast kernel"),
             }

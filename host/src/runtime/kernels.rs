@@ -8,11 +8,11 @@ pub enum Access {
     Read,
     ReadWrite,
 }
-use treelet_core::features::VARIANTS;
+use treelet_core::render::variants::VARIANTS;
 use Access::{Read, ReadWrite};
 
 /// How a render or cast kernel finds closest hits: the scan, or a tree in
-/// one of the traversal layouts (see [`crate::build::layout::Layout`]).
+/// one of the traversal layouts (see [`crate::bvh::layout::Layout`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Method {
     Scan,
@@ -70,7 +70,7 @@ pub enum Kernel {
     SortOffsets,
     /// Radix sort: one pass (one sweep with decoupled look-back).
     SortOnesweep,
-    /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::sort::SMALL_SORT_TILE`).
+    /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
     SortOnesweepSmall,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
@@ -114,7 +114,7 @@ pub enum Kernel {
     /// The compressed wide BVH: nodes and leaf primitives.
     WideEmit,
     /// Path tracing with a closest-hit method, compiled for the feature set
-    /// `treelet_core::features::VARIANTS[i]` (binary layouts: the general one only).
+    /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
     /// Ray-casting throughput (primary, bounce or diffuse passes) through a
     /// tree; `true`: compiled for triangles alone (meshes).
@@ -166,7 +166,7 @@ impl Kernel {
 
     /// Every kernel: the fixed ones and each render kernel the shader has.
     pub fn all() -> Vec<Kernel> {
-        let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::features::ALL).unwrap() as u8;
+        let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::geometry::features::ALL).unwrap() as u8;
         let mut all = Self::FIXED.to_vec();
         all.push(Kernel::CastWideWorkgroupStack);
         for method in Method::ALL {

@@ -26,7 +26,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context as _, Result};
 use serde::Deserialize;
-use treelet_core::layout::{Material, Sphere, DIFFUSE, GLASS, MIRROR};
+use treelet_core::geometry::buffers::{DIFFUSE, GLASS, MIRROR, Material, Sphere};
 
 use super::model::{CameraSpec, Scene};
 use super::primitives::{validate_spheres, Primitives};
@@ -163,7 +163,7 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         let xf = mesh.transform();
         let place = |v: [f32; 3]| xf.transform_point3(v.into()).to_array();
         triangle_materials.extend(std::iter::repeat_n(*m, loaded.len()));
-        triangles.extend(loaded.iter().map(|t| treelet_core::triangle::Triangle::new(place(t.v0), place(t.v1), place(t.v2))));
+        triangles.extend(loaded.iter().map(|t| treelet_core::geometry::triangle::Triangle::new(place(t.v0), place(t.v1), place(t.v2))));
     }
     Primitives::triangles(&triangles)
         .check()

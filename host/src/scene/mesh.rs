@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context as _, Result};
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::triangle::Triangle;
 
 use crate::scene::primitives::Primitives;
 

@@ -3,9 +3,9 @@
 use anyhow::{bail, Result};
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use treelet_core::layout::{Camera, Material, Sphere, DIFFUSE, GLASS, MIRROR};
-use treelet_core::render::SMALLPT_FOV;
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::buffers::{Camera, DIFFUSE, GLASS, MIRROR, Material, Sphere};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::render::integrator::SMALLPT_FOV;
 
 use crate::scene::primitives::Primitives;
 

@@ -1,7 +1,7 @@
 //! What a BVH is built over: spheres and triangles, in one index space
 //! (spheres first, then triangles), as the kernels see them.
 use anyhow::{bail, Result};
-use treelet_core::triangle::Triangle;
+use treelet_core::geometry::triangle::Triangle;
 use treelet_core::{Aabb, Sphere};
 
 /// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.
@@ -25,8 +25,8 @@ impl<'a> Primitives<'a> {
     }
 
     /// The same primitives as the kernels' view of them.
-    pub fn as_core(&self) -> treelet_core::traverse::Prims<'a> {
-        treelet_core::traverse::Prims {
+    pub fn as_core(&self) -> treelet_core::geometry::prims::Prims<'a> {
+        treelet_core::geometry::prims::Prims {
             spheres: self.spheres,
             sphere_count: self.spheres.len() as u32,
             triangles: self.triangles,

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use bytemuck::Pod;
-use treelet_core::workgroup::dispatch_grid;
+use treelet_core::gpu::workgroup::dispatch_grid;
 
 use super::context::GpuContext;
 use crate::runtime::backend::{Backend, StageTimes};

@@ -1,0 +1,199 @@
+//! Hierarchy and bounds in one bottom-up pass: C. Apetrei, "Fast and Simple
+//! Agglomerative LBVH Construction", CGVC 2014.
+//!
+//! One invocation per leaf climbs as in [`crate::construct::fit`], but no radix tree is
+//! built first: a node covering the sorted keys `[l, r]` finds its parent by
+//! comparing the prefixes it shares with its two neighbours. It merges with
+//! the side whose neighbour shares the longer prefix: with the keys right of
+//! `r` when `δ(r, r+1) > δ(l-1, l)` (it is then a left child, and the parent's
+//! split is `r`), else with the keys left of `l` (a right child, split
+//! `l - 1`). The two are never equal (see [`parent_side`]).
+//!
+//! At the split's slot the first child to arrive leaves the far end of its
+//! range and stops; the second swaps in its own, so learns the sibling's
+//! range, and so the parent's. This yields the binary radix tree of
+//! Karras 2012 (`crate::construct::radix_tree`) *with its node numbering*: a left child
+//! covering `[l, γ]` is node `γ`, a right child covering `[γ+1, r]` is node
+//! `γ+1`, the root is node 0 and a one-key range is a leaf. So everything
+//! after the build sees the same nodes, bit for bit, as after radix tree plus
+//! fit, from one dispatch instead of two and with half the box reads of the
+//! fit (the sibling's box only; the climber keeps its own).
+use crate::construct::fit::{load_box, store_box, write_leaf};
+use crate::construct::radix_tree::{delta, leaf_node};
+use crate::geometry::aabb::Aabb;
+use crate::geometry::buffers::{INVALID, Node};
+
+/// Whether the node covering `[l, r]` of `n` sorted keys is its parent's
+/// left child (the parent's split is then `r`; else `l - 1`).
+///
+/// Why the two prefixes never tie: if `δ(l-1, l) = δ(r, r+1) = p`, keys
+/// `l-1..=r+1` share `p` bits and differ in bit `p` across both borders, so
+/// key `l` has a 1 there and key `r` a 0; but the node's keys share more
+/// than `p` bits. (With the index tie-break the same holds for the
+/// concatenation of key and index.)
+#[inline]
+pub fn parent_side(keys: &[u64], n: u32, l: u32, r: u32) -> bool {
+    l == 0 || (r != n - 1 && delta(keys, n, r as i32, r as i32 + 1) > delta(keys, n, l as i32 - 1, l as i32))
+}
+
+/// Node index of the node covering `[l, r]`, given which child it is.
+#[inline]
+fn node_index(n: u32, l: u32, r: u32, left_child: bool) -> u32 {
+    if l == r {
+        leaf_node(n, l)
+    } else if l == 0 && r == n - 1 {
+        0
+    } else if left_child {
+        r
+    } else {
+        l
+    }
+}
+
+/// Kernel: leaf `i` (sorted position) of `n`. `keys` are the sorted keys,
+/// `sorted_prims[i]` the primitive of leaf `i`; `ends` holds one zeroed word
+/// per split where the first child to arrive leaves its far end plus one.
+/// `ORDERED`: the exchange releases this subtree's writes and acquires the
+/// sibling's (relaxed for the one device that needs it, see
+/// [`crate::gpu::atomics::add_device_acq_rel`]).
+#[allow(clippy::too_many_arguments)]
+pub fn agglomerate_kernel<const ORDERED: bool>(
+    i: u32,
+    n: u32,
+    keys: &[u64],
+    sorted_prims: &[u32],
+    prim_boxes: &[Aabb],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    ends: &mut [u32],
+) {
+    if i >= n {
+        return;
+    }
+    let mut own = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
+    if n == 1 {
+        return;
+    }
+    let (mut l, mut r, mut current) = (i, i, leaf_node(n, i));
+    let mut left_child = parent_side(keys, n, l, r);
+    loop {
+        let split = if left_child { r } else { l - 1 };
+        let far = if left_child { l } else { r };
+        let previous = if ORDERED {
+            crate::gpu::atomics::exchange_device_acq_rel(&mut ends[split as usize], far + 1)
+        } else {
+            crate::gpu::atomics::exchange_device(&mut ends[split as usize], far + 1)
+        };
+        if previous == 0 {
+            return; // The sibling's invocation will finish the parent.
+        }
+        let other = previous - 1;
+        // The sibling covers the rest of the parent's range.
+        let (lo, hi, sibling) = if left_child {
+            (l, other, node_index(n, split + 1, other, false))
+        } else {
+            (other, r, node_index(n, other, split, true))
+        };
+        let sibling_box = load_box(&nodes[sibling as usize]);
+        let (left, right) = if left_child { (current, sibling) } else { (sibling, current) };
+        own = if left_child { own.union(&sibling_box) } else { sibling_box.union(&own) };
+        let root = lo == 0 && hi == n - 1;
+        left_child = !root && parent_side(keys, n, lo, hi);
+        let parent = node_index(n, lo, hi, left_child);
+        nodes[parent as usize].left = left;
+        nodes[parent as usize].right = right;
+        store_box(&mut nodes[parent as usize], &own);
+        parents[left as usize] = parent;
+        parents[right as usize] = parent;
+        if root {
+            parents[0] = INVALID;
+            return;
+        }
+        (l, r, current) = (lo, hi, parent);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::construct::fit::fit_kernel;
+    use crate::construct::radix_tree::radix_tree_kernel;
+    use std::vec;
+    use std::vec::Vec;
+
+    /// Radix tree plus fit, and the agglomerative build, on the same keys.
+    fn both(keys: &[u64]) -> [(Vec<Node>, Vec<u32>); 2] {
+        let n = keys.len() as u32;
+        let count = 2 * keys.len() - 1;
+        // Boxes in an order unrelated to the keys, some sharing faces.
+        let boxes: Vec<Aabb> = (0..n)
+            .map(|k| {
+                let x = ((k * 7919) % 97) as f32 * 0.5;
+                Aabb::new(glam::Vec3::new(x, -x, (k % 5) as f32), glam::Vec3::new(x + 1.0, 3.0, (k % 5) as f32 + 2.0))
+            })
+            .collect();
+        let prims: Vec<u32> = (0..n).rev().collect();
+        let (mut nodes_a, mut parents_a) = (vec![Node::default(); count], vec![0u32; count]);
+        let mut flags = vec![0u32; count];
+        for i in 0..n {
+            radix_tree_kernel(i, n, keys, &mut nodes_a, &mut parents_a);
+        }
+        for i in 0..n {
+            fit_kernel::<true>(i, n, &prims, &boxes, &mut nodes_a, &mut parents_a, &mut flags);
+        }
+        let (mut nodes_b, mut parents_b) = (vec![Node::default(); count], vec![0u32; count]);
+        let mut ends = vec![0u32; count];
+        // Leaves in a scrambled order: the result must not depend on it.
+        let order: Vec<u32> = {
+            let mut o: Vec<u32> = (0..n).collect();
+            o.sort_by_key(|&k| (k.wrapping_mul(2_654_435_761)) ^ 0x5bd1_e995);
+            o
+        };
+        for &i in &order {
+            agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut nodes_b, &mut parents_b, &mut ends);
+        }
+        [(nodes_a, parents_a), (nodes_b, parents_b)]
+    }
+
+    fn check(keys: &[u64]) {
+        let [(na, pa), (nb, pb)] = both(keys);
+        for k in 0..na.len() {
+            assert_eq!(bytemuck::bytes_of(&na[k]), bytemuck::bytes_of(&nb[k]), "keys {keys:?}: node {k}");
+        }
+        assert_eq!(pa, pb, "keys {keys:?}: parents");
+    }
+
+    #[test]
+    fn same_tree_as_radix_tree_and_fit() {
+        for n in 1..70u64 {
+            check(&vec![7u64; n as usize]);
+            check(&(0..n).map(|k| k / 3).collect::<Vec<_>>());
+            check(&(0..n).map(|k| k * k).collect::<Vec<_>>());
+            check(&(0..n).map(|k| k.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 1).collect::<Vec<_>>().tap_sort());
+        }
+        let mut x = 0x1234_5678_9abc_def0u64;
+        for n in [200usize, 1000, 4097] {
+            let keys: Vec<u64> = (0..n)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    x >> (x % 50) // many lengths of common prefix, some duplicates
+                })
+                .collect::<Vec<_>>()
+                .tap_sort();
+            check(&keys);
+        }
+    }
+
+    trait TapSort {
+        fn tap_sort(self) -> Self;
+    }
+    impl TapSort for Vec<u64> {
+        fn tap_sort(mut self) -> Self {
+            self.sort_unstable();
+            self
+        }
+    }
+}

@@ -1,0 +1,95 @@
+//! Bottom-up bounds (Karras 2012, section 4): one invocation per leaf writes
+//! its leaf, then climbs towards the root. At each internal node an atomic
+//! counter lets the first arrival stop and the second, which knows both
+//! children are done, write the union of their boxes and go on. Every
+//! internal node is thus written exactly once, by the last of its children.
+//!
+//! On the GPU the boxes cross invocations, so they are written and read with
+//! device-scope atomics (under the Vulkan memory model plain accesses would
+//! not be made visible), ordered by the counter's acquire-release semantics.
+use crate::construct::radix_tree::leaf_node;
+use crate::geometry::aabb::Aabb;
+use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
+use crate::gpu::atomics;
+
+#[inline]
+pub(crate) fn store_box(node: &mut Node, b: &Aabb) {
+    for k in 0..3 {
+        atomics::store_f32(&mut node.min[k], b.min[k]);
+        atomics::store_f32(&mut node.max[k], b.max[k]);
+    }
+}
+
+#[inline]
+pub(crate) fn load_box(node: &Node) -> Aabb {
+    let mut b = Aabb::EMPTY;
+    for k in 0..3 {
+        b.min[k] = atomics::load_f32(&node.min[k]);
+        b.max[k] = atomics::load_f32(&node.max[k]);
+    }
+    b
+}
+
+/// One child's arrival at its parent during a bottom-up climb: true for the
+/// second of the two children, which then knows both subtrees are done.
+/// `ORDERED` releases this subtree's writes and acquires the sibling's
+/// (see [`atomics::add_device_acq_rel`] for the device that needs it relaxed).
+#[inline]
+pub fn second_arrival<const ORDERED: bool>(counter: &mut u32) -> bool {
+    let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
+    previous != 0
+}
+
+/// Writes leaf `i` (sorted position) of `n` and its box, which it returns;
+/// for a one-leaf tree, also its parent link (none). The start of every
+/// bottom-up climb ([`fit_kernel`], [`crate::construct::agglomerate`]).
+#[inline]
+pub(crate) fn write_leaf(i: u32, n: u32, sorted_prims: &[u32], prim_boxes: &[Aabb], nodes: &mut [Node], parents: &mut [u32]) -> Aabb {
+    let leaf = leaf_node(n, i);
+    let b = prim_boxes[sorted_prims[i as usize] as usize];
+    nodes[leaf as usize].left = i;
+    nodes[leaf as usize].right = LEAF_BIT | 1;
+    store_box(&mut nodes[leaf as usize], &b);
+    if n == 1 {
+        parents[0] = INVALID;
+    }
+    b
+}
+
+/// Kernel: leaf `i` (sorted position) of `n`. `flags` holds one zeroed counter
+/// per internal node; `sorted_prims[i]` is the primitive of leaf `i`.
+/// `ORDERED` gives the counter acquire-release semantics (see
+/// [`atomics::add_device_acq_rel`] for the one device that needs it relaxed).
+pub fn fit_kernel<const ORDERED: bool>(
+    i: u32,
+    n: u32,
+    sorted_prims: &[u32],
+    prim_boxes: &[Aabb],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    flags: &mut [u32],
+) {
+    if i >= n {
+        return;
+    }
+    let b = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
+    if n == 1 {
+        return;
+    }
+    // The climber keeps its subtree's box and reads only the sibling's.
+    let (mut current, mut own) = (leaf_node(n, i), b);
+    while current != 0 {
+        let parent = parents[current as usize];
+        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
+            return; // The sibling's invocation will finish this node.
+        }
+        let (left, right) = (nodes[parent as usize].left, nodes[parent as usize].right);
+        own = if left == current {
+            own.union(&load_box(&nodes[right as usize]))
+        } else {
+            load_box(&nodes[left as usize]).union(&own)
+        };
+        store_box(&mut nodes[parent as usize], &own);
+        current = parent;
+    }
+}

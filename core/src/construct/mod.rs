@@ -1,0 +1,35 @@
+//! # Construction
+//!
+//! Building the binary tree, stage by stage:
+//!
+//! | stage | module | paper |
+//! |---|---|---|
+//! | primitive boxes | [`primitive_boxes`] | |
+//! | centroid bounds | [`bounds`] | parallel reduction |
+//! | Morton codes | [`morton`] | Karras 2012, section 4 |
+//! | sort | [`sort`], [`scan`] | Adinets & Merrill 2022 (Onesweep) |
+//! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
+//! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
+//! | hierarchy and boxes in one pass | [`agglomerate`] | Apetrei 2014 |
+//! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
+//! | SAH leaf collapse, depth-first compaction | [`collapse`] | Karras & Aila 2013, section 4.4 |
+//! | SAH cost | [`sah`] | MacDonald & Booth 1990 |
+//! | buffer fills (the fit's arrival counters) | [`fill`] | |
+//!
+//! Node layout: `n` leaves and `n - 1` internal nodes in one array of
+//! `2n - 1` [`Node`](crate::geometry::buffers::Node)s. Internal node `i`
+//! sits at index `i` (the root is 0), leaf `j` (the `j`-th primitive in
+//! Morton order) at index `n - 1 + j`.
+pub mod agglomerate;
+pub mod bounds;
+pub mod collapse;
+pub mod fill;
+pub mod fit;
+pub mod morton;
+pub mod primitive_boxes;
+pub mod radix_tree;
+pub mod sah;
+pub mod scan;
+pub mod sort;
+pub mod treelet;
+pub mod treelet_kernels;

@@ -1,0 +1,353 @@
+//! Buffer types shared by the GPU and CPU builds.
+//!
+//! Every type is `#[repr(C)]`, `Pod`, and sized in multiples of 16 bytes with
+//! visible padding, so the host (bytemuck) and the shader (rust-gpu's explicit
+//! offsets) agree on one layout. The size assertions run in both builds.
+//! No `Vec3` in buffers: its alignment differs between the two targets.
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use crate::geometry::aabb::Aabb;
+
+/// Marks a missing link: the root's parent.
+pub const INVALID: u32 = u32::MAX;
+/// Set in [`Node::right`] of a leaf; the low bits then hold its primitive count.
+pub const LEAF_BIT: u32 = 1 << 31;
+
+/// A sphere: centre and radius. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Sphere {
+    pub center: [f32; 3],
+    pub radius: f32,
+}
+const _: () = assert!(core::mem::size_of::<Sphere>() == 16);
+
+impl Sphere {
+    pub const fn new(center: [f32; 3], radius: f32) -> Self {
+        Self { center, radius }
+    }
+}
+
+/// A BVH node. repr(C), Pod, 32 bytes.
+///
+/// * internal: `left` and `right` are node indices of the two children;
+/// * leaf: `right` has [`LEAF_BIT`] set and its low bits count the primitives,
+///   `left` is the first of them in the sorted primitive-index array.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Node {
+    pub min: [f32; 3],
+    pub left: u32,
+    pub max: [f32; 3],
+    pub right: u32,
+}
+const _: () = assert!(core::mem::size_of::<Node>() == 32);
+
+impl Node {
+    #[inline]
+    pub fn is_leaf(&self) -> bool {
+        self.right & LEAF_BIT != 0
+    }
+    /// Number of primitives under a leaf (0 for internal nodes).
+    #[inline]
+    pub fn prim_count(&self) -> u32 {
+        if self.is_leaf() {
+            self.right & !LEAF_BIT
+        } else {
+            0
+        }
+    }
+    #[inline]
+    pub fn aabb(&self) -> Aabb {
+        Aabb::from_arrays(self.min, self.max)
+    }
+    #[inline]
+    pub fn set_aabb(&mut self, b: Aabb) {
+        self.min = b.min;
+        self.max = b.max;
+    }
+}
+
+/// Parameters of the per-primitive and tree stages. repr(C), Pod, 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct BuildParams {
+    /// Number of primitives (leaves).
+    pub n: u32,
+    /// Number of elements the bounds reduction reads in this pass.
+    pub reduce_len: u32,
+    /// 1 when the reduction reads primitive boxes and reduces their centroids.
+    pub reduce_centroids: u32,
+    /// How many of the `n` primitives are spheres (the rest are triangles).
+    pub spheres: u32,
+    /// Centroid bounds of the scene (Morton quantization frame).
+    pub frame: Aabb,
+    /// Low bits dropped from each Morton key (0: all of [`crate::construct::morton::KEY_BITS`]).
+    pub key_shift: u32,
+    pub _pad0: [u32; 3],
+}
+const _: () = assert!(core::mem::size_of::<BuildParams>() == 64);
+
+/// Parameters of the radix sort's kernels. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct SortParams {
+    /// Number of keys.
+    pub n: u32,
+    /// Tiles of a one-sweep pass.
+    pub tiles: u32,
+    /// This pass (one-sweep kernel only).
+    pub pass: u32,
+    /// Passes of the whole sort.
+    pub passes: u32,
+}
+const _: () = assert!(core::mem::size_of::<SortParams>() == 16);
+
+/// Parameters of an exclusive prefix sum. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct ScanParams {
+    /// Number of elements to scan.
+    pub len: u32,
+    /// Number of scan tiles (= number of partial sums).
+    pub tiles: u32,
+    pub _pad0: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<ScanParams>() == 16);
+
+/// Parameters of [`crate::construct::fill::fill_kernel`]. repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct FillParams {
+    /// Number of u32s to write.
+    pub len: u32,
+    pub value: u32,
+    pub _pad0: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<FillParams>() == 16);
+
+/// Surface kinds of smallpt.
+pub const DIFFUSE: u32 = 0;
+pub const MIRROR: u32 = 1;
+pub const GLASS: u32 = 2;
+
+/// A material. repr(C), Pod, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Material {
+    /// Emitted radiance.
+    pub emission: [f32; 3],
+    /// [`DIFFUSE`], [`MIRROR`] or [`GLASS`].
+    pub kind: u32,
+    /// Reflectance (diffuse, mirror) or transmittance (glass).
+    pub color: [f32; 3],
+    /// Index of refraction of glass (smallpt: 1.5).
+    pub ior: f32,
+}
+const _: () = assert!(core::mem::size_of::<Material>() == 32);
+
+/// A pinhole camera as smallpt builds it. repr(C), Pod, 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Camera {
+    pub origin: [f32; 3],
+    /// Primary rays start this far along their direction (smallpt: 140, to
+    /// start inside the box).
+    pub near: f32,
+    /// Unit view direction.
+    pub dir: [f32; 3],
+    pub _pad0: u32,
+    /// Image-plane x axis, scaled by the aspect ratio and field of view.
+    pub cx: [f32; 3],
+    pub _pad1: u32,
+    /// Image-plane y axis, scaled by the field of view.
+    pub cy: [f32; 3],
+    pub _pad2: u32,
+}
+const _: () = assert!(core::mem::size_of::<Camera>() == 64);
+
+/// Parameters of one render dispatch. repr(C), Pod, 112 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct RenderParams {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel of this dispatch.
+    pub samples: u32,
+    /// Index of this dispatch's first sample (the RNG counter).
+    pub first_sample: u32,
+    pub seed: u32,
+    /// Number of spheres.
+    pub prims: u32,
+    /// Number of triangles (primitives `prims..prims + triangles`).
+    pub triangles: u32,
+    /// Which rays [`crate::render::rays::cast_kernel`] casts (primary or diffuse).
+    pub cast_mode: u32,
+    pub camera: Camera,
+    /// [`SMALLPT`] or [`NEE`]: how the render kernels estimate radiance.
+    pub integrator: u32,
+    /// Entries of the light table ([`crate::render::lights::Light`]).
+    pub light_count: u32,
+    pub _pad: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
+
+/// smallpt's estimator: emitters are found only by paths that hit them.
+pub const SMALLPT: u32 = 0;
+/// Next-event estimation with multiple importance sampling ([`crate::render::lights`]).
+pub const NEE: u32 = 1;
+
+/// Parameters of the treelet kernels. repr(C), Pod, 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct TreeletParams {
+    /// Number of primitives (leaves).
+    pub n: u32,
+    /// Where this dispatch's treelet roots start in the list of roots.
+    pub level_offset: u32,
+    /// Only subtrees of at least this many primitives are restructured.
+    pub gamma: u32,
+    /// Largest leaf the SAH may collapse a subtree into (1: no collapse).
+    pub max_leaf: u32,
+    /// SAH cost per internal node and per primitive (per unit area).
+    pub node_cost: f32,
+    pub prim_cost: f32,
+    /// Boxes are scaled by this before taking areas.
+    pub inv_extent: f32,
+    /// How many treelet roots this dispatch restructures.
+    pub level_count: u32,
+    /// The restructuring round, from 1.
+    pub round: u32,
+    /// 1: skip treelets kept last round whose subtrees have not changed since
+    /// (their DP would keep them again); 0: solve every treelet.
+    pub skip_kept: u32,
+    pub _pad: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<TreeletParams>() == 48);
+
+/// A primitive stored where its leaf reads it (the traversal layouts
+/// [`Bvh2Node`] and [`WideNode`] keep primitives in leaf order, so a leaf
+/// reads them directly instead of through an index). repr(C), Pod, 48 bytes:
+/// a triangle's three vertices as the watertight test reads them
+/// ([`crate::geometry::triangle::Triangle`]'s rows), or a sphere's centre in `p0` and
+/// radius in `p1[0]`; `prim` is the primitive's index in the scene
+/// (spheres first, then triangles), which decides its kind, material and
+/// the tie-break between equal hit distances.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct LeafPrim {
+    pub p0: [f32; 3],
+    pub prim: u32,
+    pub p1: [f32; 3],
+    pub _pad1: u32,
+    pub p2: [f32; 3],
+    pub _pad2: u32,
+}
+const _: () = assert!(core::mem::size_of::<LeafPrim>() == 48);
+
+/// A binary node holding both children's boxes (Aila & Laine 2009), so a
+/// ray tests both children with the one load that reached their parent.
+/// repr(C), Pod, 64 bytes.
+///
+/// A child with a count of 0 is the internal node of that index; a child
+/// with a count `c > 0` is a leaf of the `c` [`LeafPrim`]s from its index on.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Bvh2Node {
+    pub left_min: [f32; 3],
+    pub left: u32,
+    pub left_max: [f32; 3],
+    pub right: u32,
+    pub right_min: [f32; 3],
+    pub left_count: u32,
+    pub right_max: [f32; 3],
+    pub right_count: u32,
+}
+const _: () = assert!(core::mem::size_of::<Bvh2Node>() == 64);
+
+/// A node of the compressed 8-wide BVH (Ylitie, Karras & Laine 2017,
+/// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+/// BVHs"). repr(C), Pod, 80 bytes.
+///
+/// Child boxes are 8-bit offsets on a grid of the node's own: child `j`'s
+/// box on axis `k` spans `origin[k] + q * 2^(e[k] - 127)` for its `q_lo` and
+/// `q_hi` bytes, rounded outwards so that it contains the exact box (see
+/// [`crate::trace::cwbvh`]). Byte `j` of a `[u32; 2]` field is child `j`'s.
+///
+/// * `exp_imask`: bytes 0..3 the biased exponents `e` of x, y, z; byte 3
+///   the mask of children that are internal nodes;
+/// * `child_base`: index of the first internal child (internal children
+///   are contiguous, in slot order); `prim_base`: index of the first
+///   [`LeafPrim`] of the leaf children (contiguous too);
+/// * `meta`, per child: 0 for an empty slot; `0b001_11xxx` (24 + slot) for
+///   an internal child; for a leaf of `c <= 3` primitives, `c` ones in the
+///   top three bits and the offset of its first primitive from `prim_base`
+///   in the low five.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct WideNode {
+    pub origin: [f32; 3],
+    pub exp_imask: u32,
+    pub child_base: u32,
+    pub prim_base: u32,
+    pub meta: [u32; 2],
+    pub lo_x: [u32; 2],
+    pub lo_y: [u32; 2],
+    pub lo_z: [u32; 2],
+    pub hi_x: [u32; 2],
+    pub hi_y: [u32; 2],
+    pub hi_z: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<WideNode>() == 80);
+
+/// Parameters of the traversal-layout kernels ([`crate::trace::bvh2`],
+/// [`crate::layouts::cwbvh_build`]). repr(C), Pod, 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct LayoutParams {
+    /// Primitives (leaves of the binary tree).
+    pub n: u32,
+    /// Nodes of the binary tree the layout is made from.
+    pub nodes: u32,
+    /// How many primitives are spheres (the rest are triangles).
+    pub spheres: u32,
+    pub _pad0: u32,
+    /// SAH cost per wide node and per primitive (per unit area).
+    pub node_cost: f32,
+    pub prim_cost: f32,
+    /// Boxes are scaled by this before taking areas.
+    pub inv_extent: f32,
+    pub _pad1: u32,
+}
+const _: () = assert!(core::mem::size_of::<LayoutParams>() == 32);
+
+
+// Methods of the buffer type used by every stage.
+impl Sphere {
+    #[inline]
+    pub fn center_vec(&self) -> Vec3 {
+        Vec3::from_array(self.center)
+    }
+    /// Bounding box: centre ± radius.
+    #[inline]
+    pub fn aabb(&self) -> Aabb {
+        let c = self.center_vec();
+        let r = Vec3::splat(self.radius);
+        Aabb::new(c - r, c + r)
+    }
+}

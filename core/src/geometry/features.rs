@@ -1,0 +1,26 @@
+//! What a scene uses, as bits of a `u32`: render kernels are compiled per
+//! set of features (a const generic, monomorphized in the shader crate), so
+//! a kernel for a scene without glass has no refraction code, one for
+//! spheres only no triangle test, and so on. Code that is present costs
+//! registers and occupancy on a GPU even when never taken.
+//!
+//! Diffuse surfaces and emission are always compiled: every scene has them
+//! (the light, the walls). A kernel may only be run on a scene whose
+//! features it contains: the host chooses (see `treelet::variant`).
+
+/// The scene has spheres.
+pub const SPHERES: u32 = 1;
+/// The scene has triangles.
+pub const TRIANGLES: u32 = 2;
+/// The scene has mirror materials.
+pub const MIRROR: u32 = 4;
+/// The scene has glass (refraction).
+pub const GLASS: u32 = 8;
+/// Everything: the general kernel.
+pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS;
+
+/// Whether `features` includes `feature`.
+#[inline]
+pub const fn has(features: u32, feature: u32) -> bool {
+    features & feature != 0
+}

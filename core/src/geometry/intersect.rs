@@ -1,0 +1,322 @@
+//! Ray/sphere and ray/box intersection in f32, robust enough for smallpt's
+//! 1e5-radius walls.
+//!
+//! Ray/sphere follows Haines, Günther & Akenine-Möller, "Precision
+//! Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, ch. 7): the
+//! discriminant as `r² - |f - (f·d)d|²` and the near root as `c / q`, which
+//! avoids the cancellation of `-b ± sqrt(disc)`. Treelet goes one step
+//! further: `c = |f|² - r²` and the discriminant are differences of nearly
+//! equal squares for a huge sphere seen from near its surface, so both are
+//! summed with error-free transformations (two-product by fused multiply-add,
+//! two-sum), which keeps the hit distance to a few ulps there too.
+use glam::Vec3;
+
+use crate::geometry::buffers::Node;
+
+/// No hit.
+pub const MISS: f32 = f32::MAX;
+
+/// `a * b` as an unevaluated sum `p + e`, exactly (needs a true FMA).
+#[inline]
+fn two_prod(a: f32, b: f32) -> (f32, f32) {
+    let p = a * b;
+    (p, libm::fmaf(a, b, -p))
+}
+
+/// `a + b` as an unevaluated sum `s + e`, exactly.
+#[inline]
+fn two_sum(a: f32, b: f32) -> (f32, f32) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `|v|² - r²`, compensated: accurate even when the two nearly cancel.
+#[inline]
+pub fn length_sq_minus_sq(v: Vec3, r: f32) -> f32 {
+    let (xx, ex) = two_prod(v.x, v.x);
+    let (yy, ey) = two_prod(v.y, v.y);
+    let (zz, ez) = two_prod(v.z, v.z);
+    let (rr, er) = two_prod(r, r);
+    let (s1, e1) = two_sum(xx, yy);
+    let (s2, e2) = two_sum(s1, zz);
+    let (s3, e3) = two_sum(s2, -rr);
+    s3 + (((ex + ey) + (ez - er)) + ((e1 + e2) + e3))
+}
+
+/// Distance along the unit direction `d` from `o` to the first hit with the
+/// sphere (`center`, `radius`) beyond `t_min`, or [`MISS`].
+///
+/// ```
+/// use glam::Vec3;
+/// use treelet_core::geometry::intersect::{ray_sphere, MISS};
+/// let t = ray_sphere(Vec3::ZERO, Vec3::X, Vec3::new(10.0, 0.0, 0.0), 2.0, 0.0);
+/// assert_eq!(t, 8.0);
+/// assert_eq!(ray_sphere(Vec3::ZERO, -Vec3::X, Vec3::new(10.0, 0.0, 0.0), 2.0, 0.0), MISS);
+/// ```
+#[inline]
+pub fn ray_sphere(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32) -> f32 {
+    ray_sphere_mode(o, d, center, radius, t_min, false)
+}
+
+/// As [`ray_sphere`], but with `far_only` only the far root counts: for a
+/// ray that leaves a sphere's surface into the sphere, whose near root is
+/// the surface it starts on. (Near a sphere of radius 1e5 centred 1e5 from
+/// the origin, f32 cannot place a point closer to the surface than about
+/// 0.004, so no offset makes that near root reliably negative.)
+#[inline]
+pub fn ray_sphere_mode(o: Vec3, d: Vec3, center: Vec3, radius: f32, t_min: f32, far_only: bool) -> f32 {
+    let f = o - center;
+    let b = f.dot(d); // half of the usual b, as |d| = 1
+    let c = length_sq_minus_sq(f, radius);
+    let l = f - b * d; // from the centre to the closest point of the line
+    let disc = -length_sq_minus_sq(l, radius);
+    if disc < 0.0 {
+        return MISS;
+    }
+    let root = libm::sqrtf(disc);
+    let q = -(b + if b >= 0.0 { root } else { -root });
+    if q == 0.0 {
+        return MISS;
+    }
+    let (t0, t1) = (c / q, q);
+    let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
+    if far_only {
+        return if far > t_min { far } else { MISS };
+    }
+    if near > t_min {
+        near
+    } else if far > t_min {
+        far
+    } else {
+        MISS
+    }
+}
+
+/// Reciprocal of a direction; components that are zero (or too small to
+/// invert) become 0 and mark that axis as parallel for [`ray_box`].
+#[inline]
+pub fn safe_inverse(d: Vec3) -> Vec3 {
+    let inv = |x: f32| if x.abs() < 1e-30 { 0.0 } else { 1.0 / x };
+    Vec3::new(inv(d.x), inv(d.y), inv(d.z))
+}
+
+/// A ray as the branch-free slab tests of the traversal layouts
+/// ([`crate::trace::bvh2`], [`crate::trace::cwbvh`]) take it: origin, reciprocal
+/// direction, and a bias for far distances.
+///
+/// An axis the ray runs parallel to (or too nearly to invert) gets
+/// `±f32::MAX`, with the direction's sign, for an inverse instead of an
+/// infinity, so `(plane - origin) * inverse` is never NaN (never `0 * inf`)
+/// and its sign is exact. That alone would make a ray lying exactly in a
+/// box's far face leave the slab at `t = 0`, so far distances on such an
+/// axis get `+f32::MAX` added: the ray then stays in the slab unless it lies
+/// more than `t_max / f32::MAX` outside it (a harmless false accept below
+/// that). Near distances need nothing: a ray in a near face enters at 0.
+#[derive(Clone, Copy)]
+pub struct SlabRay {
+    pub o: [f32; 3],
+    pub inv: [f32; 3],
+    pub far_bias: [f32; 3],
+}
+
+impl SlabRay {
+    #[inline]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let d = d.to_array();
+        let mut inv = [0.0f32; 3];
+        let mut far_bias = [0.0f32; 3];
+        for k in 0..3 {
+            let r = 1.0 / d[k];
+            if r.abs() <= f32::MAX {
+                inv[k] = r;
+            } else {
+                inv[k] = f32::from_bits((d[k].to_bits() & 0x8000_0000) | f32::MAX.to_bits());
+                far_bias[k] = f32::MAX;
+            }
+        }
+        SlabRay { o: o.to_array(), inv, far_bias }
+    }
+}
+
+/// How much a slab test widens its far distance (Ize, "Robust BVH Ray
+/// Traversal", 2013: `1 + 2γ(3)`, three roundings of `(plane - o) * inv`),
+/// so that rounding never culls a box the ray touches.
+pub const FAR_WIDENING: f32 = 1.000_000_4;
+
+/// The interval `[near, far]` (far widened by [`FAR_WIDENING`]) over which
+/// the ray is inside the box `lo..hi`, clipped to `0..=t_max`; the ray
+/// meets the box where `near <= far`.
+#[inline]
+pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], ray: &SlabRay, t_max: f32) -> (f32, f32) {
+    let t = |k: usize| {
+        let (near, far) = if ray.inv[k] >= 0.0 { (lo[k], hi[k]) } else { (hi[k], lo[k]) };
+        ((near - ray.o[k]) * ray.inv[k], (far - ray.o[k]) * ray.inv[k] + ray.far_bias[k])
+    };
+    let ((nx, fx), (ny, fy), (nz, fz)) = (t(0), t(1), t(2));
+    let near = nx.max(ny).max(nz.max(0.0));
+    let far = (fx.min(fy).min(fz) * FAR_WIDENING).min(t_max);
+    (near, far)
+}
+
+/// Slab test of a node's box against a ray, hits between 0 and `t_max`.
+/// An axis the ray runs parallel to (zero in `inv_d`) admits every `t` when
+/// the origin lies within the slab, boundaries included, and none otherwise.
+/// The far distance is widened by `1 + 2γ(3)` (Ize, "Robust BVH Ray
+/// Traversal", 2013) so that rounding never culls a box the ray touches.
+#[inline]
+pub fn ray_box(node: &Node, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
+    // Arrays, not `Vec3` indexing (which rust-gpu lowers to pointer phis).
+    let (lo, hi, o, inv_d) = (node.min, node.max, o.to_array(), inv_d.to_array());
+    let mut near = 0.0f32;
+    let mut far = t_max;
+    for k in 0..3 {
+        if inv_d[k] == 0.0 {
+            if o[k] < lo[k] || o[k] > hi[k] {
+                return false;
+            }
+        } else {
+            let t1 = (lo[k] - o[k]) * inv_d[k];
+            let t2 = (hi[k] - o[k]) * inv_d[k];
+            near = near.max(t1.min(t2));
+            far = far.min(t1.max(t2) * FAR_WIDENING);
+        }
+    }
+    near <= far
+}
+
+/// Distance to push a ray off a surface at `p`: 2^-18 of its largest
+/// coordinate (about 32 ulps), so the new ray cannot hit the surface again
+/// through rounding, at any scale.
+#[inline]
+pub fn surface_offset(p: Vec3) -> f32 {
+    p.abs().max_element().max(1e-30) * (1.0 / 262_144.0)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec::Vec;
+
+    /// Reference: the same query in f64 with the same stable formulas.
+    fn ray_sphere_f64(o: [f64; 3], d: [f64; 3], c: [f64; 3], r: f64) -> Option<f64> {
+        let f = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let b = (f[0] * d[0] + f[1] * d[1] + f[2] * d[2]) / dd;
+        let l = [f[0] - b * d[0], f[1] - b * d[1], f[2] - b * d[2]];
+        let disc = r * r - (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+        if disc < 0.0 {
+            return None;
+        }
+        let cc = f[0] * f[0] + f[1] * f[1] + f[2] * f[2] - r * r;
+        let q = -(b + disc.sqrt().copysign(b));
+        let (t0, t1) = (cc / q, q);
+        let (near, far) = (t0.min(t1), t0.max(t1));
+        let s = dd.sqrt();
+        if near > 0.0 {
+            Some(near * s)
+        } else if far > 0.0 {
+            Some(far * s)
+        } else {
+            None
+        }
+    }
+
+    /// Worst relative error of the f32 hit distance over a set of rays.
+    /// (origin, direction, centre, radius)
+    type Case = ([f32; 3], [f32; 3], [f32; 3], f32);
+
+    fn worst_error(cases: &[Case]) -> f64 {
+        let mut worst = 0.0f64;
+        for &(o, d, c, r) in cases {
+            let dn = Vec3::from_array(d).normalize();
+            let t = ray_sphere(Vec3::from_array(o), dn, Vec3::from_array(c), r, 0.0);
+            let reference = ray_sphere_f64(o.map(f64::from), dn.to_array().map(f64::from), c.map(f64::from), r as f64);
+            match reference {
+                Some(tr) => {
+                    assert!(t != MISS, "missed: o {o:?} d {d:?} c {c:?} r {r}, f64 hit at {tr}");
+                    worst = worst.max(((t as f64) - tr).abs() / tr);
+                }
+                None => assert_eq!(t, MISS, "false hit: o {o:?} d {d:?} c {c:?} r {r}"),
+            }
+        }
+        worst
+    }
+
+    fn directions() -> Vec<[f32; 3]> {
+        let mut v = Vec::new();
+        for i in 0..40 {
+            let a = i as f32 * 0.157;
+            v.push([libm::cosf(a) * 0.3, libm::sinf(a) * 0.3, -1.0]);
+        }
+        v
+    }
+
+    #[test]
+    fn huge_spheres_seen_from_100_units() {
+        for r in [1e5f32, 1e6] {
+            // A wall whose near surface is 100 units in front of the origin.
+            let c = [0.0, 0.0, -(r + 100.0)];
+            let cases: Vec<_> = directions().into_iter().map(|d| ([0.0; 3], d, c, r)).collect();
+            let worst = worst_error(&cases);
+            std::println!("radius {r:e} at 100: worst relative hit-distance error {worst:e}");
+            assert!(worst < 1e-5, "radius {r}: {worst}");
+        }
+    }
+
+    #[test]
+    fn smallpt_walls_from_inside_the_box() {
+        // The left wall of smallpt's Cornell box, seen from the camera area.
+        let c = [1e5 + 1.0, 40.8, 81.6];
+        let cases: Vec<_> =
+            directions().into_iter().map(|d| ([50.0, 52.0, 100.0], [-1.0, d[0], d[1]], c, 1e5)).collect();
+        let worst = worst_error(&cases);
+        std::println!("smallpt wall: worst relative error {worst:e}");
+        assert!(worst < 1e-5, "{worst}");
+    }
+
+    #[test]
+    fn tiny_sphere_far_away() {
+        let c = [1e3, 0.0, 0.0];
+        let cases: Vec<_> = (0..40).map(|i| ([0.0; 3], [1.0, (i as f32 - 20.0) * 4e-8, 1e-7], c, 1e-3)).collect();
+        let worst = worst_error(&cases);
+        std::println!("radius 1e-3 at 1e3: worst relative error {worst:e}");
+        assert!(worst < 1e-5, "{worst}");
+    }
+
+    #[test]
+    fn grazing_rays() {
+        // Rays passing within a hair of the silhouette of a unit sphere.
+        let cases: Vec<_> =
+            (0..40).map(|i| ([-10.0, 1.0 - i as f32 * 1e-3, 0.0], [1.0, 0.0, 0.0], [0.0; 3], 1.0)).collect();
+        let worst = worst_error(&cases);
+        std::println!("grazing: worst relative error {worst:e}");
+        assert!(worst < 1e-3, "{worst}");
+    }
+
+    #[test]
+    fn rays_starting_on_the_surface_leave_it() {
+        // From a point on the surface, going outwards: no hit; inwards: the far side.
+        let c = Vec3::new(3.0, -2.0, 7.0);
+        for k in 0..50 {
+            let a = k as f32 * 0.37;
+            let n = Vec3::new(libm::cosf(a), libm::sinf(a) * 0.6, 0.8 * libm::sinf(a * 1.3)).normalize();
+            let p = c + n * 5.0;
+            let eps = surface_offset(p);
+            assert_eq!(ray_sphere(p + n * eps, n, c, 5.0, 0.0), MISS, "outward ray {k} hit its own sphere");
+            let t = ray_sphere(p - n * eps, -n, c, 5.0, 0.0);
+            assert!((t - 10.0).abs() < 1e-3, "inward ray {k}: {t}");
+        }
+    }
+
+    #[test]
+    fn boxes_with_axis_aligned_rays() {
+        let node = Node { min: [0.0, 0.0, 0.0], left: 0, max: [1.0, 1.0, 1.0], right: 0 };
+        let inv = safe_inverse(Vec3::new(1.0, 0.0, 0.0));
+        assert!(ray_box(&node, Vec3::new(-1.0, 0.5, 0.5), inv, MISS));
+        assert!(ray_box(&node, Vec3::new(-1.0, 0.0, 1.0), inv, MISS), "ray along an edge");
+        assert!(!ray_box(&node, Vec3::new(-1.0, 1.5, 0.5), inv, MISS));
+        assert!(!ray_box(&node, Vec3::new(2.0, 0.5, 0.5), inv, MISS), "box behind the ray");
+    }
+}

@@ -1,0 +1,127 @@
+//! The primitives rays are traced against: spheres then triangles in one
+//! index space, the distance to one of them, and the surface a ray leaves.
+use glam::Vec3;
+
+use crate::geometry::buffers::{LeafPrim, Sphere};
+use crate::geometry::features::{self, has};
+use crate::geometry::intersect::{ray_sphere_mode, MISS};
+use crate::geometry::triangle::{ray_triangle, Triangle, WatertightRay};
+
+/// The primitives rays are traced against (counts given apart from the
+/// slices, which on a GPU may be longer than their content).
+pub struct Prims<'a> {
+    pub spheres: &'a [Sphere],
+    pub sphere_count: u32,
+    pub triangles: &'a [Triangle],
+    pub triangle_count: u32,
+}
+
+impl<'a> Prims<'a> {
+    /// Spheres only.
+    #[cfg(not(target_arch = "spirv"))]
+    pub fn spheres(spheres: &'a [Sphere]) -> Self {
+        Prims { spheres, sphere_count: spheres.len() as u32, triangles: &[], triangle_count: 0 }
+    }
+
+    #[inline]
+    pub fn count(&self) -> u32 {
+        self.sphere_count + self.triangle_count
+    }
+
+    /// Whether primitive `prim` is a sphere, decided at compile time when
+    /// `F` (see [`crate::features`]) has only one primitive kind.
+    #[inline]
+    pub fn is_sphere<const F: u32>(&self, prim: u32) -> bool {
+        if !has(F, features::TRIANGLES) {
+            true
+        } else if !has(F, features::SPHERES) {
+            false
+        } else {
+            prim < self.sphere_count
+        }
+    }
+
+    /// Distance to primitive `prim` along the ray (a triangle's only up to
+    /// `t_max`, inclusive); `F` (see
+    /// [`crate::features`]) leaves out the test of a kind the scene lacks.
+    #[inline]
+    pub fn distance<const F: u32>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        ray: &WatertightRay,
+        from: Origin,
+        prim: u32,
+        t_max: f32,
+    ) -> f32 {
+        if self.is_sphere::<F>(prim) {
+            from.distance(o, d, &self.spheres[prim as usize], prim)
+        } else if prim == from.prim {
+            MISS // a flat triangle cannot be hit again by a ray leaving it
+        } else {
+            ray_triangle(ray, &self.triangles[(prim - self.sphere_count) as usize], t_max)
+        }
+    }
+}
+
+impl Prims<'_> {
+    /// Distance to a primitive stored in leaf order ([`LeafPrim`]), as
+    /// [`Prims::distance`] finds it from the scene's own arrays: the same
+    /// tests on the same numbers.
+    #[inline]
+    pub fn leaf_distance<const F: u32>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        ray: &WatertightRay,
+        from: Origin,
+        leaf: &LeafPrim,
+        t_max: f32,
+    ) -> f32 {
+        let prim = leaf.prim;
+        if self.is_sphere::<F>(prim) {
+            from.distance(o, d, &Sphere::new(leaf.p0, leaf.p1[0]), prim)
+        } else if prim == from.prim {
+            MISS
+        } else {
+            ray_triangle(ray, &Triangle::new(leaf.p0, leaf.p1, leaf.p2), t_max)
+        }
+    }
+
+    /// Primitive `prim` as its leaf stores it.
+    #[inline]
+    pub fn leaf_prim(&self, prim: u32) -> LeafPrim {
+        if prim < self.sphere_count {
+            let s = self.spheres[prim as usize];
+            LeafPrim { p0: s.center, prim, p1: [s.radius, 0.0, 0.0], ..Default::default() }
+        } else {
+            let t = self.triangles[(prim - self.sphere_count) as usize];
+            LeafPrim { p0: t.v0, prim, p1: t.v1, p2: t.v2, ..Default::default() }
+        }
+    }
+}
+
+/// The surface a ray starts on, if any: a ray leaving sphere `prim` cannot
+/// hit it again (`into == false`), or hits only its far side (`into`).
+#[derive(Clone, Copy)]
+pub struct Origin {
+    pub prim: u32,
+    pub into: bool,
+}
+
+impl Origin {
+    /// A ray from no surface (a camera ray).
+    pub const NONE: Origin = Origin { prim: u32::MAX, into: false };
+
+    /// Distance to sphere `prim` along the ray, honouring the start surface.
+    #[inline]
+    pub fn distance(&self, o: Vec3, d: Vec3, s: &Sphere, prim: u32) -> f32 {
+        if prim == self.prim {
+            if !self.into {
+                return MISS;
+            }
+            return ray_sphere_mode(o, d, Vec3::from_array(s.center), s.radius, 0.0, true);
+        }
+        ray_sphere_mode(o, d, Vec3::from_array(s.center), s.radius, 0.0, false)
+    }
+}

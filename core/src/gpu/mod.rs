@@ -1,0 +1,13 @@
+//! # GPU building blocks
+//!
+//! The lowest floor, and the one place where the SPIR-V and host builds
+//! differ: atomics (`spirv_std` intrinsics on the GPU, `core::sync::atomic`
+//! on the host), workgroup memory and barriers written as numbered phases
+//! (so the CPU runner can run a workgroup's invocations phase by phase),
+//! array access without bounds checks, and counter-based random numbers
+//! (the same draws on both targets). Everything above
+//! is target-free.
+pub mod atomics;
+pub mod rng;
+pub mod unchecked;
+pub mod workgroup;

@@ -1,0 +1,92 @@
+//! The binary layout made for GPUs (Aila & Laine 2009, "Understanding the
+//! Efficiency of Ray Traversal on GPUs"): each node holds both children's
+//! boxes ([`Bvh2Node`], 64 bytes), so one load tests both children; the
+//! ray goes on into the nearer child it hits, by the slab test's entry
+//! distance, and pushes the other (with that distance, to skip it on the
+//! way back if a hit came nearer). Leaves read their primitives in leaf
+//! order ([`LeafPrim`]): no index indirection.
+//!
+//! It is made from a collapsed tree in depth-first order (what
+//! [`crate::collapse`] writes: leaves of several primitives, `out_prims`
+//! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
+//! (internal node `i` of the input becomes node `f(i)` of the output, the
+//! number of internal nodes before it in depth-first order, found by
+//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
+use crate::geometry::prims::Prims;
+use crate::geometry::triangle::Triangle;
+
+/// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
+/// nodes, root 0, depth-first order: a left child follows its parent, a
+/// right child `right = i + 2 L` where `L` is its left sibling's leaf
+/// count): each internal node writes its [`Bvh2Node`]. A tree of one leaf
+/// gets a root whose second child is an empty box.
+pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32], out: &mut [Bvh2Node]) {
+    if i >= node_count {
+        return;
+    }
+    let node = nodes[i as usize];
+    if node.is_leaf() {
+        if node_count == 1 {
+            let mut root = Bvh2Node { left: node.left, left_count: node.prim_count(), ..Default::default() };
+            (root.left_min, root.left_max) = (node.min, node.max);
+            (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
+            root.right_count = 1; // a leaf that no ray reaches
+            out[0] = root;
+        }
+        return;
+    }
+    // f(i): internal nodes before i in depth-first order. A left child is
+    // its parent's next; a right child comes after its left sibling's L - 1
+    // internal nodes.
+    let mut index = 0u32;
+    let mut x = i;
+    while x != 0 {
+        let p = parents[x as usize];
+        index += if x == p + 1 { 1 } else { (x - p) / 2 };
+        x = p;
+    }
+    let (l, r) = (nodes[node.left as usize], nodes[node.right as usize]);
+    let (left, left_count) = child_ref(&l, index + 1);
+    let (right, right_count) = child_ref(&r, index + (node.right - i) / 2);
+    out[index as usize] = Bvh2Node {
+        left_min: l.min,
+        left,
+        left_max: l.max,
+        right,
+        right_min: r.min,
+        left_count,
+        right_max: r.max,
+        right_count,
+    };
+}
+
+/// A child as its parent refers to it: a leaf by its first primitive and
+/// count, an internal node by its index in the output.
+#[inline]
+fn child_ref(c: &Node, internal_index: u32) -> (u32, u32) {
+    if c.is_leaf() {
+        (c.left, c.prim_count())
+    } else {
+        (internal_index, 0)
+    }
+}
+
+/// Kernel, one invocation per primitive slot `j < n`: the primitive of
+/// slot `j` (`prim_indices[j]`, in leaf order) as its leaf stores it.
+pub fn leaf_prims_kernel(
+    j: u32,
+    n: u32,
+    sphere_count: u32,
+    prim_indices: &[u32],
+    spheres: &[Sphere],
+    triangles: &[Triangle],
+    out: &mut [LeafPrim],
+) {
+    if j >= n {
+        return;
+    }
+    let prims = Prims { spheres, sphere_count, triangles, triangle_count: n - sphere_count };
+    out[j as usize] = prims.leaf_prim(prim_indices[j as usize]);
+}
+

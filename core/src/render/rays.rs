@@ -1,0 +1,106 @@
+//! Ray-casting throughput: the two workloads a path tracer's speed is made
+//! of, cast alone. Primary rays go from the camera to their first hit;
+//! diffuse rays leave that hit in a cosine-distributed direction (incoherent,
+//! the hard case for a BVH). Each pixel casts one of each, in three passes:
+//! the camera rays, then the bounce rays made from their hits, then the
+//! bounce rays cast. The first and the last are what is timed, as the
+//! OptiX peer times its intersection launches alone.
+use glam::Vec3;
+
+use crate::geometry::buffers::RenderParams;
+use crate::geometry::intersect::surface_offset;
+use crate::geometry::prims::Origin;
+use crate::gpu::rng::BounceRng;
+use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel};
+use crate::render::sampling::cosine_direction;
+use crate::trace::hit::ClosestHit;
+
+/// [`RenderParams::cast_mode`]: camera rays; each pixel keeps its hit.
+pub const CAST_PRIMARY: u32 = 0;
+/// [`RenderParams::cast_mode`]: the diffuse rays the bounce pass made.
+pub const CAST_DIFFUSE: u32 = 1;
+/// [`RenderParams::cast_mode`]: a diffuse bounce ray from each camera hit
+/// (no tracing).
+pub const CAST_BOUNCE: u32 = 2;
+/// [`RenderParams::cast_mode`]: the caller's own rays (an engine's batch):
+/// `rays[2 id]` = (origin, farthest hit distance), `rays[2 id + 1]` =
+/// (direction, 1 to trace or 0 to skip); the closest hit replaces the
+/// first: (distance along the normalized direction, bits of the primitive,
+/// 0, 0), the primitive `u32::MAX` for none.
+pub const CAST_RAYS: u32 = 3;
+
+/// Kernel (one invocation per pixel, in tiles: see
+/// [`crate::render::integrator::tiled_pixel`]), for pixel `id` of invocation
+/// `invocation`, by `params.cast_mode`:
+/// * [`CAST_PRIMARY`]: casts the camera ray; `rays[2 id]` = (hit
+///   distance, bits of the primitive hit or `u32::MAX`, 0, 0);
+/// * [`CAST_BOUNCE`]: from that hit, `rays[2 id]` = (origin, 1 if a ray is
+///   to be cast, else 0) and `rays[2 id + 1]` = (direction, bits of the
+///   primitive it leaves);
+/// * [`CAST_DIFFUSE`]: casts that ray and writes its hit distance (or -1)
+///   into `rays[2 id][3]`.
+///
+/// `F` (see [`crate::geometry::features`]) may leave out the tests of primitive kinds
+/// the scene lacks.
+pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
+    invocation: u32,
+    params: &RenderParams,
+    scene: &SceneRefs<T>,
+    rays: &mut [[f32; 4]],
+    stack: &mut [u32; S],
+    lane: u32,
+) {
+    let (w, h) = (params.width, params.height);
+    let id = tiled_pixel(invocation, w, h);
+    if id == u32::MAX {
+        return;
+    }
+    let (i, j) = (2 * id as usize, 2 * id as usize + 1);
+    if params.cast_mode == CAST_RAYS {
+        if rays[j][3] != 0.0 {
+            let (o, d) = (Vec3::new(rays[i][0], rays[i][1], rays[i][2]), Vec3::new(rays[j][0], rays[j][1], rays[j][2]));
+            let len = d.length();
+            let hit = if len > 0.0 && len.is_finite() {
+                closest_hit::<T, F, S>(o, d / len, Origin::NONE, scene, stack, lane)
+            } else {
+                crate::trace::hit::Hit::NONE
+            };
+            let found = hit.is_hit() && hit.t <= rays[i][3];
+            rays[i] = if found { [hit.t, f32::from_bits(hit.prim), 0.0, 0.0] } else { [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0] };
+        }
+    } else if params.cast_mode == CAST_PRIMARY {
+        let (o, d) = camera_ray(params, id);
+        let hit = closest_hit::<T, F, S>(o, d, Origin::NONE, scene, stack, lane);
+        rays[i] = [hit.t, f32::from_bits(hit.prim), 0.0, 0.0];
+    } else if params.cast_mode == CAST_BOUNCE {
+        let (t, prim) = (rays[i][0], rays[i][1].to_bits());
+        if prim == u32::MAX {
+            rays[i] = [0.0; 4];
+            return;
+        }
+        let (o, d) = camera_ray(params, id);
+        let x = o + d * t;
+        let n = hit_normal_for::<F>(&scene.prims, prim, x, d);
+        let nl = if n.dot(d) < 0.0 { n } else { -n };
+        let bounce = BounceRng::new(params.seed, id, params.first_sample, 1);
+        let d2 = cosine_direction(nl, bounce.uniform(1), bounce.uniform(2));
+        let o2 = x + nl * surface_offset(x);
+        rays[i] = [o2.x, o2.y, o2.z, 1.0];
+        rays[j] = [d2.x, d2.y, d2.z, f32::from_bits(prim)];
+    } else if rays[i][3] != 0.0 {
+        let o = Vec3::new(rays[i][0], rays[i][1], rays[i][2]);
+        let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
+        let prim = rays[j][3].to_bits();
+        // Leaving the surface outwards: it cannot be hit again.
+        let hit = closest_hit::<T, F, S>(o, d, Origin { prim, into: false }, scene, stack, lane);
+        rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
+    }
+}
+
+/// Pixel `id`'s camera ray (its first subpixel, sample `first_sample`).
+#[inline]
+fn camera_ray(params: &RenderParams, id: u32) -> (Vec3, Vec3) {
+    let (w, h) = (params.width, params.height);
+    let rng = BounceRng::new(params.seed, id, params.first_sample, 0);
+    params.camera.primary_ray(id % w, h - 1 - id / w, 0, w, h, &rng)
+}

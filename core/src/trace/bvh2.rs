@@ -1,0 +1,138 @@
+//! The binary layout made for GPUs (Aila & Laine 2009, "Understanding the
+//! Efficiency of Ray Traversal on GPUs"): each node holds both children's
+//! boxes ([`Bvh2Node`], 64 bytes), so one load tests both children; the
+//! ray goes on into the nearer child it hits, by the slab test's entry
+//! distance, and pushes the other (with that distance, to skip it on the
+//! way back if a hit came nearer). Leaves read their primitives in leaf
+//! order ([`LeafPrim`]): no index indirection.
+//!
+//! It is made from a collapsed tree in depth-first order (what
+//! [`crate::construct::collapse`] writes: leaves of several primitives, `out_prims`
+//! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
+//! (internal node `i` of the input becomes node `f(i)` of the output, the
+//! number of internal nodes before it in depth-first order, found by
+//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use glam::Vec3;
+
+use crate::geometry::buffers::{Bvh2Node, LeafPrim};
+use crate::geometry::features;
+use crate::geometry::intersect::{SlabRay, slab_interval};
+use crate::geometry::prims::{Origin, Prims};
+use crate::geometry::triangle::WatertightRay;
+use crate::gpu::unchecked::{at, get, set};
+use crate::trace::hit::{ClosestHit, Hit, STACK_DEPTH};
+
+/// A tree in the layout of this module.
+pub struct Bvh2Tree<'a> {
+    pub nodes: &'a [Bvh2Node],
+    pub leaf_prims: &'a [LeafPrim],
+}
+
+impl<'a> Bvh2Tree<'a> {
+    #[inline]
+    pub fn new(nodes: &'a [Bvh2Node], leaf_prims: &'a [LeafPrim]) -> Self {
+        Bvh2Tree { nodes, leaf_prims }
+    }
+}
+
+impl ClosestHit for Bvh2Tree<'_> {
+    #[inline]
+    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        closest_hit_bvh2::<F>(o, d, from, prims, self.nodes, self.leaf_prims)
+    }
+}
+
+/// Tests the `count` primitives of a leaf from `first` on.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn leaf<const F: u32>(
+    hit: &mut Hit,
+    first: u32,
+    count: u32,
+    (o, d, from): (Vec3, Vec3, Origin),
+    ray: &WatertightRay,
+    prims: &Prims,
+    leaf_prims: &[LeafPrim],
+) {
+    let mut k = 0;
+    while k < count {
+        let p = at(leaf_prims, (first + k) as usize);
+        let t = prims.leaf_distance::<F>(o, d, ray, from, &p, hit.t);
+        if hit.is_beaten_by(t, p.prim) {
+            *hit = Hit { t, prim: p.prim };
+        }
+        k += 1;
+    }
+}
+
+/// The closest hit through a [`Bvh2Node`] tree (root 0), nearer child
+/// first; see the module doc. `F` as for
+/// [`crate::trace::classic::closest_hit_linear_for`].
+#[inline]
+pub fn closest_hit_bvh2<const F: u32>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    prims: &Prims,
+    nodes: &[Bvh2Node],
+    leaf_prims: &[LeafPrim],
+) -> Hit {
+    let mut hit = Hit::NONE;
+    if prims.count() == 0 {
+        return hit;
+    }
+    let slabs = SlabRay::new(o, d);
+    let ray = WatertightRay::new(o, d);
+    let at_ray = (o, d, from);
+    // Entries: node index and the entry distance it was pushed with.
+    let mut stack = [0u32; 2 * STACK_DEPTH];
+    let mut top = 0usize;
+    let mut node = 0u32;
+    loop {
+        let n = at(nodes, node as usize);
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
+        let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
+        // Leaves are tested at once; only internal children are walked.
+        if go_left && n.left_count > 0 {
+            leaf::<F>(&mut hit, n.left, n.left_count, at_ray, &ray, prims, leaf_prims);
+            go_left = false;
+        }
+        if go_right && n.right_count > 0 {
+            leaf::<F>(&mut hit, n.right, n.right_count, at_ray, &ray, prims, leaf_prims);
+            go_right = false;
+        }
+        if go_left && go_right {
+            let (near, far, far_t) = if ln <= rn { (n.left, n.right, rn) } else { (n.right, n.left, ln) };
+            if top < STACK_DEPTH {
+                set(&mut stack, 2 * top, far);
+                set(&mut stack, 2 * top + 1, far_t.to_bits());
+                top += 1;
+            }
+            node = near;
+        } else if go_left {
+            node = n.left;
+        } else if go_right {
+            node = n.right;
+        } else {
+            // Back to the nearest pushed child still worth entering.
+            let mut next = u32::MAX;
+            while top > 0 && next == u32::MAX {
+                top -= 1;
+                if f32::from_bits(get(&stack, 2 * top + 1)) <= hit.t {
+                    next = get(&stack, 2 * top);
+                }
+            }
+            if next == u32::MAX {
+                return hit;
+            }
+            node = next;
+        }
+    }
+}
+
+/// [`closest_hit_bvh2`] with every primitive kind compiled in.
+#[inline]
+pub fn closest_hit_bvh2_all(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Bvh2Node], leaf_prims: &[LeafPrim]) -> Hit {
+    closest_hit_bvh2::<{ features::ALL }>(o, d, from, prims, nodes, leaf_prims)
+}

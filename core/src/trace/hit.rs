@@ -1,0 +1,57 @@
+//! What every traversal returns ([`Hit`]) and the trait every layout
+//! implements ([`ClosestHit`]), so renderers and ray casts are generic over it.
+use glam::Vec3;
+
+use crate::geometry::intersect::MISS;
+use crate::geometry::prims::{Origin, Prims};
+
+/// A way to find closest hits: the scan, or a tree in one of the traversal
+/// layouts (the seed's 32-byte nodes here; [`crate::bvh2`],
+/// [`crate::cwbvh`]). The renderer and the ray-casting kernels are generic
+/// over it, so each layout gets kernels of its own.
+pub trait ClosestHit {
+    /// The closest hit of the ray `o + t d` (`d` of unit length) among the
+    /// primitives, ties to the lower index; `F` (see [`crate::features`])
+    /// may leave out the test of a kind the scene lacks. `stack` is
+    /// workgroup memory a traversal may keep the top of its stack in, at
+    /// `lane + WG * k` (see [`crate::cwbvh::closest_hit_cwbvh_with`]); a
+    /// one-word array means none.
+    fn closest_hit<const F: u32, const S: usize>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        from: Origin,
+        prims: &Prims,
+        stack: &mut [u32; S],
+        lane: u32,
+    ) -> Hit;
+}
+
+/// Depth of the traversal stack. A tree deeper than this (possible for a
+/// radix tree over pathological keys) would skip subtrees, so the host
+/// refuses to trace such trees.
+pub const STACK_DEPTH: usize = 64;
+
+/// The closest hit: distance and sphere index (`MISS`, `u32::MAX` if none).
+#[derive(Clone, Copy)]
+pub struct Hit {
+    pub t: f32,
+    pub prim: u32,
+}
+
+impl Hit {
+    pub const NONE: Hit = Hit { t: MISS, prim: u32::MAX };
+    #[inline]
+    pub fn is_hit(&self) -> bool {
+        self.prim != u32::MAX
+    }
+
+    /// Whether a hit at `t` on `prim` beats this one. Equal distances go to
+    /// the lower index, so every traversal order finds the same hit (a ray
+    /// through the rim of smallpt's light, which dips into the ceiling,
+    /// meets both at one distance).
+    #[inline]
+    pub fn is_beaten_by(&self, t: f32, prim: u32) -> bool {
+        t < self.t || (t == self.t && t != MISS && prim < self.prim)
+    }
+}

@@ -1,0 +1,325 @@
+//! Traversal layouts: how a built binary tree is laid out for the kernels
+//! that trace it (the kernels: `treelet_core::{traverse, bvh2, cwbvh,
+//! cwbvh_build}`). Every builder (LBVH, TRBVH, sweep) gives a tree of one
+//! primitive per leaf; [`lay_out`] turns it into any layout, on the device.
+use anyhow::{bail, Result};
+use serde::Serialize;
+use treelet_core::geometry::aabb::Aabb;
+use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, Node, WideNode};
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::layouts::cwbvh_build::{WIDE_NODE_COST, WIDE_PRIM_COST};
+use treelet_core::trace::hit::STACK_DEPTH;
+
+use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
+use crate::bvh::trbvh;
+use crate::runtime::backend::{check_fits, Backend, DeviceClass};
+use crate::runtime::kernels::{Kernel, Method};
+use crate::scene::primitives::Primitives;
+
+/// How a tree is stored for traversal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Layout {
+    /// The fastest measured on the device: bvh2 on GPUs and the CPU runner,
+    /// cwbvh on lavapipe (see [`Layout::resolve`]).
+    Auto,
+    /// The seed's: 32-byte nodes that hold their own box; leaves name their
+    /// primitives through an index array.
+    Classic,
+    /// Binary nodes that hold both children's boxes (Aila & Laine 2009);
+    /// primitives in leaf order.
+    Bvh2,
+    /// Compressed 8-wide nodes, child boxes quantized to bytes (Ylitie,
+    /// Karras & Laine 2017); primitives in leaf order.
+    Cwbvh,
+}
+
+impl Layout {
+    /// The layouts a tree can be traced in, `auto` aside.
+    pub const ALL: [Layout; 3] = [Layout::Classic, Layout::Bvh2, Layout::Cwbvh];
+
+    /// What `auto` stands for on `device`: the layout that rendered fastest
+    /// there (`treelet render --layout L --report F`, render-kernel time;
+    /// TRBVH, 1024x768):
+    /// * H100: bvh2 0.35 s, cwbvh 0.44 s, classic 0.84 s (a 940 544-triangle
+    ///   mesh in smallpt's room, 64 spp); bvh2 also casts the most diffuse
+    ///   rays (`treelet bench rays`, 0.95 G/s against 0.88);
+    /// * lavapipe: cwbvh 0.58 s, bvh2 0.86 s (terrain:20000, 128x96, 8 spp);
+    /// * the CPU runner: bvh2 0.20 s, cwbvh 0.24 s (the same).
+    pub fn resolve(self, device: DeviceClass) -> Layout {
+        match (self, device) {
+            (Layout::Auto, DeviceClass::CpuAdapter) => Layout::Cwbvh,
+            (Layout::Auto, _) => Layout::Bvh2,
+            (other, _) => other,
+        }
+    }
+
+    /// The name the command line takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Auto => "auto",
+            Layout::Classic => "classic",
+            Layout::Bvh2 => "bvh2",
+            Layout::Cwbvh => "cwbvh",
+        }
+    }
+
+    /// The kernels' closest-hit method for this (resolved) layout.
+    pub fn method(self) -> Method {
+        match self {
+            Layout::Classic => Method::Classic,
+            Layout::Bvh2 => Method::Bvh2,
+            Layout::Cwbvh => Method::Cwbvh,
+            Layout::Auto => panic!("internal: a layout must be resolved for its device first"),
+        }
+    }
+}
+
+/// The scene's primitives on the device, as the layouts and the render and
+/// cast kernels bind them.
+pub struct PrimBuffers<B: Backend> {
+    pub spheres: B::Buffer,
+    pub triangles: B::Buffer,
+    pub sphere_count: u32,
+    pub triangle_count: u32,
+}
+
+impl<B: Backend> PrimBuffers<B> {
+    /// Uploads `prims` (call after any build: a build may hand out again
+    /// buffers taken before it).
+    pub fn upload(b: &mut B, prims: Primitives) -> Result<Self> {
+        Ok(PrimBuffers {
+            spheres: upload_or_placeholder(b, "spheres", prims.spheres)?,
+            triangles: upload_or_placeholder(b, "triangles", prims.triangles)?,
+            sphere_count: prims.spheres.len() as u32,
+            triangle_count: prims.triangles.len() as u32,
+        })
+    }
+
+    fn count(&self) -> u32 {
+        self.sphere_count + self.triangle_count
+    }
+}
+
+/// A tree in a traversal layout, on the device: what bindings 3 (nodes) and
+/// 4 (primitive indices or leaf primitives) of the render and cast kernels
+/// take.
+pub struct TracedTree<B: Backend> {
+    pub layout: Layout,
+    pub nodes: B::Buffer,
+    pub prims: B::Buffer,
+    /// Nodes in the layout (an upper bound for cwbvh, whose buffer is sized
+    /// before the count is known; see [`wide_node_count`]).
+    pub node_count: u32,
+}
+
+/// Lays out `bvh`, a tree of one primitive per leaf in the LBVH layout (as
+/// the builders leave it), for tracing: `max_leaf` bounds the leaves of the
+/// binary layouts' SAH collapse (1: none, and `classic` then traces `bvh`
+/// as it is). Checks that the tree fits the traversal stack.
+pub fn lay_out<B: Backend>(
+    b: &mut B,
+    bvh: DeviceBvh<B>,
+    layout: Layout,
+    max_leaf: u32,
+    prims: &PrimBuffers<B>,
+) -> Result<TracedTree<B>> {
+    let layout = layout.resolve(b.class());
+    if bvh.n == 0 {
+        bail!("no primitives to lay out");
+    }
+    if bvh.n != prims.count() {
+        bail!("internal: a tree over {} primitives laid out for {}", bvh.n, prims.count());
+    }
+    match layout {
+        Layout::Cwbvh => {
+            check_depth(b, &bvh)?;
+            b.stage("layout");
+            cwbvh(b, &bvh, prims)
+        }
+        _ if max_leaf <= 1 && layout == Layout::Classic => {
+            check_depth(b, &bvh)?;
+            Ok(TracedTree { layout, node_count: bvh.node_count, nodes: bvh.nodes, prims: bvh.prim_indices })
+        }
+        _ => {
+            b.stage("collapse");
+            let collapsed = trbvh::collapse(b, bvh, max_leaf)?;
+            check_depth(b, &collapsed)?;
+            if layout == Layout::Classic {
+                return Ok(TracedTree {
+                    layout,
+                    node_count: collapsed.node_count,
+                    nodes: collapsed.nodes,
+                    prims: collapsed.prim_indices,
+                });
+            }
+            b.stage("layout");
+            bvh2(b, &collapsed, prims)
+        }
+    }
+}
+
+/// Refuses trees deeper than the traversal stack (a wide tree is never
+/// deeper than the binary tree it is made from).
+fn check_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<()> {
+    let nodes = b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?;
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 0usize)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let n = &nodes[i];
+        if !n.is_leaf() {
+            stack.push((n.left as usize, d + 1));
+            stack.push((n.right as usize, d + 1));
+        }
+    }
+    if deepest + 1 > STACK_DEPTH {
+        bail!("the BVH is {deepest} levels deep; traversal supports {}", STACK_DEPTH - 1);
+    }
+    Ok(())
+}
+
+/// The wide DP's cost model: the defaults, or for developers tuning it,
+/// `TREELET_WIDE_COSTS=NODE,PRIM`.
+fn wide_costs() -> (f32, f32) {
+    std::env::var("TREELET_WIDE_COSTS")
+        .ok()
+        .and_then(|v| {
+            let (a, b) = v.split_once(',')?;
+            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+        })
+        .unwrap_or((WIDE_NODE_COST, WIDE_PRIM_COST))
+}
+
+fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -> LayoutParams {
+    let extent = root.extent().max_element();
+    let (node_cost, prim_cost) = wide_costs();
+    LayoutParams {
+        n: bvh.n,
+        nodes: bvh.node_count,
+        spheres: prims.sphere_count,
+        node_cost,
+        prim_cost,
+        inv_extent: if extent > 0.0 { (1.0 / extent).min(f32::MAX) } else { 1.0 },
+        ..Default::default()
+    }
+}
+
+/// The two-box binary layout of a collapsed tree (depth-first order).
+fn bvh2<B: Backend>(b: &mut B, collapsed: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<TracedTree<B>> {
+    let internal = (collapsed.node_count / 2).max(1); // 2 L - 1 nodes, L - 1 internal
+    check_fits(b, "two-box nodes", internal as u64 * std::mem::size_of::<Bvh2Node>() as u64)?;
+    check_fits(b, "leaf primitives", collapsed.n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
+    let nodes = b.scratch("two-box nodes", internal as u64 * std::mem::size_of::<Bvh2Node>() as u64)?;
+    b.dispatch(
+        Kernel::Bvh2Nodes,
+        &[&p, &collapsed.nodes, &collapsed.parents, &nodes],
+        groups_for(collapsed.node_count, WORKGROUP_SIZE),
+    );
+    let leaf_prims = leaf_prims(b, &p, &collapsed.prim_indices, collapsed.n, prims)?;
+    Ok(TracedTree { layout: Layout::Bvh2, nodes, prims: leaf_prims, node_count: internal })
+}
+
+/// The primitives of slots `0..n` (`prim_indices`, in leaf order) as
+/// [`LeafPrim`]s.
+fn leaf_prims<B: Backend>(
+    b: &mut B,
+    p: &B::Buffer,
+    prim_indices: &B::Buffer,
+    n: u32,
+    prims: &PrimBuffers<B>,
+) -> Result<B::Buffer> {
+    let out = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    b.dispatch(Kernel::LeafPrims, &[p, prim_indices, &prims.spheres, &prims.triangles, &out], groups_for(n, WORKGROUP_SIZE));
+    Ok(out)
+}
+
+/// The compressed wide BVH of a tree of one primitive per leaf (see
+/// `treelet_core::layouts::cwbvh_build` for the steps).
+fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<TracedTree<B>> {
+    let n = bvh.n;
+    if bvh.node_count != 2 * n - 1 {
+        bail!("internal: the wide layout needs one primitive per leaf ({} nodes for {n} primitives)", bvh.node_count);
+    }
+    let nodes = bvh.node_count as u64;
+    // Binary internal nodes (the root when the tree is one leaf): the wide
+    // nodes are among them.
+    let internal = (n - 1).max(1);
+    check_fits(b, "wide DP costs", nodes * 32)?;
+    check_fits(b, "wide node slots", internal as u64 * 32)?;
+    check_fits(b, "wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
+    check_fits(b, "leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    let root = trbvh::root_box(b, bvh)?;
+    let p = b.upload("layout params", &[params(bvh, prims, &root)])?;
+    let flags = b.zeroed("wide DP flags", internal as u64 * 4)?;
+    let counts = b.scratch("wide DP counts", nodes * 4)?;
+    let costs = b.scratch("wide DP costs", nodes * 32)?;
+    let decisions = b.scratch("wide DP decisions", nodes * 8)?;
+    let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
+    // A stage per step, so that `bench rays` shows where the time goes.
+    b.stage("wide dp");
+    b.dispatch(dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));
+
+    let is_wide = b.scratch("wide node flags", internal as u64 * 4)?;
+    let child_offsets = b.scratch("wide child offsets", internal as u64 * 4)?;
+    let prim_offsets = b.scratch("wide primitive offsets", internal as u64 * 4)?;
+    let groups = groups_for(internal, WORKGROUP_SIZE);
+    b.stage("wide count");
+    b.dispatch(
+        Kernel::WideCount,
+        &[&p, &bvh.nodes, &bvh.parents, &counts, &decisions, &is_wide, &child_offsets, &prim_offsets],
+        groups,
+    );
+    b.stage("wide scans");
+    crate::bvh::sort::exclusive_scan(b, &child_offsets, internal)?;
+    crate::bvh::sort::exclusive_scan(b, &prim_offsets, internal)?;
+    let positions = b.scratch("wide node positions", internal as u64 * 4)?;
+    let slots = b.scratch("wide node slots", internal as u64 * 32)?;
+    b.stage("wide place");
+    b.dispatch(Kernel::WidePlace, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions, &slots], groups);
+    let out_nodes = b.scratch("wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
+    let out_prims = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    b.stage("wide emit");
+    b.dispatch(
+        Kernel::WideEmit,
+        &[
+            &p,
+            &bvh.nodes,
+            &slots,
+            &is_wide,
+            &child_offsets,
+            &prim_offsets,
+            &positions,
+            &bvh.prim_indices,
+            &prims.spheres,
+            &prims.triangles,
+            &out_nodes,
+            &out_prims,
+        ],
+        groups,
+    );
+    Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal })
+}
+
+/// The nodes of a wide tree that are in use: those reachable from the root
+/// (read back; for reports and tests).
+pub fn wide_nodes<B: Backend>(b: &mut B, tree: &TracedTree<B>) -> Result<Vec<WideNode>> {
+    let all = b.read::<WideNode>(&tree.nodes, tree.node_count as usize)?;
+    let mut used = 0usize;
+    let mut stack = vec![0usize];
+    while let Some(i) = stack.pop() {
+        used = used.max(i + 1);
+        let node = &all[i];
+        let imask = node.exp_imask >> 24;
+        for k in 0..imask.count_ones() as usize {
+            stack.push(node.child_base as usize + k);
+        }
+    }
+    Ok(all[..used].to_vec())
+}
+
+/// Nodes in use in a wide tree (see [`wide_nodes`]).
+pub fn wide_node_count<B: Backend>(b: &mut B, tree: &TracedTree<B>) -> Result<usize> {
+    Ok(wide_nodes(b, tree)?.len())
+}

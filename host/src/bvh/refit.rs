@@ -1,0 +1,38 @@
+//! Refit: new boxes for a tree whose primitives moved, its shape kept. The
+//! primitives' boxes are made as a build makes them, then the build's own
+//! bottom-up fit (`treelet_core::construct::fit`) runs over the tree's leaves and
+//! parent links, so any binary tree of one primitive per leaf refits, the
+//! treelet-restructured one included (Karras 2012, section 4, applied to an
+//! existing hierarchy).
+use anyhow::{bail, Result};
+use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+
+use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
+use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernels::Kernel;
+use crate::scene::primitives::Primitives;
+
+/// Rewrites the boxes of `bvh`'s nodes for `prims`, which must be the
+/// primitives it was built over (same count and order), moved.
+pub fn refit<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: Primitives) -> Result<StageTimes> {
+    let n = bvh.n;
+    if prims.len() != n as usize {
+        bail!("refit with {} primitives: the tree was built over {n}", prims.len());
+    }
+    if n == 0 {
+        return Ok(StageTimes::default());
+    }
+    b.stage("bounds");
+    let params = BuildParams { n, spheres: prims.spheres.len() as u32, ..Default::default() };
+    let p = b.upload("refit params", &[params])?;
+    let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
+    let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
+    let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
+    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &spheres, &triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.stage("fit");
+    let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
+    let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
+    b.dispatch(fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    b.take_times()
+}

@@ -1,0 +1,156 @@
+//! One build, run and summarized: what `treelet build` prints.
+use std::time::Instant;
+
+use anyhow::Result;
+use serde::Serialize;
+use treelet_core::construct::sah::{SahCosts, sah_cost};
+
+use crate::runtime::backend::Backend;
+use treelet_core::{Aabb, Node};
+
+use crate::bvh::lbvh::{self, Bvh, STAGES};
+use crate::bvh::trbvh::{self, TreeletConfig};
+use crate::bvh::validate::validate_primitives;
+use crate::scene::Scene;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BuildReport {
+    pub scene: String,
+    pub primitives: usize,
+    /// Of which spheres and triangles.
+    pub spheres: usize,
+    pub triangles: usize,
+    pub builder: &'static str,
+    pub device: &'static str,
+    pub adapter: String,
+    pub nodes: usize,
+    /// SAH with C_i = 1.2 per node, C_t = 1 per primitive (Karras & Aila 2013).
+    pub sah_cost: f64,
+    pub valid: bool,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<String>,
+    /// Sum of the stage times.
+    pub total_ms: f64,
+    /// Wall-clock time of the whole call, uploads and readbacks included.
+    pub wall_ms: f64,
+    pub ms: serde_json::Map<String, serde_json::Value>,
+    /// "gpu-timestamps" or "wall-clock".
+    pub timing: &'static str,
+    /// Leaves of the tree (fewer than the primitives after a leaf collapse).
+    pub leaves: usize,
+    /// Largest leaf the SAH collapse may make (trbvh, sweep).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_leaf: Option<u32>,
+    /// Treelet optimization (builder `trbvh`): its settings, the SAH before
+    /// and after, and the time of each round (ms).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rounds: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gamma: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sah_before: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sah_after: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub round_ms: Option<Vec<f64>>,
+}
+
+/// The full-sweep SAH reference build (CPU only), reported like the others.
+pub fn run_build_sweep(scene: &Scene, max_leaf: u32) -> Result<(Bvh, BuildReport)> {
+    let prims = scene.primitives();
+    prims.check()?;
+    let start = Instant::now();
+    let bvh = crate::bvh::sweep::build_collapsed_boxes(&prims.boxes(), max_leaf)?;
+    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let mut ms = serde_json::Map::new();
+    ms.insert("sweep".into(), serde_json::json!(wall_ms));
+    let report = BuildReport {
+        scene: scene.name.clone(),
+        primitives: prims.len(),
+        spheres: prims.counts().0,
+        triangles: prims.counts().1,
+        builder: "sweep",
+        device: "cpu",
+        adapter: "cpu".into(),
+        nodes: bvh.nodes.len(),
+        sah_cost: sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA),
+        valid: check.is_valid(),
+        errors: check.errors,
+        total_ms: wall_ms,
+        wall_ms,
+        ms,
+        timing: "wall-clock",
+        leaves: leaf_count(&bvh.nodes),
+        max_leaf: Some(max_leaf),
+        rounds: None,
+        gamma: None,
+        sah_before: None,
+        sah_after: None,
+        round_ms: None,
+    };
+    Ok((bvh, report))
+}
+
+/// Validates the input, builds (LBVH, then treelet rounds when `treelets`
+/// is given), validates the tree, and reports.
+pub fn run_build<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    treelets: Option<&TreeletConfig>,
+) -> Result<(Bvh, BuildReport)> {
+    let prims = scene.primitives();
+    prims.check()?;
+    let start = Instant::now();
+    let (mut device_bvh, times) = lbvh::build_primitives_on_device(backend, prims)?;
+    let mut bvh = device_bvh.read(backend)?;
+    let mut ms: serde_json::Map<String, serde_json::Value> =
+        STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
+    let mut total_ms = times.total();
+    let (mut sah_before, mut round_ms) = (None, None);
+    if let Some(config) = treelets {
+        sah_before = Some(sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA));
+        let root = bvh.nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
+        let (optimized, rounds) = trbvh::optimize(backend, device_bvh, &root, config)?;
+        device_bvh = optimized;
+        let per_round: Vec<f64> =
+            rounds.order.iter().filter(|s| s.starts_with("round")).map(|s| rounds.get(s)).collect();
+        total_ms += rounds.total();
+        ms.insert("treelets".into(), serde_json::json!(per_round.iter().sum::<f64>()));
+        ms.insert("collapse".into(), serde_json::json!(rounds.get("collapse")));
+        round_ms = Some(per_round);
+        bvh = device_bvh.read(backend)?;
+    }
+    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
+    let sah = sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA);
+    let report = BuildReport {
+        scene: scene.name.clone(),
+        primitives: prims.len(),
+        spheres: prims.counts().0,
+        triangles: prims.counts().1,
+        builder: if treelets.is_some() { "trbvh" } else { "lbvh" },
+        device: backend.device_kind(),
+        adapter: backend.adapter(),
+        nodes: bvh.nodes.len(),
+        sah_cost: sah,
+        valid: check.is_valid(),
+        errors: check.errors,
+        total_ms,
+        wall_ms,
+        ms,
+        timing: if times.source.is_empty() { "wall-clock" } else { times.source },
+        leaves: leaf_count(&bvh.nodes),
+        max_leaf: treelets.map(|c| c.max_leaf),
+        rounds: treelets.map(|c| c.rounds),
+        gamma: treelets.map(|c| c.gamma),
+        sah_before,
+        sah_after: sah_before.map(|_| sah),
+        round_ms,
+    };
+    Ok((bvh, report))
+}
+
+fn leaf_count(nodes: &[Node]) -> usize {
+    nodes.iter().filter(|n| n.is_leaf()).count()
+}

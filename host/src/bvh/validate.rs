@@ -1,0 +1,161 @@
+//! An independent validator of built trees. It shares no code with the
+//! builders: it recomputes primitive boxes itself and walks the tree from the
+//! root with an explicit stack.
+use treelet_core::geometry::buffers::{Node, Sphere};
+use treelet_core::geometry::triangle::Triangle;
+
+use crate::scene::primitives::Primitives;
+
+/// The result of [`validate`]: empty `errors` means valid.
+#[derive(Clone, Debug, Default)]
+pub struct Validation {
+    pub errors: Vec<String>,
+}
+
+impl Validation {
+    pub fn is_valid(&self) -> bool {
+        self.errors.is_empty()
+    }
+}
+
+const LEAF_FLAG: u32 = 0x8000_0000;
+const NO_PARENT: u32 = u32::MAX;
+/// Stop collecting after this many errors.
+const MAX_ERRORS: usize = 20;
+
+fn sphere_box(s: &Sphere) -> ([f32; 3], [f32; 3]) {
+    let lo = [s.center[0] - s.radius, s.center[1] - s.radius, s.center[2] - s.radius];
+    let hi = [s.center[0] + s.radius, s.center[1] + s.radius, s.center[2] + s.radius];
+    (lo, hi)
+}
+
+fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
+    let lo = [0, 1, 2].map(|k| t.v0[k].min(t.v1[k]).min(t.v2[k]));
+    let hi = [0, 1, 2].map(|k| t.v0[k].max(t.v1[k]).max(t.v2[k]));
+    (lo, hi)
+}
+
+/// The box of primitive `i` (spheres first, then triangles), computed here.
+pub(crate) fn primitive_box(prims: Primitives, i: usize) -> ([f32; 3], [f32; 3]) {
+    match i.checked_sub(prims.spheres.len()) {
+        None => sphere_box(&prims.spheres[i]),
+        Some(t) => triangle_box(&prims.triangles[t]),
+    }
+}
+
+fn encloses(outer_lo: &[f32; 3], outer_hi: &[f32; 3], lo: &[f32; 3], hi: &[f32; 3]) -> bool {
+    (0..3).all(|k| outer_lo[k] <= lo[k] && outer_hi[k] >= hi[k])
+}
+
+/// Checks every structural invariant of a BVH over `spheres`:
+/// between 1 and `2n - 1` nodes (fewer when leaves hold several
+/// primitives); the root has no parent; each node is reached exactly
+/// once from the root (no cycles, no sharing, nothing unreachable); parent
+/// links match child links; every primitive is in exactly one leaf; each
+/// internal box contains its children's boxes; each leaf box contains its
+/// primitives; the root box contains the whole scene.
+pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    validate_primitives(Primitives::spheres(spheres), nodes, parents, prim_indices)
+}
+
+/// [`validate`] for any primitives (boxes recomputed here, not by the builder's code).
+pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    let prim_box = |p: usize| match p.checked_sub(prims.spheres.len()) {
+        None => sphere_box(&prims.spheres[p]),
+        Some(t) => triangle_box(&prims.triangles[t]),
+    };
+    let mut v = Validation::default();
+    let mut err = |e: String| {
+        if v.errors.len() < MAX_ERRORS {
+            v.errors.push(e);
+        }
+    };
+    let n = prims.len();
+    if n == 0 {
+        if !nodes.is_empty() {
+            err(format!("empty scene but {} nodes", nodes.len()));
+        }
+        return v;
+    }
+    if nodes.is_empty() || nodes.len() > 2 * n - 1 {
+        err(format!("{} nodes for {n} primitives (expected 1 to {})", nodes.len(), 2 * n - 1));
+        return v;
+    }
+    if parents.len() != nodes.len() || prim_indices.len() != n {
+        err(format!(
+            "{} parents and {} primitive indices for {} nodes",
+            parents.len(),
+            prim_indices.len(),
+            nodes.len()
+        ));
+        return v;
+    }
+    if parents[0] != NO_PARENT {
+        err(format!("root has parent {}", parents[0]));
+    }
+    let mut visited = vec![false; nodes.len()];
+    let mut prim_seen = vec![0u32; n];
+    let mut stack = vec![0usize];
+    while let Some(i) = stack.pop() {
+        if visited[i] {
+            err(format!("node {i} reached twice (cycle or shared child)"));
+            continue;
+        }
+        visited[i] = true;
+        let node = &nodes[i];
+        if node.right & LEAF_FLAG != 0 {
+            let count = (node.right & !LEAF_FLAG) as usize;
+            let first = node.left as usize;
+            if count == 0 || first + count > n {
+                err(format!("leaf {i}: primitives {first}..{} out of 0..{n}", first + count));
+                continue;
+            }
+            for &p in &prim_indices[first..first + count] {
+                let p = p as usize;
+                if p >= n {
+                    err(format!("leaf {i}: primitive index {p} out of range"));
+                    continue;
+                }
+                prim_seen[p] += 1;
+                let (lo, hi) = prim_box(p);
+                if !encloses(&node.min, &node.max, &lo, &hi) {
+                    err(format!("leaf {i}: box {:?}..{:?} does not contain primitive {p}", node.min, node.max));
+                }
+            }
+        } else {
+            for child in [node.left as usize, node.right as usize] {
+                if child >= nodes.len() || child == 0 {
+                    err(format!("node {i}: child index {child} invalid"));
+                    continue;
+                }
+                if parents[child] as usize != i {
+                    err(format!("node {child}: parent link {} but child of {i}", parents[child]));
+                }
+                let c = &nodes[child];
+                if !encloses(&node.min, &node.max, &c.min, &c.max) {
+                    err(format!("node {i}: box does not contain child {child}'s box"));
+                }
+                stack.push(child);
+            }
+        }
+    }
+    if let Some(i) = visited.iter().position(|&x| !x) {
+        err(format!(
+            "node {i} is not reachable from the root ({} unreachable)",
+            visited.iter().filter(|&&x| !x).count()
+        ));
+    }
+    for (p, &count) in prim_seen.iter().enumerate() {
+        if count != 1 {
+            err(format!("primitive {p} is in {count} leaves (expected exactly 1)"));
+        }
+    }
+    let root = &nodes[0];
+    for p in 0..n {
+        let (lo, hi) = prim_box(p);
+        if !encloses(&root.min, &root.max, &lo, &hi) {
+            err(format!("root box does not contain primitive {p}"));
+        }
+    }
+    v
+}
