@@ -101,7 +101,7 @@ impl MortonFrame {
     ///
     /// ```
     /// use glam::Vec3;
-    /// use treelet_core::{morton::MortonFrame, Aabb};
+    /// use treelet_core::{construct::morton::MortonFrame, Aabb};
     /// let frame = MortonFrame::new(&Aabb::new(Vec3::ZERO, Vec3::splat(10.0)));
     /// assert_eq!(frame.code(Vec3::ZERO), 0);
     /// assert!(frame.code(Vec3::new(1.0, 1.0, 1.0)) < frame.code(Vec3::new(9.0, 9.0, 9.0)));

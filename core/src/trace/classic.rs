@@ -57,7 +57,8 @@ impl ClosestHit for ClassicTree<'_> {
 ///
 /// ```
 /// use glam::Vec3;
-/// use treelet_core::trace::classic::{closest_hit_linear, Origin, Prims};
+/// use treelet_core::geometry::prims::{Origin, Prims};
+/// use treelet_core::trace::classic::closest_hit_linear;
 /// use treelet_core::Sphere;
 /// let spheres = [Sphere::new([5.0, 0.0, 0.0], 1.0), Sphere::new([3.0, 0.0, 0.0], 1.0)];
 /// let hit = closest_hit_linear(Vec3::ZERO, Vec3::X, Origin::NONE, &Prims::spheres(&spheres));
