@@ -6,7 +6,8 @@
 use treelet::bvh::layout::Layout;
 use treelet::render::devices::{render_on_devices, Device, InjectedFailure, SampleQueue, Take};
 use treelet::render::variant::KernelChoice;
-use treelet::render::{render, Accel, Integrator, RenderSettings};
+use treelet::bvh::tree::Accel;
+use treelet::render::{render, Integrator, RenderSettings};
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::scene::{cornell, Scene};

@@ -11,7 +11,7 @@ use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
-use treelet::render::{scene_tree, Accel};
+use treelet::bvh::tree::{traced_tree, Accel};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::validate_layout::{validate_bvh2, validate_wide};
 use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
@@ -40,7 +40,7 @@ fn read<B: Backend>(b: &mut B, tree: &TracedTree<B>, n: usize) -> HostTree {
 }
 
 fn build<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> HostTree {
-    let (tree, _, _) = scene_tree(b, prims, accel, layout).unwrap();
+    let (tree, _, _) = traced_tree(b, prims, accel, layout).unwrap();
     read(b, &tree, prims.len())
 }
 

@@ -4,7 +4,8 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
-use treelet::render::{render, Accel, Integrator, RenderSettings};
+use treelet::bvh::tree::Accel;
+use treelet::render::{render, Integrator, RenderSettings};
 use treelet::render::variant::KernelChoice;
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet_core::geometry::triangle::Triangle;
@@ -171,7 +172,7 @@ fn cast_kernels_match_cpu() {
     use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
     fn cast<B: Backend>(b: &mut B, scene: &Scene, layout: Layout, kernel: Kernel, (w, h): (u32, u32)) -> Vec<[f32; 4]> {
         let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
-        let (tree, prims, _) = treelet::render::scene_tree(b, all, Accel::Trbvh, layout).unwrap();
+        let (tree, prims, _) = treelet::bvh::tree::traced_tree(b, all, Accel::Trbvh, layout).unwrap();
         let materials = b.upload("materials", &scene.materials).unwrap();
         let rays = b.zeroed("rays", (w * h) as u64 * 32).unwrap();
         let base = treelet_core::RenderParams {

@@ -9,7 +9,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::bvh::layout::{wide_nodes, Layout};
 use treelet::scene::primitives::Primitives;
-use treelet::render::{scene_tree, Accel};
+use treelet::bvh::tree::{traced_tree, Accel};
 use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim};
 use treelet_core::geometry::features::ALL;
 use treelet_core::geometry::prims::{Origin, Prims};
@@ -37,7 +37,7 @@ fn main() -> anyhow::Result<()> {
     // treelet-optimized tree, laid out three ways.
     let b = &mut CpuBackend::new();
     for layout in Layout::ALL {
-        let (tree, _, build_ms) = scene_tree(b, prims, Accel::Trbvh, layout)?;
+        let (tree, _, build_ms) = traced_tree(b, prims, Accel::Trbvh, layout)?;
         println!("{}: built and laid out over {} spheres in {build_ms:.2} ms", layout.name(), spheres.len());
         // Read the layout back and trace with its traversal function.
         let trace: Box<dyn Fn(Vec3, Vec3) -> treelet_core::trace::hit::Hit> = match layout {

@@ -9,13 +9,9 @@
 //! `cargo test` runs it on both (it is also the example's test).
 use anyhow::{ensure, Result};
 use glam::Vec3;
-use treelet::runtime::backend::Backend;
-use treelet::runtime::cpu_runner::CpuBackend;
-use treelet::runtime::gpu::{GpuBackend, GpuContext};
-use treelet::tracer::{Quality, Ray, RayHit, Tracer};
-use treelet_core::geometry::buffers::Sphere;
+use treelet::{Backend, CpuBackend, GpuBackend, GpuContext, Quality, Ray, RayHit, Sphere, Tracer, Triangle};
+// The reference every hit is checked against: treelet-core's scan.
 use treelet_core::geometry::prims::{Origin, Prims};
-use treelet_core::geometry::triangle::Triangle;
 use treelet_core::trace::classic::closest_hit_linear;
 
 /// The engine's geometry: a wavy 64 x 64 grid of quads (8 192 triangles)

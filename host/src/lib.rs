@@ -1,33 +1,59 @@
 //! # treelet
 //!
-//! The host side of Treelet, in the order of its pipeline; each folder
-//! depends only on the ones above it:
+//! GPU-built bounding volume hierarchies and closest-hit queries for an
+//! engine's own geometry, and the host side of Treelet's path tracer.
 //!
-//! - [`runtime`]: where kernels run: the [`Backend`](runtime::backend::Backend)
-//!   trait, the GPU through wgpu, and the CPU runner that calls the same
-//!   kernel functions over every invocation id;
+//! ## For an engine
+//!
+//! Everything an engine needs is at the crate root: a [`Tracer`] builds a
+//! tree over [`Sphere`]s and [`Triangle`]s on a device (a [`GpuBackend`] on
+//! any Vulkan adapter, or the [`CpuBackend`], which runs the same kernels on
+//! CPU cores), refits it after they move, and finds the closest hits
+//! ([`RayHit`]) of batches of [`Ray`]s. [`Quality`] trades build time for
+//! faster rays.
+//!
+//! ```
+//! use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
+//! let triangles = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
+//! let b = &mut CpuBackend::new(); // or GpuBackend::new(GpuContext::new()?)
+//! let mut tracer = Tracer::build(b, &[], &triangles, Quality::High)?;
+//! let hits = tracer.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0])])?;
+//! assert_eq!((hits[0].prim, hits[0].t), (0, 5.0));
+//! let moved = [Triangle::new([0.0, 0.0, 7.0], [1.0, 0.0, 7.0], [0.0, 1.0, 7.0])];
+//! tracer.refit(b, &[], &moved)?; // same shape, new boxes
+//! assert_eq!(tracer.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0])])?[0].t, 7.0);
+//! # anyhow::Ok(())
+//! ```
+//!
+//! ## The folders, bottom to top
+//!
+//! Each folder depends only on the ones above it in this list
+//! (`tests/layering.rs` checks it):
+//!
+//! - [`runtime`]: where kernels run: the [`Backend`] trait, the GPU through
+//!   wgpu, and the CPU runner that calls the same kernel functions over
+//!   every invocation id; [`plot`]: charts for reports and benchmarks;
 //! - [`scene`]: what is built and rendered: spheres and triangles, meshes,
 //!   scene files, and the checks that reject bad input;
 //! - [`bvh`]: the BVH builders (LBVH, treelet restructuring, full-sweep
-//!   SAH), the traversal layouts and the independent validators;
+//!   SAH), refit, the traversal layouts, the tree a render or an engine asks
+//!   for ([`bvh::tree`]), and the independent validators;
 //! - [`render`]: the path tracer's passes, the kernel variant a scene needs,
-//!   images in and out;
-//! - [`tracer`]: the engine API: a tree over your spheres and triangles on
-//!   a device, refit after they move, closest hits for batches of rays;
-//! - [`plot`]: charts for reports and benchmarks.
+//!   images in and out, render parts and several devices;
+//! - [`tracer`]: the engine API re-exported above.
 //!
-//! The `treelet` command (`main.rs`, `bench/`) sits on top.
-//!
-//! ```no_run
-//! use treelet::{bvh::lbvh, runtime::cpu_runner::CpuBackend, scene};
-//! let spheres = scene::random_spheres(1000, 7);
-//! let (bvh, times) = lbvh::build(&mut CpuBackend::new(), &spheres).unwrap();
-//! assert_eq!(bvh.nodes.len(), 1999);
-//! println!("{} ms", times.total());
-//! ```
+//! The `treelet` command (`main.rs`, `bench/`) sits on top. The kernels
+//! themselves are in the `treelet-core` crate, which an engine may also use
+//! directly (`no_std`): see its docs for the traversal functions.
 pub mod bvh;
 pub mod plot;
 pub mod render;
 pub mod runtime;
 pub mod scene;
 pub mod tracer;
+
+pub use runtime::backend::Backend;
+pub use runtime::cpu_runner::CpuBackend;
+pub use runtime::gpu::{GpuBackend, GpuContext};
+pub use tracer::{Quality, Ray, RayHit, Tracer};
+pub use treelet_core::{Sphere, Triangle};

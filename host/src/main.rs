@@ -10,7 +10,8 @@ use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::render::image_io;
 use treelet::bvh::layout::Layout;
 use treelet::plot::Series;
-use treelet::render::{render, Accel, Integrator, PassRow, RenderSettings};
+use treelet::bvh::tree::Accel;
+use treelet::render::{render, Integrator, PassRow, RenderSettings};
 use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
@@ -481,28 +482,10 @@ fn run(cli: Cli) -> Result<bool> {
 /// When the process started (as near as `main` knows), for wall times.
 static PROCESS_START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
 
-/// Mesa's Vulkan drivers print `error: XDG_RUNTIME_DIR is invalid or not
-/// set` when the variable is missing (containers, ssh without a session),
-/// which reads as Treelet failing. Give them a private runtime directory,
-/// as a login session would. Runs before any thread starts.
-fn quiet_mesa_runtime_dir() {
-    use std::os::unix::fs::PermissionsExt;
-    let usable = |d: &std::ffi::OsStr| std::path::Path::new(d).is_dir();
-    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| usable(&d)) {
-        return;
-    }
-    let user = std::env::var("USER").unwrap_or_default();
-    let dir = std::env::temp_dir().join(format!("treelet-runtime-{user}"));
-    let made = std::fs::create_dir_all(&dir)
-        .and_then(|()| std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)));
-    if made.is_ok() {
-        std::env::set_var("XDG_RUNTIME_DIR", &dir);
-    }
-}
-
 fn main() -> ExitCode {
     PROCESS_START.get_or_init(std::time::Instant::now);
-    quiet_mesa_runtime_dir();
+    // Before any thread starts (the library also does it when it opens Vulkan).
+    treelet::runtime::gpu::quiet_mesa_runtime_dir();
     match run(Cli::parse()) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => {

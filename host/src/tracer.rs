@@ -4,9 +4,7 @@
 //! from host slices or from a buffer that stays on the device.
 //!
 //! ```
-//! use treelet::runtime::cpu_runner::CpuBackend;
-//! use treelet::tracer::{Quality, Ray, Tracer};
-//! use treelet_core::geometry::triangle::Triangle;
+//! use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
 //! let triangles = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
 //! let b = &mut CpuBackend::new();
 //! let tracer = Tracer::build(b, &[], &triangles, Quality::Fast)?;
@@ -23,7 +21,7 @@ use treelet_core::render::rays::CAST_RAYS;
 
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::refit;
-use crate::render::{binary_tree, Accel, BuiltTree};
+use crate::bvh::tree::{binary_tree, Accel, BuiltTree};
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;

@@ -291,7 +291,7 @@ pub const TEAM_VOTES: usize = TEAMS as usize * 2 * TEAM as usize;
 /// picks the best of those and, if that lowers the treelet's cost, plans the
 /// new topology, which a lane per internal node rewires, or else it stores
 /// the root's current cost and height. `marks` (see
-/// [`mark`]; zeroed before the first round) let later rounds skip treelets
+/// `mark`; zeroed before the first round) let later rounds skip treelets
 /// that were kept and under which nothing changed: every node whose
 /// subtree changes this round is a treelet root or inside a rewired
 /// treelet (changes only come from treelets, whose roots have at least

@@ -29,7 +29,7 @@ impl<'a> Prims<'a> {
     }
 
     /// Whether primitive `prim` is a sphere, decided at compile time when
-    /// `F` (see [`crate::features`]) has only one primitive kind.
+    /// `F` (see [`crate::geometry::features`]) has only one primitive kind.
     #[inline]
     pub fn is_sphere<const F: u32>(&self, prim: u32) -> bool {
         if !has(F, features::TRIANGLES) {
@@ -43,7 +43,7 @@ impl<'a> Prims<'a> {
 
     /// Distance to primitive `prim` along the ray (a triangle's only up to
     /// `t_max`, inclusive); `F` (see
-    /// [`crate::features`]) leaves out the test of a kind the scene lacks.
+    /// [`crate::geometry::features`]) leaves out the test of a kind the scene lacks.
     #[inline]
     pub fn distance<const F: u32>(
         &self,

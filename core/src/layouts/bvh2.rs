@@ -7,7 +7,7 @@
 //! order ([`LeafPrim`]): no index indirection.
 //!
 //! It is made from a collapsed tree in depth-first order (what
-//! [`crate::collapse`] writes: leaves of several primitives, `out_prims`
+//! [`crate::construct::collapse`] writes: leaves of several primitives, `out_prims`
 //! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by

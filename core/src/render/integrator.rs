@@ -16,7 +16,7 @@
 //! when it heads into it ([`Origin`]), instead of smallpt's fixed 1e-4
 //! epsilon, which no f32 epsilon could replace near 1e5-radius walls; the
 //! origin is still pushed off the surface by a distance scaled to the
-//! point's magnitude ([`surface_offset`](crate::geometry::intersect::surface_offset)) for the benefit of other, touching
+//! point's magnitude ([`crate::geometry::intersect::surface_offset`]) for the benefit of other, touching
 //! surfaces. Paths stop after [`MAX_BOUNCES`] (a bias no render
 //! has shown: Russian roulette ends them long before).
 //! A path also ends where its throughput becomes zero (a black surface such

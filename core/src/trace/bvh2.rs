@@ -8,10 +8,10 @@
 //!
 //! It is made from a collapsed tree in depth-first order (what
 //! [`crate::construct::collapse`] writes: leaves of several primitives, `out_prims`
-//! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
+//! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`](crate::layouts::bvh2::bvh2_node_kernel)
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
-//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+//! climbing) and [`leaf_prims_kernel`](crate::layouts::bvh2::leaf_prims_kernel) (the primitives in leaf order).
 use glam::Vec3;
 
 use crate::geometry::buffers::{Bvh2Node, LeafPrim};

@@ -18,7 +18,7 @@
 //! must never cull a box the ray touches, whatever the rounding:
 //! * the builder rounds each child's box outwards to the grid, each plane
 //!   strictly beyond the box as f32 computes it, hence in real numbers too
-//!   ([`quantize_lo`], [`quantize_hi`]): the dequantized box `origin + q 2^e`
+//!   ([`quantize_lo`](crate::layouts::cwbvh::quantize_lo), [`quantize_hi`](crate::layouts::cwbvh::quantize_hi)): the dequantized box `origin + q 2^e`
 //!   contains the exact one;
 //! * the traversal computes a plane as `((origin - o) ± slack) + q 2^e`,
 //!   then `(…) * inv`: the rounding of `origin - o` is an error relative

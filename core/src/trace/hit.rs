@@ -6,15 +6,15 @@ use crate::geometry::intersect::MISS;
 use crate::geometry::prims::{Origin, Prims};
 
 /// A way to find closest hits: the scan, or a tree in one of the traversal
-/// layouts (the seed's 32-byte nodes here; [`crate::bvh2`],
-/// [`crate::cwbvh`]). The renderer and the ray-casting kernels are generic
+/// layouts (the seed's 32-byte nodes here; [`crate::trace::bvh2`],
+/// [`crate::trace::cwbvh`]). The renderer and the ray-casting kernels are generic
 /// over it, so each layout gets kernels of its own.
 pub trait ClosestHit {
     /// The closest hit of the ray `o + t d` (`d` of unit length) among the
-    /// primitives, ties to the lower index; `F` (see [`crate::features`])
+    /// primitives, ties to the lower index; `F` (see [`crate::geometry::features`])
     /// may leave out the test of a kind the scene lacks. `stack` is
     /// workgroup memory a traversal may keep the top of its stack in, at
-    /// `lane + WG * k` (see [`crate::cwbvh::closest_hit_cwbvh_with`]); a
+    /// `lane + WG * k` (see [`crate::trace::cwbvh::closest_hit_cwbvh_with`]); a
     /// one-word array means none.
     fn closest_hit<const F: u32, const S: usize>(
         &self,

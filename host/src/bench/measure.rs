@@ -6,7 +6,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::{Backend, StageTimes};
 use treelet::bvh::layout::Layout;
 use treelet::bvh::lbvh;
-use treelet::render::{render, Accel, Integrator, RenderSettings};
+use treelet::bvh::tree::Accel;
+use treelet::render::{render, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::{self, TreeletConfig};
 use treelet::render::variant::KernelChoice;
@@ -330,7 +331,7 @@ pub(crate) fn bench_rays<B: Backend>(
     all.check()?;
     let pixels = width as u64 * height as u64;
     anyhow::ensure!(pixels > 0 && pixels <= u32::MAX as u64 / 4, "image size {width}x{height} out of range");
-    let Some(built) = treelet::render::binary_tree(b, all, accel)? else { unreachable!("a tree was asked for") };
+    let Some(built) = treelet::bvh::tree::binary_tree(b, all, accel)? else { unreachable!("a tree was asked for") };
     let buffers = PrimBuffers::upload(b, all)?;
     let materials = b.upload("materials", &scene.materials)?;
     let rays = b.zeroed("rays", pixels * 32)?;

@@ -8,7 +8,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::bvh::layout::Layout;
-use treelet::render::Accel;
+use treelet::bvh::tree::Accel;
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 

@@ -7,7 +7,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::bvh::layout::Layout;
-use treelet::render::Accel;
+use treelet::bvh::tree::Accel;
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;

@@ -116,7 +116,8 @@ pub struct TracedTree<B: Backend> {
 /// Lays out `bvh`, a tree of one primitive per leaf in the LBVH layout (as
 /// the builders leave it), for tracing: `max_leaf` bounds the leaves of the
 /// binary layouts' SAH collapse (1: none, and `classic` then traces `bvh`
-/// as it is). Checks that the tree fits the traversal stack.
+/// as it is). `layout` must be resolved ([`Layout::resolve`]). Checks that
+/// the tree fits the traversal stack.
 pub fn lay_out<B: Backend>(
     b: &mut B,
     bvh: DeviceBvh<B>,
@@ -124,7 +125,10 @@ pub fn lay_out<B: Backend>(
     max_leaf: u32,
     prims: &PrimBuffers<B>,
 ) -> Result<TracedTree<B>> {
-    let layout = layout.resolve(b.class());
+    if layout == Layout::Auto {
+        // Resolved once, where the choice is made (the render's plan, or the caller).
+        bail!("internal: resolve the layout for the device (Layout::resolve) before laying out");
+    }
     if bvh.n == 0 {
         bail!("no primitives to lay out");
     }

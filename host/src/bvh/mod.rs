@@ -8,6 +8,8 @@
 //! - [`refit`]: new boxes for a tree whose primitives moved;
 //! - [`sweep`]: the full-sweep SAH tree on the CPU, the quality reference;
 //! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
+//! - [`tree`]: the tree a render or an engine asks for: the builder's
+//!   choice ([`tree::Accel`]), its binary tree, and that tree laid out;
 //! - [`validate`], [`validate_layout`]: independent checks that share no
 //!   code with the kernels;
 //! - [`report`]: one build, timed and checked (the `treelet build` command).
@@ -18,5 +20,6 @@ pub mod report;
 pub mod sort;
 pub mod sweep;
 pub mod trbvh;
+pub mod tree;
 pub mod validate;
 pub mod validate_layout;

@@ -8,7 +8,9 @@ use treelet_core::geometry::features;
 use treelet_core::render::variants::VARIANTS;
 
 use crate::bvh::layout::Layout;
+use crate::bvh::tree::Accel;
 use crate::runtime::backend::DeviceClass;
+use crate::runtime::kernels::Method;
 use crate::scene::Scene;
 
 /// What a scene contains.
@@ -188,7 +190,7 @@ pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, c
                 DeviceClass::CpuAdapter => "CPU Vulkan adapters (lavapipe)",
                 DeviceClass::CpuRunner => "the CPU runner",
             };
-            (chosen, format!("the layout that renders fastest on {on}, as measured (see `treelet::layout::Layout::resolve`)"))
+            (chosen, format!("the layout that renders fastest on {on}, as measured (see `treelet::bvh::layout::Layout::resolve`)"))
         }
         other => (other, "as asked (--layout)".to_string()),
     };
@@ -278,32 +280,13 @@ mod tests {
     }
 }
 
-/// How closest hits are found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Accel {
-    /// A linear scan for scenes below the measured crossover, else trbvh
-    /// (see `treelet::variant`).
-    Auto,
-    /// Test every primitive.
-    None,
-    /// Traverse the LBVH (Karras 2012).
-    Lbvh,
-    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
-    Trbvh,
-    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
-    Sweep,
-}
-
-impl Accel {
-    /// The word the command line takes (`--accel`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Accel::Auto => "auto",
-            Accel::None => "none",
-            Accel::Lbvh => "lbvh",
-            Accel::Trbvh => "trbvh",
-            Accel::Sweep => "sweep",
+impl Plan {
+    /// The closest-hit method of the render kernel.
+    pub fn method(&self) -> Method {
+        if self.accel == Accel::None {
+            Method::Scan
+        } else {
+            self.layout.method()
         }
     }
 }

@@ -3,7 +3,7 @@
 //!
 //! [`model`] is the scene itself and the built-in ones, [`primitives`] the
 //! spheres-then-triangles view a build takes (and its checks), [`mesh`]
-//! reads `.obj` / `.ply`, [`file`] reads JSON scene files, and [`spec`]
+//! reads `.obj` / `.ply`, [`file`](mod@file) reads JSON scene files, and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
 pub mod file;
 pub mod mesh;

@@ -207,9 +207,31 @@ impl GpuContext {
 
 /// A Vulkan instance (the backend Treelet's SPIR-V passthrough needs).
 fn instance() -> wgpu::Instance {
+    quiet_mesa_runtime_dir();
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
     desc.backends = wgpu::Backends::VULKAN;
     wgpu::Instance::new(desc)
+}
+
+/// Mesa's Vulkan drivers print `error: XDG_RUNTIME_DIR is invalid or not
+/// set` when the variable is missing (containers, ssh without a session),
+/// which reads as Treelet failing. Give them a private runtime directory,
+/// as a login session would. The `treelet` command calls it first thing;
+/// every Vulkan instance is made after it, so library users and tests get
+/// it too.
+pub fn quiet_mesa_runtime_dir() {
+    use std::os::unix::fs::PermissionsExt;
+    let usable = |d: &std::ffi::OsStr| std::path::Path::new(d).is_dir();
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| usable(&d)) {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_default();
+    let dir = std::env::temp_dir().join(format!("treelet-runtime-{user}"));
+    let made = std::fs::create_dir_all(&dir)
+        .and_then(|()| std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)));
+    if made.is_ok() {
+        std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    }
 }
 
 fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {

@@ -1,0 +1,126 @@
+//! The tree a render or an engine asks for: which builder ([`Accel`]), the
+//! binary tree it builds on the device ([`BuiltTree`]), and that tree laid
+//! out for tracing with the primitives' buffers ([`traced_tree`]).
+use anyhow::{bail, Result};
+use serde::Serialize;
+use treelet_core::geometry::buffers::Node;
+
+use crate::bvh::layout::{lay_out, Layout, PrimBuffers, TracedTree};
+use crate::bvh::lbvh;
+use crate::bvh::trbvh::{self, TreeletConfig};
+use crate::runtime::backend::{Backend, StageTimes};
+use crate::scene::primitives::Primitives;
+
+/// How closest hits are found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Accel {
+    /// A linear scan for scenes below the measured crossover, else trbvh
+    /// (see `treelet::render::variant::plan`).
+    Auto,
+    /// Test every primitive.
+    None,
+    /// Traverse the LBVH (Karras 2012).
+    Lbvh,
+    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
+    Trbvh,
+    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
+    Sweep,
+}
+
+impl Accel {
+    /// The word the command line takes (`--accel`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Auto => "auto",
+            Accel::None => "none",
+            Accel::Lbvh => "lbvh",
+            Accel::Trbvh => "trbvh",
+            Accel::Sweep => "sweep",
+        }
+    }
+}
+
+/// The tree `accel` traces for these primitives, on the device, laid out
+/// as `layout`, with the primitives' buffers (uploaded after the build, as
+/// the render and cast kernels bind them) and the build time (ms: device
+/// stages, or the CPU build of the sweep plus its layout on the device). The
+/// scan gets placeholders. `Accel::Auto` must have been resolved (see
+/// `treelet::render::variant::plan`).
+pub fn traced_tree<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    accel: Accel,
+    layout: Layout,
+) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
+    let Some(built) = binary_tree(b, all, accel)? else {
+        let buffers = PrimBuffers::upload(b, all)?;
+        let tree = TracedTree {
+            layout: Layout::Classic,
+            nodes: b.upload("no nodes", &[Node::default()])?,
+            prims: b.upload("no indices", &[0u32])?,
+            node_count: 0,
+        };
+        return Ok((tree, buffers, 0.0));
+    };
+    let buffers = PrimBuffers::upload(b, all)?;
+    let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
+    Ok((tree, buffers, built.build_ms + layout_ms))
+}
+
+/// A binary tree of one primitive per leaf, on the device, as a builder
+/// left it: what every traversal layout is made from.
+pub struct BuiltTree<B: Backend> {
+    pub bvh: lbvh::DeviceBvh<B>,
+    /// The largest leaf the binary layouts' SAH collapse makes (1: none).
+    pub max_leaf: u32,
+    /// Build time (ms): device stages, or the sweep's CPU build.
+    pub build_ms: f64,
+}
+
+impl<B: Backend> BuiltTree<B> {
+    /// Lays the tree out (it stays usable for other layouts); returns the
+    /// layout's device time (ms).
+    pub fn lay_out(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, f64)> {
+        let (tree, times) = self.lay_out_timed(b, layout, prims)?;
+        Ok((tree, times.total()))
+    }
+
+    /// [`BuiltTree::lay_out`] with the layout's stage times.
+    pub fn lay_out_timed(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, StageTimes)> {
+        b.take_times()?;
+        let tree = lay_out(b, self.bvh.clone(), layout, self.max_leaf, prims)?;
+        Ok((tree, b.take_times()?))
+    }
+}
+
+/// The binary tree `accel` traces (None for the scan): the LBVH as built,
+/// the TRBVH's restructured tree before its leaf collapse, or the full-sweep
+/// tree built on the CPU and uploaded. Starts a new build on `b`.
+pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<Option<BuiltTree<B>>> {
+    let config = TreeletConfig::default();
+    Ok(Some(match accel {
+        Accel::Auto => bail!("internal: --accel auto reached the tree builder unresolved"),
+        Accel::None => return Ok(None),
+        Accel::Lbvh | Accel::Trbvh => {
+            let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
+            let mut build_ms = times.total();
+            if accel == Accel::Trbvh {
+                let root = trbvh::root_box(b, &bvh)?;
+                let (restructured, times) = trbvh::restructure(b, bvh, &root, &config)?;
+                bvh = restructured;
+                build_ms += times.total();
+            }
+            // The LBVH is traced as built (one primitive per leaf).
+            let max_leaf = if accel == Accel::Trbvh { config.max_leaf } else { 1 };
+            BuiltTree { bvh, max_leaf, build_ms }
+        }
+        Accel::Sweep => {
+            let build = std::time::Instant::now();
+            let tree = crate::bvh::sweep::build_boxes(&all.boxes());
+            let build_ms = build.elapsed().as_secs_f64() * 1e3;
+            b.begin_build();
+            BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
+        }
+    }))
+}
