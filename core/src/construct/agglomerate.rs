@@ -2,8 +2,10 @@
 //! Agglomerative LBVH Construction", CGVC 2014.
 //!
 //! One invocation per leaf climbs as in [`crate::construct::fit`], but no radix tree is
-//! built first: a node covering the sorted keys `[l, r]` finds its parent by
-//! comparing the prefixes it shares with its two neighbours. It merges with
+//! built first, so there are no parent links to climb along (as
+//! [`crate::construct::climb::Climb`] does): a node covering the sorted keys
+//! `[l, r]` finds its parent by comparing the prefixes it shares with its
+//! two neighbours. It merges with
 //! the side whose neighbour shares the longer prefix: with the keys right of
 //! `r` when `δ(r, r+1) > δ(l-1, l)` (it is then a left child, and the parent's
 //! split is `r`), else with the keys left of `l` (a right child, split
@@ -11,13 +13,15 @@
 //!
 //! At the split's slot the first child to arrive leaves the far end of its
 //! range and stops; the second swaps in its own, so learns the sibling's
-//! range, and so the parent's. This yields the binary radix tree of
+//! range, and so the parent's
+//! ([`crate::construct::climb::second_arrival_exchange`]). This yields the binary radix tree of
 //! Karras 2012 (`crate::construct::radix_tree`) *with its node numbering*: a left child
 //! covering `[l, γ]` is node `γ`, a right child covering `[γ+1, r]` is node
 //! `γ+1`, the root is node 0 and a one-key range is a leaf. So everything
 //! after the build sees the same nodes, bit for bit, as after radix tree plus
 //! fit, from one dispatch instead of two and with half the box reads of the
 //! fit (the sibling's box only; the climber keeps its own).
+use crate::construct::climb::second_arrival_exchange;
 use crate::construct::fit::{load_box, store_box, write_leaf};
 use crate::construct::radix_tree::{delta, leaf_node};
 use crate::geometry::aabb::Aabb;
@@ -79,15 +83,12 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
     loop {
         let split = if left_child { r } else { l - 1 };
         let far = if left_child { l } else { r };
-        let previous = if ORDERED {
-            crate::gpu::atomics::exchange_device_acq_rel(&mut ends[split as usize], far + 1)
-        } else {
-            crate::gpu::atomics::exchange_device(&mut ends[split as usize], far + 1)
-        };
-        if previous == 0 {
+        // The arrival is the climb's (first stops, second goes on), but
+        // at the split, whose node is not known yet, and it hands over the
+        // first child's far end.
+        let Some(other) = second_arrival_exchange::<ORDERED>(&mut ends[split as usize], far) else {
             return; // The sibling's invocation will finish the parent.
-        }
-        let other = previous - 1;
+        };
         // The sibling covers the rest of the parent's range.
         let (lo, hi, sibling) = if left_child {
             (l, other, node_index(n, split + 1, other, false))

@@ -1,12 +1,13 @@
 //! Bottom-up bounds (Karras 2012, section 4): one invocation per leaf writes
-//! its leaf, then climbs towards the root. At each internal node an atomic
-//! counter lets the first arrival stop and the second, which knows both
-//! children are done, write the union of their boxes and go on. Every
-//! internal node is thus written exactly once, by the last of its children.
+//! its leaf, then climbs towards the root ([`crate::construct::climb`]): at
+//! each internal node the second of its children's invocations to arrive,
+//! which knows both children are done, writes the union of their boxes and
+//! goes on. Every internal node is thus written exactly once.
 //!
 //! On the GPU the boxes cross invocations, so they are written and read with
 //! device-scope atomics (under the Vulkan memory model plain accesses would
 //! not be made visible), ordered by the counter's acquire-release semantics.
+use crate::construct::climb::Climb;
 use crate::construct::radix_tree::leaf_node;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
@@ -28,16 +29,6 @@ pub(crate) fn load_box(node: &Node) -> Aabb {
         b.max[k] = atomics::load_f32(&node.max[k]);
     }
     b
-}
-
-/// One child's arrival at its parent during a bottom-up climb: true for the
-/// second of the two children, which then knows both subtrees are done.
-/// `ORDERED` releases this subtree's writes and acquires the sibling's
-/// (see [`atomics::add_device_acq_rel`] for the device that needs it relaxed).
-#[inline]
-pub fn second_arrival<const ORDERED: bool>(counter: &mut u32) -> bool {
-    let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
-    previous != 0
 }
 
 /// Writes leaf `i` (sorted position) of `n` and its box, which it returns;
@@ -77,19 +68,15 @@ pub fn fit_kernel<const ORDERED: bool>(
         return;
     }
     // The climber keeps its subtree's box and reads only the sibling's.
-    let (mut current, mut own) = (leaf_node(n, i), b);
-    while current != 0 {
-        let parent = parents[current as usize];
-        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
-            return; // The sibling's invocation will finish this node.
-        }
+    let mut own = b;
+    let mut climb = Climb::<ORDERED>::new(leaf_node(n, i));
+    while let Some(parent) = climb.next(parents, flags) {
         let (left, right) = (nodes[parent as usize].left, nodes[parent as usize].right);
-        own = if left == current {
+        own = if left == climb.child() {
             own.union(&load_box(&nodes[right as usize]))
         } else {
             load_box(&nodes[left as usize]).union(&own)
         };
         store_box(&mut nodes[parent as usize], &own);
-        current = parent;
     }
 }

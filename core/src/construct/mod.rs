@@ -9,6 +9,7 @@
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
 //! | sort | [`sort`], [`scan`] | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
+//! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`] | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
 //! | hierarchy and boxes in one pass | [`agglomerate`] | Apetrei 2014 |
 //! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
@@ -22,6 +23,7 @@
 //! Morton order) at index `n - 1 + j`.
 pub mod agglomerate;
 pub mod bounds;
+pub mod climb;
 pub mod collapse;
 pub mod fill;
 pub mod fit;

@@ -26,14 +26,15 @@
 //! rewiring 2 µs. Global reads are unchecked (`crate::gpu::unchecked`): a bounds
 //! check's branch kept the GPU from issuing the next load before the last
 //! one returned, which made forming 12 µs.
-use crate::construct::fit::second_arrival;
+use crate::construct::climb::Climb;
 use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{WG, WORKGROUP_SIZE};
 
-/// Kernel (one invocation per leaf, climbing like [`crate::construct::fit`]): writes
+/// Kernel (one invocation per leaf, climbing with [`Climb`] as
+/// [`crate::construct::fit`] does): writes
 /// every node's primitive count, subtree SAH cost and height (leaves 0), and
 /// its number of leaves after the final collapse (1 where it collapses), an
 /// internal node once both children are done. `flags` are zeroed counters.
@@ -62,12 +63,8 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, node.prim_count(), (0.0, 0.0), &costs));
     atomics::store_u32(&mut heights[leaf as usize], 0);
     atomics::store_u32(&mut tree_leaves[leaf as usize], 1);
-    let mut current = leaf;
-    while current != 0 {
-        let parent = parents[current as usize];
-        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
-            return;
-        }
+    let mut climb = Climb::<ORDERED>::new(leaf);
+    while let Some(parent) = climb.next(parents, flags) {
         let p = nodes[parent as usize];
         let (l, r) = (p.left as usize, p.right as usize);
         let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
@@ -83,7 +80,6 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
         atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
         atomics::store_u32(&mut heights[parent as usize], height);
         atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
-        current = parent;
     }
 }
 

@@ -3,7 +3,7 @@
 //! leave, before their leaf collapse), after Ylitie, Karras & Laine 2017,
 //! section 4.
 //!
-//! 1. [`wide_dp_kernel`], bottom up (climbing like [`crate::construct::fit`]): for
+//! 1. [`wide_dp_kernel`], bottom up (climbing with [`Climb`]): for
 //!    every binary node `n` and `i = 1..=8`, the SAH cost `C(n, i)` of
 //!    representing `n`'s subtree by at most `i` children of a wide node:
 //!    * `C(n, 1)`: `n` as one leaf child (at most 3 primitives, cost
@@ -32,7 +32,7 @@
 //!
 //! No step depends on the order invocations run in, so the CPU runner
 //! builds the same tree (up to the rounding of the DP's sums, fused or not).
-use crate::construct::fit::second_arrival;
+use crate::construct::climb::Climb;
 use crate::construct::treelet::TreeletCosts;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{LayoutParams, LeafPrim, Node, Sphere, WideNode};
@@ -98,12 +98,8 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
     }
     atomics::store_u32(&mut decisions[2 * leaf as usize], LEAF);
     atomics::store_u32(&mut decisions[2 * leaf as usize + 1], 0);
-    let mut current = leaf;
-    while current != 0 {
-        let parent = parents[current as usize];
-        if !second_arrival::<ORDERED>(&mut flags[parent as usize]) {
-            return;
-        }
+    let mut climb = Climb::<ORDERED>::new(leaf);
+    while let Some(parent) = climb.next(parents, flags) {
         let p = nodes[parent as usize];
         let (l, r) = (p.left as usize, p.right as usize);
         let mut left = [0f32; WIDTH];
@@ -162,7 +158,6 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
         let high = bytes[4] | bytes[5] << 8 | bytes[6] << 16 | bytes[7] << 24;
         atomics::store_u32(&mut decisions[2 * parent_index], low);
         atomics::store_u32(&mut decisions[2 * parent_index + 1], high);
-        current = parent;
     }
 }
 
