@@ -3,7 +3,7 @@
 //! (and where the CPU runner and the tests call it too).
 //!
 //! Binding 0 of every entry point is its parameter struct; the host's kernel
-//! table (`treelet::gpu::kernels`) lists the rest in the same order.
+//! table (`treelet::runtime::kernels`) lists the rest in the same order.
 #![cfg_attr(target_arch = "spirv", no_std)]
 
 pub mod bounds;

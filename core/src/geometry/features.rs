@@ -6,7 +6,7 @@
 //!
 //! Diffuse surfaces and emission are always compiled: every scene has them
 //! (the light, the walls). A kernel may only be run on a scene whose
-//! features it contains: the host chooses (see `treelet::variant`).
+//! features it contains: the host chooses (see `treelet::render::variant`).
 
 /// The scene has spheres.
 pub const SPHERES: u32 = 1;
