@@ -6,15 +6,13 @@ use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
 use treelet_core::render::lights::Light;
-use treelet_core::render::variants::VARIANTS;
 use treelet_core::trace::bvh2::Bvh2Tree;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
-/// `treelet_core::render::variants::VARIANTS`, whose names these must match: the
-/// feature sets come from it by index). The stack stays private.
+/// `treelet_core::for_each_render_variant!`). The stack stays private.
 macro_rules! render_kernel {
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
@@ -40,30 +38,26 @@ macro_rules! render_kernel {
     };
 }
 
-const _: () = assert!(VARIANTS.len() == 6, "three lines per variant");
+/// The render entry points of every variant of
+/// `treelet_core::for_each_render_variant!`: a module per variant
+/// (`render::<variant>::`) with the scan and the two layouts `auto` picks.
+macro_rules! render_entry_points {
+    ([] $($i:literal $name:ident [$($f:path),*];)*) => {
+        $(
+            pub mod $name {
+                use super::*;
+                render_kernel!(linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                render_kernel!(bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, 0 $(| $f)*);
+                render_kernel!(cwbvh_cs, WideNode, LeafPrim, WideTree::new, 0 $(| $f)*);
+            }
+        )*
+    };
+}
+treelet_core::for_each_render_variant!(render_entry_points);
 
-// The scan and the two layouts `auto` picks, per feature set (in the order
-// of `VARIANTS`).
-render_kernel!(render_linear_spheres_diffuse_cs, Node, u32, Scan::new, VARIANTS[0].0);
-render_kernel!(render_bvh2_spheres_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[0].0);
-render_kernel!(render_cwbvh_spheres_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[0].0);
-render_kernel!(render_linear_spheres_mirror_cs, Node, u32, Scan::new, VARIANTS[1].0);
-render_kernel!(render_bvh2_spheres_mirror_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[1].0);
-render_kernel!(render_cwbvh_spheres_mirror_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[1].0);
-render_kernel!(render_linear_spheres_cs, Node, u32, Scan::new, VARIANTS[2].0);
-render_kernel!(render_bvh2_spheres_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[2].0);
-render_kernel!(render_cwbvh_spheres_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[2].0);
-render_kernel!(render_linear_triangles_diffuse_cs, Node, u32, Scan::new, VARIANTS[3].0);
-render_kernel!(render_bvh2_triangles_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[3].0);
-render_kernel!(render_cwbvh_triangles_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[3].0);
-render_kernel!(render_linear_mixed_diffuse_cs, Node, u32, Scan::new, VARIANTS[4].0);
-render_kernel!(render_bvh2_mixed_diffuse_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[4].0);
-render_kernel!(render_cwbvh_mixed_diffuse_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[4].0);
-render_kernel!(render_linear_full_cs, Node, u32, Scan::new, VARIANTS[5].0);
-render_kernel!(render_bvh2_full_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, VARIANTS[5].0);
-render_kernel!(render_cwbvh_full_cs, WideNode, LeafPrim, WideTree::new, VARIANTS[5].0);
-// The seed's layout, kept for comparison: the general kernel only.
-render_kernel!(render_classic_full_cs, Node, u32, ClassicTree::new, ALL);
+// The seed's layout, kept for comparison: the general kernel only
+// (`render::classic_cs`).
+render_kernel!(classic_cs, Node, u32, ClassicTree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
 /// through one layout (`$tree` from bindings 3 and 4), its stack private,

@@ -1,16 +1,53 @@
-//! The render kernel variants: which feature sets the shader crate compiles
-//! render kernels for.
-use crate::geometry::features::{ALL, GLASS, MIRROR, SPHERES, TRIANGLES};
+//! The render kernel variants: the feature sets the shader crate compiles
+//! render kernels for, listed once ([`for_each_render_variant!`]). The
+//! shader's entry points, the host's kernel names and the CPU runner's
+//! dispatch are all expanded from that list, so a new variant is one line.
 
-/// The feature sets the shader crate compiles render kernels for (each
-/// with a linear scan and with a BVH), with the names of their entry points
-/// (`render::render_{linear,bvh}_<name>_cs`). A scene runs the smallest
-/// set that contains its features; [`ALL`] (the general kernel) is last.
-pub const VARIANTS: [(u32, &str); 6] = [
-    (SPHERES, "spheres_diffuse"),
-    (SPHERES | MIRROR, "spheres_mirror"),
-    (SPHERES | MIRROR | GLASS, "spheres"),
-    (TRIANGLES, "triangles_diffuse"),
-    (SPHERES | TRIANGLES, "mixed_diffuse"),
-    (ALL, "full"),
-];
+/// Calls `$callback!` with the one list of render variants, as
+/// `[extra args] index name [feature, ...]; ...`, in the order of
+/// [`VARIANTS`]; the features are paths to the bits of
+/// [`crate::geometry::features`]. A scene runs the smallest set that
+/// contains its features; the general kernel (every feature) is last.
+///
+/// Entry points are named after the variant: the shader crate makes
+/// `render::<name>::{linear,bvh2,cwbvh}_cs` (and `render::full::classic_cs`).
+#[macro_export]
+macro_rules! for_each_render_variant {
+    ($callback:ident $(, $arg:tt)*) => {
+        $callback! {
+            [$($arg),*]
+            0 spheres_diffuse [$crate::geometry::features::SPHERES];
+            1 spheres_mirror [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR];
+            2 spheres [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS];
+            3 triangles_diffuse [$crate::geometry::features::TRIANGLES];
+            4 mixed_diffuse [$crate::geometry::features::SPHERES, $crate::geometry::features::TRIANGLES];
+            5 full [$crate::geometry::features::ALL];
+        }
+    };
+}
+
+/// Expands the list into [`VARIANTS`].
+macro_rules! variants_table {
+    ([] $($i:literal $name:ident [$($f:path),*];)*) => {
+        /// The feature sets of [`for_each_render_variant!`] with their names,
+        /// in its order.
+        pub const VARIANTS: [(u32, &str); [$($i),*].len()] = [$((0 $(| $f)*, stringify!($name))),*];
+    };
+}
+for_each_render_variant!(variants_table);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::features::ALL;
+
+    #[test]
+    fn indices_follow_the_list_and_the_general_kernel_is_last() {
+        macro_rules! indices {
+            ([] $($i:literal $name:ident [$($f:path),*];)*) => { [$($i),*] };
+        }
+        let indices = for_each_render_variant!(indices);
+        assert!(indices.iter().enumerate().all(|(k, &i)| k == i), "{indices:?}");
+        assert_eq!(VARIANTS.last().unwrap().0, ALL);
+    }
+}

@@ -11,6 +11,8 @@ use treelet::render::{render, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::{self, TreeletConfig};
 use treelet::render::variant::KernelChoice;
+use treelet::runtime::kernels::{render_entry_point_name, Method};
+use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
 
 /// Where a benchmark runs.
@@ -134,9 +136,10 @@ pub(crate) fn bench_variants<B: Backend>(
             }
         }
         let entry = |name: &str| {
-            let method = if accel == Accel::None { "linear" } else { Layout::Auto.resolve(b.class()).method().name() };
+            let method = if accel == Accel::None { Method::Scan } else { Layout::Auto.resolve(b.class()).method() };
+            let variant = VARIANTS.iter().position(|&(_, v)| v == name)?;
             (b.device_kind() == "gpu")
-                .then(|| treelet::runtime::gpu::context::entry_point_words(&format!("render::render_{method}_{name}_cs")))
+                .then(|| treelet::runtime::gpu::context::entry_point_words(&render_entry_point_name(method, variant)))
                 .flatten()
         };
         let (kernel_s, full_s) = (median(auto), median(full));

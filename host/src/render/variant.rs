@@ -151,7 +151,7 @@ pub struct Plan {
     /// Index into `VARIANTS`.
     #[serde(skip)]
     pub variant: usize,
-    /// Entry-point name of the variant (`render_{linear,bvh}_<name>_cs`).
+    /// Name of the variant (entry points `render::<name>::<method>_cs`).
     pub kernel: &'static str,
     pub kernel_features: String,
     pub kernel_reason: String,

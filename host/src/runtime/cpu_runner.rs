@@ -81,16 +81,17 @@ fn render_variant<T: ClosestHit>(
     scene: &SceneRefs<T>,
     lights: &[Light],
 ) -> [f32; 4] {
-    const _: () = assert!(VARIANTS.len() == 6, "one arm per variant");
     let stack = &mut [0u32; 1];
-    match v {
-        0 => render_pixel::<T, { VARIANTS[0].0 }, 1>(id, p, scene, lights, stack, 0),
-        1 => render_pixel::<T, { VARIANTS[1].0 }, 1>(id, p, scene, lights, stack, 0),
-        2 => render_pixel::<T, { VARIANTS[2].0 }, 1>(id, p, scene, lights, stack, 0),
-        3 => render_pixel::<T, { VARIANTS[3].0 }, 1>(id, p, scene, lights, stack, 0),
-        4 => render_pixel::<T, { VARIANTS[4].0 }, 1>(id, p, scene, lights, stack, 0),
-        _ => render_pixel::<T, { VARIANTS[5].0 }, 1>(id, p, scene, lights, stack, 0),
+    // One arm per variant of the one list (`for_each_render_variant!`).
+    macro_rules! arms {
+        ([$v:ident] $($i:literal $name:ident [$($f:path),*];)*) => {
+            match $v {
+                $($i => render_pixel::<T, { 0 $(| $f)* }, 1>(id, p, scene, lights, stack, 0),)*
+                _ => panic!("render variant {} of {}", $v, VARIANTS.len()),
+            }
+        };
     }
+    treelet_core::for_each_render_variant!(arms, v)
 }
 
 /// Every pixel of a render dispatch (pixels are independent: the one

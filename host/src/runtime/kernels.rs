@@ -22,7 +22,7 @@ pub enum Method {
 }
 
 impl Method {
-    /// The name in entry points (`render::render_<name>_<variant>_cs`).
+    /// The name in entry points (`render::<variant>::<name>_cs`).
     pub fn name(self) -> &'static str {
         match self {
             Method::Scan => "linear",
@@ -43,15 +43,21 @@ impl Method {
     pub const ALL: [Method; 4] = [Method::Scan, Method::Classic, Method::Bvh2, Method::Cwbvh];
 }
 
-/// Entry point of render kernel `(method, variant)`, named from
-/// `VARIANTS` as the shader crate's `render_kernel!` lines are.
+/// Entry point of render kernel `(method, variant)`, as the shader crate
+/// names the modules it makes from `treelet_core::for_each_render_variant!`:
+/// `render::<variant>::<method>_cs`; the seed's layout has the general
+/// kernel only, `render::classic_cs`.
+pub fn render_entry_point_name(method: Method, variant: usize) -> String {
+    match method {
+        Method::Classic => "render::classic_cs".to_string(),
+        _ => format!("render::{}::{}_cs", VARIANTS[variant].1, method.name()),
+    }
+}
+
 fn render_entry_point(method: Method, variant: u8) -> &'static str {
     static NAMES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
     let names = NAMES.get_or_init(|| {
-        Method::ALL
-            .iter()
-            .flat_map(|m| VARIANTS.iter().map(move |(_, v)| format!("render::render_{}_{v}_cs", m.name())))
-            .collect()
+        Method::ALL.iter().flat_map(|&m| (0..VARIANTS.len()).map(move |v| render_entry_point_name(m, v))).collect()
     });
     let m = Method::ALL.iter().position(|&x| x == method).unwrap();
     &names[m * VARIANTS.len() + variant as usize]
