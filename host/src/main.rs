@@ -1,11 +1,12 @@
 //! `treelet`: build BVHs, trace and render them, on the GPU or the CPU.
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::device::{Device, DeviceChoice};
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::render::image_io;
 use treelet::bvh::layout::Layout;
@@ -27,35 +28,6 @@ struct Cli {
 }
 
 
-/// Where `render` and `build` run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum RunOn {
-    /// The first Vulkan adapter; the CPU runner when there is none.
-    Auto,
-    /// A Vulkan adapter (a GPU, or lavapipe on CPU cores); an error when there is none.
-    Gpu,
-    /// The CPU runner: the same kernels over every invocation id, with rayon.
-    Cpu,
-}
-
-impl RunOn {
-    /// The GPU context to run on, or None for the CPU runner.
-    fn open(self) -> Result<Option<std::sync::Arc<GpuContext>>> {
-        match self {
-            RunOn::Gpu => Ok(Some(GpuContext::new().context("--device gpu (--device auto or cpu run on the CPU runner)")?)),
-            RunOn::Cpu => Ok(None),
-            RunOn::Auto => match GpuContext::new() {
-                Ok(ctx) => Ok(Some(ctx)),
-                Err(e) => {
-                    // The outermost message only: it says what is missing and how to get it.
-                    eprintln!("note: {e}: running on the CPU runner instead (--device cpu skips this note)");
-                    Ok(None)
-                }
-            },
-        }
-    }
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Builder {
     /// Karras 2012, on the chosen device.
@@ -76,7 +48,7 @@ enum Command {
         #[arg(long, value_enum, default_value = "lbvh")]
         builder: Builder,
         #[arg(long, value_enum, default_value = "auto")]
-        device: RunOn,
+        device: DeviceChoice,
         /// Treelet optimization rounds (trbvh).
         #[arg(long, default_value_t = TreeletConfig::default().rounds)]
         rounds: u32,
@@ -156,7 +128,7 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "nee")]
     integrator: Integrator,
     #[arg(long, value_enum, default_value = "auto")]
-    device: RunOn,
+    device: DeviceChoice,
     /// Render on several devices at once, each taking chunks of samples as
     /// it finishes the last: all (every Vulkan adapter; the CPU runner where
     /// there is none: beside a GPU or lavapipe it slowed renders, measured),
@@ -242,7 +214,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
     };
     let (result, device, adapter, startup) = match args.device.open()? {
-        Some(ctx) => {
+        Device::Gpu(ctx) => {
             let mut b = GpuBackend::new(ctx.clone());
             explain(&|| b.class());
             let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
@@ -256,7 +228,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             });
             (r, "gpu", b.adapter(), startup)
         }
-        None => {
+        Device::Cpu => {
             let mut b = CpuBackend::new();
             explain(&|| b.class());
             (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into(), serde_json::Value::Null)
@@ -428,12 +400,9 @@ fn run(cli: Cli) -> Result<bool> {
             let scene = Scene::from_spec(&scene)?;
             let treelets = (builder == Builder::Trbvh).then_some(&config);
             let (_, report) = match (builder, device) {
-                (Builder::Sweep, RunOn::Gpu) => anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu"),
+                (Builder::Sweep, DeviceChoice::Gpu) => anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu"),
                 (Builder::Sweep, _) => run_build_sweep(&scene, max_leaf)?,
-                (_, _) => match device.open()? {
-                    Some(ctx) => run_build(&mut GpuBackend::new(ctx), &scene, treelets)?,
-                    None => run_build(&mut CpuBackend::new(), &scene, treelets)?,
-                },
+                (_, _) => treelet::with_backend!(device.open()?, |b| run_build(b, &scene, treelets)?),
             };
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

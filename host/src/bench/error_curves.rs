@@ -12,12 +12,11 @@ use treelet::bvh::layout::Layout;
 use treelet::render::variant::KernelChoice;
 use treelet::bvh::tree::Accel;
 use treelet::render::{render, Integrator, RenderSettings};
-use treelet::runtime::cpu_runner::CpuBackend;
-use treelet::runtime::gpu::GpuBackend;
 use treelet::scene::Scene;
 
-use super::figure::{bar, doc, with_backend, Figure, FigureDoc, Point, Runner, Suite, ERROR_KERNEL};
+use super::figure::{bar, doc, Figure, FigureDoc, Point, Suite, ERROR_KERNEL};
 use super::measure::median;
+use treelet::runtime::device::Device;
 use treelet::render::image_io::{self, HdrImage};
 use anyhow::bail;
 use treelet::render::{image_error, PassRow};
@@ -27,7 +26,7 @@ use treelet::render::{image_error, PassRow};
 const SCENES: [(&str, &str); 2] = [("cornell", "cornell"), ("room_disk", "scenes/room_disk.json")];
 
 /// Both figures: against wall time, then against kernel time.
-pub(crate) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
+pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
     let (w, h, spp, reference_spp) = if s.quick { (128, 96, 256, 2048) } else { (1024, 768, 1024, 4096) };
     let mut wall = doc(Figure::Error, &format!("RMSE against wall time, {w}x{h}"), "wall time (s)", "RMSE against the reference", (true, true));
     let mut kernel = doc(Figure::Error, &format!("RMSE against kernel time, {w}x{h}"), "kernel time (s)", "RMSE against the reference", (true, true));
@@ -50,7 +49,7 @@ pub(crate) fn measure(s: &Suite, runner: &Runner) -> Result<Vec<FigureDoc>> {
             error_each_pass,
             first_sample: 0,
         };
-        with_backend!(runner, |b| {
+        treelet::with_backend!(runner, |b| {
             pb.set_message(format!("{name}: reference, {reference_spp} spp"));
             let reference = render(b, &scene, &settings(Integrator::Nee, reference_spp, 99, false), None, |_| {})?.image;
             let path = s.out.join(format!("error_reference_{name}.exr"));

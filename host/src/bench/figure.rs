@@ -6,9 +6,9 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use treelet::plot::{chart, Chart, Series};
-use treelet::runtime::gpu::GpuContext;
 
-use super::measure::{median, Device};
+use super::measure::median;
+use treelet::runtime::device::DeviceChoice;
 
 /// The file name of `bench error`'s second figure, against kernel time.
 pub(crate) const ERROR_KERNEL: &str = "error-kernel";
@@ -130,7 +130,7 @@ pub struct FigureDoc {
 
 /// What every figure runs on.
 pub struct Suite {
-    pub device: Device,
+    pub device: DeviceChoice,
     pub quick: bool,
     pub out: PathBuf,
     pub repeats: usize,
@@ -138,27 +138,6 @@ pub struct Suite {
     pub mitsuba: Option<PathBuf>,
 }
 
-/// A backend for the suite's device (the GPU context is made once).
-pub(crate) enum Runner {
-    Gpu(std::sync::Arc<GpuContext>),
-    Cpu,
-}
-
-macro_rules! with_backend {
-    ($runner:expr, |$b:ident| $body:expr) => {
-        match $runner {
-            Runner::Gpu(ctx) => {
-                let $b = &mut GpuBackend::new(ctx.clone());
-                $body
-            }
-            Runner::Cpu => {
-                let $b = &mut CpuBackend::new();
-                $body
-            }
-        }
-    };
-}
-pub(crate) use with_backend;
 
 pub(crate) fn write_figure(dir: &Path, doc: &FigureDoc) -> Result<()> {
     let json = dir.join(format!("{}.json", doc.figure));

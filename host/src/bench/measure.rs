@@ -15,13 +15,6 @@ use treelet::runtime::kernels::{render_entry_point_name, Method};
 use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
 
-/// Where a benchmark runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Device {
-    Gpu,
-    Cpu,
-}
-
 /// One build on the device, the tree left there (as in a renderer).
 pub(crate) fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&TreeletConfig>) -> Result<StageTimes> {
     let (bvh, mut times) = lbvh::build_on_device(b, spheres)?;

@@ -6,14 +6,14 @@ use anyhow::Result;
 use clap::Subcommand;
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
-use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
 use treelet::bvh::tree::Accel;
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 
 use figure::{Figure, Suite};
-pub use measure::Device;
+use treelet::runtime::device::{Device, DeviceChoice};
 use measure::*;
 
 mod error_curves;
@@ -26,7 +26,7 @@ mod suite;
 #[derive(clap::Args, Clone)]
 pub struct FigureArgs {
     #[arg(long, value_enum, default_value = "gpu")]
-    device: Device,
+    device: DeviceChoice,
     /// Small sizes: minutes on lavapipe or a CPU (default: the seed's sizes and beyond).
     #[arg(long)]
     quick: bool,
@@ -96,7 +96,7 @@ pub enum BenchCommand {
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
         sizes: Vec<usize>,
         #[arg(long, value_enum, default_value = "gpu")]
-        device: Device,
+        device: DeviceChoice,
         /// Timed repeats per size (after half a second of warm-up builds).
         #[arg(long, default_value_t = 7)]
         repeats: usize,
@@ -126,7 +126,7 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 768)]
         height: u32,
         #[arg(long, value_enum, default_value = "gpu")]
-        device: Device,
+        device: DeviceChoice,
         /// Timed repeats (median reported), after one warm-up pass.
         #[arg(long, default_value_t = 7)]
         repeats: usize,
@@ -140,7 +140,7 @@ pub enum BenchCommand {
     /// render-kernel time per scene, and each kernel's SPIR-V size.
     Variants {
         #[arg(long, value_enum, default_value = "gpu")]
-        device: Device,
+        device: DeviceChoice,
         /// 256x192 at 16 spp instead of 1024x768 at 64 (for a CPU or lavapipe).
         #[arg(long)]
         quick: bool,
@@ -156,7 +156,7 @@ pub enum BenchCommand {
     /// random:N at 4 spp with each closest-hit method.
     Render {
         #[arg(long, value_enum, default_value = "gpu")]
-        device: Device,
+        device: DeviceChoice,
         /// Small sizes, for a CPU or lavapipe.
         #[arg(long)]
         quick: bool,
@@ -204,9 +204,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             let scene = if mesh_only { scene.mesh_only()? } else { scene };
             let plan = RaysPlan { layouts, workgroup_stack };
             let mut rows = Vec::new();
-            let adapter = match device {
-                Device::Gpu => {
-                    let mut b = GpuBackend::new(GpuContext::new()?);
+            let adapter = match device.open()? {
+                Device::Gpu(ctx) => {
+                    let mut b = GpuBackend::new(ctx);
                     for &a in &accels {
                         rows.extend(bench_rays(&mut b, &scene, a, &plan, (width, height), repeats)?);
                     }
@@ -265,9 +265,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         }
         BenchCommand::Variants { device, quick, scenes, repeats, json } => {
             let size = if quick { (256, 192, 16) } else { (1024, 768, 64) };
-            let (adapter, rows) = match device {
-                Device::Gpu => {
-                    let mut b = GpuBackend::new(GpuContext::new()?);
+            let (adapter, rows) = match device.open()? {
+                Device::Gpu(ctx) => {
+                    let mut b = GpuBackend::new(ctx);
                     (b.adapter(), bench_variants(&mut b, &scenes, size, repeats)?)
                 }
                 Device::Cpu => ("cpu".to_string(), bench_variants(&mut CpuBackend::new(), &scenes, size, repeats)?),
@@ -310,9 +310,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 }),
                 accels,
             };
-            let (adapter, (graph1, graph2)) = match device {
-                Device::Gpu => {
-                    let mut b = GpuBackend::new(GpuContext::new()?);
+            let (adapter, (graph1, graph2)) = match device.open()? {
+                Device::Gpu(ctx) => {
+                    let mut b = GpuBackend::new(ctx);
                     (b.adapter(), render_sweeps(&mut b, &sweep)?)
                 }
                 Device::Cpu => (CpuBackend::new().adapter(), render_sweeps(&mut CpuBackend::new(), &sweep)?),
@@ -328,9 +328,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
             let treelets = (builder == TreeBuilder::Trbvh).then_some(&config);
-            let (adapter, timing, rows) = match device {
-                Device::Gpu => {
-                    let mut b = GpuBackend::new(GpuContext::new()?).with_per_kernel_times(per_kernel);
+            let (adapter, timing, rows) = match device.open()? {
+                Device::Gpu(ctx) => {
+                    let mut b = GpuBackend::new(ctx).with_per_kernel_times(per_kernel);
                     let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
                     (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats, treelets)?)
                 }

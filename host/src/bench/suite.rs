@@ -5,7 +5,7 @@
 use anyhow::{Context, Result};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
-use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
 use treelet::bvh::tree::Accel;
 use treelet::scene::{random_spheres, Scene};
@@ -13,8 +13,9 @@ use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;
 
 use super::error_curves;
-use super::figure::{bar, doc, print_table, with_backend, write_figure, Figure, FigureDoc, Point, Runner, Suite};
-use super::measure::{bench_rays, bench_render_kernel, bench_sizes, median, Device, RaysPlan};
+use super::figure::{bar, doc, print_table, write_figure, Figure, FigureDoc, Point, Suite};
+use super::measure::{bench_rays, bench_render_kernel, bench_sizes, median, RaysPlan};
+use treelet::runtime::device::Device;
 
 /// CUB's sort times on the H100 (`peers/cub`), a reference series of
 /// graph 2.5 and 3.5.
@@ -23,14 +24,8 @@ const CUB_SORT_H100: &str = include_str!("../../../docs/results/h100-sort/cub_so
 
 pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
     std::fs::create_dir_all(&suite.out).with_context(|| format!("creating {}", suite.out.display()))?;
-    let runner = match suite.device {
-        Device::Gpu => Runner::Gpu(GpuContext::new()?),
-        Device::Cpu => Runner::Cpu,
-    };
-    let adapter = match &runner {
-        Runner::Gpu(ctx) => ctx.info.name.clone(),
-        Runner::Cpu => "cpu".to_string(),
-    };
+    let runner = suite.device.open()?;
+    let adapter = runner.name();
     let figures: Vec<Figure> = if figure == Figure::All { Figure::EACH.to_vec() } else { vec![figure] };
     let mut docs = Vec::new();
     for f in figures {
@@ -105,7 +100,7 @@ fn accel_name(a: Accel) -> &'static str {
     }
 }
 
-fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
+fn measure(figure: Figure, s: &Suite, runner: &Device) -> Result<FigureDoc> {
     let q = s.quick;
     let r = s.repeats;
     match figure {
@@ -117,7 +112,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             d.parameters = serde_json::json!({ "scene": "cornell", "width": size.0, "height": size.1, "gpu_spp": gpu_spp, "cpu_spp": cpu_spp });
             let cornell = Scene::from_spec("cornell")?;
             let pb = bar(gpu_spp.len() + cpu_spp.len(), "renders");
-            if let Runner::Gpu(ctx) = runner {
+            if let Device::Gpu(ctx) = runner {
                 let b = &mut GpuBackend::new(ctx.clone());
                 for &spp in &gpu_spp {
                     d.points.push(Point::of(format!("GPU ({})", ctx.info.name), spp as f64, &render_times(b, &cornell, (size.0, size.1, spp), (Accel::Auto, Layout::Auto), r)?));
@@ -154,7 +149,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             let mut d = doc(figure, title, "spheres (N, plus the 9 of the room)", "render-kernel time (s)", (true, true));
             d.parameters = serde_json::json!({ "width": size.0, "height": size.1, "spp": size.2, "sizes": sizes });
             let pb = bar(sizes.len() * accels.len(), "renders");
-            with_backend!(runner, |b| {
+            treelet::with_backend!(runner, |b| {
                 for &n in &sizes {
                     let scene = Scene::from_spec(&format!("random:{n}"))?;
                     for &(a, layout) in &accels {
@@ -185,8 +180,8 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                 doc(figure, "treelet optimization time against size (random:N spheres)", "primitives", "optimization time (ms)", (true, true))
             };
             d.parameters = serde_json::json!({ "sizes": device_sizes, "treelets": TreeletConfig::default() });
-            let device = if matches!(runner, Runner::Gpu(_)) { "device" } else { "CPU runner" };
-            with_backend!(runner, |b| {
+            let device = if matches!(runner, Device::Gpu(_)) { "device" } else { "CPU runner" };
+            treelet::with_backend!(runner, |b| {
                 let configs: Vec<(String, Option<TreeletConfig>)> = if figure == Figure::Graph25 {
                     vec![(format!("LBVH ({device})"), None)]
                 } else {
@@ -256,7 +251,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
                 let scene = Scene::from_spec(spec)?;
                 let tag = spec.split(':').next().unwrap_or(spec);
                 let mut found: Vec<(String, f64, f64)> = Vec::new();
-                with_backend!(runner, |b| {
+                treelet::with_backend!(runner, |b| {
                     for (name, config) in [
                         ("LBVH", None),
                         ("TRBVH g1", Some(TreeletConfig { gamma: 1, ..Default::default() })),
@@ -292,7 +287,7 @@ fn measure(figure: Figure, s: &Suite, runner: &Runner) -> Result<FigureDoc> {
             let mut d = doc(figure, "rays per second through each tree (terrain:N, mesh alone)", "triangles", "M rays/s", (true, false));
             d.parameters = serde_json::json!({ "width": w, "height": h, "sizes": sizes });
             let pb = bar(sizes.len() * 3, "trees");
-            with_backend!(runner, |b| {
+            treelet::with_backend!(runner, |b| {
                 for &n in &sizes {
                     let scene = Scene::from_spec(&format!("terrain:{n}"))?.mesh_only()?;
                     for a in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {

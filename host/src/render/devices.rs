@@ -8,7 +8,7 @@
 //! counted from (seed, pixel, sample), so the image is the one-device image
 //! up to the devices' rounding.
 use std::ops::Range;
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -18,24 +18,9 @@ use super::image_io::HdrImage;
 use super::{add_sums, mean_image, Prepared, RenderSettings};
 use crate::runtime::backend::Backend;
 use crate::runtime::cpu_runner::CpuBackend;
+pub use crate::runtime::device::Device;
 use crate::runtime::gpu::{GpuBackend, GpuContext};
 use crate::scene::Scene;
-
-/// A device of `--devices`.
-#[derive(Clone)]
-pub enum Device {
-    Gpu(Arc<GpuContext>),
-    Cpu,
-}
-
-impl Device {
-    fn name(&self) -> String {
-        match self {
-            Device::Gpu(ctx) => ctx.info.name.clone(),
-            Device::Cpu => "cpu".into(),
-        }
-    }
-}
 
 /// The devices `spec` names: `all` (every Vulkan adapter; the CPU runner
 /// where there is none), `gpu` (every Vulkan adapter), or a comma list of adapter

@@ -1,9 +1,10 @@
 //! Where kernels run: the [`backend::Backend`] trait (buffers, dispatches,
 //! stage times), its two implementations, the GPU through wgpu ([`gpu`]) and
 //! the CPU runner that calls the same kernel functions over every
-//! invocation id ([`cpu_runner`]), and the table of kernels with their
-//! bindings ([`kernels`]). Nothing here knows what a BVH or a scene is.
+//! invocation id ([`cpu_runner`]), the choice between them ([`device`]),
+//! and the table of kernels with their bindings ([`kernels`]). Nothing here knows what a BVH or a scene is.
 pub mod backend;
 pub mod cpu_runner;
+pub mod device;
 pub mod gpu;
 pub mod kernels;

@@ -1,0 +1,78 @@
+//! Device choice, in one place: what the command line, the benchmarks and a
+//! render over several devices ask for ([`DeviceChoice`]), and what opening
+//! it gives ([`Device`]): a Vulkan adapter's context or the CPU runner.
+//! [`with_backend!`](crate::with_backend) runs one piece of code on either.
+use std::sync::Arc;
+
+use anyhow::{Context, Result};
+
+use crate::runtime::gpu::GpuContext;
+
+/// Where work runs (`--device`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DeviceChoice {
+    /// The first Vulkan adapter; the CPU runner when there is none.
+    Auto,
+    /// A Vulkan adapter (a GPU, or lavapipe on CPU cores); an error when there is none.
+    Gpu,
+    /// The CPU runner: the same kernels over every invocation id, with rayon.
+    Cpu,
+}
+
+impl DeviceChoice {
+    /// Opens the device: `auto` falls back to the CPU runner with a note
+    /// that says why.
+    pub fn open(self) -> Result<Device> {
+        match self {
+            DeviceChoice::Gpu => {
+                Ok(Device::Gpu(GpuContext::new().context("--device gpu (--device auto or cpu run on the CPU runner)")?))
+            }
+            DeviceChoice::Cpu => Ok(Device::Cpu),
+            DeviceChoice::Auto => match GpuContext::new() {
+                Ok(ctx) => Ok(Device::Gpu(ctx)),
+                Err(e) => {
+                    // The outermost message only: it says what is missing and how to get it.
+                    eprintln!("note: {e}: running on the CPU runner instead (--device cpu skips this note)");
+                    Ok(Device::Cpu)
+                }
+            },
+        }
+    }
+}
+
+/// An opened device: a Vulkan adapter (its context is made once and shared
+/// by every backend made on it) or the CPU runner.
+#[derive(Clone)]
+pub enum Device {
+    Gpu(Arc<GpuContext>),
+    Cpu,
+}
+
+impl Device {
+    /// The adapter's name, or `cpu`.
+    pub fn name(&self) -> String {
+        match self {
+            Device::Gpu(ctx) => ctx.info.name.clone(),
+            Device::Cpu => "cpu".into(),
+        }
+    }
+}
+
+/// Runs `$body` with `$b` bound to a fresh backend on `$device` (a
+/// [`Device`](crate::runtime::device::Device)): a `GpuBackend` on its
+/// context, or a `CpuBackend`. The body is compiled once per backend.
+#[macro_export]
+macro_rules! with_backend {
+    ($device:expr, |$b:ident| $body:expr) => {
+        match $device {
+            $crate::runtime::device::Device::Gpu(ctx) => {
+                let $b = &mut $crate::runtime::gpu::GpuBackend::new(ctx.clone());
+                $body
+            }
+            $crate::runtime::device::Device::Cpu => {
+                let $b = &mut $crate::runtime::cpu_runner::CpuBackend::new();
+                $body
+            }
+        }
+    };
+}
