@@ -1,5 +1,5 @@
 //! The render kernel variants: the feature sets the shader crate compiles
-//! render kernels for, listed once ([`for_each_render_variant!`]). The
+//! render kernels for, listed once ([`for_each_render_variant!`](crate::for_each_render_variant)). The
 //! shader's entry points, the host's kernel names and the CPU runner's
 //! dispatch are all expanded from that list, so a new variant is one line.
 
@@ -29,7 +29,7 @@ macro_rules! for_each_render_variant {
 /// Expands the list into [`VARIANTS`].
 macro_rules! variants_table {
     ([] $($i:literal $name:ident [$($f:path),*];)*) => {
-        /// The feature sets of [`for_each_render_variant!`] with their names,
+        /// The feature sets of [`for_each_render_variant!`](crate::for_each_render_variant) with their names,
         /// in its order.
         pub const VARIANTS: [(u32, &str); [$($i),*].len()] = [$((0 $(| $f)*, stringify!($name))),*];
     };
