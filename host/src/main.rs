@@ -2,7 +2,7 @@
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
@@ -11,7 +11,7 @@ use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::render::image_io;
 use treelet::bvh::layout::Layout;
 use treelet::plot::Series;
-use treelet::bvh::tree::Accel;
+use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::{render, Integrator, PassRow, RenderSettings};
 use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
@@ -27,16 +27,6 @@ struct Cli {
     command: Command,
 }
 
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum Builder {
-    /// Karras 2012, on the chosen device.
-    Lbvh,
-    /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the chosen device.
-    Trbvh,
-    /// Full-sweep SAH, top-down on the CPU: the quality reference.
-    Sweep,
-}
 
 #[derive(Subcommand)]
 enum Command {

@@ -21,7 +21,7 @@ use treelet_core::render::rays::CAST_RAYS;
 
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::refit;
-use crate::bvh::tree::{binary_tree, Accel, BuiltTree};
+use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
@@ -68,6 +68,16 @@ pub enum Quality {
     High,
 }
 
+impl Quality {
+    /// The builder this quality stands for.
+    pub fn builder(self) -> Builder {
+        match self {
+            Quality::Fast => Builder::Lbvh,
+            Quality::High => Builder::Trbvh,
+        }
+    }
+}
+
 /// Rays a device batch holds per row (the cast kernels walk an image).
 const BATCH_WIDTH: u32 = 1024;
 
@@ -85,11 +95,7 @@ impl<B: Backend> Tracer<B> {
     pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> Result<Self> {
         let all = Primitives { spheres, triangles };
         all.check()?;
-        let accel = match quality {
-            Quality::Fast => Accel::Lbvh,
-            Quality::High => Accel::Trbvh,
-        };
-        let built = if all.len() == 0 { None } else { binary_tree(b, all, accel)? };
+        let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder())?) };
         let mut tracer = Tracer { built, prims: PrimBuffers::upload(b, all)?, tree: None, counts: (spheres.len(), triangles.len()) };
         tracer.lay_out(b)?;
         Ok(tracer)

@@ -327,7 +327,8 @@ pub(crate) fn bench_rays<B: Backend>(
     all.check()?;
     let pixels = width as u64 * height as u64;
     anyhow::ensure!(pixels > 0 && pixels <= u32::MAX as u64 / 4, "image size {width}x{height} out of range");
-    let Some(built) = treelet::bvh::tree::binary_tree(b, all, accel)? else { unreachable!("a tree was asked for") };
+    let Some(builder) = accel.builder()? else { anyhow::bail!("bench rays needs a tree: --accels lbvh, trbvh or sweep") };
+    let built = treelet::bvh::tree::binary_tree(b, all, builder)?;
     let buffers = PrimBuffers::upload(b, all)?;
     let materials = b.upload("materials", &scene.materials)?;
     let rays = b.zeroed("rays", pixels * 32)?;

@@ -8,7 +8,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
-use treelet::bvh::tree::Accel;
+use treelet::bvh::tree::{Accel, Builder};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 
@@ -84,7 +84,7 @@ pub enum BenchCommand {
     Build {
         /// lbvh: the Karras 2012 build; trbvh: the build plus treelet restructuring (stage times of both).
         #[arg(long, value_enum, default_value = "lbvh")]
-        builder: TreeBuilder,
+        builder: Builder,
         /// Treelet rounds, first gamma and largest collapsed leaf (trbvh).
         #[arg(long, default_value_t = TreeletConfig::default().rounds)]
         rounds: u32,
@@ -190,12 +190,6 @@ fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) ->
 const VARIANT_SCENES: [&str; 5] =
     ["cornell", "scenes/cornell_diffuse.json", "scenes/cornell_mirrors.json", "random:1000", "terrain:100000"];
 
-/// The device builders `bench build` times.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TreeBuilder {
-    Lbvh,
-    Trbvh,
-}
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
@@ -327,7 +321,10 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         }
         BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
-            let treelets = (builder == TreeBuilder::Trbvh).then_some(&config);
+            if builder == Builder::Sweep {
+                anyhow::bail!("bench build times the device builders (lbvh, trbvh); time the sweep builder with `treelet build --builder sweep --device cpu`");
+            }
+            let treelets = (builder == Builder::Trbvh).then_some(&config);
             let (adapter, timing, rows) = match device.open()? {
                 Device::Gpu(ctx) => {
                     let mut b = GpuBackend::new(ctx).with_per_kernel_times(per_kernel);

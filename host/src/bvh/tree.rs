@@ -1,6 +1,7 @@
-//! The tree a render or an engine asks for: which builder ([`Accel`]), the
-//! binary tree it builds on the device ([`BuiltTree`]), and that tree laid
-//! out for tracing with the primitives' buffers ([`traced_tree`]).
+//! The tree a render or an engine asks for: which builder ([`Builder`]; a
+//! render's [`Accel`] adds the scan and `auto`), the binary tree it builds
+//! on the device ([`BuiltTree`]), and that tree laid out for tracing with
+//! the primitives' buffers ([`traced_tree`]).
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::geometry::buffers::Node;
@@ -10,6 +11,20 @@ use crate::bvh::lbvh;
 use crate::bvh::trbvh::{self, TreeletConfig};
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::scene::primitives::Primitives;
+
+/// Which BVH builder: the one type for `treelet build --builder`,
+/// `treelet bench build --builder`, a render's `--accel` (through
+/// [`Accel::builder`]) and the engine API's `Quality`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Builder {
+    /// Karras 2012, on the chosen device.
+    Lbvh,
+    /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the chosen device.
+    Trbvh,
+    /// Full-sweep SAH, top-down on the CPU: the quality reference.
+    Sweep,
+}
 
 /// How closest hits are found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -39,6 +54,18 @@ impl Accel {
             Accel::Sweep => "sweep",
         }
     }
+
+    /// The builder of the tree this traces; `None` for the scan. `Auto`
+    /// must have been resolved first (see `treelet::render::variant::plan`).
+    pub fn builder(self) -> Result<Option<Builder>> {
+        Ok(match self {
+            Accel::Auto => bail!("internal: --accel auto reached the tree builder unresolved"),
+            Accel::None => None,
+            Accel::Lbvh => Some(Builder::Lbvh),
+            Accel::Trbvh => Some(Builder::Trbvh),
+            Accel::Sweep => Some(Builder::Sweep),
+        })
+    }
 }
 
 /// The tree `accel` traces for these primitives, on the device, laid out
@@ -53,7 +80,7 @@ pub fn traced_tree<B: Backend>(
     accel: Accel,
     layout: Layout,
 ) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
-    let Some(built) = binary_tree(b, all, accel)? else {
+    let Some(builder) = accel.builder()? else {
         let buffers = PrimBuffers::upload(b, all)?;
         let tree = TracedTree {
             layout: Layout::Classic,
@@ -63,6 +90,7 @@ pub fn traced_tree<B: Backend>(
         };
         return Ok((tree, buffers, 0.0));
     };
+    let built = binary_tree(b, all, builder)?;
     let buffers = PrimBuffers::upload(b, all)?;
     let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
     Ok((tree, buffers, built.build_ms + layout_ms))
@@ -94,33 +122,31 @@ impl<B: Backend> BuiltTree<B> {
     }
 }
 
-/// The binary tree `accel` traces (None for the scan): the LBVH as built,
-/// the TRBVH's restructured tree before its leaf collapse, or the full-sweep
-/// tree built on the CPU and uploaded. Starts a new build on `b`.
-pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, accel: Accel) -> Result<Option<BuiltTree<B>>> {
+/// The binary tree `builder` makes, to be laid out for tracing: the LBVH
+/// as built, the TRBVH's restructured tree before its leaf collapse, or the
+/// full-sweep tree built on the CPU and uploaded. Starts a new build on `b`.
+pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> Result<BuiltTree<B>> {
     let config = TreeletConfig::default();
-    Ok(Some(match accel {
-        Accel::Auto => bail!("internal: --accel auto reached the tree builder unresolved"),
-        Accel::None => return Ok(None),
-        Accel::Lbvh | Accel::Trbvh => {
+    Ok(match builder {
+        Builder::Lbvh | Builder::Trbvh => {
             let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
             let mut build_ms = times.total();
-            if accel == Accel::Trbvh {
+            if builder == Builder::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
                 let (restructured, times) = trbvh::restructure(b, bvh, &root, &config)?;
                 bvh = restructured;
                 build_ms += times.total();
             }
             // The LBVH is traced as built (one primitive per leaf).
-            let max_leaf = if accel == Accel::Trbvh { config.max_leaf } else { 1 };
+            let max_leaf = if builder == Builder::Trbvh { config.max_leaf } else { 1 };
             BuiltTree { bvh, max_leaf, build_ms }
         }
-        Accel::Sweep => {
+        Builder::Sweep => {
             let build = std::time::Instant::now();
             let tree = crate::bvh::sweep::build_boxes(&all.boxes());
             let build_ms = build.elapsed().as_secs_f64() * 1e3;
             b.begin_build();
             BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
         }
-    }))
+    })
 }
