@@ -187,11 +187,7 @@ pub fn render_on_devices(
     }
     let mut total = vec![[0f64; 4]; pixels];
     for (_, sums) in &results {
-        for (t, s) in total.iter_mut().zip(sums) {
-            for k in 0..4 {
-                t[k] += s[k];
-            }
-        }
+        add_sums(&mut total, sums);
     }
     let sums: Vec<[f32; 4]> = total.iter().map(|t| t.map(|v| v as f32)).collect();
     let image = mean_image(settings.width, settings.height, &total, settings.spp);

@@ -178,10 +178,10 @@ pub struct RenderResult {
 /// Adds per-pixel sums (radiance r, g, b and squared luminance) of one
 /// part of a render into `total`, in f64 so that many parts add without
 /// loss (devices, `treelet merge`).
-pub fn add_sums(total: &mut [[f64; 4]], part: &[[f32; 4]]) {
+pub fn add_sums<T: Copy + Into<f64>>(total: &mut [[f64; 4]], part: &[[T; 4]]) {
     for (t, p) in total.iter_mut().zip(part) {
         for k in 0..4 {
-            t[k] += p[k] as f64;
+            t[k] += p[k].into();
         }
     }
 }
