@@ -1,7 +1,7 @@
 //! `treelet`: build BVHs, trace and render them, on the GPU or the CPU.
 use std::process::ExitCode;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::Backend;
@@ -151,11 +151,18 @@ fn parse_range(s: &str) -> std::result::Result<std::ops::Range<u32>, String> {
 
 fn run_render(mut args: RenderArgs) -> Result<()> {
     let part = args.samples.clone();
+    // Every output is checked before any work, so a typo never costs a render.
     if let Some(range) = &part {
         if image_io::extension(&args.out) != "exr" {
             anyhow::bail!("--samples writes a part of a render: --out must name an .exr file (not {})", args.out.display());
         }
+        image_io::check_output(&args.out, "--out", &["exr"])?;
         args.spp = range.end - range.start;
+    } else {
+        image_io::check_output(&args.out, "--out", &image_io::IMAGE_FORMATS)?;
+    }
+    if let Some(report) = &args.report {
+        image_io::check_output(report, "--report", &[])?;
     }
     if args.devices.as_deref() == Some("list") {
         for (i, name) in GpuContext::adapters().iter().enumerate() {
@@ -279,7 +286,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             "samples_per_s": paths / result.total_s,
             "rows": result.rows,
         });
-        std::fs::write(path, serde_json::to_string_pretty(&doc)?)?;
+        std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(|| format!("writing {}", path.display()))?;
         // The log-log plot of error against time, beside the report.
         let (label, points): (&str, Vec<(f64, f64)>) = if reference.is_some() {
             ("RMSE against the reference", result.rows.iter().filter_map(|r| Some((r.elapsed_s, r.rmse?))).collect())
@@ -363,7 +370,7 @@ fn render_on_devices(args: &RenderArgs, spec: &str, scene: &Scene, settings: &Re
             "scene": scene.name, "width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed,
             "integrator": args.integrator, "total_s": seconds, "samples_per_s": paths / seconds, "devices": shares,
         });
-        std::fs::write(path, serde_json::to_string_pretty(&doc)?)?;
+        std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
 }
@@ -403,6 +410,13 @@ fn run(cli: Cli) -> Result<bool> {
         }
         Command::Render(args) => run_render(args).map(|_| true),
         Command::Merge { parts, out } => {
+            image_io::check_output(&out, "--out", &image_io::IMAGE_FORMATS)?;
+            // A merged image over one of its parts would lose that part's sums.
+            if let Ok(target) = out.canonicalize() {
+                if let Some(p) = parts.iter().find(|p| p.canonicalize().is_ok_and(|p| p == target)) {
+                    anyhow::bail!("--out {} names the part {}: merging would overwrite it; write elsewhere", out.display(), p.display());
+                }
+            }
             let (info, image) = treelet::render::parts::merge(&parts)?;
             image_io::write(&out, &image)?;
             eprintln!(

@@ -389,3 +389,54 @@ fn render_on_a_list_of_devices() {
     assert!(e.contains("no-such-gpu") && e.contains("names no adapter"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Every output is checked before any work: a scene that does not exist
+/// would be the first error otherwise, so each of these names the output.
+#[test]
+fn outputs_are_checked_before_the_render() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-outputs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let missing_dir = dir.join("no_such_folder");
+    let scene = dir.join("no_such_scene.json");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "--device", "cpu", "--scene", scene.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        stderr_of(&args)
+    };
+    let p = |p: std::path::PathBuf| p.to_str().unwrap().to_string();
+    let e = render(&["--out", &p(missing_dir.join("a.png"))]);
+    assert!(e.contains("no_such_folder") && e.contains("does not exist") && !e.contains("no_such_scene"), "{e}");
+    let e = render(&["--out", &p(dir.join("a.jpg"))]);
+    assert!(e.contains("unknown image format `.jpg`") && !e.contains("no_such_scene"), "{e}");
+    let e = render(&["--out", &p(dir.join("a"))]);
+    assert!(e.contains("no file extension") && !e.contains("no_such_scene"), "{e}");
+    let e = render(&["--out", &p(dir.clone())]);
+    assert!(e.contains("--out") && !e.contains("no_such_scene"), "{e}");
+    let e = render(&["--out", &p(dir.join("a.png")), "--report", &p(missing_dir.join("r.json"))]);
+    assert!(e.contains("--report") && e.contains("does not exist") && !e.contains("no_such_scene"), "{e}");
+    let e = render(&["--samples", "0..4", "--out", &p(missing_dir.join("part.exr"))]);
+    assert!(e.contains("does not exist") && !e.contains("no_such_scene"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `merge --out` naming one of its parts is refused, and the part is kept.
+#[test]
+fn merge_never_overwrites_a_part() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-merge-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let part = dir.join("a.exr");
+    let part_s = part.to_str().unwrap();
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--samples", "0..2", "--out", part_s]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let before = std::fs::read(&part).unwrap();
+    let e = stderr_of(&["merge", part_s, "--out", part_s]);
+    assert!(e.contains("names the part") && e.contains("a.exr"), "{e}");
+    // The same file through another path is the same part.
+    let other = dir.join(".").join("a.exr");
+    let e = stderr_of(&["merge", part_s, "--out", other.to_str().unwrap()]);
+    assert!(e.contains("names the part"), "{e}");
+    assert_eq!(std::fs::read(&part).unwrap(), before, "the part was changed");
+    let e = stderr_of(&["merge", part_s, "--out", dir.join("merged.jpg").to_str().unwrap()]);
+    assert!(e.contains("unknown image format `.jpg`"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

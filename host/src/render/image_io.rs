@@ -25,6 +25,46 @@ pub fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
+/// The formats [`write`] takes, by extension.
+pub const IMAGE_FORMATS: [&str; 3] = ["png", "exr", "pfm"];
+
+/// Checks, before any work is done, that `path` can be written as the
+/// output `what` (`--out`, `--report`): its extension is one of `formats`
+/// (any, if empty), it is not a folder, its folder exists and takes new
+/// files, and an existing file there can be opened for writing. Nothing is
+/// written or truncated.
+pub fn check_output(path: &Path, what: &str, formats: &[&str]) -> Result<()> {
+    let ext = extension(path);
+    if !formats.is_empty() && !formats.contains(&ext.as_str()) {
+        let list = formats.iter().map(|f| format!(".{f}")).collect::<Vec<_>>().join(", ");
+        if ext.is_empty() {
+            bail!("{what} {}: no file extension (name a {list} file)", path.display());
+        }
+        bail!("{what} {}: unknown image format `.{ext}` (use {list})", path.display());
+    }
+    if path.is_dir() {
+        bail!("{what} {} is a folder: name a file", path.display());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!("{what} {}: the folder {} does not exist", path.display(), dir.display());
+    }
+    // Whether the folder takes new files: a probe, removed at once.
+    let probe = dir.join(format!(".treelet-write-check-{}", std::process::id()));
+    std::fs::File::create(&probe).with_context(|| format!("{what} {}: cannot create files in {}", path.display(), dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    if path.exists() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .with_context(|| format!("{what} {}: the file exists and cannot be written", path.display()))?;
+    }
+    Ok(())
+}
+
 /// Writes `image` in the format its extension names: .png, .exr or .pfm.
 pub fn write(path: &Path, image: &HdrImage) -> Result<()> {
     let (w, h) = (image.width, image.height);
