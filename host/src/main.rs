@@ -172,7 +172,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         return Ok(());
     }
     let scene = Scene::from_spec(&args.scene)?;
-    let reference = args.reference.as_deref().map(image_io::read_hdr).transpose()?;
+    let reference = args.reference.as_deref().map(|r| treelet::render::parts::read_scored_image(r, "--reference")).transpose()?;
     let settings = RenderSettings {
         width: args.width,
         height: args.height,
@@ -432,7 +432,8 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Compare { image, reference } => {
-            let (img, r) = (image_io::read_hdr(&image)?, image_io::read_hdr(&reference)?);
+            use treelet::render::parts::read_scored_image;
+            let (img, r) = (read_scored_image(&image, "image")?, read_scored_image(&reference, "--reference")?);
             if (img.width, img.height) != (r.width, r.height) {
                 anyhow::bail!(
                     "{} is {}x{}, the reference {} is {}x{}",

@@ -440,3 +440,31 @@ fn merge_never_overwrites_a_part() {
     assert!(e.contains("unknown image format `.jpg`"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `compare` (and `--reference`) score images of means: a part (per-pixel
+/// sums) and an image with a non-finite pixel are refused, naming why.
+#[test]
+fn compare_refuses_parts_and_non_finite_images() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-compare-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let (part, image) = (dir.join("part.exr"), dir.join("image.pfm"));
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--samples", "0..2", "--out", &s(&part)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "2", "--out", &s(&image)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let e = stderr_of(&["compare", &s(&part), "--reference", &s(&image)]);
+    assert!(e.contains("part.exr") && e.contains("render part"), "{e}");
+    let e = stderr_of(&["compare", &s(&image), "--reference", &s(&part)]);
+    assert!(e.contains("--reference") && e.contains("render part"), "{e}");
+    // A 2x1 PFM (little-endian) with a NaN in its second pixel.
+    let nan = dir.join("nan.pfm");
+    let mut bytes = b"PF\n2 1\n-1.0\n".to_vec();
+    for v in [0.5f32, 0.5, 0.5, f32::NAN, 0.0, 0.0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(&nan, bytes).unwrap();
+    let e = stderr_of(&["compare", &s(&nan), "--reference", &s(&nan)]);
+    assert!(e.contains("nan.pfm") && e.contains("pixel (1, 0)") && e.contains("not finite"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

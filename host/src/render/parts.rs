@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use exr::prelude::*;
 
-use super::image_io::HdrImage;
+use super::image_io::{self, HdrImage};
 
 /// What a part is of.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -89,6 +89,25 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
         bail!("{}: its sample range {}..{} is empty", path.display(), info.samples.start, info.samples.end);
     }
     Ok((info, image.layer_data.channel_data.pixels.1))
+}
+
+/// Reads an image to be scored (`compare`, `render --reference`): a part
+/// holds per-pixel sums, not means, so it is refused (merge it first), and
+/// so is an image with a NaN or infinite pixel, which no error is defined
+/// for. `what` names the image in errors.
+pub fn read_scored_image(path: &Path, what: &str) -> Result<HdrImage> {
+    if image_io::extension(path) == "exr" && read_part(path).is_ok() {
+        bail!(
+            "{what} {} is a render part (per-pixel sums of a sample range), not an image: `treelet merge` it into one first",
+            path.display()
+        );
+    }
+    let image = image_io::read_hdr(path)?;
+    if let Some(i) = image.pixels.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
+        let (x, y) = (i as u32 % image.width, i as u32 / image.width);
+        bail!("{what} {}: pixel ({x}, {y}) is {:?}: not finite, so no error can be measured", path.display(), image.pixels[i]);
+    }
+    Ok(image)
 }
 
 /// Adds parts: they must be of one scene, size, seed and integrator, and
