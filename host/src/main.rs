@@ -320,6 +320,7 @@ fn write_output(args: &RenderArgs, scene: &Scene, image: &image_io::HdrImage, su
         Some(range) => {
             let info = treelet::render::parts::PartInfo {
                 scene: scene.name.clone(),
+                scene_hash: format!("{:016x}", scene.content_hash()),
                 width: args.width,
                 height: args.height,
                 seed: args.seed,
@@ -418,6 +419,12 @@ fn run(cli: Cli) -> Result<bool> {
                 }
             }
             let (info, image) = treelet::render::parts::merge(&parts)?;
+            if info.samples.start > 0 {
+                eprintln!(
+                    "note: samples 0..{} are in no part: the image is of samples {}..{} only",
+                    info.samples.start, info.samples.start, info.samples.end
+                );
+            }
             image_io::write(&out, &image)?;
             eprintln!(
                 "{}: {}x{}, samples {}..{} from {} parts, wrote {}",

@@ -468,3 +468,38 @@ fn compare_refuses_parts_and_non_finite_images() {
     assert!(e.contains("nan.pfm") && e.contains("pixel (1, 0)") && e.contains("not finite"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Parts carry a hash of the scene's contents: one file named by two paths
+/// merges, a file edited between two parts does not; a merged range that
+/// does not start at sample 0 is named.
+#[test]
+fn merge_compares_scene_contents_and_names_a_missing_start() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-merge-hash-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.json");
+    let original = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell_diffuse.json")).unwrap();
+    std::fs::write(&scene, &original).unwrap();
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let part = |scene: &std::path::Path, range: &str, name: &str| {
+        let out = dir.join(name);
+        let args = ["render", "--device", "cpu", "--width", "8", "--height", "6", "--scene", &s(scene), "--samples", range, "--out", &s(&out)];
+        let o = treelet(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        s(&out)
+    };
+    let a = part(&scene, "0..2", "a.exr");
+    let b = part(&dir.join(".").join("scene.json"), "2..4", "b.exr");
+    let o = treelet(&["merge", &a, &b, "--out", &s(&dir.join("ab.pfm"))]);
+    assert!(o.status.success(), "one file by two paths: {}", String::from_utf8_lossy(&o.stderr));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("note:"), "{}", String::from_utf8_lossy(&o.stderr));
+
+    std::fs::write(&scene, original.replace("[0.75, 0.25, 0.25]", "[0.7, 0.25, 0.25]")).unwrap();
+    let c = part(&scene, "4..6", "c.exr");
+    let e = stderr_of(&["merge", &a, &b, &c, "--out", &s(&dir.join("abc.pfm"))]);
+    assert!(e.contains("c.exr") && e.contains("edited"), "{e}");
+
+    let o = treelet(&["merge", &b, "--out", &s(&dir.join("b.pfm"))]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("samples 0..2 are in no part"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

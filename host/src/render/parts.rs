@@ -17,6 +17,8 @@ use super::image_io::{self, HdrImage};
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PartInfo {
     pub scene: String,
+    /// [`Scene::content_hash`](crate::scene::Scene::content_hash), as 16 hex digits.
+    pub scene_hash: String,
     pub width: u32,
     pub height: u32,
     pub seed: u32,
@@ -41,6 +43,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
         attributes.other.insert(Text::from(format!("{PREFIX}{key}").as_str()), value);
     };
     put("scene", text("scene name", &info.scene)?);
+    put("scene_hash", text("scene hash", &info.scene_hash)?);
     put("integrator", text("integrator", &info.integrator)?);
     put("seed", AttributeValue::Text(Text::from(info.seed.to_string().as_str())));
     put("first_sample", AttributeValue::Text(Text::from(info.samples.start.to_string().as_str())));
@@ -79,6 +82,7 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
     };
     let info = PartInfo {
         scene: field("scene")?,
+        scene_hash: field("scene_hash")?,
         width: size.width() as u32,
         height: size.height() as u32,
         seed: number("seed")?,
@@ -128,7 +132,19 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
             }
             Ok(())
         };
-        same("scene", &info.scene, &reference.scene)?;
+        // The scene's contents, not its name: one file named by two paths is
+        // one scene, and a file edited between parts is not.
+        if info.scene_hash != reference.scene_hash {
+            bail!(
+                "{} is of scene {} (contents {}), {} of scene {} (contents {}): parts of one render only (was the scene or a mesh edited between them?)",
+                p.display(),
+                info.scene,
+                info.scene_hash,
+                first.display(),
+                reference.scene,
+                reference.scene_hash
+            );
+        }
         same("size", &format!("{}x{}", info.width, info.height), &format!("{}x{}", reference.width, reference.height))?;
         same("seed", &info.seed, &reference.seed)?;
         same("integrator", &info.integrator, &reference.integrator)?;

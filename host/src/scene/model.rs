@@ -142,6 +142,23 @@ pub fn cornell_room() -> Vec<(Sphere, Material)> {
 }
 
 impl Scene {
+    /// A hash of everything a render of the scene reads (spheres,
+    /// materials, triangles, camera), whatever its name or the path it was
+    /// loaded from: parts of one render must agree on it. FNV-1a.
+    pub fn content_hash(&self) -> u64 {
+        use std::hash::Hasher;
+        let mut h = fnv::FnvHasher::default();
+        let mut field = |bytes: &[u8]| {
+            h.write_usize(bytes.len());
+            h.write(bytes);
+        };
+        field(bytemuck::cast_slice(&self.spheres));
+        field(bytemuck::cast_slice(&self.materials));
+        field(bytemuck::cast_slice(&self.triangles));
+        field(serde_json::to_string(&self.camera).unwrap_or_default().as_bytes());
+        h.finish()
+    }
+
     /// The spheres `treelet build` builds over: all but the room.
     pub fn objects(&self) -> &[Sphere] {
         &self.spheres[..self.spheres.len() - self.room]
