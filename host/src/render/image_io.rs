@@ -25,7 +25,7 @@ pub fn extension(path: &Path) -> String {
     path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
 }
 
-/// The formats [`write`] takes, by extension.
+/// The formats [`write()`] takes, by extension.
 pub const IMAGE_FORMATS: [&str; 3] = ["png", "exr", "pfm"];
 
 /// Checks, before any work is done, that `path` can be written as the
