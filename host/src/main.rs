@@ -172,6 +172,9 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         return Ok(());
     }
     let scene = Scene::from_spec(&args.scene)?;
+    if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
+        eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);
+    }
     let reference = args.reference.as_deref().map(|r| treelet::render::parts::read_scored_image(r, "--reference")).transpose()?;
     let settings = RenderSettings {
         width: args.width,

@@ -503,3 +503,20 @@ fn merge_compares_scene_contents_and_names_a_missing_start() {
     assert!(o.status.success() && err.contains("samples 0..2 are in no part"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scene whose lights are all black renders, with a warning that says so.
+#[test]
+fn a_scene_without_light_gets_a_warning() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-dark-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("dark.json");
+    let original = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell_diffuse.json")).unwrap();
+    std::fs::write(&scene, original.replace("\"emission\": [12, 12, 12]", "\"emission\": [0, 0, 0]")).unwrap();
+    let out = dir.join("dark.png");
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("warning") && err.contains("emits light"), "{err}");
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--out", out.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("emits light"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -100,6 +100,10 @@ struct SphereSpec {
     material: String,
 }
 
+/// The largest emission a material may have: a pixel's sum of squared
+/// luminance over 2^16 samples of it stays far below `f32::MAX`.
+pub const MAX_EMISSION: f32 = 1e6;
+
 /// Reads a scene file; errors name the file and the line and column, or the
 /// sphere or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -130,6 +134,18 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         }
         if m.color.iter().chain(&m.emission).any(|&v| v < 0.0) {
             bail!("scene file {name}: material `{key}` has a negative colour or emission");
+        }
+        if m.color.iter().any(|&v| v > 1.0) {
+            bail!(
+                "scene file {name}: material `{key}` has colour {:?}: a surface reflects at most the light it receives (each component in [0, 1])",
+                m.color
+            );
+        }
+        if m.emission.iter().any(|&v| v > MAX_EMISSION) {
+            bail!(
+                "scene file {name}: material `{key}` has emission {:?}, above {MAX_EMISSION:e} (a pixel's sums of squares would overflow f32)",
+                m.emission
+            );
         }
         if kind == GLASS && m.ior <= 0.0 {
             bail!("scene file {name}: material `{key}` has index of refraction {} (must be positive)", m.ior);
@@ -192,6 +208,18 @@ mod tests {
         assert_eq!(file.spheres, builtin.spheres);
         assert_eq!(file.materials, builtin.materials);
         assert_eq!(file.camera, builtin.camera);
+    }
+
+    #[test]
+    fn albedo_above_one_and_huge_emission_are_errors() {
+        let scene = |material: &str| {
+            format!(r#"{{"camera": {{"origin": [0,0,0], "direction": [0,0,1]}}, "materials": {{"m": {material}}}, "spheres": [{{"center": [0,0,5], "radius": 1, "material": "m"}}]}}"#)
+        };
+        let e = parse(&scene(r#"{"type": "diffuse", "color": [1.5, 0.5, 0.5]}"#), "a.json").unwrap_err().to_string();
+        assert!(e.contains("a.json") && e.contains("`m`") && e.contains("[0, 1]"), "{e}");
+        let e = parse(&scene(r#"{"type": "diffuse", "color": [0, 0, 0], "emission": [1e30, 0, 0]}"#), "b.json").unwrap_err().to_string();
+        assert!(e.contains("b.json") && e.contains("emission"), "{e}");
+        assert!(parse(&scene(r#"{"type": "diffuse", "color": [1, 1, 1], "emission": [1e6, 0, 0]}"#), "c.json").is_ok());
     }
 
     #[test]
