@@ -4,7 +4,9 @@
 //! every sample is rendered once, and a device that fails leaves its
 //! unfinished chunk to the others.
 use treelet::bvh::layout::Layout;
-use treelet::render::devices::{render_on_devices, Device, InjectedFailure, SampleQueue, Take};
+use treelet::render::devices::{render_on_devices, Device};
+use treelet::render::queue::{SampleQueue, Take};
+use treelet::render::{Control, InjectedFailure, RenderResult};
 use treelet::render::variant::KernelChoice;
 use treelet::bvh::tree::Accel;
 use treelet::render::{render, Integrator, RenderSettings};
@@ -35,6 +37,11 @@ fn max_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
 fn mean_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
     let s: f64 = a.iter().zip(b).flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs() as f64)).sum();
     s / (3 * a.len()) as f64
+}
+
+/// `render_on_devices` with no reference, no stop, checkpoint or resume.
+fn on_devices(devices: &[Device], scene: &Scene, s: &RenderSettings, inject: Option<InjectedFailure>) -> anyhow::Result<RenderResult> {
+    render_on_devices(devices, scene, s, None, Control { inject, ..Control::default() }, |_| {})
 }
 
 fn one_device(scene: &Scene, s: &RenderSettings) -> Vec<[f32; 3]> {
@@ -72,7 +79,7 @@ fn the_queue_hands_out_every_sample_once() {
 fn cpu_runners_together_make_the_one_device_image() {
     let scene = cornell();
     let s = settings(37, fresh_seed() as u32);
-    let (image, _, shares) = render_on_devices(&[Device::Cpu, Device::Cpu, Device::Cpu], &scene, &s, None).unwrap();
+    let RenderResult { image, shares, .. } = on_devices(&[Device::Cpu, Device::Cpu, Device::Cpu], &scene, &s, None).unwrap();
     assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 37);
     let d = max_abs(&image.pixels, &one_device(&scene, &s));
     assert!(d < 1e-4, "three CPU runners against one: {d}");
@@ -85,7 +92,7 @@ fn a_failed_device_leaves_its_chunk_to_the_others() {
     // Device 0 fails on its first chunk (both start with a one-sample chunk,
     // and no device may take more than a quarter of what is left).
     let inject = InjectedFailure { device: 0, chunk: 0 };
-    let (image, _, shares) = render_on_devices(&[Device::Cpu, Device::Cpu], &scene, &s, Some(inject)).unwrap();
+    let RenderResult { image, shares, .. } = on_devices(&[Device::Cpu, Device::Cpu], &scene, &s, Some(inject)).unwrap();
     assert!(shares[0].failed.as_deref() == Some("injected failure"), "{shares:?}");
     assert_eq!((shares[0].chunks, shares[0].samples), (0, 0));
     assert!(shares[1].chunks >= 2, "{shares:?}");
@@ -93,11 +100,11 @@ fn a_failed_device_leaves_its_chunk_to_the_others() {
     let d = max_abs(&image.pixels, &one_device(&scene, &s));
     assert!(d < 1e-4, "with a failed device, against one device: {d}");
     // When every device fails, the render fails and says why.
-    let e = render_on_devices(&[Device::Cpu], &scene, &s, Some(InjectedFailure { device: 0, chunk: 0 })).unwrap_err();
+    let e = on_devices(&[Device::Cpu], &scene, &s, Some(InjectedFailure { device: 0, chunk: 0 })).err().unwrap();
     assert!(format!("{e:#}").contains("injected failure"), "{e:#}");
 }
 
-/// The chunked path on a GPU (clear, dispatch, read back, add) is the
+/// One GPU through `render_on_devices` (a list of one, in chunks) is the
 /// plain render on that GPU; with the CPU runner beside it, the image stays
 /// the GPU's within the GPU-vs-CPU tolerance, whichever device took what.
 #[test]
@@ -106,11 +113,11 @@ fn a_gpu_and_the_cpu_runner_make_the_gpu_image() {
     let scene = cornell();
     let s = settings(64, 3);
     let alone = render(&mut GpuBackend::new(ctx.clone()), &scene, &s, None, |_| {}).unwrap().image.pixels;
-    let (chunked, _, shares) = render_on_devices(&[Device::Gpu(ctx.clone())], &scene, &s, None).unwrap();
+    let RenderResult { image: chunked, shares, .. } = on_devices(&[Device::Gpu(ctx.clone())], &scene, &s, None).unwrap();
     assert!(shares[0].chunks >= 2, "{shares:?}");
     let d = max_abs(&chunked.pixels, &alone);
     assert!(d < 1e-4, "the GPU in chunks against the GPU in one render: {d}");
-    let (both, _, shares) = render_on_devices(&[Device::Gpu(ctx), Device::Cpu], &scene, &s, None).unwrap();
+    let RenderResult { image: both, shares, .. } = on_devices(&[Device::Gpu(ctx), Device::Cpu], &scene, &s, None).unwrap();
     assert!(shares.iter().all(|s| s.failed.is_none()), "{shares:?}");
     assert_eq!(shares.iter().map(|s| s.samples).sum::<u32>(), 64);
     let other_seed = render(&mut CpuBackend::new(), &scene, &settings(64, 4), None, |_| {}).unwrap().image.pixels;

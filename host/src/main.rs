@@ -4,15 +4,16 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use treelet::runtime::backend::Backend;
-use treelet::runtime::cpu_runner::CpuBackend;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use treelet::runtime::device::{Device, DeviceChoice};
-use treelet::runtime::gpu::{GpuBackend, GpuContext};
+use treelet::runtime::gpu::GpuContext;
 use treelet::render::image_io;
 use treelet::bvh::layout::Layout;
 use treelet::plot::Series;
 use treelet::bvh::tree::{Accel, Builder};
-use treelet::render::{render, Integrator, PassRow, RenderSettings};
+use treelet::render::parts::{self, PartInfo};
+use treelet::render::{Control, Integrator, PassRow, RenderSettings, Stopped};
 use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
@@ -124,7 +125,7 @@ struct RenderArgs {
     /// there is none: beside a GPU or lavapipe it slowed renders, measured),
     /// gpu (every adapter), or a list of adapter indices or names and cpu
     /// (`--devices list` prints the adapters).
-    #[arg(long, value_name = "all|gpu|LIST", conflicts_with_all = ["device", "reference"])]
+    #[arg(long, value_name = "all|gpu|LIST", conflicts_with = "device")]
     devices: Option<String>,
     #[arg(long, default_value_t = 0)]
     seed: u32,
@@ -137,6 +138,18 @@ struct RenderArgs {
     /// Write the error-against-time rows and run facts as JSON here.
     #[arg(long)]
     report: Option<std::path::PathBuf>,
+    /// Every SECONDS, write the samples done so far as a part (beside
+    /// --out as NAME.part.exr, or --out itself with --samples), so that a
+    /// crash loses at most that much; removed when the render completes.
+    /// Ctrl-C writes it (and the image of the samples done) in any case.
+    #[arg(long, value_name = "SECONDS")]
+    checkpoint: Option<f64>,
+    /// Continue the render that PART.exr (a checkpoint, or a render stopped
+    /// with Ctrl-C) holds the start of: same scene, size, seed and
+    /// integrator; --spp (or --samples) names where it ends. On the CPU
+    /// runner the image is the uninterrupted render's, bit for bit.
+    #[arg(long, value_name = "PART.exr")]
+    resume: Option<std::path::PathBuf>,
 }
 
 /// `A..B` (B excluded) with A < B.
@@ -147,6 +160,21 @@ fn parse_range(s: &str) -> std::result::Result<std::ops::Range<u32>, String> {
         return Err(format!("`{s}`: the range is empty (FIRST must be below LAST)"));
     }
     Ok(a..b)
+}
+
+/// Set by Ctrl-C (SIGINT), SIGTERM or SIGHUP: a render stops handing out
+/// samples, finishes the chunks under way and writes what it has.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// The first signal stops the render gently; a second quits at once.
+fn catch_stop_signals() {
+    let _ = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            eprintln!("\nstopped at once: nothing more is written");
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping: the chunks under way finish, then the samples done are written (again to quit at once)");
+    });
 }
 
 fn run_render(mut args: RenderArgs) -> Result<()> {
@@ -161,8 +189,17 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     } else {
         image_io::check_output(&args.out, "--out", &image_io::IMAGE_FORMATS)?;
     }
+    // Where the samples done go when the render stops early, and its
+    // checkpoints: the part itself with --samples, else beside the image.
+    let part_path = if part.is_some() { args.out.clone() } else { args.out.with_extension("part.exr") };
+    if part.is_none() {
+        image_io::check_output(&part_path, "the part beside --out", &["exr"])?;
+    }
     if let Some(report) = &args.report {
         image_io::check_output(report, "--report", &[])?;
+    }
+    if args.checkpoint.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
+        anyhow::bail!("--checkpoint {}: seconds between checkpoints must be a positive number", args.checkpoint.unwrap_or(0.0));
     }
     if args.devices.as_deref() == Some("list") {
         for (i, name) in GpuContext::adapters().iter().enumerate() {
@@ -175,7 +212,38 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);
     }
-    let reference = args.reference.as_deref().map(|r| treelet::render::parts::read_scored_image(r, "--reference")).transpose()?;
+    let first_sample = part.as_ref().map_or(0, |r| r.start);
+    let part_info = |samples: std::ops::Range<u32>| PartInfo {
+        scene: scene.name.clone(),
+        scene_hash: format!("{:016x}", scene.content_hash()),
+        width: args.width,
+        height: args.height,
+        seed: args.seed,
+        integrator: args.integrator.name().into(),
+        samples,
+    };
+    let resume = match &args.resume {
+        Some(path) => {
+            let (info, sums) = parts::read_part(path)?;
+            let asked = part_info(first_sample..first_sample.saturating_add(args.spp));
+            if let Some(why) = info.differs_from(&asked) {
+                anyhow::bail!("--resume {}: the part is of another render than this one: {why}", path.display());
+            }
+            if info.samples.start != asked.samples.start || info.samples.end > asked.samples.end {
+                anyhow::bail!(
+                    "--resume {}: the part holds samples {}..{}, and this render is of {}..{}: it must start where the part starts and end no earlier",
+                    path.display(),
+                    info.samples.start,
+                    info.samples.end,
+                    asked.samples.start,
+                    asked.samples.end
+                );
+            }
+            Some((info.samples, sums))
+        }
+        None => None,
+    };
+    let reference = args.reference.as_deref().map(|r| parts::read_scored_image(r, "--reference")).transpose()?;
     let settings = RenderSettings {
         width: args.width,
         height: args.height,
@@ -186,11 +254,13 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         kernel: args.kernel,
         integrator: args.integrator,
         error_each_pass: args.report.is_some() || args.reference.is_some(),
-        first_sample: part.as_ref().map_or(0, |r| r.start),
+        first_sample,
     };
-    if let Some(spec) = &args.devices {
-        return render_on_devices(&args, spec, &scene, &settings);
-    }
+    // A single device is a list of one.
+    let list = match &args.devices {
+        Some(spec) => treelet::render::devices::open(spec)?,
+        None => vec![args.device.open()?],
+    };
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -202,42 +272,65 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         };
         bar.set_message(err);
     };
-    let explain = |b: &dyn Fn() -> treelet::runtime::backend::DeviceClass| {
-        if args.explain {
-            bar.suspend(|| {
-                eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, b()).explain());
-                eprintln!("integrator {}", match args.integrator {
-                    Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
-                    Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
-                });
+    if args.explain {
+        bar.suspend(|| {
+            eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, list[0].class()).explain());
+            eprintln!("integrator {}", match args.integrator {
+                Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
+                Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
             });
-        }
+        });
+    }
+    catch_stop_signals();
+    let mut checkpoints = 0u32;
+    let mut write_checkpoint = |samples: std::ops::Range<u32>, sums: &[[f32; 4]]| -> Result<()> {
+        parts::write_part(&part_path, &part_info(samples.clone()), sums)?;
+        checkpoints += 1;
+        bar.println(format!("checkpoint: samples {}..{} in {}", samples.start, samples.end, part_path.display()));
+        Ok(())
     };
-    let (result, device, adapter, startup) = match args.device.open()? {
-        Device::Gpu(ctx) => {
-            let mut b = GpuBackend::new(ctx.clone());
-            explain(&|| b.class());
-            let r = render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?;
+    let control = Control {
+        stop: Some(&STOP),
+        checkpoint: args.checkpoint.map(|s| (std::time::Duration::from_secs_f64(s), &mut write_checkpoint as &mut dyn FnMut(_, &_) -> _)),
+        resume: resume.as_ref().map(|(r, sums)| (r.clone(), sums.as_slice())),
+        inject: None,
+    };
+    let result = treelet::render::devices::render_on_devices(&list, &scene, &settings, reference.as_ref(), control, on_pass)?;
+    bar.finish_and_clear();
+    let done = result.samples.clone();
+    let write_start = std::time::Instant::now();
+    match (&result.stopped, &part) {
+        (None, Some(_)) => parts::write_part(&args.out, &part_info(done.clone()), &result.sums)?,
+        (None, None) => {
+            image_io::write(&args.out, &result.image)?;
+            // The image holds every sample now: the checkpoint is spent.
+            if checkpoints > 0 {
+                let _ = std::fs::remove_file(&part_path);
+            }
+        }
+        (Some(_), _) => {
+            // The samples done, as a part that `merge` and `--resume` take and,
+            // without --samples, as the image of them.
+            parts::write_part(&part_path, &part_info(done.clone()), &result.sums)?;
+            if part.is_none() {
+                image_io::write(&args.out, &result.image)?;
+            }
+        }
+    }
+    let write_s = write_start.elapsed().as_secs_f64();
+    let startup = match &list[..] {
+        [Device::Gpu(ctx)] => {
             let (pipelines, pipelines_s) = ctx.pipelines_built();
-            let startup = serde_json::json!({
+            serde_json::json!({
                 "device_s": ctx.startup.device_s,
                 "module_s": ctx.startup.module_s,
                 "pipelines": pipelines,
                 "pipelines_s": pipelines_s,
                 "pipeline_cache": if !ctx.has_pipeline_cache() { "none" } else if ctx.startup.cache_loaded { "loaded" } else { "new" },
-            });
-            (r, "gpu", b.adapter(), startup)
+            })
         }
-        Device::Cpu => {
-            let mut b = CpuBackend::new();
-            explain(&|| b.class());
-            (render(&mut b, &scene, &settings, reference.as_ref(), on_pass)?, "cpu", "cpu".into(), serde_json::Value::Null)
-        }
+        _ => serde_json::Value::Null,
     };
-    bar.finish_and_clear();
-    let write_start = std::time::Instant::now();
-    write_output(&args, &scene, &result.image, &result.sums)?;
-    let write_s = write_start.elapsed().as_secs_f64();
     if args.explain && !startup.is_null() {
         eprintln!(
             "start-up   device {:.3} s, shader module {:.3} s, {} pipelines {:.3} s (pipeline cache: {}); image written in {write_s:.3} s",
@@ -250,13 +343,21 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     }
     // Wall time of the whole run so far: start-up, device, pipelines, render, image.
     let process_s = PROCESS_START.get().map_or(0.0, |t| t.elapsed().as_secs_f64());
-    let paths = args.width as f64 * args.height as f64 * args.spp as f64;
+    let spp = done.end - done.start;
+    // Only the samples this run rendered count toward its rate.
+    let resumed = resume.as_ref().map_or(0, |(r, _)| r.end - r.start);
+    let paths = args.width as f64 * args.height as f64 * (spp - resumed.min(spp)) as f64;
+    let (device, adapter) = match &list[..] {
+        [Device::Gpu(ctx)] => ("gpu", ctx.info.name.clone()),
+        [Device::Cpu] => ("cpu", "cpu".to_string()),
+        _ => ("devices", format!("{} devices", list.len())),
+    };
     eprintln!(
-        "{}: {}x{} at {} spp on {adapter} (accel {}, layout {}, kernel {}, integrator {}), {:.3} s ({:.1} M camera paths/s; kernels {:.3} s, process {:.3} s), wrote {}",
+        "{}: {}x{} at {spp} spp{} on {adapter} (accel {}, layout {}, kernel {}, integrator {}), {:.3} s ({:.1} M camera paths/s; kernels {:.3} s, process {:.3} s), wrote {}",
         scene.name,
         args.width,
         args.height,
-        args.spp,
+        if resumed > 0 { format!(" ({resumed} of them resumed)") } else { String::new() },
         result.plan.accel.name(),
         if result.plan.accel == Accel::None { "-" } else { result.plan.layout.name() },
         result.plan.kernel,
@@ -265,20 +366,39 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         paths / result.total_s / 1e6,
         (result.build_ms + result.render_ms) / 1e3,
         process_s,
-        args.out.display()
+        if result.stopped.is_some() && part.is_none() { format!("{} and {}", args.out.display(), part_path.display()) } else { args.out.display().to_string() }
     );
+    if list.len() > 1 {
+        for s in &result.shares {
+            eprintln!(
+                "  {}: {} spp ({:.1}%) in {} chunks, {:.1} M paths/s{}",
+                s.device,
+                s.samples,
+                100.0 * s.samples as f64 / spp.max(1) as f64,
+                s.chunks,
+                s.paths_per_s / 1e6,
+                s.failed.as_ref().map(|f| format!(", stopped: {f}")).unwrap_or_default()
+            );
+            if s.failed.is_some() && result.stopped.is_none() {
+                eprintln!("warning: {} failed; the other devices rendered its unfinished samples", s.device);
+            }
+        }
+    }
     if let Some(path) = &args.report {
         let doc = serde_json::json!({
             "scene": scene.name,
             "width": args.width,
             "height": args.height,
-            "spp": args.spp,
+            "spp": spp,
+            "samples": [done.start, done.end],
+            "stopped": result.stopped.as_ref().map(|s| format!("{s:?}")),
             "seed": args.seed,
             "accel": result.plan.accel,
             "integrator": args.integrator,
             "plan": result.plan,
             "device": device,
             "adapter": adapter,
+            "devices": result.shares,
             "build_ms": result.build_ms,
             "render_ms": result.render_ms,
             "total_s": result.total_s,
@@ -289,7 +409,8 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             "samples_per_s": paths / result.total_s,
             "rows": result.rows,
         });
-        std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(|| format!("writing {}", path.display()))?;
+        let text = serde_json::to_string_pretty(&doc)?;
+        image_io::write_atomically(path, |tmp| Ok(std::fs::write(tmp, &text)?)).with_context(|| format!("cannot write {}", path.display()))?;
         // The log-log plot of error against time, beside the report.
         let (label, points): (&str, Vec<(f64, f64)>) = if reference.is_some() {
             ("RMSE against the reference", result.rows.iter().filter_map(|r| Some((r.elapsed_s, r.rmse?))).collect())
@@ -304,79 +425,33 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         if plot_path == args.out {
             plot_path = path.with_extension("error.png");
         }
-        let title = format!(
-            "{}: {}x{}, {} spp, accel {}, {adapter}",
-            scene.name, args.width, args.height, args.spp, result.plan.accel.name()
-        );
+        let title = format!("{}: {}x{}, {spp} spp, accel {}, {adapter}", scene.name, args.width, args.height, result.plan.accel.name());
         let series = [Series { label: format!("{device} ({adapter})"), points }];
         match treelet::plot::error_vs_time(&plot_path, &title, label, &series) {
             Ok(()) => eprintln!("wrote {} and {}", path.display(), plot_path.display()),
             Err(e) => eprintln!("wrote {}; no plot: {e:#}", path.display()),
         }
     }
-    Ok(())
-}
-
-/// The image, or with `--samples` the part (sums and their range).
-fn write_output(args: &RenderArgs, scene: &Scene, image: &image_io::HdrImage, sums: &[[f32; 4]]) -> Result<()> {
-    match &args.samples {
-        Some(range) => {
-            let info = treelet::render::parts::PartInfo {
-                scene: scene.name.clone(),
-                scene_hash: format!("{:016x}", scene.content_hash()),
-                width: args.width,
-                height: args.height,
-                seed: args.seed,
-                integrator: args.integrator.name().into(),
-                samples: range.clone(),
-            };
-            treelet::render::parts::write_part(&args.out, &info, sums)
+    match &result.stopped {
+        None => Ok(()),
+        Some(Stopped::Interrupted) => {
+            eprintln!(
+                "interrupted: samples {}..{} of {}..{} are done; `--resume {}` with the same options continues the render",
+                done.start,
+                done.end,
+                first_sample,
+                first_sample + args.spp,
+                part_path.display()
+            );
+            Ok(())
         }
-        None => image_io::write(&args.out, image),
+        Some(Stopped::Failed(why)) => anyhow::bail!(
+            "every device failed ({why}); samples {}..{} are done and written to {} (`--resume` it)",
+            done.start,
+            done.end,
+            part_path.display()
+        ),
     }
-}
-
-/// `render --devices`: one image from several devices (see `treelet::render::devices`).
-fn render_on_devices(args: &RenderArgs, spec: &str, scene: &Scene, settings: &RenderSettings) -> Result<()> {
-    use treelet::render::devices;
-    let list = devices::open(spec)?;
-    let start = std::time::Instant::now();
-    let (image, sums, shares) = devices::render_on_devices(&list, scene, settings, None)?;
-    let seconds = start.elapsed().as_secs_f64();
-    write_output(args, scene, &image, &sums)?;
-    let paths = args.width as f64 * args.height as f64 * args.spp as f64;
-    eprintln!(
-        "{}: {}x{} at {} spp on {} devices, {seconds:.3} s ({:.1} M camera paths/s), wrote {}",
-        scene.name,
-        args.width,
-        args.height,
-        args.spp,
-        shares.len(),
-        paths / seconds / 1e6,
-        args.out.display()
-    );
-    for s in &shares {
-        eprintln!(
-            "  {}: {} spp ({:.1}%) in {} chunks, {:.1} M paths/s{}",
-            s.device,
-            s.samples,
-            100.0 * s.samples as f64 / args.spp as f64,
-            s.chunks,
-            s.paths_per_s / 1e6,
-            s.failed.as_ref().map(|f| format!(", stopped: {f}")).unwrap_or_default()
-        );
-        if s.failed.is_some() {
-            eprintln!("warning: {} failed; the other devices rendered its unfinished samples", s.device);
-        }
-    }
-    if let Some(path) = &args.report {
-        let doc = serde_json::json!({
-            "scene": scene.name, "width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed,
-            "integrator": args.integrator, "total_s": seconds, "samples_per_s": paths / seconds, "devices": shares,
-        });
-        std::fs::write(path, serde_json::to_string_pretty(&doc)?).with_context(|| format!("writing {}", path.display()))?;
-    }
-    Ok(())
 }
 
 fn print_summary(r: &BuildReport) {
@@ -470,7 +545,15 @@ fn main() -> ExitCode {
     PROCESS_START.get_or_init(std::time::Instant::now);
     // Before any thread starts (the library also does it when it opens Vulkan).
     treelet::runtime::gpu::quiet_mesa_runtime_dir();
-    match run(Cli::parse()) {
+    let outcome = run(Cli::parse());
+    // A render stopped by a signal exits as the shell expects of one (128 + SIGINT).
+    if STOP.load(Ordering::SeqCst) {
+        if let Err(e) = &outcome {
+            eprintln!("error: {e:#}");
+        }
+        return ExitCode::from(130);
+    }
+    match outcome {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => {
             eprintln!("error: the built tree failed validation");

@@ -520,3 +520,98 @@ fn a_scene_without_light_gets_a_warning() {
     assert!(!String::from_utf8_lossy(&o.stderr).contains("emits light"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The `samples A..B` that a stopped render's summary names.
+fn samples_done(stderr: &str) -> std::ops::Range<u32> {
+    let at = stderr.find("interrupted: samples ").unwrap_or_else(|| panic!("no `interrupted:` line in: {stderr}"));
+    let range = stderr[at + "interrupted: samples ".len()..].split_whitespace().next().unwrap();
+    let (a, b) = range.split_once("..").unwrap();
+    a.parse().unwrap()..b.parse().unwrap()
+}
+
+/// Ctrl-C (SIGINT) stops a long render without losing it: it exits 130
+/// and writes the image of the samples done and a part of them; `merge`
+/// turns the part into that same image, and `--resume` continues it to the
+/// image that an uninterrupted render makes, bit for bit on the CPU runner.
+#[test]
+fn an_interrupted_render_keeps_its_samples_and_resumes_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-interrupt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let base = ["render", "--device", "cpu", "--width", "8", "--height", "8", "--seed", "3"];
+    let child = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(base)
+        .args(["--spp", "100000000", "--out", &p("img.exr")])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(2500));
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    let done = samples_done(&err);
+    assert!(done.start == 0 && done.end > 0 && done.end < 100000000, "{done:?}");
+    assert!(err.contains("--resume"), "{err}");
+
+    // The part merges into the image written at the stop.
+    let o = treelet(&["merge", &p("img.part.exr"), "--out", &p("merged.exr")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = treelet(&["compare", &p("merged.exr"), "--reference", &p("img.exr")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("compare prints JSON");
+    assert_eq!(v["rmse"].as_f64(), Some(0.0), "{v}");
+
+    // Resumed to N samples, it is the render of N samples. N is chosen so
+    // that the passes up to the stop are those of the first render's
+    // schedule (4, 8, 16, ...: whole powers of two below N/2).
+    let n = 2 * (done.end + 1).next_power_of_two();
+    let o = treelet(&[&base[..], &["--spp", &n.to_string(), "--resume", &p("img.part.exr"), "--out", &p("resumed.exr")]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = treelet(&[&base[..], &["--spp", &n.to_string(), "--out", &p("whole.exr")]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = treelet(&["compare", &p("resumed.exr"), "--reference", &p("whole.exr")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("compare prints JSON");
+    assert_eq!(v["rmse"].as_f64(), Some(0.0), "resumed at {} of {n}: {v}", done.end);
+    assert_eq!(std::fs::read(p("resumed.exr")).unwrap(), std::fs::read(p("whole.exr")).unwrap());
+
+    // A part of another render is refused, naming the difference.
+    let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--seed", "4", "--spp", &n.to_string(), "--resume", &p("img.part.exr"), "--out", &p("x.exr")]);
+    assert!(e.contains("--resume") && e.contains("seed"), "{e}");
+    let e = stderr_of(&[&base[..], &["--spp", "2", "--resume", &p("img.part.exr"), "--out", &p("x.exr")]].concat());
+    assert!(e.contains("--resume") && e.contains("end no earlier"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--checkpoint` writes the samples done as it goes: a render killed
+/// outright (SIGKILL: no chance to write anything) leaves its last
+/// checkpoint, which merges into an image; a render that completes removes
+/// its checkpoint, and no temporary file is left behind.
+#[test]
+fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-checkpoint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "100000000", "--checkpoint", "0.2"])
+        .args(["--out", &p("img.png")])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(2500));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = treelet(&["merge", &p("img.part.exr"), "--out", &p("merged.png")]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("samples 0.."), "{err}");
+    assert!(!std::path::Path::new(&p("img.png")).exists(), "a killed render wrote no image");
+
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "256", "--checkpoint", "0.01", "--out", &p("done.png")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::path::Path::new(&p("done.png")).exists());
+    assert!(!std::path::Path::new(&p("done.part.exr")).exists(), "the checkpoint of a completed render is removed");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().to_string()).filter(|n| n.starts_with('.')).collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+    let e = stderr_of(&["render", "--device", "cpu", "--checkpoint", "0", "--out", &p("x.png")]);
+    assert!(e.contains("--checkpoint"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

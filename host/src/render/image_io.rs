@@ -65,26 +65,55 @@ pub fn check_output(path: &Path, what: &str, formats: &[&str]) -> Result<()> {
     Ok(())
 }
 
-/// Writes `image` in the format its extension names: .png, .exr or .pfm.
+/// Writes a file by `write` into a temporary file beside `path` (with the
+/// same extension), then renames it over `path`: a crash or a failed write
+/// never leaves a half-written file where a good one was.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+    let suffix = path.extension().map_or_else(String::new, |e| format!(".{}", e.to_string_lossy()));
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(&suffix);
+    // As a plain create would make it (0666 less the umask), not tempfile's 0600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let tmp = builder.tempfile_in(dir).with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    write(tmp.path())?;
+    tmp.persist(path).map_err(|e| anyhow::anyhow!("cannot rename the finished file over it: {}", e.error))?;
+    Ok(())
+}
+
+/// Writes `image` in the format its extension names (.png, .exr or .pfm),
+/// atomically ([`write_atomically`]).
 pub fn write(path: &Path, image: &HdrImage) -> Result<()> {
+    write_atomically(path, |tmp| write_format(tmp, &extension(path), image))
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes `image` to `path` in the format `ext`.
+fn write_format(path: &Path, ext: &str, image: &HdrImage) -> Result<()> {
     let (w, h) = (image.width, image.height);
-    match extension(path).as_str() {
+    match ext {
         "png" => {
             use image::codecs::png::{CompressionType, FilterType, PngEncoder};
             let bytes: Vec<u8> = image.pixels.iter().flat_map(|p| p.map(to_srgb8)).collect();
             // Fast compression: a render's PNG is written on every run, and the
             // default level takes several times longer for a few percent of size.
-            let file = std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+            let file = std::fs::File::create(path)?;
             let encoder = PngEncoder::new_with_quality(std::io::BufWriter::new(file), CompressionType::Fast, FilterType::Adaptive);
             image::ImageEncoder::write_image(encoder, &bytes, w, h, image::ExtendedColorType::Rgb8)
-                .with_context(|| format!("cannot write {}", path.display()))
+                .context("encoding failed")
         }
         "exr" => {
             let floats: Vec<f32> = image.pixels.iter().flatten().copied().collect();
             image::Rgb32FImage::from_raw(w, h, floats)
                 .context("image size mismatch")?
                 .save_with_format(path, image::ImageFormat::OpenExr)
-                .with_context(|| format!("cannot write {}", path.display()))
+                .context("encoding failed")
         }
         "pfm" => {
             let mut out = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
@@ -93,9 +122,9 @@ pub fn write(path: &Path, image: &HdrImage) -> Result<()> {
                     out.extend_from_slice(&v.to_le_bytes());
                 }
             }
-            std::fs::write(path, out).with_context(|| format!("cannot write {}", path.display()))
+            std::fs::write(path, out).map_err(Into::into)
         }
-        other => bail!("{}: unknown image format `.{other}` (use .png, .exr or .pfm)", path.display()),
+        other => bail!("unknown image format `.{other}` (use .png, .exr or .pfm)"),
     }
 }
 
@@ -182,7 +211,7 @@ mod tests {
             assert_eq!(read_hdr(&path).unwrap(), sample(), "{ext}");
         }
         write(&dir.join("a.png"), &sample()).unwrap();
-        assert!(write(&dir.join("a.bmp"), &sample()).unwrap_err().to_string().contains("unknown image format"));
+        assert!(format!("{:#}", write(&dir.join("a.bmp"), &sample()).unwrap_err()).contains("unknown image format"));
     }
 
     #[test]
@@ -198,5 +227,24 @@ mod tests {
         assert_eq!(to_srgb8(1.0), 255);
         assert_eq!(to_srgb8(7.0), 255);
         assert_eq!(to_srgb8(0.5), 186);
+    }
+
+    /// A write that fails half-way leaves the file that was there whole,
+    /// and no temporary file beside it.
+    #[test]
+    fn a_failed_write_leaves_the_old_file() {
+        let dir = std::env::temp_dir().join(format!("treelet-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.pfm");
+        write(&path, &sample()).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        let e = write_atomically(&path, |tmp| {
+            std::fs::write(tmp, b"PF\n2 1\n")?;
+            bail!("disk full")
+        });
+        assert!(format!("{:#}", e.unwrap_err()).contains("disk full"));
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "only a.pfm is left");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

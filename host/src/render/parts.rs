@@ -27,9 +27,30 @@ pub struct PartInfo {
     pub samples: Range<u32>,
 }
 
+impl PartInfo {
+    /// How `self` is of another render than `other` (scene contents, size,
+    /// seed, integrator), if it is: parts add up only when none differs.
+    /// The scene is compared by its contents, not its name: one file named
+    /// by two paths is one scene, and a file edited between parts is not.
+    pub fn differs_from(&self, other: &PartInfo) -> Option<String> {
+        if self.scene_hash != other.scene_hash {
+            return Some(format!(
+                "one is of scene {} (contents {}), the other of scene {} (contents {}) (was the scene or a mesh edited between them?)",
+                self.scene, self.scene_hash, other.scene, other.scene_hash
+            ));
+        }
+        let pairs = [
+            ("size", format!("{}x{}", self.width, self.height), format!("{}x{}", other.width, other.height)),
+            ("seed", self.seed.to_string(), other.seed.to_string()),
+            ("integrator", self.integrator.clone(), other.integrator.clone()),
+        ];
+        pairs.into_iter().find(|(_, a, b)| a != b).map(|(what, a, b)| format!("one is of {what} {a}, the other of {b}"))
+    }
+}
+
 const PREFIX: &str = "treelet.";
 
-/// Writes `sums` (one per pixel, image order) as a part.
+/// Writes `sums` (one per pixel, image order) as a part, atomically.
 pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()> {
     let (w, h) = (info.width as usize, info.height as usize);
     if sums.len() != w * h {
@@ -57,7 +78,8 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
             (s[0], s[1], s[2], s[3])
         }),
     );
-    Image::from_layer(layer).write().to_file(path).with_context(|| format!("cannot write {}", path.display()))
+    image_io::write_atomically(path, |tmp| Ok(Image::from_layer(layer).write().to_file(tmp)?))
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Reads a part: what it is of, and its sums.
@@ -126,28 +148,9 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
     }
     let reference = parts[0].1.clone();
     for (p, info, _) in &parts[1..] {
-        let same = |what: &str, a: &dyn std::fmt::Display, b: &dyn std::fmt::Display| -> Result<()> {
-            if a.to_string() != b.to_string() {
-                bail!("{} is of {what} {a}, {} of {b}: parts of one render only", p.display(), first.display());
-            }
-            Ok(())
-        };
-        // The scene's contents, not its name: one file named by two paths is
-        // one scene, and a file edited between parts is not.
-        if info.scene_hash != reference.scene_hash {
-            bail!(
-                "{} is of scene {} (contents {}), {} of scene {} (contents {}): parts of one render only (was the scene or a mesh edited between them?)",
-                p.display(),
-                info.scene,
-                info.scene_hash,
-                first.display(),
-                reference.scene,
-                reference.scene_hash
-            );
+        if let Some(why) = info.differs_from(&reference) {
+            bail!("{} and {} are not parts of one render: {why}", p.display(), first.display());
         }
-        same("size", &format!("{}x{}", info.width, info.height), &format!("{}x{}", reference.width, reference.height))?;
-        same("seed", &info.seed, &reference.seed)?;
-        same("integrator", &info.integrator, &reference.integrator)?;
     }
     parts.sort_by_key(|(_, info, _)| info.samples.start);
     for pair in parts.windows(2) {
@@ -178,8 +181,8 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
     let samples = parts[0].1.samples.start..parts[parts.len() - 1].1.samples.end;
     let mut sums = vec![[0f64; 4]; parts[0].2.len()];
     for (_, _, part) in &parts {
-        super::add_sums(&mut sums, part);
+        super::sums::add_sums(&mut sums, part);
     }
-    let image = super::mean_image(reference.width, reference.height, &sums, samples.end - samples.start);
+    let image = super::sums::mean_image(reference.width, reference.height, &sums, samples.end - samples.start);
     Ok((PartInfo { samples, ..reference }, image))
 }

@@ -49,7 +49,7 @@ pub enum DeviceClass {
     CpuRunner,
 }
 
-pub trait Backend {
+pub trait Backend: Send {
     /// A device buffer; cloning clones the handle, not the data.
     type Buffer: Clone;
 

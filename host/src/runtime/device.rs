@@ -56,6 +56,16 @@ impl Device {
             Device::Cpu => "cpu".into(),
         }
     }
+
+    /// What kind of device it is (as its backend's `class()` says).
+    pub fn class(&self) -> crate::runtime::backend::DeviceClass {
+        use crate::runtime::backend::DeviceClass;
+        match self {
+            Device::Gpu(ctx) if ctx.info.device_type == wgpu::DeviceType::Cpu => DeviceClass::CpuAdapter,
+            Device::Gpu(_) => DeviceClass::Gpu,
+            Device::Cpu => DeviceClass::CpuRunner,
+        }
+    }
 }
 
 /// Runs `$body` with `$b` bound to a fresh backend on `$device` (a

@@ -1,0 +1,147 @@
+//! One device's part of a render before its first sample: the tree built
+//! and laid out, the scene and light table uploaded, the kernel chosen, and
+//! the accumulation buffer of per-pixel sums that its dispatches add to.
+use anyhow::{bail, Result};
+use treelet_core::geometry::buffers::RenderParams;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::render::integrator::tiled_invocations;
+use treelet_core::render::lights::{Light, light_power};
+
+use crate::bvh::layout::{PrimBuffers, TracedTree};
+use crate::bvh::lbvh;
+use crate::bvh::tree::traced_tree;
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::Kernel;
+use crate::scene::Scene;
+use crate::scene::primitives::Primitives;
+use super::settings::{samples_per_dispatch, RenderSettings};
+use super::variant::{self, Plan};
+
+/// The light table of `prims` (spheres then triangles, one material each):
+/// every emitter, chosen in proportion to its power
+/// (`treelet_core::render::lights::light_power`), in primitive order. Empty
+/// without emitters.
+pub fn light_table(prims: Primitives, materials: &[treelet_core::geometry::buffers::Material]) -> Vec<Light> {
+    let p = prims.as_core();
+    let powers: Vec<(u32, f64)> = (0..p.count())
+        .map(|i| (i, light_power(&p, materials, i) as f64))
+        .filter(|&(_, w)| w > 0.0 && w.is_finite())
+        .collect();
+    let total: f64 = powers.iter().map(|&(_, w)| w).sum();
+    let mut cumulative = 0.0;
+    let mut table: Vec<Light> = powers
+        .iter()
+        .map(|&(prim, w)| {
+            cumulative += w;
+            Light { prim, pmf: (w / total) as f32, cdf: (cumulative / total) as f32, _pad: 0 }
+        })
+        .collect();
+    if let Some(last) = table.last_mut() {
+        last.cdf = 1.0; // Whatever rounding did, the last light takes the rest.
+    }
+    table
+}
+
+/// Everything a render needs on one device before its first sample: the
+/// tree and buffers, the kernel, and an accumulation buffer of per-pixel
+/// sums. A render is samples dispatched into it, in any ranges, on any
+/// number of devices (see [`super::run`]).
+pub struct Prepared<B: Backend> {
+    tree: TracedTree<B>,
+    buffers: PrimBuffers<B>,
+    materials: B::Buffer,
+    lights: B::Buffer,
+    accum: B::Buffer,
+    kernel: Kernel,
+    /// Render parameters but for the samples of a dispatch.
+    params: RenderParams,
+    per_dispatch: u32,
+    pixels: u64,
+    pub build_ms: f64,
+    pub plan: Plan,
+}
+
+impl<B: Backend> Prepared<B> {
+    /// Checks the settings and the scene, builds the tree on `b` and uploads
+    /// the scene. `base`: per-pixel sums the accumulation starts from (a
+    /// resumed render's part), else zeros.
+    pub fn new(b: &mut B, scene: &Scene, settings: &RenderSettings, base: Option<&[[f32; 4]]>) -> Result<Self> {
+        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, first_sample, .. } = *settings;
+        if width == 0 || height == 0 || spp == 0 {
+            bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
+        }
+        let pixels = width as u64 * height as u64;
+        if pixels > u32::MAX as u64 / 2 {
+            bail!("image size {width}x{height} is too large ({pixels} pixels)");
+        }
+        if first_sample.checked_add(spp).is_none() {
+            bail!("samples {first_sample}.. plus {spp}: the sample index must stay below 2^32");
+        }
+        // Everything the render traces: spheres (the room included), then triangles.
+        let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+        all.check()?;
+        if scene.materials.len() != all.len() {
+            bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
+        }
+        let plan = variant::plan(scene, accel, layout, kernel, b.class());
+        let (tree, buffers, build_ms) = traced_tree(b, all, plan.accel, plan.layout)?;
+        let materials = b.upload("materials", &scene.materials)?;
+        let table = light_table(all, &scene.materials);
+        let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
+        let accum = match base {
+            Some(sums) if sums.len() as u64 == pixels => b.upload("accumulation", sums)?,
+            Some(sums) => bail!("the sums to resume from are of {} pixels, the image has {pixels}", sums.len()),
+            None => b.zeroed("accumulation", pixels * 16)?,
+        };
+        let params = RenderParams {
+            width,
+            height,
+            seed,
+            prims: scene.spheres.len() as u32,
+            triangles: scene.triangles.len() as u32,
+            camera: scene.camera.camera(width, height),
+            integrator: integrator.code(),
+            light_count: table.len() as u32,
+            ..Default::default()
+        };
+        Ok(Prepared {
+            tree,
+            buffers,
+            materials,
+            lights,
+            accum,
+            kernel: Kernel::Render(plan.method(), plan.variant as u8),
+            params,
+            per_dispatch: samples_per_dispatch(pixels, b.class()),
+            pixels,
+            build_ms,
+            plan,
+        })
+    }
+
+    /// Dispatches samples `first .. first + count` of every pixel, adding
+    /// to the accumulation (recorded, not waited for).
+    pub fn dispatch_samples(&self, b: &mut B, first: u32, count: u32) -> Result<()> {
+        b.stage("render");
+        let mut done = 0;
+        while done < count {
+            let samples = (count - done).min(self.per_dispatch);
+            let p = b.upload("render params", &[RenderParams { samples, first_sample: first + done, ..self.params }])?;
+            let t = &self.tree;
+            b.dispatch(
+                self.kernel,
+                &[&p, &self.buffers.spheres, &self.materials, &t.nodes, &t.prims, &self.accum, &self.buffers.triangles, &self.lights],
+                groups_for(tiled_invocations(self.params.width, self.params.height), WORKGROUP_SIZE),
+            );
+            done += samples;
+        }
+        Ok(())
+    }
+
+    /// The per-pixel sums so far (waits for the dispatches).
+    pub fn read_sums(&self, b: &mut B) -> Result<Vec<[f32; 4]>> {
+        b.read(&self.accum, self.pixels as usize)
+    }
+
+}
+

@@ -1,0 +1,123 @@
+//! What a render is asked for: image size, samples, seed, tree, kernel and
+//! estimator ([`RenderSettings`]), and how its samples are cut into
+//! dispatches and passes.
+use serde::Serialize;
+
+use crate::bvh::layout::Layout;
+use crate::bvh::tree::Accel;
+use crate::runtime::backend::DeviceClass;
+use super::variant::KernelChoice;
+
+/// How radiance is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// smallpt's: emitters count only where a path hits them.
+    Smallpt,
+    /// Next-event estimation: a light sampled at every diffuse bounce, with
+    /// multiple importance sampling (`treelet_core::render::lights`).
+    Nee,
+}
+
+impl Integrator {
+    pub(super) fn code(self) -> u32 {
+        match self {
+            Integrator::Smallpt => treelet_core::geometry::buffers::SMALLPT,
+            Integrator::Nee => treelet_core::geometry::buffers::NEE,
+        }
+    }
+
+    /// The word the command line takes (`--integrator`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Smallpt => "smallpt",
+            Integrator::Nee => "nee",
+        }
+    }
+
+    /// What it is, for figures.
+    pub fn label(self) -> &'static str {
+        match self {
+            Integrator::Smallpt => "smallpt's estimator",
+            Integrator::Nee => "next-event estimation",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel in all (smallpt's 2x2 subpixels take them in turn).
+    pub spp: u32,
+    pub seed: u32,
+    pub accel: Accel,
+    /// How the tree is laid out for traversal.
+    pub layout: Layout,
+    /// The render kernel: the smallest variant for the scene, or the general one.
+    pub kernel: KernelChoice,
+    pub integrator: Integrator,
+    /// Read the image back and measure its error after every pass (for a
+    /// report or a reference); else only after the last, which saves a
+    /// readback of the whole image per pass.
+    pub error_each_pass: bool,
+    /// The index of the first sample: a render of samples `first_sample ..
+    /// first_sample + spp` is that part of a longer render (the random
+    /// numbers are counted from (seed, pixel, sample)), so parts rendered
+    /// apart add up to it (`treelet render --samples`, `treelet merge`).
+    pub first_sample: u32,
+}
+
+/// Camera paths per dispatch at most, so that no dispatch runs long enough
+/// for a driver to time it out, whatever the sample count.
+pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;
+
+/// Samples per pixel per dispatch at most: each invocation loops over
+/// that many camera paths of its pixel.
+///
+/// lavapipe (Mesa 22.3, LLVM 15) gets the image wrong when that loop is
+/// long, and the CPU runner, which runs the same code, never does; the
+/// cause is not known. Seen twice: far too dark at 512 samples a dispatch
+/// with smallpt's estimator (cornell at 64x48 and 32x24; 256 were right),
+/// and, with next-event estimation in the disk-lit room, most of the light
+/// lost from the second dispatch on at 32 and 64 samples a dispatch (16x12
+/// to 128x96; 24 and fewer were right at every size tried). CPU adapters
+/// therefore take 16; more dispatches cost them little.
+pub fn max_samples_per_dispatch(class: DeviceClass) -> u32 {
+    match class {
+        DeviceClass::CpuAdapter => 16,
+        DeviceClass::Gpu | DeviceClass::CpuRunner => 64,
+    }
+}
+
+/// Samples per pixel in one dispatch for an image of `pixels` on a device
+/// of `class`: as many as [`MAX_PATHS_PER_DISPATCH`] and
+/// [`max_samples_per_dispatch`] allow, at least one.
+pub fn samples_per_dispatch(pixels: u64, class: DeviceClass) -> u32 {
+    (MAX_PATHS_PER_DISPATCH / pixels.max(1)).clamp(1, max_samples_per_dispatch(class) as u64) as u32
+}
+
+/// Cumulative sample counts after each pass: 4, 8, 16, ... then `spp`.
+pub fn pass_schedule(spp: u32) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut s = 4u32.min(spp);
+    while s < spp {
+        out.push(s);
+        s = s.saturating_mul(2);
+    }
+    out.push(spp);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedule_doubles_and_ends_at_spp() {
+        assert_eq!(pass_schedule(1), vec![1]);
+        assert_eq!(pass_schedule(4), vec![4]);
+        assert_eq!(pass_schedule(64), vec![4, 8, 16, 32, 64]);
+        assert_eq!(pass_schedule(100), vec![4, 8, 16, 32, 64, 100]);
+    }
+}
