@@ -24,7 +24,7 @@ const CORE_FLOORS: &[(&str, u32)] =
 
 /// Floors of the host library's top-level folders; a top-level file (`tracer.rs`) is a folder named by its stem.
 const HOST_LIB_FLOORS: &[(&str, u32)] =
-    &[("runtime", 0), ("plot", 0), ("scene", 1), ("bvh", 2), ("render", 3), ("tracer", 4)];
+    &[("runtime", 0), ("plot", 0), ("input", 0), ("scene", 1), ("bvh", 2), ("render", 3), ("tracer", 4)];
 
 /// The crate roots checked, relative to the workspace root.
 const CRATES: &[CrateSpec] = &[

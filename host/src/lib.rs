@@ -34,19 +34,22 @@
 //! - [`runtime`]: where kernels run: the [`Backend`] trait, the GPU through
 //!   wgpu, and the CPU runner that calls the same kernel functions over
 //!   every invocation id; [`plot`]: charts for reports and benchmarks;
+//!   [`input`]: reading the files a user names (regular files only, capped);
 //! - [`scene`]: what is built and rendered: spheres and triangles, meshes,
 //!   scene files, and the checks that reject bad input;
 //! - [`bvh`]: the BVH builders (LBVH, treelet restructuring, full-sweep
 //!   SAH), refit, the traversal layouts, the tree a render or an engine asks
 //!   for ([`bvh::tree`]), and the independent validators;
-//! - [`render`]: the path tracer's passes, the kernel variant a scene needs,
-//!   images in and out, render parts and several devices;
+//! - [`render`]: the one render loop (one device or several, checkpoints,
+//!   stops, resumes), the kernel variant a scene needs, images in and out,
+//!   render parts;
 //! - [`tracer`]: the engine API re-exported above.
 //!
 //! The `treelet` command (`main.rs`, `bench/`) sits on top. The kernels
 //! themselves are in the `treelet-core` crate, which an engine may also use
 //! directly (`no_std`): see its docs for the traversal functions.
 pub mod bvh;
+pub mod input;
 pub mod plot;
 pub mod render;
 pub mod runtime;

@@ -26,6 +26,9 @@ mod bench;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The largest file (scene, mesh, image, part) read, in bytes.
+    #[arg(long, global = true, value_name = "BYTES", default_value_t = treelet::input::DEFAULT_MAX_INPUT_BYTES)]
+    max_input_bytes: u64,
 }
 
 
@@ -469,7 +472,21 @@ fn print_summary(r: &BuildReport) {
     println!("time       {:.3} ms ({}; {})", r.total_ms, r.timing, stages.join(", "));
 }
 
+/// Caps the CPU runner's threads: `RAYON_NUM_THREADS` far above the cores
+/// only costs (a million threads would take the machine's memory), so more
+/// than 4 per core are cut to that, with a warning.
+fn bound_threads() {
+    let Some(asked) = std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.trim().parse::<usize>().ok()) else { return };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let max = 4 * cores;
+    if asked > max {
+        eprintln!("warning: RAYON_NUM_THREADS={asked} is more than 4 threads per core ({cores} cores here): using {max}");
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(max).build_global();
+    }
+}
+
 fn run(cli: Cli) -> Result<bool> {
+    treelet::input::set_max_input_bytes(cli.max_input_bytes);
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
@@ -545,6 +562,7 @@ fn main() -> ExitCode {
     PROCESS_START.get_or_init(std::time::Instant::now);
     // Before any thread starts (the library also does it when it opens Vulkan).
     treelet::runtime::gpu::quiet_mesa_runtime_dir();
+    bound_threads();
     let outcome = run(Cli::parse());
     // A render stopped by a signal exits as the shell expects of one (128 + SIGINT).
     if STOP.load(Ordering::SeqCst) {

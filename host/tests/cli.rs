@@ -615,3 +615,89 @@ fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
     assert!(e.contains("--checkpoint"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs `treelet args` with `env`, killed after `seconds`: a hang fails the
+/// test instead of blocking it.
+fn treelet_within(seconds: u64, env: &[(&str, &str)], args: &[&str]) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(args)
+        .envs(env.iter().copied())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() >= seconds {
+            child.kill().unwrap();
+            panic!("treelet {args:?} still ran after {seconds} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// Only regular files are read, within a size cap a flag raises: a FIFO
+/// would block, a link to /dev/zero read forever; a folder named like a
+/// mesh is named as a folder.
+#[test]
+fn inputs_are_regular_files_within_a_cap() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-inputs-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    assert!(Command::new("mkfifo").arg(p("fifo.obj")).status().unwrap().success());
+    assert!(Command::new("mkfifo").arg(p("fifo.json")).status().unwrap().success());
+    std::os::unix::fs::symlink("/dev/zero", p("zero.ply")).unwrap();
+    for (scene, says) in [("fifo.obj", "not a regular file"), ("fifo.json", "not a regular file"), ("zero.ply", "not a regular file"), ("folder.obj", "is a folder")] {
+        let o = treelet_within(60, &[], &["build", "--device", "cpu", "--scene", &p(scene)]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && e.contains(scene) && e.contains(says), "{scene}: {e}");
+    }
+    let o = treelet_within(60, &[], &["compare", &p("fifo.obj"), "--reference", &p("zero.ply")]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("not a regular file"));
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell_diffuse.json");
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", scene, "--max-input-bytes", "100", "--out", &p("x.png")]);
+    assert!(e.contains("cornell_diffuse.json") && e.contains("--max-input-bytes"), "{e}");
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "1", "--scene", scene, "--max-input-bytes", "100000", "--out", &p("x.png")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Loader errors name the line (OBJ, as tobj does not) or the element
+/// (PLY), and the reason, on one line.
+#[test]
+fn loader_errors_name_the_line_or_element() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-loaders-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, &[u8], &[&str]); 6] = [
+        ("pos.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n", &["line 3", "position", "v 0 1 x"]),
+        ("bounds.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 9\n", &["line 5", "out of bounds", "f 1 2 9"]),
+        ("back.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 -3\nv 0 1 0\n", &["line 3", "out of bounds"]),
+        ("face.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a\n", &["line 4", "face parse error"]),
+        ("binary.obj", b"v 0 0 0\n\x00\xff\xfe\x00\n", &["line 2", "not UTF-8"]),
+        (
+            "vertex.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 zz\n0 1 0\n3 0 1 2\n",
+            &["vertex 1", "Line 11"],
+        ),
+    ];
+    for (name, bytes, says) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = stderr_of(&["build", "--device", "cpu", "--scene", path.to_str().unwrap()]);
+        assert!(e.contains(name) && says.iter().all(|s| e.contains(s)), "{name}: {e}");
+        assert_eq!(e.trim().lines().count(), 1, "{name}: one line: {e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A thread count far past the cores is cut (with a warning), so a tiny
+/// render does not stall starting a million threads.
+#[test]
+fn huge_thread_counts_are_bounded() {
+    let out = std::env::temp_dir().join(format!("treelet-cli-threads-{}.png", std::process::id()));
+    let o = treelet_within(120, &[("RAYON_NUM_THREADS", "1000000")], &["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "2", "--out", out.to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && e.contains("RAYON_NUM_THREADS") && e.contains("warning"), "{e}");
+    let _ = std::fs::remove_file(&out);
+}

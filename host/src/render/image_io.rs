@@ -130,6 +130,7 @@ fn write_format(path: &Path, ext: &str, image: &HdrImage) -> Result<()> {
 
 /// Reads a linear HDR image (.exr or .pfm).
 pub fn read_hdr(path: &Path) -> Result<HdrImage> {
+    crate::input::check(path, "image")?;
     match extension(path).as_str() {
         "exr" => {
             let img = image::open(path).with_context(|| format!("cannot read {}", path.display()))?.into_rgb32f();
@@ -138,7 +139,7 @@ pub fn read_hdr(path: &Path) -> Result<HdrImage> {
             Ok(HdrImage { width, height, pixels })
         }
         "pfm" => {
-            let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+            let bytes = crate::input::read(path, "image")?;
             parse_pfm(&bytes).with_context(|| format!("{}: not a valid colour PFM file", path.display()))
         }
         other => bail!("{}: a reference must be .exr or .pfm, not `.{other}`", path.display()),

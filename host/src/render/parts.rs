@@ -84,6 +84,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
 
 /// Reads a part: what it is of, and its sums.
 pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
+    crate::input::check(path, "part")?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| (size.width(), vec![[0f32; 4]; size.width() * size.height()]),

@@ -107,7 +107,7 @@ pub const MAX_EMISSION: f32 = 1e6;
 /// Reads a scene file; errors name the file and the line and column, or the
 /// sphere or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read scene file {}", path.display()))?;
+    let text = crate::input::read_text(path, "scene file")?;
     parse_in(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 

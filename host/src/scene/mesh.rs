@@ -29,11 +29,14 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
 /// Wavefront OBJ: every object's faces, triangulated; materials are not read.
 pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
-    let mut reader = std::io::BufReader::new(file);
+    let text = crate::input::read_text(path, "mesh")?;
     // Material libraries are ignored: Treelet assigns its own material.
-    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
-        .map_err(|e| anyhow!("{}: not a valid OBJ file: {e}", path.display()))?;
+    let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default())).map_err(|e| {
+        match obj_error_line(&text, &e) {
+            Some((line, content)) => anyhow!("{}: line {line}: {e} in `{}`", path.display(), content.trim()),
+            None => anyhow!("{}: not a valid OBJ file: {e}", path.display()),
+        }
+    })?;
     let mut triangles = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
@@ -54,16 +57,89 @@ pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     Ok(triangles)
 }
 
+/// The element (name and index) that the line named in a PLY parser's
+/// `message` ("Line N: ...") holds, from the header's element counts; for
+/// ASCII files, where a line is an element.
+fn ply_error_element(bytes: &[u8], message: &str) -> Option<(String, u64)> {
+    let line: usize = message.strip_prefix("Line ")?.split(':').next()?.trim().parse().ok()?;
+    let text = String::from_utf8_lossy(&bytes[..bytes.len().min(1 << 16)]);
+    let mut elements = Vec::new();
+    let mut header_end = None;
+    for (n, l) in text.lines().enumerate() {
+        let words: Vec<&str> = l.split_whitespace().collect();
+        match words.as_slice() {
+            ["format", f, ..] if *f != "ascii" => return None,
+            ["element", name, count] => elements.push((name.to_string(), count.parse::<u64>().ok()?)),
+            ["end_header"] => {
+                header_end = Some(n + 1);
+                break;
+            }
+            _ => {}
+        }
+    }
+    let mut index = (line as u64).checked_sub(header_end? as u64 + 1)?;
+    for (name, count) in elements {
+        if index < count {
+            return Some((name, index));
+        }
+        index -= count;
+    }
+    None
+}
+
+/// The line (from 1, with its text) that tobj's `error` is about, which
+/// tobj does not say: the first line that fails the check that the error
+/// names. Only finds the line; the loading is tobj's.
+fn obj_error_line<'t>(text: &'t str, error: &tobj::LoadError) -> Option<(usize, &'t str)> {
+    use tobj::LoadError as E;
+    let numbers = |words: &[&str], n: usize| words.len() >= n && words[..n].iter().all(|w| w.parse::<f32>().is_ok());
+    let total_positions = text.lines().filter(|l| l.split_whitespace().next() == Some("v")).count() as i64;
+    let mut positions = 0i64;
+    for (n, line) in text.lines().enumerate() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some((&key, rest)) = words.split_first() else { continue };
+        let bad = match (key, error) {
+            ("v", E::PositionParseError) => !numbers(rest, 3),
+            ("vn", E::NormalParseError) => !numbers(rest, 3),
+            ("vt", E::TexcoordParseError) => !numbers(rest, 1),
+            ("f", E::FaceParseError) => {
+                rest.len() < 3 || rest.iter().any(|v| v.split('/').next().is_none_or(|i| i.parse::<i64>().is_err()))
+            }
+            ("f", E::FaceVertexOutOfBounds) => rest.iter().any(|v| {
+                // 1-based, or negative: counted back from the positions so far.
+                match v.split('/').next().and_then(|i| i.parse::<i64>().ok()) {
+                    Some(i) if i > 0 => i > total_positions,
+                    Some(i) if i < 0 => positions + i < 0,
+                    _ => true,
+                }
+            }),
+            _ => false,
+        };
+        if bad {
+            return Some((n + 1, line));
+        }
+        if key == "v" {
+            positions += 1;
+        }
+    }
+    None
+}
+
 /// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
 /// `face` elements with a `vertex_indices` (or `vertex_index`) list.
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let file = std::fs::File::open(path).with_context(|| format!("{}: cannot open", path.display()))?;
-    let mut reader = std::io::BufReader::new(file);
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut reader)
-        .map_err(|e| anyhow!("{}: not a valid PLY file: {e}", path.display()))?;
+    let bytes = crate::input::read(path, "mesh")?;
+    let ply = Parser::<DefaultElement>::new().read_ply(&mut bytes.as_slice()).map_err(|e| {
+        // The parser's message spans lines and names a line of the file, not
+        // the element: one line, with the element that line holds.
+        let message = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+        match ply_error_element(&bytes, &message) {
+            Some((element, index)) => anyhow!("{}: {element} {index}: {message}", path.display()),
+            None => anyhow!("{}: not a valid PLY file: {message}", path.display()),
+        }
+    })?;
     let name = path.display();
     let vertices = ply.payload.get("vertex").ok_or_else(|| anyhow!("{name}: no `vertex` element"))?;
     let faces = ply.payload.get("face").ok_or_else(|| anyhow!("{name}: no `face` element"))?;

@@ -1,0 +1,104 @@
+//! Files a user names (scenes, meshes, images, parts), read safely: only
+//! regular files, so that a FIFO cannot block a run and a link to an endless
+//! device cannot fill the memory, and none larger than a cap that
+//! `--max-input-bytes` raises.
+use std::io::Read;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anyhow::{bail, Context as _, Result};
+
+/// The cap on an input file's size unless raised: 8 GiB, above the largest
+/// mesh measured (a 14 M triangle PLY of about 300 MB) by far, below what
+/// a machine without that much memory could read.
+pub const DEFAULT_MAX_INPUT_BYTES: u64 = 8 << 30;
+
+static MAX_INPUT_BYTES: AtomicU64 = AtomicU64::new(DEFAULT_MAX_INPUT_BYTES);
+
+/// Sets the cap on an input file's size (`--max-input-bytes`).
+pub fn set_max_input_bytes(bytes: u64) {
+    MAX_INPUT_BYTES.store(bytes, Ordering::Relaxed);
+}
+
+/// The cap on an input file's size.
+pub fn max_input_bytes() -> u64 {
+    MAX_INPUT_BYTES.load(Ordering::Relaxed)
+}
+
+/// Checks that `path` (a `what`: "scene file", "mesh", ...) is a regular
+/// file within the cap, without opening it (opening a FIFO blocks).
+/// Returns its size.
+pub fn check(path: &Path, what: &str) -> Result<u64> {
+    let meta = std::fs::metadata(path).with_context(|| format!("{what} {}: cannot read it", path.display()))?;
+    check_meta(path, what, &meta)
+}
+
+fn check_meta(path: &Path, what: &str, meta: &std::fs::Metadata) -> Result<u64> {
+    if meta.is_dir() {
+        bail!("{what} {} is a folder, not a file", path.display());
+    }
+    if !meta.is_file() {
+        bail!("{what} {} is not a regular file (a FIFO, socket or device?): only files are read", path.display());
+    }
+    let max = max_input_bytes();
+    if meta.len() > max {
+        bail!("{what} {} has {} bytes, more than the {max} bytes an input may have (--max-input-bytes raises it)", path.display(), meta.len());
+    }
+    Ok(meta.len())
+}
+
+/// Reads the whole of `path` (see [`check`]); never more than the cap,
+/// even if the file grows while it is read.
+pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
+    check(path, what)?;
+    let file = std::fs::File::open(path).with_context(|| format!("{what} {}: cannot open it", path.display()))?;
+    // What was opened is checked too: the path may have changed since.
+    let len = check_meta(path, what, &file.metadata().with_context(|| format!("{what} {}", path.display()))?)?;
+    let mut bytes = Vec::with_capacity(len as usize);
+    let max = max_input_bytes();
+    file.take(max + 1).read_to_end(&mut bytes).with_context(|| format!("{what} {}: read error", path.display()))?;
+    if bytes.len() as u64 > max {
+        bail!("{what} {} grew past the {max} bytes an input may have while it was read", path.display());
+    }
+    Ok(bytes)
+}
+
+/// Reads `path` as UTF-8 text (see [`read`]); an error names the line of
+/// the first byte that is not text.
+pub fn read_text(path: &Path, what: &str) -> Result<String> {
+    let bytes = read(path, what)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = 1 + e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count();
+        anyhow::anyhow!("{what} {}: line {line}: not UTF-8 text (a binary file?)", path.display())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_folders_fifos_devices_and_files_over_the_cap() {
+        let dir = std::env::temp_dir().join(format!("treelet-input-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("x.obj")).unwrap();
+        let e = format!("{:#}", read(&dir.join("x.obj"), "mesh").unwrap_err());
+        assert!(e.contains("is a folder"), "{e}");
+        let fifo = dir.join("fifo.obj");
+        if std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()) {
+            let e = format!("{:#}", read(&fifo, "mesh").unwrap_err());
+            assert!(e.contains("not a regular file"), "{e}");
+        }
+        let e = format!("{:#}", read(Path::new("/dev/zero"), "mesh").unwrap_err());
+        assert!(e.contains("not a regular file"), "{e}");
+        let small = dir.join("small.json");
+        std::fs::write(&small, "0123456789").unwrap();
+        assert_eq!(read(&small, "scene file").unwrap().len(), 10);
+        let e = format!("{:#}", read(&dir.join("none.json"), "scene file").unwrap_err());
+        assert!(e.contains("none.json") && e.contains("cannot read"), "{e}");
+        std::fs::write(dir.join("bin.obj"), b"v 0 0 0\nv \xff\xfe\n").unwrap();
+        let e = format!("{:#}", read_text(&dir.join("bin.obj"), "mesh").unwrap_err());
+        assert!(e.contains("line 2") && e.contains("not UTF-8"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
