@@ -13,7 +13,9 @@ use treelet::bvh::layout::Layout;
 use treelet::plot::Series;
 use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::parts::{self, PartInfo};
+use treelet::render::settings::MemoryEstimate;
 use treelet::render::{Control, Integrator, PassRow, RenderSettings, Stopped};
+use treelet::runtime::memory::{available_bytes, human};
 use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
@@ -275,9 +277,18 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         };
         bar.set_message(err);
     };
+    let classes: Vec<_> = list.iter().map(Device::class).collect();
+    let memory = MemoryEstimate::of(&settings, (scene.spheres.len() + scene.triangles.len()) as u64, &classes);
     if args.explain {
         bar.suspend(|| {
             eprintln!("{}", variant::plan(&scene, args.accel, args.layout, args.kernel, list[0].class()).explain());
+            eprintln!(
+                "memory     about {} of host memory (image {}, scene and trees {}); {} available (TREELET_MAX_MEMORY caps it)",
+                human(memory.total_bytes),
+                human(memory.image_bytes),
+                human(memory.scene_bytes),
+                available_bytes().map_or("unknown".into(), human)
+            );
             eprintln!("integrator {}", match args.integrator {
                 Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
                 Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
@@ -410,6 +421,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             "startup": startup,
             "write_s": write_s,
             "samples_per_s": paths / result.total_s,
+            "memory_estimate": memory,
             "rows": result.rows,
         });
         let text = serde_json::to_string_pretty(&doc)?;

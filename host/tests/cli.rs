@@ -701,3 +701,31 @@ fn huge_thread_counts_are_bounded() {
     assert!(o.status.success() && e.contains("RAYON_NUM_THREADS") && e.contains("warning"), "{e}");
     let _ = std::fs::remove_file(&out);
 }
+
+/// Sizes past the memory are refused before anything is allocated, with
+/// the estimate and the limit (no abort from a failed allocation):
+/// against the machine's memory, and against TREELET_MAX_MEMORY.
+#[test]
+fn renders_past_the_memory_are_refused_with_the_estimate() {
+    let out = std::env::temp_dir().join(format!("treelet-cli-memory-{}.png", std::process::id()));
+    let out = out.to_str().unwrap();
+    // About 190 GiB of image sums: no test machine has that much free.
+    let o = treelet_within(60, &[], &["render", "--device", "cpu", "--width", "46000", "--height", "46000", "--out", out]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("46000x46000") && e.contains("GiB") && e.contains("available"), "{e}");
+    let small = [("TREELET_MAX_MEMORY", "1000000")];
+    let o = treelet_within(60, &small, &["render", "--device", "cpu", "--width", "512", "--height", "384", "--out", out]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && e.contains("512x384") && e.contains("976.6 KiB available"), "{e}");
+    let o = treelet_within(60, &small, &["render", "--device", "cpu", "--scene", "random:100000", "--width", "8", "--height", "8", "--out", out]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && e.contains("random:100000") && e.contains("100000 spheres"), "{e}");
+    let o = treelet_within(60, &[("TREELET_MAX_MEMORY", "30000000")], &["build", "--device", "cpu", "--scene", "random:100000"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && e.contains("tree over 100000 primitives"), "{e}");
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "1", "--explain", "--out", out]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && e.contains("of host memory") && e.contains("available"), "{e}");
+    let _ = std::fs::remove_file(out);
+}

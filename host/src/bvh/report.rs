@@ -101,6 +101,7 @@ pub fn run_build<B: Backend>(
 ) -> Result<(Bvh, BuildReport)> {
     let prims = scene.primitives();
     prims.check()?;
+    crate::bvh::tree::check_build_memory(prims.len() as u64, backend.class())?;
     let start = Instant::now();
     let (mut device_bvh, times) = lbvh::build_primitives_on_device(backend, prims)?;
     let mut bvh = device_bvh.read(backend)?;

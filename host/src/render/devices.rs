@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use super::image_io::HdrImage;
 use super::outcome::{PassRow, RenderResult};
 use super::run::{device_loop, run, Control, Worker};
-use super::settings::{samples_per_dispatch, RenderSettings};
+use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
 use crate::runtime::cpu_runner::CpuBackend;
 pub use crate::runtime::device::Device;
 use crate::runtime::gpu::{GpuBackend, GpuContext};
@@ -65,6 +65,9 @@ pub fn render_on_devices(
     control: Control<'_>,
     on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
+    let classes: Vec<_> = devices.iter().map(Device::class).collect();
+    let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
+    MemoryEstimate::of(settings, prims, &classes).check(settings, prims)?;
     let gpus = devices.iter().filter(|d| matches!(d, Device::Gpu(_))).count();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let cpu_threads = cores.saturating_sub(gpus).max(1);

@@ -28,7 +28,7 @@ use super::image_io::HdrImage;
 use super::outcome::{PassRow, RenderResult, Share, Stopped};
 use super::prepared::Prepared;
 use super::queue::{Grid, SampleQueue, Take};
-use super::settings::{samples_per_dispatch, RenderSettings};
+use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
 use super::sums::{add_sums, error_row, mean_image};
 use super::variant::Plan;
 use crate::runtime::backend::Backend;
@@ -86,6 +86,8 @@ pub fn render_with<B: Backend>(
     control: Control<'_>,
     on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
+    let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
+    MemoryEstimate::of(settings, prims, &[b.class()]).check(settings, prims)?;
     let step = samples_per_dispatch(settings.width as u64 * settings.height as u64, b.class());
     let name = b.adapter();
     let worker: Worker<'_> = Box::new(move |job| device_loop(b, job));

@@ -8,3 +8,4 @@ pub mod cpu_runner;
 pub mod device;
 pub mod gpu;
 pub mod kernels;
+pub mod memory;

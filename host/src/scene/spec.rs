@@ -4,6 +4,9 @@ use anyhow::{bail, Context as _, Result};
 
 use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
 use super::primitives::MAX_PRIMITIVES;
+use crate::runtime::memory;
+use treelet_core::geometry::buffers::{Material, Sphere};
+use treelet_core::geometry::triangle::Triangle;
 
 impl Scene {
     /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON
@@ -35,6 +38,8 @@ impl Scene {
                 if n > MAX_PRIMITIVES as usize {
                     bail!("scene `{spec}`: {n} primitives, at most {} are supported", MAX_PRIMITIVES);
                 }
+                let bytes = n as u64 * (std::mem::size_of::<Sphere>() + std::mem::size_of::<Material>()) as u64;
+                memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} spheres and their materials"))?;
                 Ok(random_scene(spec, n, seed))
             }
             Some("terrain") => {
@@ -46,6 +51,8 @@ impl Scene {
                 if n > MAX_PRIMITIVES as usize {
                     bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
                 }
+                let bytes = n as u64 * (2 * std::mem::size_of::<Triangle>() + std::mem::size_of::<Material>()) as u64;
+                memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))?;
                 Ok(mesh_scene(spec, &terrain(n)))
             }
             _ => bail!(
