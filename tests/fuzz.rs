@@ -46,6 +46,7 @@ fn write_seeds() -> Vec<(String, Vec<u8>)> {
         seed: 7,
         integrator: "nee".into(),
         samples: 4..12,
+        planned_end: 16,
     };
     parts::write_part(&dir.join("part.exr"), &info, &sums).unwrap();
     let image = HdrImage { width: w, height: h, pixels: (0..w * h).map(|i| [i as f32 * 0.1, 0.2, 0.3]).collect() };

@@ -226,6 +226,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         seed: args.seed,
         integrator: args.integrator.name().into(),
         samples,
+        planned_end: first_sample.saturating_add(args.spp),
     };
     let resume = match &args.resume {
         Some(path) => {
@@ -530,6 +531,12 @@ fn run(cli: Cli) -> Result<bool> {
                 eprintln!(
                     "note: samples 0..{} are in no part: the image is of samples {}..{} only",
                     info.samples.start, info.samples.start, info.samples.end
+                );
+            }
+            if info.planned_end > info.samples.end {
+                eprintln!(
+                    "note: samples {}..{} are in no part: a part was of a render planned up to sample {} (stopped early, or a checkpoint)",
+                    info.samples.end, info.planned_end, info.planned_end
                 );
             }
             image_io::write(&out, &image)?;

@@ -554,9 +554,11 @@ fn an_interrupted_render_keeps_its_samples_and_resumes_bit_for_bit() {
     assert!(done.start == 0 && done.end > 0 && done.end < 100000000, "{done:?}");
     assert!(err.contains("--resume"), "{err}");
 
-    // The part merges into the image written at the stop.
+    // The part merges into the image written at the stop, with a note of
+    // the samples that the stop left out.
     let o = treelet(&["merge", &p("img.part.exr"), "--out", &p("merged.exr")]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && e.contains(&format!("samples {}..100000000 are in no part", done.end)), "{e}");
     let o = treelet(&["compare", &p("merged.exr"), "--reference", &p("img.exr")]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("compare prints JSON");
     assert_eq!(v["rmse"].as_f64(), Some(0.0), "{v}");

@@ -25,6 +25,10 @@ pub struct PartInfo {
     pub integrator: String,
     /// The samples rendered: `first..last`.
     pub samples: Range<u32>,
+    /// Where the render that wrote it was to end (past `samples.end` when
+    /// it was stopped early, or wrote it as a checkpoint), so that `merge`
+    /// can name samples missing at the end.
+    pub planned_end: u32,
 }
 
 impl PartInfo {
@@ -69,6 +73,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
     put("seed", AttributeValue::Text(Text::from(info.seed.to_string().as_str())));
     put("first_sample", AttributeValue::Text(Text::from(info.samples.start.to_string().as_str())));
     put("last_sample", AttributeValue::Text(Text::from(info.samples.end.to_string().as_str())));
+    put("planned_last_sample", AttributeValue::Text(Text::from(info.planned_end.to_string().as_str())));
     let layer = Layer::new(
         (w, h),
         attributes,
@@ -111,7 +116,11 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
         seed: number("seed")?,
         integrator: field("integrator")?,
         samples: number("first_sample")?..number("last_sample")?,
+        planned_end: 0,
     };
+    // Parts written before it was recorded were planned to their own end.
+    let planned_end = if other.contains_key(&Text::from(format!("{PREFIX}planned_last_sample").as_str())) { number("planned_last_sample")? } else { info.samples.end };
+    let info = PartInfo { planned_end: planned_end.max(info.samples.end), ..info };
     if info.samples.is_empty() {
         bail!("{}: its sample range {}..{} is empty", path.display(), info.samples.start, info.samples.end);
     }
@@ -139,7 +148,8 @@ pub fn read_scored_image(path: &Path, what: &str) -> Result<HdrImage> {
 
 /// Adds parts: they must be of one scene, size, seed and integrator, and
 /// their sample ranges must neither overlap nor leave gaps. Returns what
-/// the sum is of (its range: the union), and the image of mean radiance.
+/// the sum is of (its range: the union; its planned end: the furthest any
+/// part was planned to), and the image of mean radiance.
 pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
     let Some(first) = paths.first() else { bail!("no parts to merge") };
     let mut parts = Vec::new();
@@ -185,5 +195,6 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
         super::sums::add_sums(&mut sums, part);
     }
     let image = super::sums::mean_image(reference.width, reference.height, &sums, samples.end - samples.start);
-    Ok((PartInfo { samples, ..reference }, image))
+    let planned_end = parts.iter().map(|p| p.1.planned_end).max().unwrap_or(samples.end);
+    Ok((PartInfo { samples, planned_end, ..reference }, image))
 }
