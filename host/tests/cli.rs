@@ -731,3 +731,65 @@ fn renders_past_the_memory_are_refused_with_the_estimate() {
     assert!(o.status.success() && e.contains("of host memory") && e.contains("available"), "{e}");
     let _ = std::fs::remove_file(out);
 }
+
+/// `deploy/slurm-array.sh submit` on a real one-node Slurm cluster
+/// (`deploy/slurm-local.sh`, started by the test; needs root and the
+/// slurm-wlm and munge packages, which CI installs): the job array renders
+/// the parts, the dependent job merges them, and the image is the single
+/// render's. Without Slurm the test fails under CI and is skipped, with a
+/// word, elsewhere.
+#[test]
+fn slurm_array_script_on_a_real_cluster() {
+    let have = Command::new("sh").args(["-c", "command -v slurmd && command -v munged && [ $(id -u) = 0 ]"]).output().unwrap();
+    if !have.status.success() {
+        assert!(std::env::var_os("CI").is_none(), "CI needs slurm-wlm, munge and root for this test (.ci/run installs them)");
+        eprintln!("skipped: no slurmd, munged or root here");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("treelet-slurm-real-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let deploy = concat!(env!("CARGO_MANIFEST_DIR"), "/../deploy");
+    let cluster = dir.join("cluster");
+    /// Stops the cluster however the test ends.
+    struct Stop(std::path::PathBuf, &'static str);
+    impl Drop for Stop {
+        fn drop(&mut self) {
+            let _ = Command::new("bash").arg(format!("{}/slurm-local.sh", self.1)).arg("stop").arg(&self.0).status();
+        }
+    }
+    let start = Command::new("bash").arg(format!("{deploy}/slurm-local.sh")).arg("start").arg(&cluster).output().unwrap();
+    let _stop = Stop(cluster.clone(), deploy);
+    assert!(start.status.success(), "the cluster did not start: {}", String::from_utf8_lossy(&start.stderr));
+    let conf = cluster.join("slurm.conf");
+    let submit = Command::new("bash")
+        .arg(format!("{deploy}/slurm-array.sh"))
+        .arg("submit")
+        .current_dir(&dir)
+        .env("SLURM_CONF", &conf)
+        .env("TREELET", env!("CARGO_BIN_EXE_treelet"))
+        .envs([("DEVICE", "cpu"), ("WIDTH", "24"), ("HEIGHT", "16"), ("SPP", "30"), ("TASKS", "4"), ("SEED", "2"), ("OUT", "merged.pfm")])
+        .output()
+        .unwrap();
+    assert!(submit.status.success(), "submit: {}", String::from_utf8_lossy(&submit.stderr));
+    let waited = std::time::Instant::now();
+    loop {
+        let q = Command::new("squeue").arg("-h").env("SLURM_CONF", &conf).output().unwrap();
+        if q.status.success() && q.stdout.is_empty() {
+            break;
+        }
+        assert!(waited.elapsed().as_secs() < 300, "jobs still queued: {}", String::from_utf8_lossy(&q.stdout));
+        std::thread::sleep(std::time::Duration::from_millis(250));
+    }
+    let logs: Vec<String> = std::fs::read_dir(dir.join("parts")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(logs.iter().filter(|n| n.ends_with(".log")).count() == 5, "four task logs and the merge's: {logs:?}");
+    let merged = dir.join("merged.pfm");
+    assert!(merged.exists(), "no merged image; logs: {logs:?}");
+    let whole = dir.join("whole.pfm").to_string_lossy().to_string();
+    let args = ["render", "--device", "cpu", "--width", "24", "--height", "16", "--spp", "30", "--seed", "2", "--out", &whole];
+    assert!(treelet(&args).status.success());
+    let out = treelet(&["compare", merged.to_str().unwrap(), "--reference", &whole]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    assert!(v["rmse"].as_f64().unwrap() < 1e-5, "{v}");
+    drop(_stop);
+    let _ = std::fs::remove_dir_all(&dir);
+}
