@@ -162,6 +162,27 @@ fn render_rejects_bad_settings() {
     assert!(e.to_string().contains("reference image is 3x3"), "{e}");
 }
 
+/// A render past the GPU's own memory (Vulkan's largest device-local heap)
+/// is refused before anything is allocated on it, with the estimate, the
+/// adapter and its memory.
+#[test]
+fn render_past_device_memory_is_refused() {
+    let Some(ctx) = gpu() else { return };
+    let heap = ctx.device_memory.expect("Vulkan reports the adapter's memory heaps");
+    // 16 bytes of sums a pixel: one pixel more than the heap holds.
+    let pixels = heap / 16 + 1;
+    if pixels > u32::MAX as u64 / 2 {
+        eprintln!("{} has {heap} bytes: more than an image can fill; nothing to check", ctx.info.name);
+        return;
+    }
+    let width = 65536u32;
+    let height = pixels.div_ceil(width as u64) as u32;
+    let mut b = GpuBackend::new(ctx.clone());
+    let e = treelet::render::Prepared::new(&mut b, &cornell(), &settings(width, height, 1, 0, Accel::None), None).err().unwrap();
+    let e = format!("{e:#}");
+    assert!(e.contains("device memory") && e.contains(&ctx.info.name) && e.contains(&format!("{width}x{height}")), "{e}");
+}
+
 /// The ray-casting benchmark's kernels: primary and diffuse rays through the
 /// TRBVH of a mesh scene in each layout (and cwbvh with its stack's top in
 /// workgroup memory), GPU against the CPU run of the same kernel.

@@ -290,6 +290,13 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
                 human(memory.scene_bytes),
                 available_bytes().map_or("unknown".into(), human)
             );
+            for d in &list {
+                if let Device::Gpu(ctx) = d {
+                    let needed = MemoryEstimate::device_bytes(&settings, (scene.spheres.len() + scene.triangles.len()) as u64);
+                    let has = ctx.device_memory.map_or("an unknown amount".into(), human);
+                    eprintln!("           about {} of device memory on {}, which has {has}", human(needed), ctx.info.name);
+                }
+            }
             eprintln!("integrator {}", match args.integrator {
                 Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
                 Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",

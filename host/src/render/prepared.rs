@@ -14,7 +14,8 @@ use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
 use crate::scene::Scene;
 use crate::scene::primitives::Primitives;
-use super::settings::{samples_per_dispatch, RenderSettings};
+use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
+use crate::runtime::memory::human;
 use super::variant::{self, Plan};
 
 /// The light table of `prims` (spheres then triangles, one material each):
@@ -82,6 +83,18 @@ impl<B: Backend> Prepared<B> {
         all.check()?;
         if scene.materials.len() != all.len() {
             bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
+        }
+        if let Some(memory) = b.device_memory_bytes() {
+            let needed = MemoryEstimate::device_bytes(settings, all.len() as u64);
+            if needed > memory {
+                bail!(
+                    "this render needs about {} of device memory ({width}x{height} image and a tree of {} primitives), and `{}` has {}",
+                    human(needed),
+                    all.len(),
+                    b.adapter(),
+                    human(memory)
+                );
+            }
         }
         let plan = variant::plan(scene, accel, layout, kernel, b.class());
         let (tree, buffers, build_ms) = traced_tree(b, all, plan.accel, plan.layout)?;

@@ -126,6 +126,14 @@ impl MemoryEstimate {
         MemoryEstimate { image_bytes, scene_bytes, total_bytes: image_bytes.saturating_add(scene_bytes) }
     }
 
+    /// The device memory a render takes on one device: its accumulation and
+    /// the tree's buffers (the CPU runner's measured per-primitive bytes:
+    /// the same buffers).
+    pub fn device_bytes(settings: &RenderSettings, prims: u64) -> u64 {
+        let pixels = settings.width as u64 * settings.height as u64;
+        pixels.saturating_mul(BYTES_PER_PIXEL_PER_DEVICE).saturating_add(tree_host_bytes(prims, DeviceClass::CpuRunner))
+    }
+
     /// Refuses the render if the machine has less memory available.
     pub fn check(&self, settings: &RenderSettings, prims: u64) -> anyhow::Result<()> {
         use crate::runtime::memory::{check_fits, human};

@@ -81,6 +81,11 @@ pub trait Backend: Send {
     }
     /// Largest buffer this device accepts in one binding, in bytes.
     fn max_buffer_bytes(&self) -> u64;
+    /// The device's own memory, in bytes, where it has one apart from the
+    /// host's and says how large (Vulkan's largest device-local heap).
+    fn device_memory_bytes(&self) -> Option<u64> {
+        None
+    }
     /// A buffer holding `data`.
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
     /// A buffer of at least `bytes` bytes whose contents are undefined

@@ -198,6 +198,9 @@ impl Backend for GpuBackend {
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_binding_bytes()
     }
+    fn device_memory_bytes(&self) -> Option<u64> {
+        self.ctx.device_memory
+    }
 
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
         let bytes: &[u8] = bytemuck::cast_slice(data);

@@ -30,6 +30,9 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     /// Whether compute passes can be timed with timestamp queries.
     pub timestamps: bool,
+    /// The adapter's largest device-local memory heap, in bytes (for lavapipe,
+    /// the host's memory), if Vulkan says.
+    pub device_memory: Option<u64>,
     module: wgpu::ShaderModule,
     pipelines: Mutex<HashMap<Kernel, Arc<Pipeline>>>,
     /// The driver's compiled pipelines, kept on disk between runs.
@@ -97,6 +100,21 @@ impl Drop for GpuContext {
     }
 }
 
+/// The largest device-local memory heap of `adapter` (Vulkan's memory
+/// properties), in bytes; `None` off Vulkan.
+fn device_local_bytes(adapter: &wgpu::Adapter) -> Option<u64> {
+    // SAFETY: reads the physical device's memory properties only; the
+    // adapter, and with it the instance, outlives the call.
+    let hal = unsafe { adapter.as_hal::<wgpu::hal::api::Vulkan>() }?;
+    let instance = hal.shared_instance().raw_instance();
+    let props = unsafe { instance.get_physical_device_memory_properties(hal.raw_physical_device()) };
+    props.memory_heaps[..props.memory_heap_count as usize]
+        .iter()
+        .filter(|h| h.flags.contains(ash::vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+}
+
 impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred) and
     /// loads the shader module. Fails with a clear message when there is none.
@@ -140,6 +158,7 @@ impl GpuContext {
             bail!("adapter `{}` lacks features Treelet needs: {missing:?}", info.name);
         }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let device_memory = device_local_bytes(&adapter);
         let cache_path = cache_file(&info).filter(|_| adapter.features().contains(wgpu::Features::PIPELINE_CACHE));
         let optional = [(timestamps, wgpu::Features::TIMESTAMP_QUERY), (cache_path.is_some(), wgpu::Features::PIPELINE_CACHE)];
         let features = optional.iter().filter(|o| o.0).fold(needed, |f, o| f | o.1);
@@ -171,7 +190,7 @@ impl GpuContext {
             };
             DiskCache { cache, path }
         });
-        Ok(Arc::new(Self { device, queue, info, limits, timestamps, module, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
+        Ok(Arc::new(Self { device, queue, info, limits, timestamps, device_memory, module, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
     }
 
     /// The pipeline of `kernel`, built the first time it is asked for.
