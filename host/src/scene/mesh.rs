@@ -259,6 +259,6 @@ mod tests {
             assert!(e.contains(name), "{name}: error `{e}` does not name the file");
         }
         let e = format!("{:#}", load(Path::new("/nonexistent/x.obj")).unwrap_err());
-        assert!(e.contains("cannot open"), "{e}");
+        assert!(e.contains("/nonexistent/x.obj") && e.contains("cannot read"), "{e}");
     }
 }
