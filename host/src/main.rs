@@ -86,16 +86,17 @@ enum Command {
 }
 
 #[derive(clap::Args)]
+#[command(allow_negative_numbers = true)]
 struct RenderArgs {
     /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = positive)]
     width: u32,
-    #[arg(long, default_value_t = 384)]
+    #[arg(long, default_value_t = 384, value_parser = positive)]
     height: u32,
     /// Samples per pixel (taken in turn by the 2x2 subpixels).
-    #[arg(long, default_value_t = 64, conflicts_with = "samples")]
+    #[arg(long, default_value_t = 64, conflicts_with = "samples", value_parser = positive)]
     spp: u32,
     /// Render only samples FIRST..LAST (LAST excluded) and write them to
     /// --out (.exr) as a part: per-pixel sums and the range in its header,
@@ -155,6 +156,15 @@ struct RenderArgs {
     /// runner the image is the uninterrupted render's, bit for bit.
     #[arg(long, value_name = "PART.exr")]
     resume: Option<std::path::PathBuf>,
+}
+
+/// A whole number from 1 to 2^32 - 1 (sizes, sample counts).
+fn positive(s: &str) -> std::result::Result<u32, String> {
+    match s.trim().parse::<i64>() {
+        Ok(v) if v >= 1 && v <= u32::MAX as i64 => Ok(v as u32),
+        Ok(v) => Err(format!("{v} is not a positive whole number below 2^32")),
+        Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
 }
 
 /// `A..B` (B excluded) with A < B.

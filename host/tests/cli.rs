@@ -55,6 +55,11 @@ fn render_bad_input_names_the_problem() {
     std::fs::write(&broken, "{\n  \"camera\": { \"origin\": [0, 0, 0],\n  \"direction\": [0, 0, -1] \n").unwrap();
     let e = stderr_of(&["render", "--device", "cpu", "--scene", broken.to_str().unwrap()]);
     assert!(e.contains("broken.json") && e.contains("line 4"), "{e}");
+    // A negative or zero size is named as such, not as an unknown argument.
+    let e = stderr_of(&["render", "--width", "-1"]);
+    assert!(e.contains("--width") && e.contains("-1 is not a positive whole number"), "{e}");
+    let e = stderr_of(&["render", "--spp", "0"]);
+    assert!(e.contains("--spp") && e.contains("0 is not a positive"), "{e}");
 
     let unknown = dir.join("unknown.json");
     std::fs::write(
@@ -79,7 +84,7 @@ fn render_bad_input_names_the_problem() {
     let e = stderr_of(&["render", "--device", "cpu", "--scene", "nowhere.json"]);
     assert!(e.contains("nowhere.json"), "{e}");
     let e = stderr_of(&["render", "--device", "cpu", "--width", "0"]);
-    assert!(e.contains("must be positive"), "{e}");
+    assert!(e.contains("--width") && e.contains("0 is not a positive"), "{e}");
     let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "4", "--out", "x.bmp"]);
     assert!(e.contains("unknown image format"), "{e}");
     let e = stderr_of(&["render", "--device", "cpu", "--scene", "teapot"]);
@@ -680,7 +685,7 @@ fn loader_errors_name_the_line_or_element() {
         (
             "vertex.ply",
             b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 zz\n0 1 0\n3 0 1 2\n",
-            &["vertex 1", "Line 11"],
+            &["vertex 1", "Line 11", "`1 0 zz`"],
         ),
     ];
     for (name, bytes, says) in cases {

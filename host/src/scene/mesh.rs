@@ -134,7 +134,13 @@ pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
     let ply = Parser::<DefaultElement>::new().read_ply(&mut bytes.as_slice()).map_err(|e| {
         // The parser's message spans lines and names a line of the file, not
         // the element: one line, with the element that line holds.
-        let message = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+        let full = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+        // "Line N: Couldn't read element line. String: '...' Error: ..." names
+        // the line's text and then repeats itself: keep the first sentence and the text.
+        let message = match full.split_once(" String: ") {
+            Some((head, rest)) => format!("{} in `{}`", head.trim_end_matches('.'), rest.split('\'').nth(1).unwrap_or("").trim()),
+            None => full,
+        };
         match ply_error_element(&bytes, &message) {
             Some((element, index)) => anyhow!("{}: {element} {index}: {message}", path.display()),
             None => anyhow!("{}: not a valid PLY file: {message}", path.display()),
