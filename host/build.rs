@@ -8,7 +8,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // u64 Morton codes and radix-sort keys.
         .capability(Capability::Int64)
         // Device-scope atomics (bottom-up fit): needs SPIR-V passthrough in wgpu.
-        .capability(Capability::VulkanMemoryModelDeviceScope);
+        .capability(Capability::VulkanMemoryModelDeviceScope)
+        // Subgroup operations (Vulkan 1.1 core): ids, ballots, shuffles, sums.
+        .capability(Capability::GroupNonUniform)
+        .capability(Capability::GroupNonUniformBallot)
+        .capability(Capability::GroupNonUniformShuffle)
+        .capability(Capability::GroupNonUniformArithmetic);
     builder.release = true;
     builder.build_script.defaults = true;
     builder.build_script.env_shader_spv_path = Some(true);

@@ -191,3 +191,50 @@ fn zeroed_clears_reused_buffers() {
     assert!(clean == dirty, "the pool should hand out the same buffer again");
     assert_eq!(b.read::<u32>(&clean, 1000).unwrap(), vec![0; 1000]);
 }
+
+/// Subgroup operations on the GPU against their emulation on the CPU runner:
+/// the multisplit ranking kernel (a ballot of the lanes with keys, then one
+/// per bit of the digit) on fresh random keys, at counts that cross
+/// subgroups and workgroups, run on the CPU at the subgroup size the GPU
+/// ran with; and, independently of both, every rank and count counted by
+/// hand over the subgroup's keys.
+#[test]
+fn subgroup_multisplit_matches_the_cpu_emulation() {
+    use treelet::runtime::kernels::Kernel;
+    use treelet_core::geometry::buffers::SortParams;
+    use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
+    fn run<B: Backend>(b: &mut B, keys: &[u64], pass: u32) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+        let n = keys.len() as u32;
+        let groups = groups_for(n, WORKGROUP_SIZE);
+        let p = b.upload("params", &[SortParams { n, tiles: groups, pass, passes: 8 }]).unwrap();
+        let k = b.upload("keys", keys).unwrap();
+        let (ranks, counts, sizes) = (b.zeroed("ranks", n as u64 * 4).unwrap(), b.zeroed("counts", n as u64 * 4).unwrap(), b.zeroed("sizes", groups as u64 * 4).unwrap());
+        b.dispatch(Kernel::Multisplit, &[&p, &k, &ranks, &counts, &sizes], groups);
+        (b.read(&ranks, n as usize).unwrap(), b.read(&counts, n as usize).unwrap(), b.read(&sizes, groups as usize).unwrap())
+    }
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    for (n, distinct) in [(1usize, 256u64), (31, 4), (256, 256), (1000, 3), (70_001, 256), (5000, 1)] {
+        // Digits from a few values (long runs of equal ones) to all 256.
+        let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() & !(0xffu64 << 8) | (rng.random_range(0..distinct) << 8)).collect();
+        for pass in [0u32, 1] {
+            let (ranks, counts, sizes) = run(&mut GpuBackend::new(ctx.clone()), &keys, pass);
+            let size = sizes[0];
+            assert!(size.is_power_of_two() && sizes.iter().all(|&s| s == size), "subgroup sizes seen: {:?}", &sizes[..sizes.len().min(8)]);
+            if n == 1 && pass == 0 {
+                eprintln!("{} runs subgroups of {size} lanes", ctx.info.name);
+            }
+            let cpu = run(&mut CpuBackend::with_subgroup_size(size), &keys, pass);
+            assert!(cpu == (ranks.clone(), counts.clone(), sizes.clone()), "n {n}, pass {pass}, subgroup size {size}: GPU and CPU differ");
+            let digit = |i: usize| (keys[i] >> (8 * pass)) & 0xff;
+            for i in 0..n {
+                let first = i / size as usize * size as usize;
+                let last = (first + size as usize).min(n);
+                let below = (first..i).filter(|&k| digit(k) == digit(i)).count() as u32;
+                let all = (first..last).filter(|&k| digit(k) == digit(i)).count() as u32;
+                assert_eq!((ranks[i], counts[i]), (below, all), "n {n}, pass {pass}, key {i}, subgroup size {size}");
+            }
+        }
+    }
+}

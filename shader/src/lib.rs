@@ -12,6 +12,7 @@ pub mod cwbvh;
 pub mod fill;
 pub mod fit;
 pub mod morton;
+pub mod multisplit;
 pub mod radix_tree;
 pub mod render;
 pub mod scan;

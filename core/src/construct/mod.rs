@@ -7,7 +7,7 @@
 //! | primitive boxes | [`primitive_boxes`] | |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
-//! | sort | [`sort`], [`scan`] | Adinets & Merrill 2022 (Onesweep) |
+//! | sort | [`sort`], [`scan`]; [`multisplit`] (ranking by subgroup ballots) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`] | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
@@ -28,6 +28,7 @@ pub mod collapse;
 pub mod fill;
 pub mod fit;
 pub mod morton;
+pub mod multisplit;
 pub mod primitive_boxes;
 pub mod radix_tree;
 pub mod sah;

@@ -12,6 +12,8 @@ use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::geometry::aabb::Aabb;
+use treelet_core::construct::multisplit::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
+use treelet_core::gpu::subgroup::{self, Lane};
 use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
 use treelet_core::render::lights::Light;
@@ -31,15 +33,37 @@ use crate::runtime::kernels::{Kernel, Method};
 /// A CPU buffer: 8-byte words, so that any Pod type of alignment ≤ 8 views it.
 pub type CpuBuffer = Rc<RefCell<Vec<u64>>>;
 
-#[derive(Default)]
 pub struct CpuBackend {
     times: StageTimes,
     current: Option<(&'static str, Instant)>,
+    /// Lanes of a subgroup in the emulation of subgroup operations
+    /// (`treelet_core::gpu::subgroup`): set it to a GPU's to compare exactly.
+    subgroup_size: u32,
 }
+
+impl Default for CpuBackend {
+    fn default() -> Self {
+        CpuBackend { times: StageTimes::default(), current: None, subgroup_size: DEFAULT_SUBGROUP_SIZE }
+    }
+}
+
+/// The CPU runner's subgroup size unless set: NVIDIA's.
+pub const DEFAULT_SUBGROUP_SIZE: u32 = 32;
 
 impl CpuBackend {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A CPU runner whose subgroups have `size` lanes (a power of two from
+    /// 1 to 64, as Vulkan's are).
+    pub fn with_subgroup_size(size: u32) -> Self {
+        assert!(size.is_power_of_two() && size <= subgroup::MAX_SUBGROUP_SIZE, "subgroup size {size}");
+        CpuBackend { subgroup_size: size, ..Self::default() }
+    }
+
+    pub fn subgroup_size(&self) -> u32 {
+        self.subgroup_size
     }
 
     fn close_stage(&mut self) {
@@ -58,6 +82,27 @@ fn view<T: Pod>(words: &mut [u64]) -> &mut [T] {
 
 fn params<T: Pod>(words: &mut [u64]) -> T {
     view::<T>(words)[0]
+}
+
+/// Runs a phased kernel with subgroup operations
+/// (`treelet_core::gpu::subgroup`): for each workgroup and phase,
+/// `f(group, phase, local_id, lanes)` for every local id, then the phase's
+/// operation `op(phase)` over each subgroup of `size` lanes of `lanes`.
+fn subgroup_workgroups(groups: u32, phases: u32, size: u32, op: impl Fn(u32) -> u32, mut f: impl FnMut(u32, u32, u32, &mut [Lane; WG])) {
+    let mut lanes = [Lane::default(); WG];
+    for group in 0..groups {
+        for phase in 0..phases {
+            for lid in 0..WORKGROUP_SIZE {
+                f(group, phase, lid, &mut lanes);
+            }
+            let op = op(phase);
+            if op != subgroup::OP_NONE {
+                for chunk in lanes.chunks_mut(size as usize) {
+                    subgroup::emulate(op, chunk);
+                }
+            }
+        }
+    }
 }
 
 /// Runs a phased workgroup kernel: for each workgroup, each phase, each local
@@ -223,7 +268,7 @@ impl Backend for CpuBackend {
         assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
         let mut guards: Vec<_> = bindings.iter().map(|b| b.borrow_mut()).collect();
         let mut b: Vec<&mut [u64]> = guards.iter_mut().map(|g| g.as_mut_slice()).collect();
-        run_kernel(kernel, &mut b, groups);
+        run_kernel(kernel, &mut b, groups, self.subgroup_size);
     }
 
     fn read<T: Pod>(&mut self, buffer: &CpuBuffer, count: usize) -> Result<Vec<T>> {
@@ -240,7 +285,7 @@ impl Backend for CpuBackend {
 }
 
 /// Calls the core function of `kernel` for every invocation of the dispatch.
-fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
+fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: u32) {
     match (kernel, b) {
         (Kernel::Fill, [p, data]) => {
             let p: treelet_core::FillParams = params(p);
@@ -285,6 +330,16 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) {
             let (mut values, mut out, mut sums) = ([0u32; WG], [0u32; WG], [0u32; 16]);
             workgroups(groups, sort::OFFSETS_PHASES, |g, phase, lid| {
                 sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
+            });
+        }
+        (Kernel::Multisplit, [p, keys, ranks, counts, sizes]) => {
+            let p: treelet_core::SortParams = params(p);
+            let (keys, ranks, counts, sizes) = (view(keys), view(ranks), view(counts), view(sizes));
+            let mut states = [MultisplitLane::default(); WG];
+            let size = subgroup_size;
+            subgroup_workgroups(groups, MULTISPLIT_PHASES, size, multisplit_op, |g, phase, lid, lanes| {
+                let (id, l) = (g * WORKGROUP_SIZE + lid, lid as usize);
+                multisplit_phase(phase, id, g, lid % size, size, &p, keys, ranks, counts, sizes, &mut states[l], &mut lanes[l]);
             });
         }
         (Kernel::SortTileCounts, [p, keys, tile_counts]) => {

@@ -82,6 +82,9 @@ pub enum Kernel {
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
     SortOnesweepScanned,
+    /// Ranks keys by digit within their subgroup with ballots (Onesweep's
+    /// warp-level multisplit; `treelet_core::construct::multisplit`).
+    Multisplit,
     ScanReduce,
     ScanSpine,
     ScanDownsweep,
@@ -130,7 +133,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 37] = [
+    const FIXED: [Kernel; 38] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -141,6 +144,7 @@ impl Kernel {
         Kernel::SortOnesweepSmall,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
+        Kernel::Multisplit,
         Kernel::ScanReduce,
         Kernel::ScanSpine,
         Kernel::ScanDownsweep,
@@ -198,6 +202,7 @@ impl Kernel {
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
+            Kernel::Multisplit => "multisplit::multisplit_cs",
             Kernel::ScanReduce => "scan::scan_reduce_cs",
             Kernel::ScanSpine => "scan::scan_spine_cs",
             Kernel::ScanDownsweep => "scan::scan_downsweep_cs",
@@ -245,6 +250,7 @@ impl Kernel {
             Kernel::SortOffsets => &[Read, ReadWrite],
             Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
+            Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {

@@ -1,0 +1,200 @@
+//! Subgroup operations (ballot, shuffle, sums and prefix sums across the
+//! lanes of a subgroup), on the GPU and on the CPU.
+//!
+//! This extends the phase model of [`super::workgroup`]. A kernel that uses
+//! subgroup operations is written in numbered phases, and a phase may end in
+//! one subgroup operation, which is a function of the phase number alone
+//! (`const fn <kernel>_op(phase) -> u32`, one of the `OP_*` below): the phase
+//! writes the operation's input into its lane's [`Lane`], the entry point (or
+//! the CPU runner) applies the operation, and the next phase reads the result
+//! from the same [`Lane`]. A value that crosses a subgroup operation lives in
+//! the lane's own state:
+//!
+//! - on the GPU, local variables of the invocation (registers: no workgroup
+//!   memory, and no barrier, as subgroup operations synchronize their lanes
+//!   themselves), with [`apply`] calling the SPIR-V instruction;
+//! - on the CPU, one element per lane of arrays kept by the runner, which runs
+//!   the phase for every lane, then [`emulate`]s the operation subgroup by
+//!   subgroup.
+//!
+//! One source, and the CPU run is exact at any subgroup size, which the CPU
+//! runner takes as a parameter so that it matches the GPU's (H100: 32;
+//! lavapipe: 8). Every lane runs every phase, so every operation is reached
+//! in uniform control flow, which SPIR-V's non-uniform operations need for a
+//! result over the whole subgroup. Lanes are numbered as the GPU numbers
+//! them in a one-dimensional workgroup: subgroup `lid / size`, lane
+//! `lid % size` (what Vulkan implementations do with full subgroups; the GPU
+//! = CPU tests check it on each device).
+//!
+//! Subgroup sizes from 1 to 64 are supported (ballots are 64-bit masks).
+
+/// No subgroup operation after this phase.
+pub const OP_NONE: u32 = 0;
+/// `output` = the mask (bit `l` for lane `l`) of the lanes whose `input` is
+/// not zero. Lanes past the subgroup's size are 0.
+pub const OP_BALLOT: u32 = 1;
+/// `output` = the `input` of lane `arg` (lane `arg` must exist).
+pub const OP_SHUFFLE: u32 = 2;
+/// `output` = the sum (wrapping) of the `input`s of the lanes below this one.
+pub const OP_EXCLUSIVE_ADD: u32 = 3;
+/// `output` = the sum (wrapping) of the `input`s of this lane and those below.
+pub const OP_INCLUSIVE_ADD: u32 = 4;
+/// `output` = the sum (wrapping) of every lane's `input`.
+pub const OP_ADD: u32 = 5;
+
+/// Largest subgroup size supported (ballots are 64-bit).
+pub const MAX_SUBGROUP_SIZE: u32 = 64;
+
+/// One lane's side of a subgroup operation.
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Lane {
+    pub input: u32,
+    /// A second operand: the source lane of [`OP_SHUFFLE`].
+    pub arg: u32,
+    /// The result (a ballot's 64-bit mask).
+    pub output: u64,
+}
+
+/// Applies `op` across the subgroup on the GPU: `lane` is this invocation's.
+#[cfg(target_arch = "spirv")]
+#[inline]
+pub fn apply(op: u32, lane: &mut Lane) {
+    use spirv_std::arch::{subgroup_ballot, subgroup_exclusive_i_add, subgroup_i_add, subgroup_inclusive_i_add, subgroup_shuffle};
+    if op == OP_BALLOT {
+        let mask = subgroup_ballot(lane.input != 0);
+        lane.output = mask.x as u64 | (mask.y as u64) << 32;
+    } else if op == OP_SHUFFLE {
+        lane.output = subgroup_shuffle(lane.input, lane.arg) as u64;
+    } else if op == OP_EXCLUSIVE_ADD {
+        lane.output = subgroup_exclusive_i_add(lane.input) as u64;
+    } else if op == OP_INCLUSIVE_ADD {
+        lane.output = subgroup_inclusive_i_add(lane.input) as u64;
+    } else if op == OP_ADD {
+        lane.output = subgroup_i_add(lane.input) as u64;
+    }
+}
+
+/// Applies `op` to one subgroup's lanes on the CPU (`lanes.len()` is the
+/// subgroup's size, at most [`MAX_SUBGROUP_SIZE`]), as the GPU's [`apply`]
+/// does in each of its invocations.
+#[inline]
+pub fn emulate(op: u32, lanes: &mut [Lane]) {
+    let n = lanes.len();
+    match op {
+        OP_BALLOT => {
+            let mut mask = 0u64;
+            for (l, lane) in lanes.iter().enumerate() {
+                if lane.input != 0 {
+                    mask |= 1 << l;
+                }
+            }
+            for lane in lanes.iter_mut() {
+                lane.output = mask;
+            }
+        }
+        OP_SHUFFLE => {
+            let mut values = [0u32; MAX_SUBGROUP_SIZE as usize];
+            for l in 0..n {
+                values[l] = lanes[l].input;
+            }
+            for lane in lanes.iter_mut() {
+                lane.output = values[lane.arg as usize] as u64;
+            }
+        }
+        OP_EXCLUSIVE_ADD | OP_INCLUSIVE_ADD => {
+            let mut sum = 0u32;
+            for lane in lanes.iter_mut() {
+                let before = sum;
+                sum = sum.wrapping_add(lane.input);
+                lane.output = if op == OP_EXCLUSIVE_ADD { before } else { sum } as u64;
+            }
+        }
+        OP_ADD => {
+            let sum = lanes.iter().fold(0u32, |s, l| s.wrapping_add(l.input));
+            for lane in lanes.iter_mut() {
+                lane.output = sum as u64;
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The mask of the lanes below `lane` (`lane` < 64).
+#[inline]
+pub fn lanes_below(lane: u32) -> u64 {
+    (1u64 << lane) - 1
+}
+
+/// The mask of every lane of a subgroup of `size` lanes.
+#[inline]
+pub fn all_lanes(size: u32) -> u64 {
+    if size >= 64 { u64::MAX } else { (1u64 << size) - 1 }
+}
+
+/// Bits set in a 64-bit mask (two 32-bit counts: 64-bit `OpBitCount` is
+/// not required of Vulkan drivers).
+#[inline]
+pub fn popcount(mask: u64) -> u32 {
+    (mask as u32).count_ones() + ((mask >> 32) as u32).count_ones()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::rng::hash;
+    extern crate std;
+
+    /// Plain references, one lane at a time.
+    fn reference(op: u32, inputs: &[(u32, u32)], l: usize) -> u64 {
+        let n = inputs.len();
+        match op {
+            OP_BALLOT => (0..n).filter(|&k| inputs[k].0 != 0).map(|k| 1u64 << k).sum(),
+            OP_SHUFFLE => inputs[inputs[l].1 as usize].0 as u64,
+            OP_EXCLUSIVE_ADD => inputs[..l].iter().map(|x| x.0 as u64).sum::<u64>() as u32 as u64,
+            OP_INCLUSIVE_ADD => inputs[..=l].iter().map(|x| x.0 as u64).sum::<u64>() as u32 as u64,
+            OP_ADD => inputs.iter().map(|x| x.0 as u64).sum::<u64>() as u32 as u64,
+            _ => 0,
+        }
+    }
+
+    #[test]
+    fn each_operation_matches_a_plain_reference_at_every_size() {
+        // A fresh seed each run (printed, to repeat a failure).
+        let seed = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().subsec_nanos();
+        std::eprintln!("seed {seed}");
+        for size in [1u32, 4, 8, 16, 32, 64] {
+            for trial in 0..50u32 {
+                let draw = |k: u32| hash(seed ^ hash(trial ^ hash(size ^ hash(k))));
+                let inputs: [(u32, u32); 64] = core::array::from_fn(|l| {
+                    let v = draw(l as u32);
+                    // Small values half the time (ballots of zero and non-zero), any the rest (wrapping sums).
+                    let v = if trial % 2 == 0 { v % 3 } else { v };
+                    (v, draw(64 + l as u32) % size)
+                });
+                let inputs = &inputs[..size as usize];
+                for op in [OP_BALLOT, OP_SHUFFLE, OP_EXCLUSIVE_ADD, OP_INCLUSIVE_ADD, OP_ADD] {
+                    let mut lanes = [Lane::default(); 64];
+                    for (l, &(input, arg)) in inputs.iter().enumerate() {
+                        lanes[l] = Lane { input, arg, output: 0 };
+                    }
+                    emulate(op, &mut lanes[..size as usize]);
+                    for l in 0..size as usize {
+                        assert_eq!(lanes[l].output, reference(op, inputs, l), "op {op}, size {size}, lane {l}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn masks_and_counts() {
+        assert_eq!(lanes_below(0), 0);
+        assert_eq!(lanes_below(5), 0b11111);
+        assert_eq!(lanes_below(63), u64::MAX >> 1);
+        assert_eq!(all_lanes(8), 0xff);
+        assert_eq!(all_lanes(64), u64::MAX);
+        assert_eq!(popcount(u64::MAX), 64);
+        assert_eq!(popcount(1 << 40 | 3), 3);
+    }
+}
