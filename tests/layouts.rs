@@ -280,3 +280,42 @@ fn gpu_layouts_equal_cpu() {
         }
     }
 }
+
+/// The kernels a render's pipelines are built ahead for
+/// (`treelet::render::prepared::kernels`) are every kernel the render
+/// dispatches, for each tree and layout: on the CPU runner, which asks the
+/// same questions of the device as a GPU (ordered atomics, look-back) and
+/// records what it ran. A kernel left out would be compiled in the middle
+/// of the timed render on a fresh machine.
+#[test]
+fn pipelines_built_ahead_cover_what_a_render_dispatches() {
+    use treelet::render::{render, Integrator, RenderSettings};
+    use treelet::render::variant::{plan, KernelChoice};
+    use treelet::runtime::cpu_runner::CpuBackend;
+    use treelet::bvh::tree::Accel;
+    use treelet::bvh::layout::Layout;
+    for scene in [treelet::scene::cornell(), treelet::scene::random_scene("random:3000", 3000, 7), treelet::scene::mesh_scene("terrain", &treelet::scene::terrain(5000))] {
+        for accel in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
+            for layout in [Layout::Classic, Layout::Bvh2, Layout::Cwbvh] {
+                let settings = RenderSettings {
+                    width: 16,
+                    height: 12,
+                    spp: 8,
+                    seed: 1,
+                    accel,
+                    layout,
+                    kernel: KernelChoice::Auto,
+                    integrator: Integrator::Nee,
+                    error_each_pass: false,
+                    first_sample: 0,
+                };
+                let mut b = CpuBackend::new();
+                let p = plan(&scene, accel, layout, KernelChoice::Auto, treelet::runtime::backend::Backend::class(&b));
+                let ahead: std::collections::BTreeSet<_> = treelet::render::prepared::kernels(&b, &p).into_iter().collect();
+                render(&mut b, &scene, &settings, None, |_| {}).unwrap();
+                let missing: Vec<_> = b.kernels_dispatched().difference(&ahead).collect();
+                assert!(missing.is_empty(), "{} with {accel:?} in {layout:?}: not built ahead: {missing:?}", scene.name);
+            }
+        }
+    }
+}

@@ -353,11 +353,14 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let startup = match &list[..] {
         [Device::Gpu(ctx)] => {
             let (pipelines, pipelines_s) = ctx.pipelines_built();
+            let (prepare_s, slowest) = ctx.pipeline_report(3);
             serde_json::json!({
                 "device_s": ctx.startup.device_s,
                 "module_s": ctx.startup.module_s,
                 "pipelines": pipelines,
                 "pipelines_s": pipelines_s,
+                "pipelines_ahead_wall_s": prepare_s,
+                "slowest_pipelines": slowest.iter().map(|(k, s)| serde_json::json!({"kernel": k.entry_point(), "s": s})).collect::<Vec<_>>(),
                 "pipeline_cache": if !ctx.has_pipeline_cache() { "none" } else if ctx.startup.cache_loaded { "loaded" } else { "new" },
             })
         }
@@ -365,13 +368,21 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     };
     if args.explain && !startup.is_null() {
         eprintln!(
-            "start-up   device {:.3} s, shader module {:.3} s, {} pipelines {:.3} s (pipeline cache: {}); image written in {write_s:.3} s",
+            "start-up   device {:.3} s, shader module {:.3} s, {} pipelines {:.3} s, built ahead in {:.3} s of wall (pipeline cache: {}); image written in {write_s:.3} s",
             startup["device_s"].as_f64().unwrap_or(0.0),
             startup["module_s"].as_f64().unwrap_or(0.0),
             startup["pipelines"],
             startup["pipelines_s"].as_f64().unwrap_or(0.0),
+            startup["pipelines_ahead_wall_s"].as_f64().unwrap_or(0.0),
             startup["pipeline_cache"].as_str().unwrap_or("none"),
         );
+        let slowest: Vec<String> = startup["slowest_pipelines"]
+            .as_array()
+            .map(|a| a.iter().map(|p| format!("{} {:.3} s", p["kernel"].as_str().unwrap_or("?"), p["s"].as_f64().unwrap_or(0.0))).collect())
+            .unwrap_or_default();
+        if !slowest.is_empty() {
+            eprintln!("           slowest pipelines: {}", slowest.join(", "));
+        }
     }
     // Wall time of the whole run so far: start-up, device, pipelines, render, image.
     let process_s = PROCESS_START.get().map_or(0.0, |t| t.elapsed().as_secs_f64());

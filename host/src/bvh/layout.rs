@@ -209,6 +209,22 @@ fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -
     }
 }
 
+/// The kernels laying a tree out in `layout` dispatches on `b` (the same
+/// question of `b` as it asks), for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B, layout: Layout) -> Vec<Kernel> {
+    match layout {
+        Layout::Cwbvh => {
+            let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
+            let mut k = vec![Kernel::Fill, dp, Kernel::WideCount, Kernel::WidePlace, Kernel::WideEmit];
+            k.extend([Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep]);
+            k
+        }
+        // Classic and bvh2 collapse the tree's leaves first (classic only when it has leaves to collapse).
+        Layout::Classic | Layout::Auto => trbvh::collapse_kernels(b),
+        Layout::Bvh2 => [trbvh::collapse_kernels(b), vec![Kernel::Bvh2Nodes, Kernel::LeafPrims]].concat(),
+    }
+}
+
 /// The two-box binary layout of a collapsed tree (depth-first order).
 fn bvh2<B: Backend>(b: &mut B, collapsed: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<TracedTree<B>> {
     let internal = (collapsed.node_count / 2).max(1); // 2 L - 1 nodes, L - 1 internal

@@ -117,6 +117,19 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
     device_bvh.read(b)
 }
 
+/// The kernels [`build_primitives_on_device`] dispatches on `b` (the same
+/// questions of `b` as it asks), for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    let ordered = b.ordered_atomics_in_divergent_flow();
+    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBoxes, Kernel::ReduceBounds, Kernel::Morton];
+    k.extend(crate::bvh::sort::kernels(b));
+    k.extend(match Hierarchy::from_env() {
+        Hierarchy::RadixTreeThenFit => vec![Kernel::RadixTree, if ordered { Kernel::Fit } else { Kernel::FitRelaxed }],
+        Hierarchy::Agglomerative => vec![if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed }],
+    });
+    k
+}
+
 /// [`build_primitives_on_device`] with the given way of making the hierarchy.
 pub fn build_primitives_with<B: Backend>(
     b: &mut B,

@@ -9,6 +9,18 @@ use treelet_core::gpu::workgroup::groups_for;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
 
+/// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b` (the
+/// same question of `b` as they ask), for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep];
+    if b.look_back_works() {
+        k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweep, Kernel::SortOnesweepSmall]);
+    } else {
+        k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
+    }
+    k
+}
+
 /// Exclusive prefix sum of the first `len` u32s of `data`, in place.
 pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Result<()> {
     let tiles = groups_for(len, SCAN_TILE);

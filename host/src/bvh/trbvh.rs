@@ -288,6 +288,21 @@ fn collapse_pass<B: Backend>(
     })
 }
 
+/// The kernels [`restructure`] and [`collapse`] dispatch on `b` (the same
+/// question of `b` as they ask), for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    let mut k = collapse_kernels(b);
+    k.extend([Kernel::TreeletHistogram, Kernel::TreeletScatter, Kernel::TreeletRestructure]);
+    k
+}
+
+/// The kernels [`collapse`] dispatches on `b` (its counts come from the
+/// treelet pass's init kernel).
+pub fn collapse_kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    let init = if b.ordered_atomics_in_divergent_flow() { Kernel::TreeletInit } else { Kernel::TreeletInitRelaxed };
+    vec![Kernel::Fill, init, Kernel::Collapse]
+}
+
 /// The root box of a device BVH (one node read back).
 pub fn root_box<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<Aabb> {
     Ok(b.read::<Node>(&bvh.nodes, 1)?.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY))

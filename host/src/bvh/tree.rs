@@ -96,6 +96,26 @@ pub fn traced_tree<B: Backend>(
     Ok((tree, buffers, built.build_ms + layout_ms))
 }
 
+/// The kernels [`traced_tree`] dispatches on `b` for `accel` in `layout`,
+/// gathered from the modules that dispatch them, for building their
+/// pipelines ahead and at once (`GpuContext::prepare`). A missing one would
+/// only be built when first used; `tests/layouts.rs` checks that none is.
+pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate::runtime::kernels::Kernel> {
+    let builder = match accel.builder() {
+        Ok(Some(builder)) => builder,
+        _ => return Vec::new(),
+    };
+    let mut k = match builder {
+        Builder::Lbvh => lbvh::kernels(b),
+        Builder::Trbvh => [lbvh::kernels(b), trbvh::kernels(b)].concat(),
+        Builder::Sweep => Vec::new(),
+    };
+    k.extend(crate::bvh::layout::kernels(b, layout));
+    k.sort();
+    k.dedup();
+    k
+}
+
 /// A binary tree of one primitive per leaf, on the device, as a builder
 /// left it: what every traversal layout is made from.
 pub struct BuiltTree<B: Backend> {

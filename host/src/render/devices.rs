@@ -7,6 +7,7 @@ use super::image_io::HdrImage;
 use super::outcome::{PassRow, RenderResult};
 use super::run::{device_loop, run, Control, Worker};
 use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
+use crate::runtime::backend::Backend;
 use crate::runtime::cpu_runner::CpuBackend;
 pub use crate::runtime::device::Device;
 use crate::runtime::gpu::{GpuBackend, GpuContext};
@@ -68,6 +69,15 @@ pub fn render_on_devices(
     let classes: Vec<_> = devices.iter().map(Device::class).collect();
     let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
     MemoryEstimate::of(settings, prims, &classes).check(settings, prims)?;
+    // A fresh machine's driver compiles each pipeline for seconds: before the clock starts, all at once.
+    for d in devices {
+        if let Device::Gpu(ctx) = d {
+            let mut b = GpuBackend::new(ctx.clone());
+            let plan = super::variant::plan(scene, settings.accel, settings.layout, settings.kernel, b.class());
+            let kernels = super::prepared::kernels(&b, &plan);
+            b.prepare_kernels(&kernels);
+        }
+    }
     let gpus = devices.iter().filter(|d| matches!(d, Device::Gpu(_))).count();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let cpu_threads = cores.saturating_sub(gpus).max(1);

@@ -62,6 +62,15 @@ pub struct Prepared<B: Backend> {
     pub plan: Plan,
 }
 
+/// The kernels a render of `plan` dispatches on `b`: its tree's and its
+/// render kernel, for building their pipelines before the timed work
+/// ([`Backend::prepare_kernels`]).
+pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
+    let mut k = crate::bvh::tree::kernels_of(b, plan.accel, plan.layout);
+    k.extend([Kernel::Fill, Kernel::Render(plan.method(), plan.variant as u8)]);
+    k
+}
+
 impl<B: Backend> Prepared<B> {
     /// Checks the settings and the scene, builds the tree on `b` and uploads
     /// the scene. `base`: per-pixel sums the accumulation starts from (a

@@ -109,6 +109,13 @@ pub trait Backend: Send {
     /// Starts a new build: buffers handed out for the previous one may be
     /// handed out again (their results must have been read back).
     fn begin_build(&mut self) {}
+    /// Builds the pipelines of `kernels` ahead of the work that uses them,
+    /// several at once where the device compiles them (a GPU's driver);
+    /// returns the wall seconds it took. Kernels left out are built when
+    /// first used, as always.
+    fn prepare_kernels(&mut self, _kernels: &[Kernel]) -> f64 {
+        0.0
+    }
     /// Dispatches that follow belong to `stage` (for timing).
     fn stage(&mut self, stage: &'static str);
     /// Runs `kernel` over `groups` workgroups with these bindings (params first).

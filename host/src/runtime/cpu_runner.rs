@@ -39,11 +39,13 @@ pub struct CpuBackend {
     /// Lanes of a subgroup in the emulation of subgroup operations
     /// (`treelet_core::gpu::subgroup`): set it to a GPU's to compare exactly.
     subgroup_size: u32,
+    /// Every kernel dispatched so far (what a GPU would need pipelines for).
+    dispatched: std::collections::BTreeSet<Kernel>,
 }
 
 impl Default for CpuBackend {
     fn default() -> Self {
-        CpuBackend { times: StageTimes::default(), current: None, subgroup_size: DEFAULT_SUBGROUP_SIZE }
+        CpuBackend { times: StageTimes::default(), current: None, subgroup_size: DEFAULT_SUBGROUP_SIZE, dispatched: Default::default() }
     }
 }
 
@@ -64,6 +66,11 @@ impl CpuBackend {
 
     pub fn subgroup_size(&self) -> u32 {
         self.subgroup_size
+    }
+
+    /// Every kernel dispatched on this backend so far.
+    pub fn kernels_dispatched(&self) -> &std::collections::BTreeSet<Kernel> {
+        &self.dispatched
     }
 
     fn close_stage(&mut self) {
@@ -269,6 +276,7 @@ impl Backend for CpuBackend {
         let mut guards: Vec<_> = bindings.iter().map(|b| b.borrow_mut()).collect();
         let mut b: Vec<&mut [u64]> = guards.iter_mut().map(|g| g.as_mut_slice()).collect();
         run_kernel(kernel, &mut b, groups, self.subgroup_size);
+        self.dispatched.insert(kernel);
     }
 
     fn read<T: Pod>(&mut self, buffer: &CpuBuffer, count: usize) -> Result<Vec<T>> {

@@ -201,6 +201,9 @@ impl Backend for GpuBackend {
     fn device_memory_bytes(&self) -> Option<u64> {
         self.ctx.device_memory
     }
+    fn prepare_kernels(&mut self, kernels: &[Kernel]) -> f64 {
+        self.ctx.prepare(kernels)
+    }
 
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
         let bytes: &[u8] = bytemuck::cast_slice(data);

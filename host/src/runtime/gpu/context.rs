@@ -39,8 +39,10 @@ pub struct GpuContext {
     cache: Option<DiskCache>,
     /// Where the start-up time went.
     pub startup: Startup,
-    /// Pipelines built so far, and their seconds (the cache is saved on drop only when some were).
-    built: Mutex<(u32, f64)>,
+    /// Pipelines built so far, their seconds (summed), each one's seconds,
+    /// and the wall seconds of [`GpuContext::prepare`] (the cache is saved on
+    /// drop only when some were built).
+    built: Mutex<(u32, f64, Vec<(Kernel, f64)>, f64)>,
 }
 
 /// Seconds spent opening the device and building pipelines.
@@ -193,24 +195,73 @@ impl GpuContext {
         Ok(Arc::new(Self { device, queue, info, limits, timestamps, device_memory, module, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
     }
 
-    /// The pipeline of `kernel`, built the first time it is asked for.
+    /// The pipeline of `kernel`, built the first time it is asked for (the
+    /// driver compiles it then: on a fresh machine, seconds for the largest
+    /// kernels; see [`GpuContext::prepare`]).
     pub fn pipeline(&self, kernel: Kernel) -> Arc<Pipeline> {
+        if let Some(p) = self.pipelines.lock().unwrap_or_else(|e| e.into_inner()).get(&kernel) {
+            return p.clone();
+        }
+        // Built without holding the map, so that several build at once.
+        let start = Instant::now();
+        let p = Arc::new(build_pipeline(&self.device, &self.module, kernel, self.cache.as_ref().map(|c| &c.cache)));
+        let seconds = start.elapsed().as_secs_f64();
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
-        pipelines
-            .entry(kernel)
-            .or_insert_with(|| {
-                let start = Instant::now();
-                let p = build_pipeline(&self.device, &self.module, kernel, self.cache.as_ref().map(|c| &c.cache));
-                let mut built = self.built.lock().unwrap_or_else(|e| e.into_inner());
-                *built = (built.0 + 1, built.1 + start.elapsed().as_secs_f64());
-                Arc::new(p)
-            })
-            .clone()
+        if let Some(first) = pipelines.get(&kernel) {
+            return first.clone(); // Another thread built it meanwhile.
+        }
+        pipelines.insert(kernel, p.clone());
+        let mut built = self.built.lock().unwrap_or_else(|e| e.into_inner());
+        built.0 += 1;
+        built.1 += seconds;
+        built.2.push((kernel, seconds));
+        p
     }
 
-    /// Pipelines built so far and the seconds they took.
+    /// Builds the pipelines of `kernels` that are not built yet, several at
+    /// once (the driver's compiles run in parallel on the host's cores), so
+    /// that work timed afterwards does not wait for a compile. Returns the
+    /// wall seconds it took.
+    pub fn prepare(&self, kernels: &[Kernel]) -> f64 {
+        let start = Instant::now();
+        let missing: Vec<Kernel> = {
+            let pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+            let mut m: Vec<Kernel> = kernels.iter().copied().filter(|k| !pipelines.contains_key(k)).collect();
+            m.sort();
+            m.dedup();
+            m
+        };
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(missing.len());
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        std::thread::scope(|s| {
+            for _ in 0..threads {
+                s.spawn(|| {
+                    while let Some(&k) = missing.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) {
+                        self.pipeline(k);
+                    }
+                });
+            }
+        });
+        let seconds = start.elapsed().as_secs_f64();
+        self.built.lock().unwrap_or_else(|e| e.into_inner()).3 += seconds;
+        seconds
+    }
+
+    /// Pipelines built so far and the seconds their builds took (summed
+    /// over threads).
     pub fn pipelines_built(&self) -> (u32, f64) {
-        *self.built.lock().unwrap_or_else(|e| e.into_inner())
+        let built = self.built.lock().unwrap_or_else(|e| e.into_inner());
+        (built.0, built.1)
+    }
+
+    /// The wall seconds spent in [`GpuContext::prepare`], and the slowest
+    /// pipeline builds so far, slowest first.
+    pub fn pipeline_report(&self, slowest: usize) -> (f64, Vec<(Kernel, f64)>) {
+        let built = self.built.lock().unwrap_or_else(|e| e.into_inner());
+        let mut each = built.2.clone();
+        each.sort_by(|a, b| b.1.total_cmp(&a.1));
+        each.truncate(slowest);
+        (built.3, each)
     }
 
     /// Whether compiled pipelines are kept on disk between runs.
