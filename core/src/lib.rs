@@ -12,7 +12,7 @@
 //!
 //! | folder | what | papers |
 //! |---|---|---|
-//! | [`gpu`] | atomics, workgroup phases, unchecked access, fills: the one GPU/CPU split | |
+//! | [`gpu`] | atomics, workgroup phases, subgroup operations (and their CPU emulation), unchecked access, fills: the one GPU/CPU split | |
 //! | [`geometry`] | buffer types, boxes, spheres, triangles, ray intersection, feature bits | Ize 2013; Woop, Benthin & Wald 2013 |
 //! | [`construct`] | Morton codes, radix sort, radix tree, bottom-up fit, agglomerative build, treelet restructuring, leaf collapse, SAH | Karras 2012; Apetrei 2014; Karras & Aila 2013; Adinets & Merrill 2022 |
 //! | [`layouts`] | two-box binary nodes and compressed 8-wide nodes, made from a built tree | Aila & Laine 2009; Ylitie, Karras & Laine 2017 |
