@@ -245,10 +245,22 @@ pub(crate) fn bench_sizes<B: Backend>(
         let mut names: Vec<&'static str> = Vec::new();
         let mut samples: std::collections::BTreeMap<&'static str, Vec<f64>> = Default::default();
         let mut totals = Vec::new();
-        // Warm up (pipelines, buffer pool, GPU clocks) for at least half a second.
+        // Warm up (pipelines, buffer pool, GPU clocks) for at least half a
+        // second and until the build time is stable: the last five within 3%
+        // of each other (clocks still rising show as a falling time), or 5 s.
         let warm = std::time::Instant::now();
-        while warm.elapsed().as_secs_f64() < 0.5 {
-            build_once(b, &spheres, builder)?;
+        let mut recent: std::collections::VecDeque<f64> = Default::default();
+        loop {
+            recent.push_back(build_once(b, &spheres, builder)?.total());
+            if recent.len() > 5 {
+                recent.pop_front();
+            }
+            let (lo, hi) = recent.iter().fold((f64::MAX, 0.0f64), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+            let stable = recent.len() == 5 && hi <= lo * 1.03;
+            let elapsed = warm.elapsed().as_secs_f64();
+            if (elapsed >= 0.5 && stable) || elapsed >= 5.0 {
+                break;
+            }
         }
         bar.inc(1);
         for _ in 0..repeats {
