@@ -294,14 +294,16 @@ pub fn run(
             }
             if checkpointing && queue.idle() {
                 if let Some(done) = g.consistent() {
-                    if done.end > first {
-                        if let Some((every, write)) = control.checkpoint.as_mut() {
-                            write(done, &g.sums_f32())?;
-                            checkpoint_due = Some(Instant::now() + *every);
-                        }
-                    }
+                    // The sums are copied: the devices go on while the part is written.
+                    let sums = (done.end > first).then(|| g.sums_f32());
                     checkpointing = false;
                     queue.pause(false);
+                    if let Some((every, write)) = control.checkpoint.as_mut() {
+                        if let Some(sums) = sums {
+                            write(done, &sums)?;
+                        }
+                        checkpoint_due = Some(Instant::now() + *every);
+                    }
                 }
             }
         }
