@@ -12,7 +12,7 @@
 //!
 //! - on the GPU, local variables of the invocation (registers: no workgroup
 //!   memory, and no barrier, as subgroup operations synchronize their lanes
-//!   themselves), with [`apply`] calling the SPIR-V instruction;
+//!   themselves), with `apply` (GPU builds only) calling the SPIR-V instruction;
 //! - on the CPU, one element per lane of arrays kept by the runner, which runs
 //!   the phase for every lane, then [`emulate`]s the operation subgroup by
 //!   subgroup.
@@ -76,7 +76,7 @@ pub fn apply(op: u32, lane: &mut Lane) {
 }
 
 /// Applies `op` to one subgroup's lanes on the CPU (`lanes.len()` is the
-/// subgroup's size, at most [`MAX_SUBGROUP_SIZE`]), as the GPU's [`apply`]
+/// subgroup's size, at most [`MAX_SUBGROUP_SIZE`]), as the GPU's `apply`
 /// does in each of its invocations.
 #[inline]
 pub fn emulate(op: u32, lanes: &mut [Lane]) {
