@@ -125,3 +125,23 @@ fn a_gpu_and_the_cpu_runner_make_the_gpu_image() {
     eprintln!("GPU + CPU runner against the GPU alone: mean |diff| {diff:.2e}, noise {noise:.2e}; shares {shares:?}");
     assert!(diff < 0.25 * noise, "GPU + CPU against GPU: {diff}, noise {noise}");
 }
+
+/// Sums stay on each device until the end, so a device that fails after
+/// some chunks has read none of them back: they all go back to the queue,
+/// the other device renders them again, and the image is still the
+/// one-device image, with every sample counted once.
+#[test]
+fn a_device_failing_late_hands_back_its_unread_chunks() {
+    let scene = cornell();
+    let s = RenderSettings { width: 16, height: 16, ..settings(256, 13) };
+    // Device 0 renders its first chunk, then fails as it takes its second
+    // (device 1 takes at most a quarter of what is left at a time, so a
+    // second chunk is there for it).
+    let inject = InjectedFailure { device: 0, chunk: 1 };
+    let RenderResult { image, shares, samples, .. } = on_devices(&[Device::Cpu, Device::Cpu], &scene, &s, Some(inject)).unwrap();
+    assert_eq!(shares[0].failed.as_deref(), Some("injected failure"), "{shares:?}");
+    assert_eq!((shares[0].samples, shares[1].samples), (0, 256), "the failed device's chunk counts for nothing: {shares:?}");
+    assert_eq!(samples, 0..256);
+    let d = max_abs(&image.pixels, &one_device(&scene, &s));
+    assert!(d < 1e-4, "with a late failure, against one device: {d}");
+}

@@ -150,7 +150,7 @@ impl SampleQueue {
         Take::Range(start..stop)
     }
 
-    /// A range taken is rendered.
+    /// A range taken is rendered and its sums are read back.
     pub fn finished(&self) {
         self.lock().out -= 1;
     }
@@ -160,12 +160,6 @@ impl SampleQueue {
         let mut s = self.lock();
         s.given_back.push(r);
         s.out -= 1;
-    }
-
-    /// A range finished earlier was lost (its device failed before reading
-    /// it back): another device renders it again.
-    pub fn redo(&self, r: Range<u32>) {
-        self.lock().given_back.push(r);
     }
 
     /// No new range (ranges given back still go out) until resumed.

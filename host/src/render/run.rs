@@ -5,10 +5,11 @@
 //! [`SampleQueue`] as it finishes the last, sized by its own rate (about
 //! [`CHUNK_S`] each), so a fast GPU takes most and a slow device still
 //! helps. Its dispatches add to its own accumulation; it reads the sums back
-//! only when they are needed: at the end, at the end of a pass whose error
-//! is measured, at a checkpoint or a stop, and after every chunk when there
-//! are several devices (so that a device that fails loses only its chunk,
-//! which goes back to the queue for the others).
+//! only when they are needed: when the queue has nothing new for it (at the
+//! end), at the end of a pass whose error is measured, at a checkpoint or a
+//! stop. A chunk stays out in the queue until its sums are read back, so a
+//! device that fails hands its unread chunks back to the others, who wait
+//! for them.
 //!
 //! This thread gathers what the devices read back: it adds their sums, makes
 //! each pass's row, writes checkpoints (the queue pauses until every chunk
@@ -109,7 +110,6 @@ pub struct DeviceJob<'a> {
     queue: &'a SampleQueue,
     /// The sums device 0 starts from (a resumed part), and their range.
     base: Option<(Range<u32>, &'a [[f32; 4]])>,
-    read_each_chunk: bool,
     rows: bool,
     inject: Option<u32>,
     events: Sender<Event>,
@@ -135,37 +135,42 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         Err(error) => return send(Event::Failed { device: job.device, error, lost: Vec::new() }),
     };
     send(Event::Ready { plan: prepared.plan.clone(), build_ms: prepared.build_ms });
-    // Ranges in the accumulation, and those of them not read back yet.
+    // Ranges in the accumulation, and those of them not read back yet. A
+    // range stays out in the queue until it is read back: if the device
+    // fails first, it goes back for the others, who wait for it meanwhile.
     let mut covers: Vec<Range<u32>> = base.into_iter().map(|b| b.0).collect();
     let mut unread: Vec<Range<u32>> = Vec::new();
     let read_back = |b: &mut B, covers: &[Range<u32>], unread: &mut Vec<Range<u32>>, for_rows: bool| -> Result<()> {
         let start = Instant::now();
         let sums = prepared.read_sums(b)?;
         send(Event::ReadBack { device: job.device, sums, covers: covers.to_vec(), read_s: start.elapsed().as_secs_f64(), for_rows });
-        unread.clear();
+        for _ in unread.drain(..) {
+            job.queue.finished();
+        }
         Ok(())
     };
     // The first chunk, a few samples, measures the device's rate.
     let (mut want, mut chunks) = (1u32, 0u32);
-    // On failure: the error, and chunks done that went back to the queue.
-    let outcome: Result<(), (anyhow::Error, Vec<Range<u32>>)> = loop {
+    let outcome: Result<()> = loop {
         let range = match job.queue.take(want) {
             Take::Range(r) => r,
             Take::Wait => {
-                if !unread.is_empty() && job.queue.holding() {
+                // Nothing new to take: read back what this device holds (the
+                // others may be waiting for it, and a checkpoint or stop needs it).
+                if !unread.is_empty() {
                     if let Err(e) = read_back(b, &covers, &mut unread, false) {
-                        break Err((e, Vec::new()));
+                        break Err(e);
                     }
                 }
                 std::thread::sleep(Duration::from_millis(2));
                 continue;
             }
-            Take::Done if unread.is_empty() => break Ok(()),
-            Take::Done => break read_back(b, &covers, &mut unread, false).map_err(|e| (e, Vec::new())),
+            // Unread ranges are out: the queue says done only when there are none.
+            Take::Done => break Ok(()),
         };
         if job.inject == Some(chunks) {
             job.queue.give_back(range);
-            break Err((anyhow!("injected failure"), Vec::new()));
+            break Err(anyhow!("injected failure"));
         }
         let chunk_start = Instant::now();
         let len = range.end - range.start;
@@ -184,7 +189,7 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
             Ok(ms) => ms,
             Err(e) => {
                 job.queue.give_back(range);
-                break Err((e, Vec::new()));
+                break Err(e);
             }
         };
         chunks += 1;
@@ -196,25 +201,23 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         // fast one waits seldom.
         let rate = len as f64 / chunk_start.elapsed().as_secs_f64().max(1e-6);
         want = (rate * CHUNK_S).clamp(1.0, 4096.0) as u32;
+        // Sums stay on the device (a read-back of the whole image per chunk
+        // cost each of two H100s 8 to 10% of its rate) but for an error row,
+        // a checkpoint or a stop.
         let for_rows = job.rows && job.queue.grid().is_pass_end(range.end);
-        if job.read_each_chunk || for_rows || job.queue.holding() {
-            // The range stays out until it is read back: if the read fails, it
-            // goes back to the queue while the other devices still wait for it.
+        if for_rows || job.queue.holding() {
             if let Err(e) = read_back(b, &covers, &mut unread, for_rows) {
-                unread.retain(|r| *r != range);
-                job.queue.give_back(range.clone());
-                break Err((e, vec![range]));
+                break Err(e);
             }
         }
-        job.queue.finished();
     };
-    if let Err((error, mut lost)) = outcome {
-        // What was done and not read back is lost with the device: render it again.
+    if let Err(error) = outcome {
+        // What was done and not read back is lost with the device: the
+        // others render it again.
         for r in &unread {
-            job.queue.redo(r.clone());
+            job.queue.give_back(r.clone());
         }
-        lost.append(&mut unread);
-        send(Event::Failed { device: job.device, error, lost });
+        send(Event::Failed { device: job.device, error, lost: unread });
     }
 }
 
@@ -267,7 +270,6 @@ pub fn run(
             settings,
             queue: &queue,
             base: control.resume.clone(),
-            read_each_chunk: devices > 1,
             rows: error_each_pass,
             inject: control.inject.filter(|f| f.device == device).map(|f| f.chunk),
             events: tx.clone(),
