@@ -127,7 +127,8 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "auto")]
     device: DeviceChoice,
     /// Render on several devices at once, each taking chunks of samples as
-    /// it finishes the last: all (every Vulkan adapter; the CPU runner where
+    /// it finishes the last (without it, a machine with several GPUs renders
+    /// on all its GPUs; `--devices 0` takes one): all (every Vulkan adapter; the CPU runner where
     /// there is none: beside a GPU or lavapipe it slowed renders, measured),
     /// gpu (every adapter), or a list of adapter indices or names and cpu
     /// (`--devices list` prints the adapters).
@@ -272,9 +273,13 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         error_each_pass: args.report.is_some() || args.reference.is_some(),
         first_sample,
     };
-    // A single device is a list of one.
+    // A single device is a list of one; by default a machine with several
+    // GPUs renders on all of them.
     let list = match &args.devices {
         Some(spec) => treelet::render::devices::open(spec)?,
+        None if args.device == DeviceChoice::Auto && GpuContext::gpu_adapters().len() > 1 => {
+            GpuContext::gpu_adapters().into_iter().map(|i| Ok(Device::Gpu(GpuContext::with_adapter(i)?))).collect::<Result<Vec<_>>>()?
+        }
         None => vec![args.device.open()?],
     };
     let bar = ProgressBar::new(args.spp as u64);
@@ -422,6 +427,13 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
                 s.paths_per_s / 1e6,
                 s.failed.as_ref().map(|f| format!(", stopped: {f}")).unwrap_or_default()
             );
+            if args.explain {
+                let other = s.seconds - s.prepare_s - s.kernel_s - s.read_s;
+                eprintln!(
+                    "    time: prepare {:.3} s, render kernels {:.3} s, read-backs {:.3} s, the rest (waits, submissions) {:.3} s of {:.3} s",
+                    s.prepare_s, s.kernel_s, s.read_s, other, s.seconds
+                );
+            }
             if s.failed.is_some() && result.stopped.is_none() {
                 eprintln!("warning: {} failed; the other devices rendered its unfinished samples", s.device);
             }

@@ -80,5 +80,10 @@ pub struct Share {
     pub paths_per_s: f64,
     /// Why it stopped early, if it did (its unfinished chunks went to the others).
     pub failed: Option<String>,
+    /// Where its time went: preparing (tree build, uploads; wall), render
+    /// kernels (GPU timestamps where available), reading its sums back.
+    pub prepare_s: f64,
+    pub kernel_s: f64,
+    pub read_s: f64,
 }
 

@@ -135,6 +135,13 @@ impl GpuContext {
         adapters.iter().map(|a| a.get_info().name).collect()
     }
 
+    /// The indices (as [`GpuContext::with_adapter`] takes them) of the
+    /// Vulkan adapters that are GPUs, not CPU implementations such as lavapipe.
+    pub fn gpu_adapters() -> Vec<usize> {
+        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN));
+        (0..adapters.len()).filter(|&i| adapters[i].get_info().device_type != wgpu::DeviceType::Cpu).collect()
+    }
+
     async fn new_async(index: Option<usize>) -> Result<Arc<Self>> {
         let start = Instant::now();
         let instance = instance();
