@@ -430,8 +430,8 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             if args.explain {
                 let other = s.seconds - s.prepare_s - s.kernel_s - s.read_s;
                 eprintln!(
-                    "    time: prepare {:.3} s, render kernels {:.3} s, read-backs {:.3} s, the rest (waits, submissions) {:.3} s of {:.3} s",
-                    s.prepare_s, s.kernel_s, s.read_s, other, s.seconds
+                    "    time: prepare {:.3} s (tree build and layout on the device {:.3} s), render kernels {:.3} s, read-backs {:.3} s, the rest (waits, submissions) {:.3} s of {:.3} s",
+                    s.prepare_s, s.build_s, s.kernel_s, s.read_s, other, s.seconds
                 );
             }
             if s.failed.is_some() && result.stopped.is_none() {

@@ -83,6 +83,8 @@ pub struct Share {
     /// Where its time went: preparing (tree build, uploads; wall), render
     /// kernels (GPU timestamps where available), reading its sums back.
     pub prepare_s: f64,
+    /// Of `prepare_s`, the tree's build and layout on the device (device time).
+    pub build_s: f64,
     pub kernel_s: f64,
     pub read_s: f64,
 }

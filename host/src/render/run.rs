@@ -357,6 +357,7 @@ impl Gather {
                 paths_per_s: 0.0,
                 failed: None,
                 prepare_s: 0.0,
+                build_s: 0.0,
                 kernel_s: 0.0,
                 read_s: 0.0,
             })
@@ -392,6 +393,7 @@ impl Gather {
         match event {
             Event::Ready { device, plan, build_ms, prepare_s } => {
                 self.shares[device].prepare_s = prepare_s;
+                self.shares[device].build_s = build_ms / 1e3;
                 if self.plan.is_none() {
                     self.plan = Some(plan);
                     self.build_ms = build_ms;
