@@ -52,7 +52,8 @@ fn write_seeds() -> Vec<(String, Vec<u8>)> {
     let image = HdrImage { width: w, height: h, pixels: (0..w * h).map(|i| [i as f32 * 0.1, 0.2, 0.3]).collect() };
     image_io::write(&dir.join("image.exr"), &image).unwrap();
     image_io::write(&dir.join("image.pfm"), &image).unwrap();
-    let out = ["part.exr", "image.exr", "image.pfm"].map(|n| (n.to_string(), std::fs::read(dir.join(n)).unwrap())).to_vec();
+    let out =
+        ["part.exr", "image.exr", "image.pfm"].map(|n| (n.to_string(), std::fs::read(dir.join(n)).unwrap())).to_vec();
     let _ = std::fs::remove_dir_all(&dir);
     out
 }

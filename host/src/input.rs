@@ -42,7 +42,11 @@ fn check_meta(path: &Path, what: &str, meta: &std::fs::Metadata) -> Result<u64> 
     }
     let max = max_input_bytes();
     if meta.len() > max {
-        bail!("{what} {} has {} bytes, more than the {max} bytes an input may have (--max-input-bytes raises it)", path.display(), meta.len());
+        bail!(
+            "{what} {} has {} bytes, more than the {max} bytes an input may have (--max-input-bytes raises it)",
+            path.display(),
+            meta.len()
+        );
     }
     Ok(meta.len())
 }

@@ -22,7 +22,11 @@ pub const MULTISPLIT_PHASES: u32 = MULTISPLIT_BITS + 2;
 /// The subgroup operation after phase `phase`.
 #[inline]
 pub const fn multisplit_op(phase: u32) -> u32 {
-    if phase <= MULTISPLIT_BITS { OP_BALLOT } else { OP_NONE }
+    if phase <= MULTISPLIT_BITS {
+        OP_BALLOT
+    } else {
+        OP_NONE
+    }
 }
 
 /// What a lane keeps across the phases (registers on the GPU).
@@ -58,7 +62,8 @@ pub fn multisplit_phase(
     let valid = id < params.n;
     if phase == 0 {
         if valid {
-            state.digit = ((at(keys, id as usize) >> (MULTISPLIT_BITS * params.pass)) & ((1 << MULTISPLIT_BITS) - 1)) as u32;
+            state.digit =
+                ((at(keys, id as usize) >> (MULTISPLIT_BITS * params.pass)) & ((1 << MULTISPLIT_BITS) - 1)) as u32;
         }
         // Ballot: which lanes hold a key (past the end, none does).
         io.input = valid as u32;
@@ -106,7 +111,20 @@ mod tests {
                 for phase in 0..MULTISPLIT_PHASES {
                     for id in 0..WG as u32 {
                         let l = id as usize;
-                        multisplit_phase(phase, id, 0, id % size, size, &params, &keys, &mut ranks, &mut counts, &mut sizes, &mut states[l], &mut lanes[l]);
+                        multisplit_phase(
+                            phase,
+                            id,
+                            0,
+                            id % size,
+                            size,
+                            &params,
+                            &keys,
+                            &mut ranks,
+                            &mut counts,
+                            &mut sizes,
+                            &mut states[l],
+                            &mut lanes[l],
+                        );
                     }
                     for chunk in lanes.chunks_mut(size as usize) {
                         emulate(multisplit_op(phase), chunk);

@@ -60,7 +60,9 @@ pub struct Lane {
 #[cfg(target_arch = "spirv")]
 #[inline]
 pub fn apply(op: u32, lane: &mut Lane) {
-    use spirv_std::arch::{subgroup_ballot, subgroup_exclusive_i_add, subgroup_i_add, subgroup_inclusive_i_add, subgroup_shuffle};
+    use spirv_std::arch::{
+        subgroup_ballot, subgroup_exclusive_i_add, subgroup_i_add, subgroup_inclusive_i_add, subgroup_shuffle,
+    };
     if op == OP_BALLOT {
         let mask = subgroup_ballot(lane.input != 0);
         lane.output = mask.x as u64 | (mask.y as u64) << 32;
@@ -129,7 +131,11 @@ pub fn lanes_below(lane: u32) -> u64 {
 /// The mask of every lane of a subgroup of `size` lanes.
 #[inline]
 pub fn all_lanes(size: u32) -> u64 {
-    if size >= 64 { u64::MAX } else { (1u64 << size) - 1 }
+    if size >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << size) - 1
+    }
 }
 
 /// Bits set in a 64-bit mask (two 32-bit counts: 64-bit `OpBitCount` is

@@ -88,4 +88,3 @@ pub struct Share {
     pub kernel_s: f64,
     pub read_s: f64,
 }
-

@@ -3,20 +3,20 @@
 //! the accumulation buffer of per-pixel sums that its dispatches add to.
 use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::RenderParams;
-use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
-use treelet_core::render::lights::{Light, light_power};
+use treelet_core::render::lights::{light_power, Light};
 
+use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
+use super::variant::{self, Plan};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
 use crate::bvh::tree::traced_tree;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
-use crate::scene::Scene;
-use crate::scene::primitives::Primitives;
-use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
 use crate::runtime::memory::human;
-use super::variant::{self, Plan};
+use crate::scene::primitives::Primitives;
+use crate::scene::Scene;
 
 /// The light table of `prims` (spheres then triangles, one material each):
 /// every emitter, chosen in proportion to its power
@@ -76,7 +76,8 @@ impl<B: Backend> Prepared<B> {
     /// the scene. `base`: per-pixel sums the accumulation starts from (a
     /// resumed render's part), else zeros.
     pub fn new(b: &mut B, scene: &Scene, settings: &RenderSettings, base: Option<&[[f32; 4]]>) -> Result<Self> {
-        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, first_sample, .. } = *settings;
+        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, first_sample, .. } =
+            *settings;
         if width == 0 || height == 0 || spp == 0 {
             bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
         }
@@ -148,11 +149,21 @@ impl<B: Backend> Prepared<B> {
         let mut done = 0;
         while done < count {
             let samples = (count - done).min(self.per_dispatch);
-            let p = b.upload("render params", &[RenderParams { samples, first_sample: first + done, ..self.params }])?;
+            let p =
+                b.upload("render params", &[RenderParams { samples, first_sample: first + done, ..self.params }])?;
             let t = &self.tree;
             b.dispatch(
                 self.kernel,
-                &[&p, &self.buffers.spheres, &self.materials, &t.nodes, &t.prims, &self.accum, &self.buffers.triangles, &self.lights],
+                &[
+                    &p,
+                    &self.buffers.spheres,
+                    &self.materials,
+                    &t.nodes,
+                    &t.prims,
+                    &self.accum,
+                    &self.buffers.triangles,
+                    &self.lights,
+                ],
                 groups_for(tiled_invocations(self.params.width, self.params.height), WORKGROUP_SIZE),
             );
             done += samples;
@@ -164,6 +175,4 @@ impl<B: Backend> Prepared<B> {
     pub fn read_sums(&self, b: &mut B) -> Result<Vec<[f32; 4]>> {
         b.read(&self.accum, self.pixels as usize)
     }
-
 }
-

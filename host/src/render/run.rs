@@ -73,7 +73,9 @@ pub fn render<B: Backend>(
 ) -> Result<RenderResult> {
     let r = render_with(b, scene, settings, reference, Control::default(), on_pass)?;
     match &r.stopped {
-        Some(Stopped::Failed(why)) => bail!("the device failed after samples {}..{}: {why}", r.samples.start, r.samples.end),
+        Some(Stopped::Failed(why)) => {
+            bail!("the device failed after samples {}..{}: {why}", r.samples.start, r.samples.end)
+        }
         _ => Ok(r),
     }
 }
@@ -117,12 +119,31 @@ pub struct DeviceJob<'a> {
 }
 
 enum Event {
-    Ready { device: usize, plan: Plan, build_ms: f64, prepare_s: f64 },
-    Chunk { device: usize, range: Range<u32>, kernel_ms: f64 },
+    Ready {
+        device: usize,
+        plan: Plan,
+        build_ms: f64,
+        prepare_s: f64,
+    },
+    Chunk {
+        device: usize,
+        range: Range<u32>,
+        kernel_ms: f64,
+    },
     /// A device's sums so far, which hold the samples of `covers`.
-    ReadBack { device: usize, sums: Vec<[f32; 4]>, covers: Vec<Range<u32>>, read_s: f64, for_rows: bool },
+    ReadBack {
+        device: usize,
+        sums: Vec<[f32; 4]>,
+        covers: Vec<Range<u32>>,
+        read_s: f64,
+        for_rows: bool,
+    },
     /// A device failed; the chunks in `lost` were done but not read back.
-    Failed { device: usize, error: anyhow::Error, lost: Vec<Range<u32>> },
+    Failed {
+        device: usize,
+        error: anyhow::Error,
+        lost: Vec<Range<u32>>,
+    },
 }
 
 /// One device's loop: prepare, then chunks until the queue is done.
@@ -136,7 +157,12 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         Ok(p) => p,
         Err(error) => return send(Event::Failed { device: job.device, error, lost: Vec::new() }),
     };
-    send(Event::Ready { device: job.device, plan: prepared.plan.clone(), build_ms: prepared.build_ms, prepare_s: prepare_start.elapsed().as_secs_f64() });
+    send(Event::Ready {
+        device: job.device,
+        plan: prepared.plan.clone(),
+        build_ms: prepared.build_ms,
+        prepare_s: prepare_start.elapsed().as_secs_f64(),
+    });
     // Ranges in the accumulation, and those of them not read back yet. A
     // range stays out in the queue until it is read back: if the device
     // fails first, it goes back for the others, who wait for it meanwhile.
@@ -145,7 +171,13 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
     let read_back = |b: &mut B, covers: &[Range<u32>], unread: &mut Vec<Range<u32>>, for_rows: bool| -> Result<()> {
         let start = Instant::now();
         let sums = prepared.read_sums(b)?;
-        send(Event::ReadBack { device: job.device, sums, covers: covers.to_vec(), read_s: start.elapsed().as_secs_f64(), for_rows });
+        send(Event::ReadBack {
+            device: job.device,
+            sums,
+            covers: covers.to_vec(),
+            read_s: start.elapsed().as_secs_f64(),
+            for_rows,
+        });
         for _ in unread.drain(..) {
             job.queue.finished();
         }
@@ -235,7 +267,9 @@ pub fn run(
     mut on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
     let RenderSettings { width, height, spp, first_sample: first, error_each_pass, .. } = *settings;
-    let Some(end) = first.checked_add(spp) else { bail!("samples {first}.. plus {spp}: the sample index must stay below 2^32") };
+    let Some(end) = first.checked_add(spp) else {
+        bail!("samples {first}.. plus {spp}: the sample index must stay below 2^32")
+    };
     if let Some(r) = reference {
         if (r.width, r.height) != (width, height) {
             bail!("reference image is {}x{}, the render {width}x{height}", r.width, r.height);
@@ -339,7 +373,12 @@ struct Gather {
 }
 
 impl Gather {
-    fn new(names: &[String], first: u32, (width, height): (u32, u32), resume: Option<&(Range<u32>, &[[f32; 4]])>) -> Self {
+    fn new(
+        names: &[String],
+        first: u32,
+        (width, height): (u32, u32),
+        resume: Option<&(Range<u32>, &[[f32; 4]])>,
+    ) -> Self {
         let mut read: Vec<_> = names.iter().map(|_| None).collect();
         let mut done = Vec::new();
         if let Some((r, sums)) = resume {
@@ -461,14 +500,30 @@ impl Gather {
     }
 
     /// The pass row at sample `at`, its error measured from `sums` if given.
-    fn row(&self, grid: &Grid, at: u32, start: Instant, sums: Option<&[[f32; 4]]>, reference: Option<&HdrImage>) -> PassRow {
+    fn row(
+        &self,
+        grid: &Grid,
+        at: u32,
+        start: Instant,
+        sums: Option<&[[f32; 4]]>,
+        reference: Option<&HdrImage>,
+    ) -> PassRow {
         let elapsed_s = start.elapsed().as_secs_f64();
         let times = (elapsed_s, elapsed_s - self.measuring_s, (self.build_ms + self.kernel_ms) / 1e3);
         let pass = grid.pass_of(at) as u32;
         let spp = at - self.first;
         match sums {
             Some(sums) => error_row(pass, spp, times, sums, reference),
-            None => PassRow { pass, spp, elapsed_s, wall_s: times.1, kernel_s: times.2, rmse: None, rel_mse: None, mean_std_error: None },
+            None => PassRow {
+                pass,
+                spp,
+                elapsed_s,
+                wall_s: times.1,
+                kernel_s: times.2,
+                rmse: None,
+                rel_mse: None,
+                mean_std_error: None,
+            },
         }
     }
 
@@ -511,7 +566,12 @@ impl Gather {
         for share in &mut self.shares {
             share.paths_per_s = share.samples as f64 * self.pixels as f64 / share.seconds.max(1e-9);
         }
-        let failures = self.errors.iter().map(|(d, e)| format!("{}: {e:#}", self.shares[*d].device)).collect::<Vec<_>>().join("; ");
+        let failures = self
+            .errors
+            .iter()
+            .map(|(d, e)| format!("{}: {e:#}", self.shares[*d].device))
+            .collect::<Vec<_>>()
+            .join("; ");
         let Some(done) = self.consistent() else {
             bail!("the samples read back are not one range from sample {} ({})", asked.start, failures);
         };

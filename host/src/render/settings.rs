@@ -3,10 +3,10 @@
 //! dispatches and passes.
 use serde::Serialize;
 
+use super::variant::KernelChoice;
 use crate::bvh::layout::Layout;
 use crate::bvh::tree::{tree_host_bytes, Accel};
 use crate::runtime::backend::DeviceClass;
-use super::variant::KernelChoice;
 
 /// How radiance is estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
@@ -118,11 +118,9 @@ impl MemoryEstimate {
     /// The estimate for `settings` over `prims` primitives on devices of `classes`.
     pub fn of(settings: &RenderSettings, prims: u64, classes: &[DeviceClass]) -> Self {
         let pixels = settings.width as u64 * settings.height as u64;
-        let image_bytes = pixels.saturating_mul(HOST_BYTES_PER_PIXEL + BYTES_PER_PIXEL_PER_DEVICE * classes.len() as u64);
-        let scene_bytes = classes
-            .iter()
-            .map(|&c| tree_host_bytes(prims, c))
-            .fold(0u64, u64::saturating_add);
+        let image_bytes =
+            pixels.saturating_mul(HOST_BYTES_PER_PIXEL + BYTES_PER_PIXEL_PER_DEVICE * classes.len() as u64);
+        let scene_bytes = classes.iter().map(|&c| tree_host_bytes(prims, c)).fold(0u64, u64::saturating_add);
         MemoryEstimate { image_bytes, scene_bytes, total_bytes: image_bytes.saturating_add(scene_bytes) }
     }
 

@@ -40,7 +40,13 @@ pub fn image_error(image: impl Iterator<Item = [f64; 3]>, reference: &HdrImage) 
 }
 
 /// `times`: elapsed, wall and kernel seconds (see [`PassRow`]).
-pub(super) fn error_row(pass: u32, spp: u32, times: (f64, f64, f64), sums: &[[f32; 4]], reference: Option<&HdrImage>) -> PassRow {
+pub(super) fn error_row(
+    pass: u32,
+    spp: u32,
+    times: (f64, f64, f64),
+    sums: &[[f32; 4]],
+    reference: Option<&HdrImage>,
+) -> PassRow {
     let n = spp as f64;
     let (elapsed_s, wall_s, kernel_s) = times;
     let mut row = PassRow { pass, spp, elapsed_s, wall_s, kernel_s, rmse: None, rel_mse: None, mean_std_error: None };
@@ -63,4 +69,3 @@ pub(super) fn error_row(pass: u32, spp: u32, times: (f64, f64, f64), sums: &[[f3
     }
     row
 }
-
