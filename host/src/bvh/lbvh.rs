@@ -43,6 +43,10 @@ pub struct DeviceBvh<B: Backend> {
     pub prim_indices: B::Buffer,
     pub sorted_keys: B::Buffer,
     pub centroid_bounds: Aabb,
+    /// The spheres and triangles the build read, as it uploaded them (valid
+    /// until the next build on the backend), so that traversal need not
+    /// upload them again; `None` for a tree built elsewhere.
+    pub prims: Option<(B::Buffer, B::Buffer)>,
 }
 
 impl<B: Backend> Clone for DeviceBvh<B> {
@@ -55,6 +59,7 @@ impl<B: Backend> Clone for DeviceBvh<B> {
             prim_indices: self.prim_indices.clone(),
             sorted_keys: self.sorted_keys.clone(),
             centroid_bounds: self.centroid_bounds,
+            prims: self.prims.clone(),
         }
     }
 }
@@ -73,6 +78,7 @@ impl<B: Backend> DeviceBvh<B> {
             prim_indices: b.upload("primitive indices", &bvh.prim_indices)?,
             sorted_keys: b.upload("keys", &keys)?,
             centroid_bounds: bvh.centroid_bounds,
+            prims: None,
         })
     }
 
@@ -151,6 +157,7 @@ pub fn build_primitives_with<B: Backend>(
             prim_indices: empty.clone(),
             sorted_keys: empty,
             centroid_bounds: Aabb::EMPTY,
+            prims: None,
         };
         return Ok((bvh, b.take_times()?));
     }
@@ -219,7 +226,8 @@ pub fn build_primitives_with<B: Backend>(
 
     let times = b.take_times()?;
     let node_count = node_count as u32;
-    Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds }, times))
+    let prims = Some((spheres, triangles));
+    Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds, prims }, times))
 }
 
 /// How the hierarchy and its boxes are made from the sorted keys; both give

@@ -285,6 +285,7 @@ fn collapse_pass<B: Backend>(
         prim_indices: prims,
         sorted_keys: bvh.sorted_keys.clone(),
         centroid_bounds: bvh.centroid_bounds,
+        prims: bvh.prims.clone(),
     })
 }
 
