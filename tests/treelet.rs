@@ -178,7 +178,10 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
             // as GLSL `Fma`). A device may execute `Fma` unfused: lavapipe does,
             // and a near-tie between two treelet topologies can then go the
             // other way. Where `Fma` is fused (the H100) the tree must be the
-            // CPU's bit for bit; on a CPU adapter its SAH must agree within 1e-4.
+            // CPU's bit for bit; on a CPU adapter its SAH must agree within 1e-3.
+            // (A flip in an early round changes the treelets of later ones:
+            // seed 7292463453395754375 gave 3.2e-4 at n = 30 000 on lavapipe,
+            // the GPU's tree the better, on the code of bccaada as on later.)
             let mut gpu = GpuBackend::new(ctx);
             let fused = !gpu.runs_on_cpu();
             let (g, _) = run(&mut gpu, &spheres, &config);
@@ -197,7 +200,7 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
                     c.nodes[i]
                 );
                 assert!(!fused, "{what}");
-                assert!((gs - after).abs() <= 1e-4 * after, "{what}");
+                assert!((gs - after).abs() <= 1e-3 * after, "{what}");
                 eprintln!("unfused Fma on this adapter: {what}");
                 continue;
             }
