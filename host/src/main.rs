@@ -275,11 +275,10 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     };
     // A single device is a list of one; by default a machine with several
     // GPUs renders on all of them.
+    let gpus = if args.devices.is_none() && args.device == DeviceChoice::Auto { GpuContext::gpu_adapters() } else { Vec::new() };
     let list = match &args.devices {
         Some(spec) => treelet::render::devices::open(spec)?,
-        None if args.device == DeviceChoice::Auto && GpuContext::gpu_adapters().len() > 1 => {
-            GpuContext::gpu_adapters().into_iter().map(|i| Ok(Device::Gpu(GpuContext::with_adapter(i)?))).collect::<Result<Vec<_>>>()?
-        }
+        None if gpus.len() > 1 => gpus.into_iter().map(|i| Ok(Device::Gpu(GpuContext::with_adapter(i)?))).collect::<Result<Vec<_>>>()?,
         None => vec![args.device.open()?],
     };
     let bar = ProgressBar::new(args.spp as u64);

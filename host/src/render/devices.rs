@@ -7,7 +7,6 @@ use super::image_io::HdrImage;
 use super::outcome::{PassRow, RenderResult};
 use super::run::{device_loop, run, Control, Worker};
 use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
-use crate::runtime::backend::Backend;
 use crate::runtime::cpu_runner::CpuBackend;
 pub use crate::runtime::device::Device;
 use crate::runtime::gpu::{GpuBackend, GpuContext};
@@ -69,13 +68,10 @@ pub fn render_on_devices(
     let classes: Vec<_> = devices.iter().map(Device::class).collect();
     let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
     MemoryEstimate::of(settings, prims, &classes).check(settings, prims)?;
-    // A fresh machine's driver compiles each pipeline for seconds: before the clock starts, all at once.
+    // Before the clock starts (see `prepare_pipelines`).
     for d in devices {
         if let Device::Gpu(ctx) = d {
-            let mut b = GpuBackend::new(ctx.clone());
-            let plan = super::variant::plan(scene, settings.accel, settings.layout, settings.kernel, b.class());
-            let kernels = super::prepared::kernels(&b, &plan);
-            b.prepare_kernels(&kernels);
+            super::prepared::prepare_pipelines(&mut GpuBackend::new(ctx.clone()), scene, settings);
         }
     }
     let gpus = devices.iter().filter(|d| matches!(d, Device::Gpu(_))).count();

@@ -71,6 +71,15 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
     k
 }
 
+/// Builds the pipelines of a render of `scene` with `settings` on `b`
+/// before its timed work: a fresh machine's driver compiles each for
+/// seconds, so all at once ([`Backend::prepare_kernels`]).
+pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
+    let plan = variant::plan(scene, settings.accel, settings.layout, settings.kernel, b.class());
+    let kernels = kernels(b, &plan);
+    b.prepare_kernels(&kernels);
+}
+
 impl<B: Backend> Prepared<B> {
     /// Checks the settings and the scene, builds the tree on `b` and uploads
     /// the scene. `base`: per-pixel sums the accumulation starts from (a

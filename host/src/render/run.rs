@@ -92,10 +92,7 @@ pub fn render_with<B: Backend>(
 ) -> Result<RenderResult> {
     let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
     MemoryEstimate::of(settings, prims, &[b.class()]).check(settings, prims)?;
-    // A fresh machine's driver compiles each pipeline for seconds: before the clock starts, all at once.
-    let plan = super::variant::plan(scene, settings.accel, settings.layout, settings.kernel, b.class());
-    let kernels = super::prepared::kernels(b, &plan);
-    b.prepare_kernels(&kernels);
+    super::prepared::prepare_pipelines(b, scene, settings);
     let step = samples_per_dispatch(settings.width as u64 * settings.height as u64, b.class());
     let name = b.adapter();
     let worker: Worker<'_> = Box::new(move |job| device_loop(b, job));
