@@ -113,7 +113,12 @@ fn sort_stress_on_large_inputs() {
         let keys: Vec<u64> = (0..n).map(|_| rng.random::<u64>() >> rng.random_range(0..64)).collect();
         let values: Vec<u32> = (0..n).collect();
         b.begin_build();
-        let tiles = [SortTiles::Large, SortTiles::Small][(trial / 3) % 2];
+        let kinds: &[SortTiles] = if treelet::bvh::sort::multisplit_runs_on(&b) {
+            &[SortTiles::Large, SortTiles::Small, SortTiles::Multisplit]
+        } else {
+            &[SortTiles::Large, SortTiles::Small]
+        };
+        let tiles = kinds[(trial / 3) % kinds.len()];
         let g = run_sort(&mut b, &keys, &values, 64, tiles);
         let mut expected: Vec<(u64, u32)> = keys.into_iter().zip(values).collect();
         expected.sort_by_key(|&(k, _)| k);
@@ -122,10 +127,10 @@ fn sort_stress_on_large_inputs() {
     }
 }
 
-/// Sorts `keys` (values: their indices) on the GPU and the CPU runner by
-/// their low `key_bits` bits and compares both with a stable std sort.
-/// Sorts with large and with small tiles, on the GPU and the CPU runner,
-/// against std's stable sort.
+/// Sorts `keys` (values: their indices) by their low `key_bits` bits with
+/// large tiles, small tiles and tiles ranked by subgroups (the CPU runner at
+/// subgroup sizes 16, 32 and 64; the GPU where its subgroups are large
+/// enough), on the GPU and the CPU runner, against std's stable sort.
 fn check_sort(ctx: &std::sync::Arc<treelet::runtime::gpu::GpuContext>, keys: &[u64], key_bits: u32, what: &str) {
     let n = keys.len();
     let values: Vec<u32> = (0..n as u32).collect();
@@ -135,11 +140,19 @@ fn check_sort(ctx: &std::sync::Arc<treelet::runtime::gpu::GpuContext>, keys: &[u
     let (ek, ev): (Vec<u64>, Vec<u32>) = expected.into_iter().unzip();
     // Without look-back (lavapipe) the GPU sorts with large tiles only.
     let look_back_on_gpu = GpuBackend::new(ctx.clone()).look_back_works();
-    for tiles in [SortTiles::Small, SortTiles::Large] {
-        let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits, tiles);
-        assert!(c.0 == ek, "cpu keys, {tiles:?} tiles, {what}");
-        assert!(c.1 == ev, "cpu values (stability), {tiles:?} tiles, {what}");
-        if tiles != SortTiles::Large && !look_back_on_gpu {
+    for size in [16, 32, 64] {
+        let c = run_sort(&mut CpuBackend::with_subgroup_size(size), keys, &values, key_bits, SortTiles::Multisplit);
+        assert!(c.0 == ek, "cpu keys, multisplit tiles, subgroups of {size}, {what}");
+        assert!(c.1 == ev, "cpu values (stability), multisplit tiles, subgroups of {size}, {what}");
+    }
+    let multisplit_on_gpu = treelet::bvh::sort::multisplit_runs_on(&GpuBackend::new(ctx.clone()));
+    for tiles in [SortTiles::Small, SortTiles::Large, SortTiles::Multisplit] {
+        if tiles != SortTiles::Multisplit {
+            let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits, tiles);
+            assert!(c.0 == ek, "cpu keys, {tiles:?} tiles, {what}");
+            assert!(c.1 == ev, "cpu values (stability), {tiles:?} tiles, {what}");
+        }
+        if (tiles == SortTiles::Small && !look_back_on_gpu) || (tiles == SortTiles::Multisplit && !multisplit_on_gpu) {
             continue;
         }
         let g = run_sort(&mut GpuBackend::new(ctx.clone()), keys, &values, key_bits, tiles);
@@ -237,4 +250,16 @@ fn subgroup_multisplit_matches_the_cpu_emulation() {
             }
         }
     }
+}
+
+/// Asked for the pass ranked by subgroups on a device whose subgroups are
+/// too small for it, the sort says so instead of sorting wrong.
+#[test]
+fn sort_ranked_by_subgroups_refuses_small_subgroups() {
+    let mut b = CpuBackend::with_subgroup_size(8);
+    let keys: Vec<u64> = (0..5000u64).rev().collect();
+    let values: Vec<u32> = (0..5000).collect();
+    let (kb, vb) = (b.upload("keys", &keys).unwrap(), b.upload("values", &values).unwrap());
+    let err = treelet::bvh::sort::radix_sort_tiled(&mut b, &kb, &vb, 5000, 64, SortTiles::Multisplit).err().expect("an error");
+    assert!(err.to_string().contains("subgroups of at least 16 lanes"), "{err}");
 }

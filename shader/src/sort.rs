@@ -1,6 +1,11 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
+use treelet_core::construct::sort_multisplit::{
+    MULTISPLIT_SORT_ITEMS, MULTISPLIT_SORT_TILE, MultisplitPassLane, SUBGROUP_COUNTS, multisplit_pass_phase,
+    multisplit_pass_phases, multisplit_pass_sync,
+};
+use treelet_core::gpu::subgroup::{Lane, apply};
 use treelet_core::geometry::buffers::SortParams;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
@@ -38,9 +43,13 @@ pub fn sort_offsets_cs(
 }
 
 /// A sort pass's entry point; `$look_back` and `$items` as in
-/// `treelet_core::construct::sort::onesweep_phase` (entry points cannot be generic).
+/// `treelet_core::construct::sort::onesweep_phase` (entry points cannot be
+/// generic). The phases are unrolled, each with its number a constant
+/// (`$phase`, all of `0..onesweep_phases($items)`), so that the driver's
+/// compiler keeps only that phase's branch of the function: a loop over
+/// phases pays for the whole function in every phase.
 macro_rules! onesweep_kernel {
-    ($name:ident, $look_back:literal, $items:expr) => {
+    ($name:ident, $look_back:literal, $items:expr, [$($phase:literal)*]) => {
         #[spirv(compute(threads(256)))]
         #[allow(clippy::too_many_arguments)]
         pub fn $name(
@@ -65,13 +74,14 @@ macro_rules! onesweep_kernel {
             #[spirv(workgroup)] scan_sums: &mut [u32; 16],
         ) {
             let group = linear_group(group.x, group.y, groups.x);
-            for phase in 0..sort::onesweep_phases($items) {
+            const _: () = assert!([$($phase),*].len() as u32 == sort::onesweep_phases($items));
+            $(
                 sort::onesweep_phase::<
                     $look_back,
                     { $items },
                     { ($items * treelet_core::WORKGROUP_SIZE) as usize },
                 >(
-                    phase,
+                    $phase,
                     lid,
                     group,
                     params,
@@ -92,14 +102,75 @@ macro_rules! onesweep_kernel {
                     scan_sums,
                 );
                 barrier();
-            }
+            )*
         }
     };
 }
 
-onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS);
-onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS);
-onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS);
+onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23]);
+onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11]);
+onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23]);
+
+/// A sort pass ranked by subgroups: each lane's state stays in registers,
+/// and only the phases that need it end in a workgroup barrier.
+#[spirv(compute(threads(256)))]
+#[allow(clippy::too_many_arguments)]
+pub fn sort_multisplit_cs(
+    #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(subgroup_id)] subgroup: u32,
+    #[spirv(subgroup_local_invocation_id)] lane: u32,
+    #[spirv(subgroup_size)] size: u32,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
+    #[spirv(workgroup)] ticket: &mut [u32; 1],
+    #[spirv(workgroup)] counts: &mut [u32; SUBGROUP_COUNTS],
+    #[spirv(workgroup)] ranks: &mut [u32; MULTISPLIT_SORT_TILE as usize],
+    #[spirv(workgroup)] running: &mut [u32; WG],
+    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
+    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
+) {
+    let mut me = MultisplitPassLane::default();
+    let mut io = Lane::default();
+    // The phases unrolled, each with its number a constant, so that the
+    // driver's compiler keeps only that phase's branch of the function
+    // (a loop over phases pays for the whole function in every phase).
+    macro_rules! phases {
+        ($($phase:literal)*) => {
+            const _: () = assert!([$($phase),*].len() as u32 == multisplit_pass_phases(MULTISPLIT_SORT_ITEMS));
+            $(
+                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS, { MULTISPLIT_SORT_TILE as usize }>(
+                    $phase,
+                    lid,
+                    subgroup,
+                    lane,
+                    size,
+                    params,
+                    keys_in,
+                    values_in,
+                    keys_out,
+                    values_out,
+                    sort_state,
+                    ticket,
+                    counts,
+                    ranks,
+                    running,
+                    local_offsets,
+                    global_offsets,
+                    scan_sums,
+                    &mut me,
+                    &mut io,
+                );
+                apply(multisplit_pass_sync($phase, MULTISPLIT_SORT_ITEMS), &mut io);
+            )*
+        };
+    }
+    phases!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
+}
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(

@@ -7,7 +7,7 @@
 //! | primitive boxes | [`primitive_boxes`] | |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
-//! | sort | [`sort`], [`scan`]; [`multisplit`] (ranking by subgroup ballots) | Adinets & Merrill 2022 (Onesweep) |
+//! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`] | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
@@ -34,5 +34,6 @@ pub mod radix_tree;
 pub mod sah;
 pub mod scan;
 pub mod sort;
+pub mod sort_multisplit;
 pub mod treelet;
 pub mod treelet_kernels;

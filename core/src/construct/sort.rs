@@ -48,13 +48,16 @@
 //! pass, and no workgroup ever waits on another.
 //!
 //! Ranks are counted as in Satish, Harris & Garland (2009) without warp
-//! ballots (so the same code runs on the CPU): per round of 256 keys,
+//! ballots (so the same code runs at any subgroup size): per round of 256 keys,
 //! per-chunk digit counts scanned over the round's chunks, plus a count
 //! within the chunk four packed digits at a time ([`count_before`]). The
 //! result is identical on every device and on the CPU. A round takes two
 //! phases (barriers), its ranking sharing a phase with the next round's
 //! counting in a second set of counters: on the H100 the phases, not the
-//! memory traffic, bound a pass.
+//! memory traffic, bound a pass. [`super::sort_multisplit`] is the same pass
+//! ranked by subgroup ballots instead (Onesweep's own ranking), for devices
+//! with subgroups of 16 lanes or more; it shares [`tile_offset`] and
+//! [`write_tile`] with this one.
 //!
 //! Kernels are phase functions: see [`crate::gpu::workgroup`]. Hot reads and
 //! writes skip bounds checks on the GPU ([`crate::gpu::unchecked`]; the CPU runner
@@ -437,36 +440,8 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
         }
         return;
     }
-    if phase == look_back_phase && !LOOK_BACK {
-        global_offsets[l] = sort_state[(lid * params.tiles + tile) as usize];
-    } else if phase == look_back_phase {
-        // Invocation `lid` looks back for digit `lid`.
-        let count = running[l];
-        let own = state::status(params.tiles, params.pass, tile, lid);
-        let mut prefix = 0;
-        if tile == 0 {
-            prefix = sort_state[(state::COUNTS + params.pass * RADIX + lid) as usize];
-        } else {
-            atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
-            let mut earlier = tile - 1;
-            // Until a tile's inclusive count, add up aggregates; a tile that
-            // has published nothing yet is read again (its workgroup is
-            // running: see the module doc).
-            loop {
-                let s = atomics::load_u32(&sort_state[state::status(params.tiles, params.pass, earlier, lid)]);
-                if s & !COUNT_MASK != 0 {
-                    prefix += s & COUNT_MASK;
-                    if s & INCLUSIVE != 0 {
-                        break;
-                    }
-                    earlier -= 1;
-                }
-            }
-        }
-        atomics::store_u32(&mut sort_state[own], INCLUSIVE | (prefix + count));
-        global_offsets[l] = prefix;
-        // The next pass uses the other region: clear this tile's row of it.
-        atomics::store_u32(&mut sort_state[state::status(params.tiles, params.pass + 1, tile, lid)], 0);
+    if phase == look_back_phase {
+        global_offsets[l] = tile_offset::<LOOK_BACK>(lid, tile, params, sort_state, running[l]);
     }
     let scan_step = phase - look_back_phase;
     if scan_step < SMALL_SCAN_PHASES {
@@ -482,17 +457,82 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
             }
         }
     } else {
-        // Consecutive invocations write consecutive places of a digit's run.
-        for round in 0..ITEMS {
-            let position = round * WORKGROUP_SIZE + lid;
-            if position < valid {
-                let k = get(counts, position as usize);
-                let key = at(keys_in, (base + k) as usize);
-                let d = digit(key, shift) as usize;
-                let dest = (get(global_offsets, d) + position - get(local_offsets, d)) as usize;
-                put(keys_out, dest, key);
-                put(values_out, dest, at(values_in, (base + k) as usize));
+        write_tile(lid, base, valid, ITEMS, shift, counts, local_offsets, global_offsets, keys_in, values_in, keys_out, values_out);
+    }
+}
+
+/// Where the tile's keys of digit `lid` start in the output (one phase,
+/// invocation `lid` for digit `lid`; `count`: the tile's keys of that
+/// digit). With `LOOK_BACK`, by decoupled look-back over the earlier tiles'
+/// status words in `sort_state` (see [`state`]), publishing this tile's;
+/// without, read from the scanned [`tile_counts_phase`] counts that
+/// `sort_state` holds then.
+#[inline]
+pub fn tile_offset<const LOOK_BACK: bool>(
+    lid: u32,
+    tile: u32,
+    params: &SortParams,
+    sort_state: &mut [u32],
+    count: u32,
+) -> u32 {
+    if !LOOK_BACK {
+        return sort_state[(lid * params.tiles + tile) as usize];
+    }
+    let own = state::status(params.tiles, params.pass, tile, lid);
+    let mut prefix = 0;
+    if tile == 0 {
+        prefix = sort_state[(state::COUNTS + params.pass * RADIX + lid) as usize];
+    } else {
+        atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
+        let mut earlier = tile - 1;
+        // Until a tile's inclusive count, add up aggregates; a tile that
+        // has published nothing yet is read again (its workgroup is
+        // running: see the module doc).
+        loop {
+            let s = atomics::load_u32(&sort_state[state::status(params.tiles, params.pass, earlier, lid)]);
+            if s & !COUNT_MASK != 0 {
+                prefix += s & COUNT_MASK;
+                if s & INCLUSIVE != 0 {
+                    break;
+                }
+                earlier -= 1;
             }
+        }
+    }
+    atomics::store_u32(&mut sort_state[own], INCLUSIVE | (prefix + count));
+    // The next pass uses the other region: clear this tile's row of it.
+    atomics::store_u32(&mut sort_state[state::status(params.tiles, params.pass + 1, tile, lid)], 0);
+    prefix
+}
+
+/// The tile's keys and values to the output, in the tile's order
+/// (`order[position]` = the key's index in the tile): consecutive
+/// invocations write consecutive places of a digit's run.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn write_tile<const N: usize>(
+    lid: u32,
+    base: u32,
+    valid: u32,
+    items: u32,
+    shift: u32,
+    order: &[u32; N],
+    local_offsets: &[u32; WG],
+    global_offsets: &[u32; WG],
+    keys_in: &[u64],
+    values_in: &[u32],
+    keys_out: &mut [u64],
+    values_out: &mut [u32],
+) {
+    for round in 0..items {
+        let position = round * WORKGROUP_SIZE + lid;
+        if position < valid {
+            let k = get(order, position as usize);
+            let key = at(keys_in, (base + k) as usize);
+            let d = digit(key, shift) as usize;
+            let dest = (get(global_offsets, d) + position - get(local_offsets, d)) as usize;
+            put(keys_out, dest, key);
+            put(values_out, dest, at(values_in, (base + k) as usize));
         }
     }
 }

@@ -3,6 +3,7 @@
 use anyhow::Result;
 use treelet_core::construct::scan::SCAN_TILE;
 use treelet_core::construct::sort::{MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE, histogram_tile, passes_for, state};
+use treelet_core::construct::sort_multisplit::{MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE};
 use treelet_core::geometry::buffers::{ScanParams, SortParams};
 use treelet_core::gpu::workgroup::groups_for;
 
@@ -15,6 +16,9 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep];
     if b.look_back_works() {
         k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweep, Kernel::SortOnesweepSmall]);
+        if SortTiles::Auto.resolve(u32::MAX) == SortTiles::Multisplit && multisplit_runs_on(b) {
+            k.push(Kernel::SortMultisplit);
+        }
     } else {
         k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
     }
@@ -35,19 +39,31 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
     Ok(())
 }
 
-/// Which tiles the sort passes take (with look-back; without it, large).
+/// Which pass kernel and tiles the sort takes (with look-back; without it,
+/// large tiles ranked in workgroup memory).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SortTiles {
-    /// By size: `TREELET_SORT_TILES=small|large` overrides it (to measure).
+    /// By size and device: `TREELET_SORT_TILES=small|large|multisplit`
+    /// overrides it (to measure).
     Auto,
     /// `treelet_core::construct::sort::SMALL_SORT_TILE` keys per workgroup.
     Small,
     /// `treelet_core::construct::sort::SORT_TILE` keys per workgroup.
     Large,
+    /// Tiles ranked by subgroups
+    /// (`treelet_core::construct::sort_multisplit`), on devices whose
+    /// subgroups have at least `MIN_SUBGROUP_SIZE` lanes.
+    Multisplit,
 }
 
 impl SortTiles {
     /// The tiles a sort of `n` keys takes.
+    ///
+    /// Never the tiles ranked by subgroups unless asked: on the H100 (one
+    /// machine, `bench build --per-kernel`, medians of 11) their pass takes
+    /// 0.188 / 0.660 / 2.58 / 9.80 ms at 65 536 / 1M / 4M / 16M keys, where
+    /// small tiles take 0.137 / 0.578 / 2.15 / 8.34 and large ones 0.273 (65 536)
+    /// and 0.583 / 2.18 / 7.96 ms (their loop over phases not yet unrolled).
     fn resolve(self, n: u32) -> SortTiles {
         if self != SortTiles::Auto {
             return self;
@@ -55,15 +71,26 @@ impl SortTiles {
         match std::env::var("TREELET_SORT_TILES").as_deref() {
             Ok("small") => SortTiles::Small,
             Ok("large") => SortTiles::Large,
+            Ok("multisplit") => SortTiles::Multisplit,
             _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
             _ => SortTiles::Large,
         }
     }
 }
 
+/// Whether `b` can run the pass ranked by subgroups: look-back, and
+/// subgroups of `MIN_SUBGROUP_SIZE` lanes or more.
+pub fn multisplit_runs_on<B: Backend>(b: &B) -> bool {
+    b.look_back_works() && b.min_subgroup_size() >= MIN_SUBGROUP_SIZE
+}
+
+
+
 /// Largest sort that takes small tiles by default: on the H100 small tiles
-/// sort 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
-/// both the same at 262 144, large ones 1M in 0.58 ms (small: 0.72).
+/// sorted 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
+/// both the same at 262 144, large ones 1M in 0.58 ms (small: 0.72). With
+/// their phases unrolled, small tiles take 0.137 ms at 65 536 and 0.578 at
+/// 1M (large, looped: 0.583): the crossover is to be measured again.
 const SMALL_TILES_UP_TO: u32 = 200_000;
 
 /// Sorts `n` `(key, value)` pairs by the low `key_bits` bits of the keys,
@@ -98,8 +125,17 @@ pub fn radix_sort_tiled<B: Backend>(
     let passes = passes_for(key_bits);
     // Small tiles where large ones would leave the GPU idle (look-back only).
     let tile_size = if b.look_back_works() { tile_size.resolve(n) } else { SortTiles::Large };
+    if tile_size == SortTiles::Multisplit && !multisplit_runs_on(b) {
+        anyhow::bail!(
+            "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",
+            b.adapter(),
+            b.min_subgroup_size(),
+            if b.look_back_works() { "" } else { " and runs the sort without look-back" }
+        );
+    }
     let (kernel, tile) = match tile_size {
         SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
+        SortTiles::Multisplit => (Kernel::SortMultisplit, MULTISPLIT_SORT_TILE),
         _ => (Kernel::SortOnesweep, SORT_TILE),
     };
     let tiles = groups_for(n, tile);

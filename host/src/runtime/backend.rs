@@ -79,6 +79,11 @@ pub trait Backend: Send {
     fn look_back_works(&self) -> bool {
         true
     }
+    /// Fewest lanes a subgroup of this device may have: kernels written for
+    /// larger subgroups keep another path below their minimum.
+    fn min_subgroup_size(&self) -> u32 {
+        1
+    }
     /// Largest buffer this device accepts in one binding, in bytes.
     fn max_buffer_bytes(&self) -> u64;
     /// The device's own memory, in bytes, where it has one apart from the

@@ -102,7 +102,7 @@ fn subgroup_workgroups(groups: u32, phases: u32, size: u32, op: impl Fn(u32) -> 
             for lid in 0..WORKGROUP_SIZE {
                 f(group, phase, lid, &mut lanes);
             }
-            let op = op(phase);
+            let op = op(phase) & subgroup::OP_MASK;
             if op != subgroup::OP_NONE {
                 for chunk in lanes.chunks_mut(size as usize) {
                     subgroup::emulate(op, chunk);
@@ -251,6 +251,9 @@ impl Backend for CpuBackend {
     fn runs_on_cpu(&self) -> bool {
         true
     }
+    fn min_subgroup_size(&self) -> u32 {
+        self.subgroup_size
+    }
     fn max_buffer_bytes(&self) -> u64 {
         u64::MAX
     }
@@ -348,6 +351,44 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             subgroup_workgroups(groups, MULTISPLIT_PHASES, size, multisplit_op, |g, phase, lid, lanes| {
                 let (id, l) = (g * WORKGROUP_SIZE + lid, lid as usize);
                 multisplit_phase(phase, id, g, lid % size, size, &p, keys, ranks, counts, sizes, &mut states[l], &mut lanes[l]);
+            });
+        }
+        (Kernel::SortMultisplit, [p, keys_in, values_in, keys_out, values_out, sort_state]) => {
+            use treelet_core::construct::sort_multisplit::*;
+            let p: treelet_core::SortParams = params(p);
+            let (keys_in, values_in, sort_state) = (view(keys_in), view(values_in), view(sort_state));
+            let (keys_out, values_out) = (view(keys_out), view(values_out));
+            let size = subgroup_size;
+            let mut ticket = [0u32; 1];
+            let mut counts = [0u32; SUBGROUP_COUNTS];
+            let mut ranks = [0u32; MULTISPLIT_SORT_TILE as usize];
+            let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
+            let mut lanes = [MultisplitPassLane::default(); WG];
+            let phases = multisplit_pass_phases(MULTISPLIT_SORT_ITEMS);
+            let sync = |phase| multisplit_pass_sync(phase, MULTISPLIT_SORT_ITEMS);
+            subgroup_workgroups(groups, phases, size, sync, |_, phase, lid, io| {
+                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS, { MULTISPLIT_SORT_TILE as usize }>(
+                    phase,
+                    lid,
+                    lid / size,
+                    lid % size,
+                    size,
+                    &p,
+                    keys_in,
+                    values_in,
+                    keys_out,
+                    values_out,
+                    sort_state,
+                    &mut ticket,
+                    &mut counts,
+                    &mut ranks,
+                    &mut running,
+                    &mut local_offsets,
+                    &mut global_offsets,
+                    &mut scan_sums,
+                    &mut lanes[lid as usize],
+                    &mut io[lid as usize],
+                )
             });
         }
         (Kernel::SortTileCounts, [p, keys, tile_counts]) => {

@@ -78,6 +78,9 @@ pub enum Kernel {
     SortOnesweep,
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
     SortOnesweepSmall,
+    /// Radix sort: one pass ranked by subgroups (Onesweep's warp-level
+    /// multisplit; `treelet_core::construct::sort_multisplit`).
+    SortMultisplit,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -133,7 +136,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 38] = [
+    const FIXED: [Kernel; 39] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -142,6 +145,7 @@ impl Kernel {
         Kernel::SortOffsets,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
+        Kernel::SortMultisplit,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
@@ -200,6 +204,7 @@ impl Kernel {
             Kernel::SortOffsets => "sort::sort_offsets_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
+            Kernel::SortMultisplit => "sort::sort_multisplit_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit::multisplit_cs",
@@ -248,7 +253,7 @@ impl Kernel {
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
-            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned | Kernel::SortMultisplit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],

@@ -195,6 +195,11 @@ impl Backend for GpuBackend {
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
             && std::env::var("TREELET_SORT_LOOK_BACK").map_or(true, |v| v != "0")
     }
+    fn min_subgroup_size(&self) -> u32 {
+        // Vulkan's minSubgroupSize (subgroup size control, core in 1.3);
+        // wgpu reports 4 where the device does not say.
+        self.ctx.info.subgroup_min_size
+    }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_binding_bytes()
     }
