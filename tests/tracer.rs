@@ -135,3 +135,64 @@ fn tracer_rejects_bad_input_by_name() {
     let e = format!("{:#}", t.refit(b, &[], &[good[0], good[0]]).unwrap_err());
     assert!(e.contains("2 triangles") && e.contains("built over"), "{e}");
 }
+
+/// Occlusion queries agree with closest hits: a ray is occluded exactly when
+/// the scan's closest hit (no tree, no bound) lies within its `t_max`. Rays
+/// are bounded just past their closest hit, just short of it, at random,
+/// not at all, at zero and at NaN; on the CPU runner and the GPU, both
+/// qualities, before and after a refit.
+#[test]
+fn occlusion_agrees_with_closest_hit() {
+    let seed = fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let g = geometry(&mut rng, 200, 1300);
+    let m = moved(&g, &mut rng);
+    let unbounded = rays(&mut rng, 2000).into_iter().map(|r| Ray { t_max: f32::INFINITY, ..r }).collect::<Vec<_>>();
+    let bounded = |g: &Geometry, rng: &mut rand_pcg::Pcg64| -> Vec<Ray> {
+        unbounded
+            .iter()
+            .enumerate()
+            .map(|(k, r)| {
+                let t = scan(g, r).t;
+                let t_max = match k % 6 {
+                    0 if t.is_finite() => t * 1.001,
+                    1 if t.is_finite() => t * 0.999,
+                    2 => rng.random_range(0.0..150.0),
+                    3 => f32::INFINITY,
+                    4 => 0.0,
+                    5 if k % 12 == 5 => f32::NAN,
+                    _ => rng.random_range(0.0..60.0),
+                };
+                Ray { t_max, ..*r }
+            })
+            .collect()
+    };
+    let expected = |g: &Geometry, rays: &[Ray]| -> Vec<bool> { rays.iter().map(|r| scan(g, r).is_hit()).collect() };
+    let (rays_g, rays_m) = (bounded(&g, &mut rng), bounded(&m, &mut rng));
+    let (want_g, want_m) = (expected(&g, &rays_g), expected(&m, &rays_m));
+    let occluded = want_g.iter().filter(|&&o| o).count();
+    assert!(occluded > 100 && occluded < 1900, "{occluded} of 2000 occluded: the test would prove little");
+    fn run<B: Backend>(b: &mut B, g: &Geometry, m: &Geometry, rays: (&[Ray], &[Ray]), quality: Quality) -> (Vec<bool>, Vec<bool>) {
+        let mut t = Tracer::build(b, &g.0, &g.1, quality).unwrap();
+        let first = t.occluded(b, rays.0).unwrap();
+        t.refit(b, &m.0, &m.1).unwrap();
+        (first, t.occluded(b, rays.1).unwrap())
+    }
+    let ctx = gpu();
+    for quality in [Quality::Fast, Quality::High] {
+        let mut results = vec![("cpu", run(&mut CpuBackend::new(), &g, &m, (&rays_g, &rays_m), quality))];
+        if let Some(ctx) = &ctx {
+            results.push(("gpu", run(&mut GpuBackend::new(ctx.clone()), &g, &m, (&rays_g, &rays_m), quality)));
+        }
+        for (device, (first, second)) in results {
+            let wrong: Vec<usize> = (0..first.len()).filter(|&k| first[k] != want_g[k]).collect();
+            eprintln!("{device} {quality:?}: {} wrong of {} ({} occluded); wrong by k % 6: {:?}", wrong.len(), first.len(), occluded, (0..6).map(|c| wrong.iter().filter(|&&k| k % 6 == c).count()).collect::<Vec<_>>());
+            for (k, (got, want)) in first.iter().zip(&want_g).enumerate() {
+                assert_eq!(got, want, "{device} {quality:?} seed {seed}: ray {k} {:?}, closest hit {:?}", rays_g[k], scan(&g, &unbounded[k]));
+            }
+            for (k, (got, want)) in second.iter().zip(&want_m).enumerate() {
+                assert_eq!(got, want, "{device} {quality:?} seed {seed}, refit: ray {k} {:?}, closest hit {:?}", rays_m[k], scan(&m, &unbounded[k]));
+            }
+        }
+    }
+}

@@ -1,7 +1,8 @@
-//! Closest hits for an engine's own geometry: build a tree over its spheres
-//! and triangles on a device (the GPU, or the CPU runner with the same
-//! kernels), refit the tree after they move, and trace batches of rays,
-//! from host slices or from a buffer that stays on the device.
+//! Closest hits and occlusion queries for an engine's own geometry: build a
+//! tree over its spheres and triangles on a device (the GPU, or the CPU
+//! runner with the same kernels), refit the tree after they move, and trace
+//! batches of rays, from host slices or from a buffer that stays on the
+//! device.
 //!
 //! ```
 //! use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
@@ -10,6 +11,9 @@
 //! let tracer = Tracer::build(b, &[], &triangles, Quality::Fast)?;
 //! let hits = tracer.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0])])?;
 //! assert_eq!((hits[0].prim, hits[0].t), (0, 5.0));
+//! // Shadow rays: is anything hit up to `t_max`?
+//! let shadow = [Ray { t_max: 4.0, ..Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0]) }, Ray::new([0.2, 0.2, 0.0], [0.0, 0.0, 1.0])];
+//! assert_eq!(tracer.occluded(b, &shadow)?, vec![false, true]);
 //! # anyhow::Ok(())
 //! ```
 use anyhow::{bail, Result};
@@ -17,7 +21,7 @@ use treelet_core::geometry::buffers::{RenderParams, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::render::integrator::tiled_invocations;
-use treelet_core::render::rays::CAST_RAYS;
+use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::refit;
@@ -145,6 +149,20 @@ impl<B: Backend> Tracer<B> {
         Ok((0..rays.len()).map(|k| RayHit { t: out[2 * k][0], prim: out[2 * k][1].to_bits() }).collect())
     }
 
+    /// Whether each ray hits anything up to its `t_max` (inclusive): an
+    /// occlusion query, which stops at the first hit it finds (shadow and
+    /// ambient-occlusion rays). Agrees with [`Tracer::closest_hits`]: a ray
+    /// is occluded exactly when its closest hit is within `t_max`.
+    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
+        if self.tree.is_none() {
+            return Ok(vec![false; rays.len()]);
+        }
+        let buffer = b.upload("rays", &device_rays(rays)?)?;
+        self.occluded_on_device(b, &buffer, rays.len())?;
+        let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
+        Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+    }
+
     /// Traces `count` rays that are already on the device (for callers that
     /// hold their rays in a GPU buffer, e.g. a `wgpu::Buffer` through
     /// [`GpuBackend`](crate::runtime::gpu::GpuBackend)), in place: ray `k` is
@@ -153,6 +171,17 @@ impl<B: Backend> Tracer<B> {
     /// 0). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
     /// `count` must be zero. Submitted, not waited for.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_RAYS)
+    }
+
+    /// [`Tracer::occluded`] on rays already on the device, laid out as for
+    /// [`Tracer::closest_hits_on_device`]: `rays[2k]` becomes (1 if
+    /// occluded else 0, 0, 0, 0). Submitted, not waited for.
+    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+    }
+
+    fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
         let slots = batch_slots(count)? as u32;
         let (width, height) = (BATCH_WIDTH.min(slots.max(1)), slots.div_ceil(BATCH_WIDTH).max(1));
         let params = RenderParams {
@@ -160,7 +189,7 @@ impl<B: Backend> Tracer<B> {
             height,
             prims: self.prims.sphere_count,
             triangles: self.prims.triangle_count,
-            cast_mode: CAST_RAYS,
+            cast_mode,
             ..Default::default()
         };
         let p = b.upload("trace params", &[params])?;

@@ -30,13 +30,13 @@ use glam::Vec3;
 
 use crate::geometry::buffers::{Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
 use crate::geometry::features::{self, has};
-use crate::geometry::intersect::surface_offset;
+use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::{Origin, Prims};
-use crate::geometry::triangle::Triangle;
+use crate::geometry::triangle::{Triangle, WatertightRay};
 use crate::gpu::rng::BounceRng;
 use crate::render::lights::{Light, light_pdf, light_pmf, power_heuristic, sample_light, select_light};
 use crate::render::sampling::{cosine_direction, luminance};
-use crate::trace::hit::{ClosestHit, Hit};
+use crate::trace::hit::{ClosestHit, Hit, Query};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
@@ -113,7 +113,22 @@ pub fn closest_hit<T: ClosestHit, const F: u32, const S: usize>(
     stack: &mut [u32; S],
     lane: u32,
 ) -> Hit {
-    scene.tree.closest_hit::<F, S>(o, d, from, &scene.prims, stack, lane)
+    trace::<T, F, S>(o, d, from, Query::CLOSEST, scene, stack, lane)
+}
+
+/// What `query` asks of the ray through the scene's tree (see
+/// [`ClosestHit::trace`]).
+#[inline]
+pub fn trace<T: ClosestHit, const F: u32, const S: usize>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    query: Query,
+    scene: &SceneRefs<T>,
+    stack: &mut [u32; S],
+    lane: u32,
+) -> Hit {
+    scene.tree.trace::<F, S>(o, d, from, query, &scene.prims, stack, lane)
 }
 
 /// One path in flight: what the loop of [`radiance`] carries from one
@@ -141,8 +156,12 @@ pub struct Path {
     /// as smallpt's estimator on the H100; with one, 3 times; with pbrt-v4's
     /// roulette as well, 1.8 times). While one is pending, `(o, d, from)` is
     /// the shadow ray, `next_*` the path's bounce, and `shadow_value` what
-    /// the light adds if the ray reaches `shadow_light` first.
+    /// the light adds if the ray reaches `shadow_light` first: if an
+    /// occlusion query finds nothing else up to `shadow_t`, where the ray
+    /// meets the light (it stops at the first occluder, and the light is
+    /// never its own).
     shadow_light: u32,
+    shadow_t: f32,
     shadow_value: Vec3,
     shadow_d: Vec3,
     next_o: Vec3,
@@ -167,6 +186,7 @@ impl Path {
             bsdf_pdf: 0.0,
             last_x: o,
             shadow_light: NO_LIGHT,
+            shadow_t: 0.0,
             shadow_value: Vec3::ZERO,
             shadow_d: Vec3::Z,
             next_o: o,
@@ -204,11 +224,13 @@ impl Path {
             return false;
         }
         let nee = params.integrator == NEE && params.light_count > 0;
-        let hit = closest_hit::<T, F, S>(self.o, self.d, self.from, scene, stack, lane);
-        if self.shadow_light != NO_LIGHT {
+        let shadow = self.shadow_light != NO_LIGHT;
+        let query = if shadow { Query::occlusion(self.shadow_t, self.shadow_light) } else { Query::CLOSEST };
+        let hit = trace::<T, F, S>(self.o, self.d, self.from, query, scene, stack, lane);
+        if shadow {
             // Anything else first, glass too, occludes it: paths through
             // glass reach a light by their bounces, at full weight.
-            if hit.prim == self.shadow_light {
+            if !hit.is_hit() {
                 self.result += self.shadow_value;
             }
             self.shadow_light = NO_LIGHT;
@@ -257,7 +279,15 @@ impl Path {
             if nee {
                 let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
                 if s.light != NO_LIGHT {
-                    (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                    // Where the shadow ray (as traced below) meets the light,
+                    // by the test the traversal itself would make; a ray
+                    // that grazes past it numerically carries nothing.
+                    let (so, from) = (x + nl * eps, Origin { prim: hit.prim, into: s.dir.dot(n) < 0.0 });
+                    let t = scene.prims.distance::<F>(so, s.dir, &WatertightRay::new(so, s.dir), from, s.light, MISS);
+                    if t < MISS {
+                        (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                        self.shadow_t = t;
+                    }
                 }
             }
             self.d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));

@@ -8,12 +8,12 @@
 use glam::Vec3;
 
 use crate::geometry::buffers::RenderParams;
-use crate::geometry::intersect::surface_offset;
+use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::Origin;
 use crate::gpu::rng::BounceRng;
-use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel};
+use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel, trace};
 use crate::render::sampling::cosine_direction;
-use crate::trace::hit::ClosestHit;
+use crate::trace::hit::{ClosestHit, Hit, Query};
 
 /// [`RenderParams::cast_mode`]: camera rays; each pixel keeps its hit.
 pub const CAST_PRIMARY: u32 = 0;
@@ -28,6 +28,15 @@ pub const CAST_BOUNCE: u32 = 2;
 /// first: (distance along the normalized direction, bits of the primitive,
 /// 0, 0), the primitive `u32::MAX` for none.
 pub const CAST_RAYS: u32 = 3;
+/// [`RenderParams::cast_mode`]: occlusion queries of the caller's rays, laid
+/// out as for [`CAST_RAYS`]: whether anything is hit up to the farthest
+/// distance replaces the first: (1 or 0, 0, 0, 0). The walk stops at the
+/// first hit it finds.
+pub const CAST_OCCLUDED: u32 = 4;
+/// [`RenderParams::cast_mode`]: the diffuse rays the bounce pass made, as
+/// occlusion queries at any distance (shadow rays toward an infinitely far
+/// light): as [`CAST_DIFFUSE`], with the distance of the first hit found.
+pub const CAST_DIFFUSE_OCCLUDED: u32 = 5;
 
 /// Kernel (one invocation per pixel, in tiles: see
 /// [`crate::render::integrator::tiled_pixel`]), for pixel `id` of invocation
@@ -38,7 +47,8 @@ pub const CAST_RAYS: u32 = 3;
 ///   to be cast, else 0) and `rays[2 id + 1]` = (direction, bits of the
 ///   primitive it leaves);
 /// * [`CAST_DIFFUSE`]: casts that ray and writes its hit distance (or -1)
-///   into `rays[2 id][3]`.
+///   into `rays[2 id][3]`; [`CAST_DIFFUSE_OCCLUDED`] as an occlusion query;
+/// * [`CAST_RAYS`], [`CAST_OCCLUDED`]: the caller's rays.
 ///
 /// `F` (see [`crate::geometry::features`]) may leave out the tests of primitive kinds
 /// the scene lacks.
@@ -56,17 +66,26 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         return;
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);
-    if params.cast_mode == CAST_RAYS {
+    if params.cast_mode == CAST_RAYS || params.cast_mode == CAST_OCCLUDED {
         if rays[j][3] != 0.0 {
             let (o, d) = (Vec3::new(rays[i][0], rays[i][1], rays[i][2]), Vec3::new(rays[j][0], rays[j][1], rays[j][2]));
             let len = d.length();
-            let hit = if len > 0.0 && len.is_finite() {
-                closest_hit::<T, F, S>(o, d / len, Origin::NONE, scene, stack, lane)
+            let t_max = rays[i][3];
+            // An infinite `t_max` is no bound; a NaN one finds nothing.
+            let query = if params.cast_mode == CAST_OCCLUDED { Query::occlusion(t_max, u32::MAX) } else { Query::closest_within(t_max) };
+            let hit = if len > 0.0 && len.is_finite() && t_max >= 0.0 {
+                trace::<T, F, S>(o, d / len, Origin::NONE, query, scene, stack, lane)
             } else {
-                crate::trace::hit::Hit::NONE
+                Hit::NONE
             };
-            let found = hit.is_hit() && hit.t <= rays[i][3];
-            rays[i] = if found { [hit.t, f32::from_bits(hit.prim), 0.0, 0.0] } else { [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0] };
+            let found = hit.is_hit() && hit.t <= t_max;
+            rays[i] = if params.cast_mode == CAST_OCCLUDED {
+                [found as u32 as f32, 0.0, 0.0, 0.0]
+            } else if found {
+                [hit.t, f32::from_bits(hit.prim), 0.0, 0.0]
+            } else {
+                [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0]
+            };
         }
     } else if params.cast_mode == CAST_PRIMARY {
         let (o, d) = camera_ray(params, id);
@@ -92,7 +111,8 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
         let prim = rays[j][3].to_bits();
         // Leaving the surface outwards: it cannot be hit again.
-        let hit = closest_hit::<T, F, S>(o, d, Origin { prim, into: false }, scene, stack, lane);
+        let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
+        let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
 }

@@ -8,7 +8,7 @@ use crate::geometry::features::{self};
 use crate::geometry::intersect::{ray_box, safe_inverse};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
-use crate::trace::hit::{ClosestHit, Hit, STACK_DEPTH};
+use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
 /// Every primitive tested: no tree. (Not zero-sized: rust-gpu cannot take
 /// the address of a zero-sized field.)
@@ -26,8 +26,8 @@ impl Scan {
 
 impl ClosestHit for Scan {
     #[inline]
-    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
-        closest_hit_linear_for::<F>(o, d, from, prims)
+    fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        trace_linear::<F>(o, d, from, query, prims)
     }
 }
 
@@ -47,8 +47,8 @@ impl<'a> ClassicTree<'a> {
 
 impl ClosestHit for ClassicTree<'_> {
     #[inline]
-    fn closest_hit<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
-        closest_hit_bvh_for::<F>(o, d, from, prims, self.nodes, self.prim_indices)
+    fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
+        trace_bvh::<F>(o, d, from, query, prims, self.nodes, self.prim_indices)
     }
 }
 
@@ -66,15 +66,21 @@ impl ClosestHit for ClassicTree<'_> {
 /// ```
 #[inline]
 pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: &Prims) -> Hit {
-    let mut hit = Hit::NONE;
+    trace_linear::<F>(o, d, from, Query::CLOSEST, prims)
+}
+
+/// [`closest_hit_linear_for`] for any [`Query`].
+#[inline]
+pub fn trace_linear<const F: u32>(o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims) -> Hit {
+    let mut hit = query.start();
     let ray = WatertightRay::new(o, d);
     let mut i = 0;
     let count = prims.count();
-    while i < count {
+    // An occlusion query stops at its first hit (by the condition, not a
+    // `return` from inside the loop: see `trace::bvh2`).
+    while i < count && !query.done(&hit) {
         let t = prims.distance::<F>(o, d, &ray, from, i, hit.t);
-        // In index order, the first of equal distances stays: the lower
-        // index, as [`Hit::is_beaten_by`] picks, without its extra test.
-        if t < hit.t {
+        if i != query.skip && hit.is_beaten_by(t, i) {
             hit = Hit { t, prim: i };
         }
         i += 1;
@@ -87,7 +93,21 @@ pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prim
 /// [`closest_hit_linear_for`].
 #[inline]
 pub fn closest_hit_bvh_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: &Prims, nodes: &[Node], prim_indices: &[u32]) -> Hit {
-    let mut hit = Hit::NONE;
+    trace_bvh::<F>(o, d, from, Query::CLOSEST, prims, nodes, prim_indices)
+}
+
+/// [`closest_hit_bvh_for`] for any [`Query`].
+#[inline]
+pub fn trace_bvh<const F: u32>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    query: Query,
+    prims: &Prims,
+    nodes: &[Node],
+    prim_indices: &[u32],
+) -> Hit {
+    let mut hit = query.start();
     if prims.count() == 0 {
         return hit;
     }
@@ -103,13 +123,16 @@ pub fn closest_hit_bvh_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prims: 
         }
         if node.is_leaf() {
             let mut k = 0;
-            while k < node.prim_count() {
+            while k < node.prim_count() && !query.done(&hit) {
                 let prim = prim_indices[(node.left + k) as usize];
                 let t = prims.distance::<F>(o, d, &ray, from, prim, hit.t);
-                if hit.is_beaten_by(t, prim) {
+                if prim != query.skip && hit.is_beaten_by(t, prim) {
                     hit = Hit { t, prim };
                 }
                 k += 1;
+            }
+            if query.done(&hit) {
+                return hit;
             }
         } else if top + 2 <= STACK_DEPTH {
             // Visit the child whose box centre is nearer along the ray first.

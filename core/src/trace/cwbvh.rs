@@ -42,7 +42,7 @@ use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
 use crate::gpu::unchecked::{at, get, set};
 use crate::layouts::cwbvh::grid_step;
-use crate::trace::hit::{ClosestHit, Hit, STACK_DEPTH};
+use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
 
 /// Grid cells each plane is pushed out by in the traversal (see the module
@@ -152,17 +152,18 @@ impl<'a> WideTree<'a> {
 
 impl ClosestHit for WideTree<'_> {
     #[inline]
-    fn closest_hit<const F: u32, const S: usize>(
+    fn trace<const F: u32, const S: usize>(
         &self,
         o: Vec3,
         d: Vec3,
         from: Origin,
+        query: Query,
         prims: &Prims,
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit {
         let mut private = [0u32; 2 * WIDE_STACK];
-        closest_hit_cwbvh_with::<F, S>(o, d, from, prims, self.nodes, self.leaf_prims, &mut private, stack, lane as usize)
+        trace_cwbvh_with::<F, S>(o, d, from, query, prims, self.nodes, self.leaf_prims, &mut private, stack, lane as usize)
     }
 }
 
@@ -194,7 +195,7 @@ pub fn closest_hit_cwbvh<const F: u32>(
     leaf_prims: &[LeafPrim],
 ) -> Hit {
     let mut stack = [0u32; 2 * WIDE_STACK];
-    closest_hit_cwbvh_with::<F, 1>(o, d, from, prims, nodes, leaf_prims, &mut stack, &mut [0u32; 1], 0)
+    trace_cwbvh_with::<F, 1>(o, d, from, Query::CLOSEST, prims, nodes, leaf_prims, &mut stack, &mut [0u32; 1], 0)
 }
 
 /// [`closest_hit_cwbvh`] with its stack in `private` and, for its top
@@ -213,7 +214,25 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
     shared: &mut [u32; SHARED],
     lane: usize,
 ) -> Hit {
-    let mut hit = Hit::NONE;
+    trace_cwbvh_with::<F, SHARED>(o, d, from, Query::CLOSEST, prims, nodes, leaf_prims, private, shared, lane)
+}
+
+/// [`closest_hit_cwbvh_with`] for any [`Query`].
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
+    query: Query,
+    prims: &Prims,
+    nodes: &[WideNode],
+    leaf_prims: &[LeafPrim],
+    private: &mut [u32; 2 * WIDE_STACK],
+    shared: &mut [u32; SHARED],
+    lane: usize,
+) -> Hit {
+    let mut hit = query.start();
     if prims.count() == 0 {
         return hit;
     }
@@ -252,14 +271,19 @@ pub fn closest_hit_cwbvh_with<const F: u32, const SHARED: usize>(
             prim_base = n.prim_base;
             prim_hits = mask & 0x00FF_FFFF;
         }
-        while prim_hits != 0 {
+        // An occlusion query stops at its first hit (by the conditions, not
+        // a `return` from inside the loop: see `trace::bvh2`).
+        while prim_hits != 0 && !query.done(&hit) {
             let bit = 31 - prim_hits.leading_zeros();
             prim_hits &= !(1u32 << bit);
             let p = at(leaf_prims, (prim_base + bit) as usize);
             let t = prims.leaf_distance::<F>(o, d, &ray, from, &p, hit.t);
-            if hit.is_beaten_by(t, p.prim) {
+            if p.prim != query.skip && hit.is_beaten_by(t, p.prim) {
                 hit = Hit { t, prim: p.prim };
             }
+        }
+        if query.done(&hit) {
+            return hit;
         }
         if node_hits <= 0x00FF_FFFF {
             if top == 0 {

@@ -1,5 +1,6 @@
-//! What every traversal returns ([`Hit`]) and the trait every layout
-//! implements ([`ClosestHit`]), so renderers and ray casts are generic over it.
+//! What every traversal looks for ([`Query`]) and returns ([`Hit`]), and the
+//! trait every layout implements ([`ClosestHit`]), so renderers and ray
+//! casts are generic over it.
 use glam::Vec3;
 
 use crate::geometry::intersect::MISS;
@@ -10,21 +11,66 @@ use crate::geometry::prims::{Origin, Prims};
 /// [`crate::trace::cwbvh`]). The renderer and the ray-casting kernels are generic
 /// over it, so each layout gets kernels of its own.
 pub trait ClosestHit {
-    /// The closest hit of the ray `o + t d` (`d` of unit length) among the
-    /// primitives, ties to the lower index; `F` (see [`crate::geometry::features`])
+    /// What `query` asks of the ray `o + t d` (`d` of unit length) among the
+    /// primitives: the closest hit up to `query.t_max`, ties to the lower
+    /// index, or any hit up to it; `F` (see [`crate::geometry::features`])
     /// may leave out the test of a kind the scene lacks. `stack` is
     /// workgroup memory a traversal may keep the top of its stack in, at
     /// `lane + WG * k` (see [`crate::trace::cwbvh::closest_hit_cwbvh_with`]); a
     /// one-word array means none.
-    fn closest_hit<const F: u32, const S: usize>(
+    #[allow(clippy::too_many_arguments)]
+    fn trace<const F: u32, const S: usize>(
         &self,
         o: Vec3,
         d: Vec3,
         from: Origin,
+        query: Query,
         prims: &Prims,
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit;
+}
+
+/// What a traversal looks for: the closest hit up to `t_max`, or, for an
+/// occlusion query (`any`), the first hit it finds up to `t_max` (whether
+/// there is one: what shadow and ambient-occlusion rays need, and cheaper:
+/// the walk stops there). `skip` is a primitive never hit (a shadow ray's
+/// own light, so that it is never its own occluder), `u32::MAX` for none.
+#[derive(Clone, Copy)]
+pub struct Query {
+    pub t_max: f32,
+    pub skip: u32,
+    pub any: bool,
+}
+
+impl Query {
+    /// The closest hit at any distance.
+    pub const CLOSEST: Query = Query { t_max: MISS, skip: u32::MAX, any: false };
+
+    /// The closest hit up to `t_max` (inclusive).
+    #[inline]
+    pub fn closest_within(t_max: f32) -> Query {
+        Query { t_max, ..Query::CLOSEST }
+    }
+
+    /// Any hit up to `t_max` (inclusive) other than primitive `skip`.
+    #[inline]
+    pub fn occlusion(t_max: f32, skip: u32) -> Query {
+        Query { t_max, skip, any: true }
+    }
+
+    /// The hit a traversal starts from: none nearer than `t_max` yet (a
+    /// NaN or larger `t_max` is no bound).
+    #[inline]
+    pub fn start(&self) -> Hit {
+        Hit { t: if self.t_max < MISS { self.t_max } else { MISS }, prim: u32::MAX }
+    }
+
+    /// Whether a traversal that found `hit` is done: an occlusion query's first hit.
+    #[inline]
+    pub fn done(&self, hit: &Hit) -> bool {
+        self.any && hit.is_hit()
+    }
 }
 
 /// Depth of the traversal stack. A tree deeper than this (possible for a

@@ -310,6 +310,9 @@ pub(crate) struct RaysRow {
     pub(crate) diffuse_median_ms: f64,
     pub(crate) primary_mrays_per_s: f64,
     pub(crate) diffuse_mrays_per_s: f64,
+    /// The same diffuse rays as occlusion queries (any hit, no bound).
+    pub(crate) occlusion_median_ms: f64,
+    pub(crate) occlusion_mrays_per_s: f64,
 }
 
 /// What `bench rays` times through one tree: its layouts, each with its
@@ -359,7 +362,7 @@ pub(crate) fn bench_rays<B: Backend>(
         }
         for (stack, kernel) in kernels {
             let bindings = [&buffers.spheres, &materials, &tree.nodes, &tree.prims, &rays, &buffers.triangles];
-            let (primary_ms, diffuse_ms, diffuse_rays) = time_casts(b, scene, kernel, &bindings, (width, height), repeats)?;
+            let (primary_ms, diffuse_ms, occlusion_ms, diffuse_rays) = time_casts(b, scene, kernel, &bindings, (width, height), repeats)?;
             rows.push(RaysRow {
                 scene: scene.name.clone(),
                 accel,
@@ -375,6 +378,8 @@ pub(crate) fn bench_rays<B: Backend>(
                 diffuse_median_ms: diffuse_ms,
                 primary_mrays_per_s: pixels as f64 / primary_ms / 1e3,
                 diffuse_mrays_per_s: diffuse_rays as f64 / diffuse_ms / 1e3,
+                occlusion_median_ms: occlusion_ms,
+                occlusion_mrays_per_s: diffuse_rays as f64 / occlusion_ms / 1e3,
             });
         }
     }
@@ -382,8 +387,9 @@ pub(crate) fn bench_rays<B: Backend>(
 }
 
 /// Median kernel times (ms) of the primary and the diffuse pass of `kernel`
-/// (bindings 1.. as the cast kernels take them), and the number of diffuse
-/// rays (pixels whose camera ray hit).
+/// (bindings 1.. as the cast kernels take them) and of the same diffuse rays
+/// as occlusion queries, and the number of diffuse rays (pixels whose
+/// camera ray hit).
 pub(crate) fn time_casts<B: Backend>(
     b: &mut B,
     scene: &Scene,
@@ -391,9 +397,9 @@ pub(crate) fn time_casts<B: Backend>(
     bindings: &[&B::Buffer; 6],
     (width, height): (u32, u32),
     repeats: usize,
-) -> Result<(f64, f64, u64)> {
+) -> Result<(f64, f64, f64, u64)> {
     use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
-    use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_PRIMARY};
+    use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_DIFFUSE_OCCLUDED, CAST_PRIMARY};
     let pixels = width * height;
     let base = treelet_core::RenderParams {
         width,
@@ -405,7 +411,7 @@ pub(crate) fn time_casts<B: Backend>(
         ..Default::default()
     };
     let groups = groups_for(treelet_core::render::integrator::tiled_invocations(width, height), WORKGROUP_SIZE);
-    let (mut primary, mut diffuse) = (Vec::new(), Vec::new());
+    let (mut primary, mut diffuse, mut occlusion) = (Vec::new(), Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,
     // which drop while a CPU-built tree is being made), then the timed ones.
@@ -420,8 +426,17 @@ pub(crate) fn time_casts<B: Backend>(
         if r > warm_passes + repeats {
             break;
         }
-        // The bounce rays are made between the two timed passes.
-        for (stage, mode) in [("primary", CAST_PRIMARY), ("bounce", CAST_BOUNCE), ("diffuse", CAST_DIFFUSE)] {
+        // The bounce rays are made between the two timed passes, then made
+        // again (the same rays) for the occlusion queries.
+        let passes = [
+            ("primary", CAST_PRIMARY),
+            ("bounce", CAST_BOUNCE),
+            ("diffuse", CAST_DIFFUSE),
+            ("remake", CAST_PRIMARY),
+            ("remake", CAST_BOUNCE),
+            ("occlusion", CAST_DIFFUSE_OCCLUDED),
+        ];
+        for (stage, mode) in passes {
             b.stage(stage);
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
             let [spheres, materials, nodes, prims, rays, triangles] = *bindings;
@@ -440,7 +455,8 @@ pub(crate) fn time_casts<B: Backend>(
         }
         primary.push(t.get("primary"));
         diffuse.push(t.get("diffuse"));
+        occlusion.push(t.get("occlusion"));
     }
-    Ok((median(primary), median(diffuse), diffuse_rays))
+    Ok((median(primary), median(diffuse), median(occlusion), diffuse_rays))
 }
 

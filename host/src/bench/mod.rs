@@ -216,8 +216,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             };
             println!("rays per second, {} ({} primitives), {width}x{height}, {adapter}, median of {repeats}", scene.name, rows.first().map_or(0, |r| r.primitives));
             println!(
-                "{:>6}{:>8}{:>10}{:>11}{:>11}{:>12}{:>12}{:>16}{:>16}",
-                "accel", "layout", "stack", "build ms", "layout ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s"
+                "{:>6}{:>8}{:>10}{:>11}{:>11}{:>12}{:>12}{:>16}{:>16}{:>16}",
+                "accel", "layout", "stack", "build ms", "layout ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s", "occluded Mray/s"
             );
             for r in rows.iter().filter(|r| r.layout_stages.len() > 1) {
                 let stages: Vec<String> = r.layout_stages.iter().map(|(s, ms)| format!("{s} {ms:.3}")).collect();
@@ -225,7 +225,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             for r in &rows {
                 println!(
-                    "{:>6}{:>8}{:>10}{:>11.3}{:>11.3}{:>12.3}{:>12.3}{:>16.1}{:>16.1}",
+                    "{:>6}{:>8}{:>10}{:>11.3}{:>11.3}{:>12.3}{:>12.3}{:>16.1}{:>16.1}{:>16.1}",
                     format!("{:?}", r.accel).to_lowercase(),
                     r.layout.name(),
                     r.stack,
@@ -234,7 +234,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                     r.primary_median_ms,
                     r.diffuse_median_ms,
                     r.primary_mrays_per_s,
-                    r.diffuse_mrays_per_s
+                    r.diffuse_mrays_per_s,
+                    r.occlusion_mrays_per_s
                 );
             }
             if let Some(path) = json {
