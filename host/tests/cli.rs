@@ -277,19 +277,27 @@ fn first_run_without_vulkan_renders_on_the_cpu_runner() {
 }
 
 /// With Vulkan present (lavapipe in CI) and no runtime directory set, Mesa
-/// stays quiet.
+/// stays quiet, on the adapter and when `auto` looks at it; and `auto`
+/// renders on the CPU runner where the only adapters run on CPU cores,
+/// saying so.
 #[test]
 fn no_xdg_runtime_dir_message() {
     let image = std::env::temp_dir().join(format!("treelet-xdg-{}.png", std::process::id()));
-    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
-        .args(["render", "--width", "16", "--height", "12", "--spp", "4", "--out"])
-        .arg(&image)
-        .env_remove("XDG_RUNTIME_DIR")
-        .output()
-        .expect("run treelet");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    let gpus = treelet::runtime::gpu::GpuContext::gpu_adapters();
+    for device in ["gpu", "auto"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+            .args(["render", "--width", "16", "--height", "12", "--spp", "4", "--device", device, "--out"])
+            .arg(&image)
+            .env_remove("XDG_RUNTIME_DIR")
+            .output()
+            .expect("run treelet");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+        if device == "auto" && gpus.is_empty() {
+            assert!(err.contains("runs on CPU cores") && err.contains(" on cpu "), "{err}");
+        }
+    }
     std::fs::remove_file(&image).ok();
 }
 
