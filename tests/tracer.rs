@@ -44,23 +44,53 @@ fn rays(rng: &mut impl Rng, n: usize) -> Vec<Ray> {
         .map(|k| {
             let o = [rng.random_range(-10.0..110.0), rng.random_range(-10.0..110.0), rng.random_range(-10.0..110.0)];
             let d = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
-            // Every fourth ray stops at 30 units.
-            Ray { origin: o, dir: d, t_max: if k % 4 == 0 { 30.0 } else { f32::INFINITY } }
+            // Every fourth ray stops at 30 units; every third starts at 10.
+            let t_min = if k % 3 == 0 { 10.0 } else { 0.0 };
+            Ray { origin: o, dir: d, t_min, t_max: if k % 4 == 0 { 30.0 } else { f32::INFINITY } }
         })
         .collect()
 }
 
+/// The closest hit from `t_min` on (the scan from the point at `t_min`),
+/// up to `t_max`: distance and primitive (the record is checked apart).
 fn scan(g: &Geometry, r: &Ray) -> RayHit {
     let prims = Prims { spheres: &g.0, sphere_count: g.0.len() as u32, triangles: &g.1, triangle_count: g.1.len() as u32 };
     let d = Vec3::from(r.dir);
     if d.length() == 0.0 {
-        return RayHit { t: f32::INFINITY, prim: u32::MAX };
+        return RayHit::MISS;
     }
-    let h = closest_hit_linear(Vec3::from(r.origin), d.normalize(), Origin::NONE, &prims);
-    if h.is_hit() && h.t <= r.t_max {
-        RayHit { t: h.t, prim: h.prim }
+    let h = closest_hit_linear(Vec3::from(r.origin) + d.normalize() * r.t_min, d.normalize(), Origin::NONE, &prims);
+    if h.is_hit() && h.t + r.t_min <= r.t_max {
+        RayHit { t: h.t + r.t_min, prim: h.prim, ..RayHit::MISS }
     } else {
-        RayHit { t: f32::INFINITY, prim: u32::MAX }
+        RayHit::MISS
+    }
+}
+
+/// A hit's record against the primitive itself: the point its barycentrics
+/// give (a triangle's) or its normal gives (a sphere's) is the point at
+/// distance `t` along the ray, within the intersection tests' error, and
+/// the normal is the primitive's, of unit length.
+fn check_record(what: &str, g: &Geometry, r: &Ray, h: &RayHit) {
+    let x = Vec3::from(r.origin) + Vec3::from(r.dir).normalize() * h.t;
+    let n = Vec3::from(h.normal);
+    let tol = 1e-3 * (1.0 + x.length());
+    assert!((n.length() - 1.0).abs() < 1e-4, "{what}: ray {r:?}: normal {n} of {h:?}");
+    match g.0.get(h.prim as usize) {
+        Some(s) => {
+            let on = Vec3::from(s.center) + n * s.radius;
+            assert!((on - x).length() < tol, "{what}: ray {r:?}: sphere hit {h:?} at {x}, normal gives {on}");
+            assert_eq!(h.barycentrics, [0.0; 2], "{what}: a sphere has no barycentrics");
+        }
+        None => {
+            let t = &g.1[h.prim as usize - g.0.len()];
+            let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
+            let [b1, b2] = h.barycentrics;
+            assert!(b1 >= -1e-6 && b2 >= -1e-6 && b1 + b2 <= 1.0 + 1e-5, "{what}: ray {r:?}: barycentrics of {h:?}");
+            let p = a * (1.0 - b1 - b2) + b * b1 + c * b2;
+            assert!((p - x).length() < tol, "{what}: ray {r:?}: triangle hit {h:?} at {x}, barycentrics give {p}");
+            assert!((n - (b - a).cross(c - a).normalize()).length() < 1e-4, "{what}: ray {r:?}: normal of {h:?}");
+        }
     }
 }
 
@@ -74,6 +104,7 @@ fn check(what: &str, hits: &[RayHit], g: &Geometry, rays: &[Ray]) {
         assert_eq!(h.is_hit(), s.is_hit(), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
         if s.is_hit() {
             hit += 1;
+            check_record(what, g, r, h);
             assert!((h.t - s.t).abs() <= 1e-4 * s.t.max(1.0), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
             assert!(h.prim == s.prim || (h.t - s.t).abs() <= 1e-5 * s.t.max(1.0), "{what}: ray {r:?}: tracer {h:?}, scan {s:?}");
         }
@@ -122,6 +153,22 @@ fn tracer_small_and_empty_scenes() {
     assert!(!empty.closest_hits(b, &[Ray::new([0.0; 3], [1.0, 0.0, 0.0])]).unwrap()[0].is_hit());
     // A zero direction hits nothing.
     assert!(!t.closest_hits(b, &[Ray::new([0.2, 0.2, 0.0], [0.0; 3])]).unwrap()[0].is_hit());
+    // t_min: past a sphere's near side, its far side; past the triangle, nothing.
+    let ball = [treelet::Sphere::new([0.0, 0.0, 10.0], 2.0)];
+    let s = Tracer::build(b, &ball, &[], Quality::Fast).unwrap();
+    let from = |t_min| Ray { t_min, ..Ray::new([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]) };
+    let hits = s.closest_hits(b, &[from(0.0), from(8.5), from(12.5)]).unwrap();
+    assert_eq!((hits[0].prim, hits[0].t, hits[0].normal), (0, 8.0, [0.0, 0.0, -1.0]), "{hits:?}");
+    assert_eq!((hits[1].prim, hits[1].t, hits[1].normal), (0, 12.0, [0.0, 0.0, 1.0]), "{hits:?}");
+    assert!(!hits[2].is_hit(), "{hits:?}");
+    let tri = t.closest_hits(b, &[from(0.0), from(5.5)]).unwrap();
+    assert_eq!((tri[0].prim, tri[0].t), (0, 5.0));
+    assert!(!tri[1].is_hit());
+    assert_eq!(t.occluded(b, &[from(0.0), from(5.5)]).unwrap(), vec![true, false]);
+    for bad in [-1.0, f32::NAN, f32::INFINITY] {
+        let e = format!("{:#}", t.closest_hits(b, &[Ray::new([0.0; 3], [1.0, 0.0, 0.0]), from(bad)]).unwrap_err());
+        assert!(e.contains("ray 1") && e.contains("t_min"), "{e}");
+    }
 }
 
 #[test]

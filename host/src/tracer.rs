@@ -31,32 +31,43 @@ use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
 
 /// A ray of a batch: from `origin` along `dir` (any length but zero), hits
-/// up to distance `t_max` (along the normalized direction). A ray that
-/// leaves a surface should start a little off it: nothing is excluded.
+/// from distance `t_min` (finite, at least 0) up to `t_max` (both along the
+/// normalized direction). A ray that leaves a surface should start a little
+/// off it, or set `t_min`: nothing else is excluded.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     pub origin: [f32; 3],
     pub dir: [f32; 3],
+    pub t_min: f32,
     pub t_max: f32,
 }
 
 impl Ray {
     /// A ray with no limit on its hit distance.
     pub fn new(origin: [f32; 3], dir: [f32; 3]) -> Ray {
-        Ray { origin, dir, t_max: f32::INFINITY }
+        Ray { origin, dir, t_min: 0.0, t_max: f32::INFINITY }
     }
 }
 
 /// The closest hit of a ray: the primitive (spheres first, then triangles,
-/// in the order given to [`Tracer::build`]) and the distance along the
-/// normalized direction; `prim == u32::MAX` and `t` infinite for none.
+/// in the order given to [`Tracer::build`]), the distance along the
+/// normalized direction, a triangle's barycentric coordinates of the hit
+/// (of `v1` and `v2`: the point is `(1 - b1 - b2) v0 + b1 v1 + b2 v2`; 0 for
+/// a sphere), to interpolate vertex normals and texture coordinates, and the
+/// geometric normal (unit; a triangle's `(v1 - v0) x (v2 - v0)`, a sphere's
+/// outward). For no hit: `prim == u32::MAX`, `t` infinite, the rest 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayHit {
     pub t: f32,
     pub prim: u32,
+    pub barycentrics: [f32; 2],
+    pub normal: [f32; 3],
 }
 
 impl RayHit {
+    /// No hit.
+    pub const MISS: RayHit = RayHit { t: f32::INFINITY, prim: u32::MAX, barycentrics: [0.0; 2], normal: [0.0; 3] };
+
     pub fn is_hit(&self) -> bool {
         self.prim != u32::MAX
     }
@@ -91,6 +102,9 @@ pub struct Tracer<B: Backend> {
     prims: PrimBuffers<B>,
     tree: Option<TracedTree<B>>,
     counts: (usize, usize),
+    /// The primitives on the host too, for the hits' normals.
+    spheres: Vec<Sphere>,
+    triangles: Vec<Triangle>,
 }
 
 impl<B: Backend> Tracer<B> {
@@ -100,7 +114,14 @@ impl<B: Backend> Tracer<B> {
         let all = Primitives { spheres, triangles };
         all.check()?;
         let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder())?) };
-        let mut tracer = Tracer { built, prims: PrimBuffers::upload(b, all)?, tree: None, counts: (spheres.len(), triangles.len()) };
+        let mut tracer = Tracer {
+            built,
+            prims: PrimBuffers::upload(b, all)?,
+            tree: None,
+            counts: (spheres.len(), triangles.len()),
+            spheres: spheres.to_vec(),
+            triangles: triangles.to_vec(),
+        };
         tracer.lay_out(b)?;
         Ok(tracer)
     }
@@ -126,6 +147,7 @@ impl<B: Backend> Tracer<B> {
             refit(b, &built.bvh, all)?;
         }
         self.prims = PrimBuffers::upload(b, all)?;
+        (self.spheres, self.triangles) = (spheres.to_vec(), triangles.to_vec());
         self.lay_out(b)
     }
 
@@ -138,15 +160,38 @@ impl<B: Backend> Tracer<B> {
         Ok(())
     }
 
-    /// The closest hit of each ray.
+    /// The closest hit of each ray, with its hit record (see [`RayHit`]).
     pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
         if self.tree.is_none() {
-            return Ok(vec![RayHit { t: f32::INFINITY, prim: u32::MAX }; rays.len()]);
+            check_rays(rays)?;
+            return Ok(vec![RayHit::MISS; rays.len()]);
         }
         let buffer = b.upload("rays", &device_rays(rays)?)?;
         self.closest_hits_on_device(b, &buffer, rays.len())?;
         let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
-        Ok((0..rays.len()).map(|k| RayHit { t: out[2 * k][0], prim: out[2 * k][1].to_bits() }).collect())
+        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| self.hit_record(r, o[0])).collect())
+    }
+
+    /// The host's record of a device hit `(t, prim, b1, b2)` of ray `r`
+    /// (traced from `t_min` on: see [`device_rays`]).
+    fn hit_record(&self, r: &Ray, [t, prim, b1, b2]: [f32; 4]) -> RayHit {
+        let prim = prim.to_bits();
+        if prim == u32::MAX {
+            return RayHit::MISS;
+        }
+        let t = t + r.t_min;
+        let normal = match self.spheres.get(prim as usize) {
+            Some(s) => {
+                let x = glam::Vec3::from(r.origin) + glam::Vec3::from(r.dir).normalize() * t;
+                (x - glam::Vec3::from(s.center)).normalize_or_zero()
+            }
+            None => {
+                let tri = &self.triangles[prim as usize - self.spheres.len()];
+                let (a, b, c) = (glam::Vec3::from(tri.v0), glam::Vec3::from(tri.v1), glam::Vec3::from(tri.v2));
+                (b - a).cross(c - a).normalize_or_zero()
+            }
+        };
+        RayHit { t, prim, barycentrics: [b1, b2], normal: normal.into() }
     }
 
     /// Whether each ray hits anything up to its `t_max` (inclusive): an
@@ -155,6 +200,7 @@ impl<B: Backend> Tracer<B> {
     /// is occluded exactly when its closest hit is within `t_max`.
     pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
         if self.tree.is_none() {
+            check_rays(rays)?;
             return Ok(vec![false; rays.len()]);
         }
         let buffer = b.upload("rays", &device_rays(rays)?)?;
@@ -167,8 +213,10 @@ impl<B: Backend> Tracer<B> {
     /// hold their rays in a GPU buffer, e.g. a `wgpu::Buffer` through
     /// [`GpuBackend`](crate::runtime::gpu::GpuBackend)), in place: ray `k` is
     /// `rays[2k]` = (origin, t_max) and `rays[2k + 1]` = (direction, 1), as
-    /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, 0,
-    /// 0). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, b1,
+    /// b2): a triangle's barycentric coordinates of the hit as in [`RayHit`]
+    /// (0 for a sphere; the normal is the engine's to take from its own
+    /// primitive). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
     /// `count` must be zero. Submitted, not waited for.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_RAYS)
@@ -210,13 +258,27 @@ impl<B: Backend> Tracer<B> {
 
 /// `rays` as [`Tracer::closest_hits_on_device`] reads them from a device
 /// buffer: two `[f32; 4]` a ray, padded with zeros to [`batch_slots`] pairs.
+/// The device layout has no `t_min`: a ray is moved `t_min` along its
+/// direction and its `t_max` shortened by as much (hit distances then count
+/// from there); engines that fill device buffers themselves do the same.
 pub fn device_rays(rays: &[Ray]) -> Result<Vec<[f32; 4]>> {
+    check_rays(rays)?;
     let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
     for (k, r) in rays.iter().enumerate() {
-        data[2 * k] = [r.origin[0], r.origin[1], r.origin[2], r.t_max];
+        let d = glam::Vec3::from(r.dir);
+        let o = if r.t_min > 0.0 && d.length() > 0.0 { glam::Vec3::from(r.origin) + d.normalize() * r.t_min } else { r.origin.into() };
+        data[2 * k] = [o.x, o.y, o.z, r.t_max - r.t_min];
         data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
     }
     Ok(data)
+}
+
+/// Every ray's `t_min` is finite and at least 0.
+fn check_rays(rays: &[Ray]) -> Result<()> {
+    if let Some((k, r)) = rays.iter().enumerate().find(|(_, r)| !(r.t_min >= 0.0 && r.t_min.is_finite())) {
+        bail!("ray {k}: t_min {} must be finite and at least 0", r.t_min);
+    }
+    Ok(())
 }
 
 /// Ray pairs a device batch of `count` rays holds (rows of whole width).

@@ -119,6 +119,13 @@ fn pick(v: [f32; 3], k: usize) -> f32 {
 /// seen edge-on) is never hit.
 #[inline]
 pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
+    ray_triangle_barycentrics(ray, tri, t_max).0
+}
+
+/// [`ray_triangle`] with the hit's barycentric coordinates: `(t, b1, b2)`,
+/// the hit point being `(1 - b1 - b2) v0 + b1 v1 + b2 v2` (both 0 on a miss).
+#[inline]
+pub fn ray_triangle_barycentrics(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> (f32, f32, f32) {
     let (kx, ky, kz) = ((ray.axes & 3) as usize, (ray.axes >> 2 & 3) as usize, (ray.axes >> 4) as usize);
     let [sx, sy, sz] = ray.shear;
     let o = ray.origin;
@@ -130,23 +137,23 @@ pub fn ray_triangle(ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
     let (ax, ay) = (pick(a, kx) - sx * az, pick(a, ky) - sy * az);
     let (bx, by) = (pick(b, kx) - sx * bz, pick(b, ky) - sy * bz);
     let (cx, cy) = (pick(c, kx) - sx * cz, pick(c, ky) - sy * cz);
-    // Scaled barycentrics: the signed areas seen from the ray.
+    // Scaled barycentrics (of v0, v1, v2): the signed areas seen from the ray.
     let u = difference_of_products(cx, by, cy, bx);
     let v = difference_of_products(ax, cy, ay, cx);
     let w = difference_of_products(bx, ay, by, ax);
     if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return MISS;
+        return (MISS, 0.0, 0.0);
     }
     let det = u + v + w;
     if det == 0.0 {
-        return MISS;
+        return (MISS, 0.0, 0.0);
     }
     let t_scaled = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
     let t = t_scaled / det;
     if t > 0.0 && t <= t_max {
-        t
+        (t, v / det, w / det)
     } else {
-        MISS
+        (MISS, 0.0, 0.0)
     }
 }
 

@@ -9,7 +9,8 @@ use glam::Vec3;
 
 use crate::geometry::buffers::RenderParams;
 use crate::geometry::intersect::{MISS, surface_offset};
-use crate::geometry::prims::Origin;
+use crate::geometry::prims::{Origin, Prims};
+use crate::geometry::triangle::{WatertightRay, ray_triangle_barycentrics};
 use crate::gpu::rng::BounceRng;
 use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel, trace};
 use crate::render::sampling::cosine_direction;
@@ -26,7 +27,9 @@ pub const CAST_BOUNCE: u32 = 2;
 /// `rays[2 id]` = (origin, farthest hit distance), `rays[2 id + 1]` =
 /// (direction, 1 to trace or 0 to skip); the closest hit replaces the
 /// first: (distance along the normalized direction, bits of the primitive,
-/// 0, 0), the primitive `u32::MAX` for none.
+/// b1, b2), the primitive `u32::MAX` for none; `b1`, `b2` are a triangle's
+/// barycentric coordinates of the hit (of `v1` and `v2`: the point is
+/// `(1 - b1 - b2) v0 + b1 v1 + b2 v2`), 0 for a sphere.
 pub const CAST_RAYS: u32 = 3;
 /// [`RenderParams::cast_mode`]: occlusion queries of the caller's rays, laid
 /// out as for [`CAST_RAYS`]: whether anything is hit up to the farthest
@@ -82,7 +85,8 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
             rays[i] = if params.cast_mode == CAST_OCCLUDED {
                 [found as u32 as f32, 0.0, 0.0, 0.0]
             } else if found {
-                [hit.t, f32::from_bits(hit.prim), 0.0, 0.0]
+                let (b1, b2) = barycentrics::<F>(&scene.prims, hit.prim, o, d / len);
+                [hit.t, f32::from_bits(hit.prim), b1, b2]
             } else {
                 [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0]
             };
@@ -115,6 +119,18 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
+}
+
+/// The barycentric coordinates (of `v1`, `v2`) where the ray `o + t d` hits
+/// primitive `prim`, by the traversal's own test; 0 for a sphere.
+#[inline]
+fn barycentrics<const F: u32>(prims: &Prims, prim: u32, o: Vec3, d: Vec3) -> (f32, f32) {
+    if prims.is_sphere::<F>(prim) {
+        return (0.0, 0.0);
+    }
+    let tri = &prims.triangles[(prim - prims.sphere_count) as usize];
+    let (_, b1, b2) = ray_triangle_barycentrics(&WatertightRay::new(o, d), tri, MISS);
+    (b1, b2)
 }
 
 /// Pixel `id`'s camera ray (its first subpixel, sample `first_sample`).
