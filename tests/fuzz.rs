@@ -1,5 +1,6 @@
 //! Every loader on mutated bytes of a small corpus: meshes (OBJ, ASCII and
 //! binary PLY from `tests/corpus`), scene files (`tests/corpus/scene.json`),
+//! glTF scenes (`square.gltf` with its buffer embedded, `square.glb`),
 //! render parts and HDR images (EXR and PFM, written fresh by the code
 //! under test). Each input gives a result or an error that names the file,
 //! never a panic. A bounded run: 1000 cases per loader by default (about a second),
@@ -116,6 +117,11 @@ proptest! {
     #[test]
     fn mutated_scene_files_never_panic(edits in edits()) {
         check(&corpus(&["json"]), 0, &edits, treelet::scene::file::load)?;
+    }
+
+    #[test]
+    fn mutated_gltf_files_never_panic(which in 0usize..2, edits in edits()) {
+        check(&corpus(&["gltf", "glb"]), which, &edits, treelet::scene::gltf::load)?;
     }
 
     #[test]

@@ -38,7 +38,7 @@ struct Cli {
 enum Command {
     /// Build a BVH over a scene, check it, and report its cost and stage times.
     Build {
-        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), cornell, a .json scene file, or an .obj/.ply mesh.
+        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), cornell, a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
         #[arg(long, default_value = "random:100000")]
         scene: String,
         #[arg(long, value_enum, default_value = "lbvh")]
@@ -88,7 +88,7 @@ enum Command {
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
 struct RenderArgs {
-    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, or an .obj/.ply mesh.
+    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
     #[arg(long, default_value_t = 512, value_parser = positive)]

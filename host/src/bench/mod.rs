@@ -110,7 +110,7 @@ pub enum BenchCommand {
     /// Rays per second: one primary and one diffuse ray per pixel, cast alone
     /// (no shading), through the chosen tree.
     Rays {
-        /// Scene: cornell, random:N[:SEED], terrain:N, a .json scene, or an .obj/.ply mesh.
+        /// Scene: cornell, random:N[:SEED], terrain:N, a .json scene, a .gltf/.glb scene, or an .obj/.ply mesh.
         #[arg(long, default_value = "random:65536")]
         scene: String,
         #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![Accel::Lbvh, Accel::Trbvh])]

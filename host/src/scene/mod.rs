@@ -6,6 +6,7 @@
 //! reads `.obj` / `.ply`, [`file`](mod@file) reads JSON scene files, and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
 pub mod file;
+pub mod gltf;
 pub mod mesh;
 pub mod model;
 pub mod primitives;

@@ -1,5 +1,5 @@
 //! Scene names as the command line takes them: `cornell`, `random:N[:SEED]`,
-//! `terrain:N`, a JSON scene file, or an `.obj` / `.ply` mesh.
+//! `terrain:N`, a JSON scene file, a glTF 2.0 scene, or an `.obj` / `.ply` mesh.
 use anyhow::{bail, Context as _, Result};
 
 use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
@@ -19,6 +19,9 @@ impl Scene {
             return super::file::load(std::path::Path::new(spec));
         }
         let lower = spec.to_ascii_lowercase();
+        if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            return super::gltf::load(std::path::Path::new(spec));
+        }
         if lower.ends_with(".obj") || lower.ends_with(".ply") {
             let triangles = super::mesh::load(std::path::Path::new(spec))?;
             return Ok(mesh_scene(spec, &triangles));
@@ -56,7 +59,7 @@ impl Scene {
                 Ok(mesh_scene(spec, &terrain(n)))
             }
             _ => bail!(
-                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file or an .obj/.ply mesh"
+                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh"
             ),
         }
     }

@@ -1,0 +1,405 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers, or `.glb`), through the `gltf`
+//! crate: the triangle meshes of the default scene, placed by their nodes'
+//! transforms (flattened into one set of triangles), their materials mapped
+//! to the path tracer's, and the first perspective camera.
+//!
+//! Materials (metallic-roughness, with the transmission, IOR and emissive
+//! strength extensions): transmission above one half is glass (colour: the
+//! base colour, index: `KHR_materials_ior`, 1.5 without it); metallic at
+//! least one half with roughness below 0.2 is a mirror; anything else is
+//! diffuse in its base colour. Emission is the emissive factor times its
+//! strength. Textures are not read: a material with one renders in its
+//! factor alone, and a note says so. Punctual lights
+//! (`KHR_lights_punctual`) are not supported either (emissive surfaces
+//! light the scene): a note says so. Buffers are embedded (`.glb`, base64
+//! data URIs) or files beside the scene, read within the input limits.
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use glam::{Mat4, Vec3};
+use treelet_core::geometry::buffers::{Material, DIFFUSE, GLASS, MIRROR};
+use treelet_core::geometry::triangle::Triangle;
+
+use super::file::MAX_EMISSION;
+use super::model::{CameraSpec, Scene};
+use super::primitives::Primitives;
+
+/// Loads a glTF 2.0 file as a scene; errors name the file and the mesh,
+/// primitive or material at fault.
+pub fn load(path: &Path) -> Result<Scene> {
+    let name = path.display().to_string();
+    let bytes = crate::input::read(path, "glTF file")?;
+    precheck(&bytes, &name)?;
+    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
+    let buffers = buffers(&gltf, path.parent().unwrap_or(Path::new(".")), &name)?;
+    check_ranges(&gltf.document, &name)?;
+    let document = &gltf.document;
+    let scene =
+        document.default_scene().or_else(|| document.scenes().next()).with_context(|| format!("{name}: no scene"))?;
+    let mut out = Loaded::default();
+    for node in scene.nodes() {
+        walk(&node, Mat4::IDENTITY, &buffers, &name, &mut out)?;
+    }
+    if out.triangles.is_empty() {
+        bail!("{name}: the scene has no triangles");
+    }
+    Primitives::triangles(&out.triangles).check().with_context(|| format!("{name}: after the node transforms"))?;
+    if out.textured {
+        eprintln!("note: {name}: textures are not read; textured materials render in their colour factors alone");
+    }
+    if document.extensions_used().any(|e| e == "KHR_lights_punctual") {
+        eprintln!(
+            "note: {name}: punctual lights (KHR_lights_punctual) are not supported; only emissive materials give light"
+        );
+    }
+    let camera = out.camera.unwrap_or_else(|| framing(&out.triangles));
+    Ok(Scene { name, spheres: Vec::new(), materials: out.materials, room: 0, camera, triangles: out.triangles })
+}
+
+/// What the `gltf` crate indexes without checking (found by fuzzing: its
+/// validation indexes a primitive's POSITION accessor before checking that
+/// it exists): every attribute's accessor exists.
+fn precheck(bytes: &[u8], name: &str) -> Result<()> {
+    let json = if bytes.starts_with(b"glTF") {
+        gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid GLB file: {e}"))?.json.into_owned()
+    } else {
+        bytes.to_vec()
+    };
+    let root: gltf::json::Root =
+        gltf::json::deserialize::from_slice(&json).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = primitive.attributes.values().find(|a| a.value() >= root.accessors.len()) {
+                bail!("{name}: mesh {m} primitive {p}: accessor {} does not exist", a.value());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every buffer view within its buffer and every accessor within its view,
+/// so that reading them cannot go out of bounds.
+fn check_ranges(document: &gltf::Document, name: &str) -> Result<()> {
+    for view in document.views() {
+        let end = view.offset().checked_add(view.length());
+        if end.is_none_or(|end| end > view.buffer().length()) {
+            bail!("{name}: buffer view {} reaches past its buffer", view.index());
+        }
+    }
+    for accessor in document.accessors() {
+        let Some(view) = accessor.view() else { continue };
+        let element = accessor.size();
+        let stride = view.stride().unwrap_or(element);
+        let last = accessor.count().checked_sub(1).map(|k| k.checked_mul(stride).and_then(|x| x.checked_add(element)));
+        let end = match last {
+            None => Some(accessor.offset()),
+            Some(l) => l.and_then(|l| l.checked_add(accessor.offset())),
+        };
+        if end.is_none_or(|end| end > view.length()) || stride < element {
+            bail!("{name}: accessor {} reaches past its buffer view", accessor.index());
+        }
+        if accessor.sparse().is_some() {
+            bail!("{name}: accessor {}: sparse accessors are not supported", accessor.index());
+        }
+    }
+    Ok(())
+}
+
+#[derive(Default)]
+struct Loaded {
+    triangles: Vec<Triangle>,
+    materials: Vec<Material>,
+    camera: Option<CameraSpec>,
+    textured: bool,
+}
+
+/// Each buffer's bytes: the `.glb` binary chunk, a base64 data URI, or a
+/// file beside the scene.
+fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
+    use base64::Engine as _;
+    let mut out = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let i = buffer.index();
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => {
+                gltf.blob.clone().with_context(|| format!("{name}: buffer {i}: no binary chunk"))?
+            }
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                let (_, encoded) = uri
+                    .split_once(";base64,")
+                    .with_context(|| format!("{name}: buffer {i}: a data URI that is not base64"))?;
+                base64::engine::general_purpose::STANDARD
+                    .decode(encoded)
+                    .map_err(|e| anyhow!("{name}: buffer {i}: bad base64: {e}"))?
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                if uri.contains("://") {
+                    bail!("{name}: buffer {i}: `{uri}` is not a local file");
+                }
+                crate::input::read(&dir.join(uri), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
+            }
+        };
+        if data.len() < buffer.length() {
+            bail!("{name}: buffer {i} holds {} bytes, the file says {}", data.len(), buffer.length());
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Adds `node` and its children, placed by `parent` times their transforms.
+fn walk(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<()> {
+    let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+    if !world.is_finite() {
+        bail!("{name}: node {} has a non-finite transform", node.index());
+    }
+    if let Some(mesh) = node.mesh() {
+        for primitive in mesh.primitives() {
+            let at = format!("{name}: mesh {} primitive {}", mesh.index(), primitive.index());
+            if primitive.mode() != gltf::mesh::Mode::Triangles {
+                bail!("{at}: {:?} primitives are not supported (triangles only)", primitive.mode());
+            }
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .with_context(|| format!("{at}: no positions"))?
+                .map(|p| world.transform_point3(p.into()))
+                .collect();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if indices.len() % 3 != 0 {
+                bail!("{at}: {} indices, not a multiple of three", indices.len());
+            }
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                bail!("{at}: index {bad} past its {} vertices", positions.len());
+            }
+            let material = material(&primitive.material(), &at, out)?;
+            for t in indices.chunks(3) {
+                let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize].to_array());
+                out.triangles.push(Triangle::new(a, b, c));
+                out.materials.push(material);
+            }
+        }
+    }
+    if let (None, Some(camera)) = (&out.camera, node.camera()) {
+        if let gltf::camera::Projection::Perspective(p) = camera.projection() {
+            let origin = world.transform_point3(Vec3::ZERO);
+            let direction = world.transform_vector3(-Vec3::Z);
+            out.camera = Some(CameraSpec {
+                origin: origin.into(),
+                direction: direction.into(),
+                near: 0.0,
+                fov: (p.yfov() / 2.0).tan(),
+            });
+        }
+    }
+    for child in node.children() {
+        walk(&child, world, buffers, name, out)?;
+    }
+    Ok(())
+}
+
+/// The path tracer's material for a glTF material (see the module doc).
+fn material(m: &gltf::Material, at: &str, out: &mut Loaded) -> Result<Material> {
+    let pbr = m.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
+    let color = [r, g, b];
+    out.textured |= pbr.base_color_texture().is_some() || m.emissive_texture().is_some();
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let emission = m.emissive_factor().map(|e| e * strength);
+    let what = format!("{at}: material `{}`", m.name().unwrap_or("(default)"));
+    if color.iter().chain(&emission).any(|v| !v.is_finite() || *v < 0.0) || color.iter().any(|&v| v > 1.0) {
+        bail!(
+            "{what}: colour {color:?} and emission {emission:?} must be finite, colour in [0, 1], emission at least 0"
+        );
+    }
+    if emission.iter().any(|&v| v > MAX_EMISSION) {
+        bail!("{what}: emission {emission:?} above {MAX_EMISSION:e}");
+    }
+    let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+    let (kind, ior) = if transmission > 0.5 {
+        let ior = m.ior().unwrap_or(1.5);
+        if !(ior > 0.0 && ior.is_finite()) {
+            bail!("{what}: index of refraction {ior}");
+        }
+        (GLASS, ior)
+    } else if pbr.metallic_factor() >= 0.5 && pbr.roughness_factor() < 0.2 {
+        (MIRROR, 0.0)
+    } else {
+        (DIFFUSE, 0.0)
+    };
+    Ok(Material { emission, kind, color, ior })
+}
+
+/// A camera for a file without one: on the +z side of the triangles' box,
+/// looking down -z at its centre, the box filling about the image.
+fn framing(triangles: &[Triangle]) -> CameraSpec {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for t in triangles {
+        for v in [t.v0, t.v1, t.v2] {
+            lo = lo.min(v.into());
+            hi = hi.max(v.into());
+        }
+    }
+    let (center, half) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
+    let fov = 0.5;
+    let distance = half.x.max(half.y) / fov + half.z;
+    CameraSpec { origin: (center + Vec3::Z * distance.max(1e-3)).into(), direction: [0.0, 0.0, -1.0], near: 0.0, fov }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use base64::Engine as _;
+
+    /// Two triangles (a unit square in z = 0, indexed) as a buffer: four
+    /// positions, then six u16 indices.
+    fn square_buffer() -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+            for v in p {
+                bytes.extend(v.to_le_bytes());
+            }
+        }
+        for i in [0u16, 1, 2, 0, 2, 3] {
+            bytes.extend(i.to_le_bytes());
+        }
+        bytes
+    }
+
+    /// A glTF document over `uri` (the buffer's), with the square placed by
+    /// two nodes (a parent translation, a child scale), a camera node, and
+    /// three primitives of three materials; `mode` and `index_count` let
+    /// tests break it.
+    fn document(uri: &str, mode: u32, index_count: u32) -> String {
+        format!(
+            r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"],
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 2]}}],
+  "nodes": [
+    {{"translation": [10, 0, 0], "children": [1]}},
+    {{"scale": [2, 2, 2], "mesh": 0}},
+    {{"translation": [0, 0, 9], "camera": 0}}
+  ],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 1.0, "znear": 0.1}}}}],
+  "meshes": [{{"primitives": [
+    {{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0, "mode": {mode}}},
+    {{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 1}},
+    {{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 2}}
+  ]}}],
+  "materials": [
+    {{"pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.25, 1, 1], "metallicFactor": 0}}, "emissiveFactor": [1, 1, 0.5],
+      "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 4}}}}}},
+    {{"pbrMetallicRoughness": {{"metallicFactor": 0}}, "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1}}, "KHR_materials_ior": {{"ior": 1.33}}}}}},
+    {{"pbrMetallicRoughness": {{"metallicFactor": 1, "roughnessFactor": 0}}}}
+  ],
+  "buffers": [{{"uri": "{uri}", "byteLength": 60}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+    {{"bufferView": 1, "componentType": 5123, "count": {index_count}, "type": "SCALAR"}}
+  ]
+}}"#
+        )
+    }
+
+    fn data_uri() -> String {
+        format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(square_buffer())
+        )
+    }
+
+    fn dir() -> std::path::PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("treelet-gltf-{}-{:?}", std::process::id(), std::thread::current().id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn check_scene(s: &Scene) {
+        assert_eq!(s.triangles.len(), 6, "three primitives of two triangles");
+        // The child's scale, then the parent's translation.
+        assert_eq!(s.triangles[0], Triangle::new([10.0, 0.0, 0.0], [12.0, 0.0, 0.0], [12.0, 2.0, 0.0]));
+        assert_eq!(s.materials.len(), 6);
+        assert_eq!(
+            s.materials[0],
+            Material { emission: [4.0, 4.0, 2.0], kind: DIFFUSE, color: [0.5, 0.25, 1.0], ior: 0.0 }
+        );
+        assert_eq!((s.materials[2].kind, s.materials[2].ior), (GLASS, 1.33));
+        assert_eq!(s.materials[4].kind, MIRROR);
+        assert_eq!(s.camera.origin, [0.0, 0.0, 9.0]);
+        assert_eq!(s.camera.direction, [0.0, 0.0, -1.0]);
+        assert!((s.camera.fov - 0.5f32.tan()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn embedded_external_and_binary_files_load_the_same_scene() {
+        let d = dir();
+        let embedded = d.join("square.gltf");
+        std::fs::write(&embedded, document(&data_uri(), 4, 6)).unwrap();
+        check_scene(&load(&embedded).unwrap());
+        std::fs::write(d.join("square.bin"), square_buffer()).unwrap();
+        let external = d.join("external.gltf");
+        std::fs::write(&external, document("square.bin", 4, 6)).unwrap();
+        check_scene(&load(&external).unwrap());
+        // GLB: a header, the JSON chunk (padded with spaces), the BIN chunk.
+        let json = document("", 4, 6).replace(r#""uri": "", "#, "");
+        let mut json = json.into_bytes();
+        json.resize(json.len().div_ceil(4) * 4, b' ');
+        let bin = square_buffer(); // 60 bytes, a multiple of 4
+        let mut glb = Vec::new();
+        glb.extend(b"glTF");
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        glb.extend((json.len() as u32).to_le_bytes());
+        glb.extend(b"JSON");
+        glb.extend(&json);
+        glb.extend((bin.len() as u32).to_le_bytes());
+        glb.extend(b"BIN\0");
+        glb.extend(&bin);
+        let binary = d.join("square.glb");
+        std::fs::write(&binary, glb).unwrap();
+        check_scene(&Scene::from_spec(binary.to_str().unwrap()).unwrap());
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn bad_files_fail_naming_the_problem() {
+        let d = dir();
+        let cases = [
+            ("broken.gltf", "{ not json".to_string(), "not a valid glTF"),
+            ("points.gltf", document(&data_uri(), 0, 6), "primitive 0: Points primitives are not supported"),
+            ("short.gltf", document(&data_uri(), 4, 5), "not a multiple of three"),
+            ("missing.gltf", document("nowhere.bin", 4, 6), "buffer 0"),
+            ("remote.gltf", document("https://example.com/a.bin", 4, 6), "not a local file"),
+            (
+                "noaccessor.gltf",
+                document(&data_uri(), 4, 6).replacen(r#""POSITION": 0"#, r#""POSITION": 7"#, 1),
+                "accessor 7 does not exist",
+            ),
+            (
+                "longview.gltf",
+                document(&data_uri(), 4, 6)
+                    .replace(r#""byteOffset": 48, "byteLength": 12"#, r#""byteOffset": 48, "byteLength": 40"#),
+                "buffer view 1 reaches past",
+            ),
+            (
+                "longaccessor.gltf",
+                document(&data_uri(), 4, 6).replace(r#""count": 4, "type": "VEC3""#, r#""count": 5, "type": "VEC3""#),
+                "accessor 0 reaches past",
+            ),
+        ];
+        for (file, text, expected) in cases {
+            let path = d.join(file);
+            std::fs::write(&path, text).unwrap();
+            let e = format!("{:#}", load(&path).unwrap_err());
+            assert!(e.contains(expected) && e.contains(file), "{file}: {e}");
+        }
+        std::fs::remove_dir_all(&d).ok();
+    }
+}
