@@ -19,6 +19,20 @@ const ACQ_REL_STORAGE: u32 = Semantics::ACQUIRE_RELEASE.bits() | Semantics::UNIF
 #[cfg(target_arch = "spirv")]
 const RELAXED: u32 = Semantics::NONE.bits();
 
+/// `slot` as an atomic on the host: what the unstable `AtomicU32::from_mut`
+/// does, on stable Rust (so that crates depending on Treelet build on any
+/// toolchain).
+#[cfg(not(target_arch = "spirv"))]
+#[inline]
+fn host_atomic(slot: &mut u32) -> &core::sync::atomic::AtomicU32 {
+    use core::sync::atomic::AtomicU32;
+    const _: () = assert!(core::mem::align_of::<AtomicU32>() == core::mem::align_of::<u32>());
+    // SAFETY: `slot` is valid, aligned (asserted above) and exclusively
+    // borrowed for the returned reference's lifetime, so no other access,
+    // atomic or not, can overlap it.
+    unsafe { AtomicU32::from_ptr(slot) }
+}
+
 /// Adds `value` to a storage-buffer counter with device scope, relaxed;
 /// returns the previous value.
 #[inline]
@@ -29,8 +43,8 @@ pub fn add_device(slot: &mut u32, value: u32) -> u32 {
     }
     #[cfg(not(target_arch = "spirv"))]
     {
-        use core::sync::atomic::{AtomicU32, Ordering};
-        AtomicU32::from_mut(slot).fetch_add(value, Ordering::Relaxed)
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).fetch_add(value, Ordering::Relaxed)
     }
 }
 
@@ -49,8 +63,8 @@ pub fn add_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     }
     #[cfg(not(target_arch = "spirv"))]
     {
-        use core::sync::atomic::{AtomicU32, Ordering};
-        AtomicU32::from_mut(slot).fetch_add(value, Ordering::AcqRel)
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).fetch_add(value, Ordering::AcqRel)
     }
 }
 
@@ -64,8 +78,8 @@ pub fn exchange_device(slot: &mut u32, value: u32) -> u32 {
     }
     #[cfg(not(target_arch = "spirv"))]
     {
-        use core::sync::atomic::{AtomicU32, Ordering};
-        AtomicU32::from_mut(slot).swap(value, Ordering::Relaxed)
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).swap(value, Ordering::Relaxed)
     }
 }
 
@@ -79,8 +93,8 @@ pub fn exchange_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     }
     #[cfg(not(target_arch = "spirv"))]
     {
-        use core::sync::atomic::{AtomicU32, Ordering};
-        AtomicU32::from_mut(slot).swap(value, Ordering::AcqRel)
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).swap(value, Ordering::AcqRel)
     }
 }
 

@@ -14,8 +14,12 @@ use anyhow::{bail, Context as _, Result};
 
 use crate::runtime::kernels::{Access, Kernel};
 
-/// The SPIR-V module compiled from the `shader` crate by `build.rs`.
+/// The SPIR-V module of the `shader` crate: compiled by `build.rs` with
+/// feature `rebuild-shaders`, else the committed `host/shaders/treelet_shader.spv`.
 pub const SHADER_SPV: &[u8] = include_bytes!(env!("treelet_shader.spv"));
+/// Where the committed SPIR-V module lives (`host/shaders/`): what builds
+/// without feature `rebuild-shaders` use as [`SHADER_SPV`].
+pub const COMMITTED_SHADER_PATH: &str = env!("treelet_shader_committed.spv");
 
 pub struct Pipeline {
     pub pipeline: wgpu::ComputePipeline,

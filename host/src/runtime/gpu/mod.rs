@@ -6,4 +6,4 @@ pub mod backend;
 pub mod context;
 
 pub use backend::GpuBackend;
-pub use context::{quiet_mesa_runtime_dir, GpuContext};
+pub use context::{quiet_mesa_runtime_dir, GpuContext, COMMITTED_SHADER_PATH, SHADER_SPV};
