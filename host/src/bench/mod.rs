@@ -16,6 +16,7 @@ use figure::{Figure, Suite};
 use treelet::runtime::device::{Device, DeviceChoice};
 use measure::*;
 
+mod clocks;
 mod error_curves;
 mod figure;
 mod measure;
@@ -198,12 +199,15 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             let scene = if mesh_only { scene.mesh_only()? } else { scene };
             let plan = RaysPlan { layouts, workgroup_stack };
             let mut rows = Vec::new();
+            let mut clocks = None;
             let adapter = match device.open()? {
                 Device::Gpu(ctx) => {
                     let mut b = GpuBackend::new(ctx);
+                    let before = clocks::read();
                     for &a in &accels {
                         rows.extend(bench_rays(&mut b, &scene, a, &plan, (width, height), repeats)?);
                     }
+                    clocks = Some((before, clocks::read()));
                     b.adapter()
                 }
                 Device::Cpu => {
@@ -215,6 +219,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 }
             };
             println!("rays per second, {} ({} primitives), {width}x{height}, {adapter}, median of {repeats}", scene.name, rows.first().map_or(0, |r| r.primitives));
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
             println!(
                 "{:>6}{:>8}{:>10}{:>11}{:>11}{:>12}{:>12}{:>16}{:>16}{:>16}",
                 "accel", "layout", "stack", "build ms", "layout ms", "primary ms", "diffuse ms", "primary Mray/s", "diffuse Mray/s", "occluded Mray/s"
@@ -239,7 +246,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 );
             }
             if let Some(path) = json {
-                let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows });
+                let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
+                let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows, "clocks": clocks });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())
@@ -326,18 +334,23 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 anyhow::bail!("bench build times the device builders (lbvh, trbvh); time the sweep builder with `treelet build --builder sweep --device cpu`");
             }
             let treelets = (builder == Builder::Trbvh).then_some(&config);
-            let (adapter, timing, rows) = match device.open()? {
+            let (adapter, timing, rows, clocks) = match device.open()? {
                 Device::Gpu(ctx) => {
                     let mut b = GpuBackend::new(ctx).with_per_kernel_times(per_kernel);
                     let ts = if b.context().timestamps { "gpu-timestamps" } else { "wall-clock" };
-                    (b.adapter(), ts, bench_sizes(&mut b, &sizes, repeats, treelets)?)
+                    let before = clocks::read();
+                    let rows = bench_sizes(&mut b, &sizes, repeats, treelets)?;
+                    (b.adapter(), ts, rows, Some((before, clocks::read())))
                 }
                 Device::Cpu => {
                     let mut b = CpuBackend::new();
-                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats, treelets)?)
+                    (b.adapter(), "wall-clock", bench_sizes(&mut b, &sizes, repeats, treelets)?, None)
                 }
             };
             println!("{builder:?} build, {adapter} ({timing}), median of {repeats} (ms)");
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
             let names: Vec<&str> =
                 rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
             let short = |s: &str| s.rsplit("::").next().unwrap_or(s).trim_end_matches("_cs").to_string();
@@ -358,7 +371,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let builder = format!("{builder:?}").to_lowercase();
                 let doc = serde_json::json!({
                     "adapter": adapter, "builder": builder, "treelets": treelets,
-                    "timing": timing, "repeats": repeats, "rows": rows
+                    "timing": timing, "repeats": repeats, "rows": rows,
+                    "clocks": clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }))
                 });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
