@@ -105,6 +105,8 @@ pub struct Tracer<B: Backend> {
     /// The primitives on the host too, for the hits' normals.
     spheres: Vec<Sphere>,
     triangles: Vec<Triangle>,
+    /// Device time of the last build or refit, layout included (ms).
+    update_ms: f64,
 }
 
 impl<B: Backend> Tracer<B> {
@@ -121,8 +123,10 @@ impl<B: Backend> Tracer<B> {
             counts: (spheres.len(), triangles.len()),
             spheres: spheres.to_vec(),
             triangles: triangles.to_vec(),
+            update_ms: 0.0,
         };
-        tracer.lay_out(b)?;
+        let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
+        tracer.update_ms = build_ms + tracer.lay_out(b)?;
         Ok(tracer)
     }
 
@@ -143,21 +147,36 @@ impl<B: Backend> Tracer<B> {
         }
         let all = Primitives { spheres, triangles };
         all.check()?;
-        if let Some(built) = &self.built {
-            refit(b, &built.bvh, all)?;
-        }
+        let refit_ms = match &self.built {
+            Some(built) => refit(b, &built.bvh, all)?.total(),
+            None => 0.0,
+        };
         self.prims = PrimBuffers::upload(b, all)?;
         (self.spheres, self.triangles) = (spheres.to_vec(), triangles.to_vec());
-        self.lay_out(b)
+        self.update_ms = refit_ms + self.lay_out(b)?;
+        Ok(())
+    }
+
+    /// Device time of the last [`Tracer::build`] or [`Tracer::refit`], in
+    /// ms: the tree's build or refit and its layout for tracing (GPU
+    /// timestamps where the device has them; wall clock on the CPU runner).
+    /// Uploads and the host's work are not in it.
+    pub fn last_update_ms(&self) -> f64 {
+        self.update_ms
     }
 
     /// The two-box binary layout: the fastest to trace in our measurements.
-    fn lay_out(&mut self, b: &mut B) -> Result<()> {
-        self.tree = match &self.built {
-            Some(built) => Some(built.lay_out(b, Layout::Bvh2, &self.prims)?.0),
-            None => None,
+    /// Returns its device time (ms).
+    fn lay_out(&mut self, b: &mut B) -> Result<f64> {
+        let (tree, ms) = match &self.built {
+            Some(built) => {
+                let (tree, ms) = built.lay_out(b, Layout::Bvh2, &self.prims)?;
+                (Some(tree), ms)
+            }
+            None => (None, 0.0),
         };
-        Ok(())
+        self.tree = tree;
+        Ok(ms)
     }
 
     /// The closest hit of each ray, with its hit record (see [`RayHit`]).

@@ -184,6 +184,25 @@ fn bench_rays_mesh_only() {
     assert!(e.contains("has no triangles"), "{e}");
 }
 
+/// `bench dynamic` animates a mesh frame by frame (refit, rebuilds, rays)
+/// and writes what it measured; a scene without triangles is refused.
+#[test]
+fn bench_dynamic_times_refit_rebuild_and_rays() {
+    let json = std::env::temp_dir().join(format!("treelet-dynamic-{}.json", std::process::id()));
+    let args = ["bench", "dynamic", "--device", "cpu", "--frames", "2", "--width", "16", "--height", "12"];
+    let out = treelet(&[&args[..], &["--scene", "terrain:800", "--json", json.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = &doc["row"];
+    assert_eq!((row["triangles"].as_u64(), row["rays"].as_u64(), row["frames"].as_u64()), (Some(800), Some(192), Some(2)), "{doc}");
+    for key in ["refit_ms", "rebuild_lbvh_ms", "rebuild_trbvh_ms", "closest_refit_mrays", "occluded_rebuilt_mrays"] {
+        assert!(row[key].as_f64().is_some_and(|v| v > 0.0 && v.is_finite()), "{key}: {doc}");
+    }
+    std::fs::remove_file(&json).ok();
+    let e = stderr_of(&[&args[..], &["--scene", "random:10"]].concat());
+    assert!(e.contains("has no triangles"), "{e}");
+}
+
 #[test]
 fn figure_writes_json_png_and_results() {
     let dir = std::env::temp_dir().join(format!("treelet-figure-{}", std::process::id()));

@@ -17,6 +17,7 @@ use treelet::runtime::device::{Device, DeviceChoice};
 use measure::*;
 
 mod clocks;
+mod dynamic;
 mod error_curves;
 mod figure;
 mod measure;
@@ -137,6 +138,26 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+    /// An animated mesh through the engine API: per frame, refit against
+    /// rebuild (LBVH, TRBVH), and one frame's rays (closest hits and
+    /// occlusion queries) through the refit and the rebuilt tree.
+    Dynamic {
+        /// The mesh: terrain:N, an .obj/.ply mesh or a .gltf/.glb scene (its triangles).
+        #[arg(long, default_value = "terrain:1000000")]
+        scene: String,
+        /// Timed frames (after one warm-up frame).
+        #[arg(long, default_value_t = 11)]
+        frames: usize,
+        /// The frame's rays: a grid of this many looking down onto the mesh.
+        #[arg(long, default_value_t = 1920)]
+        width: u32,
+        #[arg(long, default_value_t = 1080)]
+        height: u32,
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: DeviceChoice,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
     /// Specialized render kernels against the general one (--kernel full):
     /// render-kernel time per scene, and each kernel's SPIR-V size.
     Variants {
@@ -194,6 +215,28 @@ const VARIANT_SCENES: [&str; 5] =
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
+        BenchCommand::Dynamic { scene, frames, width, height, device, json } => {
+            let scene = Scene::from_spec(&scene)?;
+            let device = device.open()?;
+            let before = clocks::read();
+            let (adapter, row) = treelet::with_backend!(&device, |b| (b.adapter(), dynamic::bench_dynamic(b, &scene, frames, (width, height))?));
+            let clocks = matches!(device, Device::Gpu(_)).then(|| (before, clocks::read()));
+            println!("dynamic mesh {} ({} triangles), {} rays a frame, {adapter}, median of {frames} frames", scene.name, row.triangles, row.rays);
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
+            println!("  refit            {:>9.3} ms  (wall {:.3})", row.refit_ms, row.wall_refit_ms);
+            println!("  rebuild, LBVH    {:>9.3} ms  (wall {:.3})", row.rebuild_lbvh_ms, row.wall_rebuild_lbvh_ms);
+            println!("  rebuild, TRBVH   {:>9.3} ms  (wall {:.3})", row.rebuild_trbvh_ms, row.wall_rebuild_trbvh_ms);
+            println!("  closest hits     {:>9.1} Mray/s refit, {:.1} rebuilt (TRBVH)", row.closest_refit_mrays, row.closest_rebuilt_mrays);
+            println!("  occlusion        {:>9.1} Mray/s refit, {:.1} rebuilt (TRBVH)", row.occluded_refit_mrays, row.occluded_rebuilt_mrays);
+            if let Some(path) = json {
+                let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
+                let doc = serde_json::json!({ "adapter": adapter, "scene": scene.name, "clocks": clocks, "row": row });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
         BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, json } => {
             let scene = Scene::from_spec(&scene)?;
             let scene = if mesh_only { scene.mesh_only()? } else { scene };
