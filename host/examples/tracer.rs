@@ -1,7 +1,10 @@
 //! Treelet inside an engine: a tree over the engine's own triangles and
 //! spheres on a device, closest hits for a batch of rays, then the geometry
 //! moves, the tree is refit and the rays traced again. Every hit is checked
-//! against a scan of every primitive (`treelet_core`'s reference).
+//! against a scan of every primitive (`treelet_core`'s reference). Then a
+//! frame loop: refit or rebuild, camera rays, shadow rays as occlusion
+//! queries, and the device time of each (there are no instances yet: the
+//! moving balls are part of the one tree).
 //!
 //!     cargo run --release -p treelet --example tracer            # the first Vulkan adapter
 //!     cargo run --release -p treelet --example tracer -- cpu     # the CPU runner
@@ -85,6 +88,58 @@ fn run<B: Backend>(b: &mut B) -> Result<()> {
     Ok(())
 }
 
+/// An engine's frame loop: the waves and balls move every frame; the tree
+/// is refit each frame and rebuilt every fourth (a refit tree slows down as
+/// the geometry drifts from what it was built for); each frame traces its
+/// camera rays, then shadow rays from their hits towards a sun as occlusion
+/// queries, and prints what each step cost on the device.
+fn frame_loop<B: Backend>(b: &mut B, frames: usize) -> Result<()> {
+    let rays = rays();
+    let sun = Vec3::new(0.3, 1.0, 0.2).normalize();
+    let first = geometry(0.0);
+    let mut tracer = Tracer::build(b, &first.0, &first.1, Quality::Fast)?;
+    for frame in 1..=frames {
+        let scene = geometry(frame as f32 * 0.2);
+        let update = if frame % 4 == 0 {
+            tracer = Tracer::build(b, &scene.0, &scene.1, Quality::Fast)?;
+            "rebuild"
+        } else {
+            tracer.refit(b, &scene.0, &scene.1)?;
+            "refit"
+        };
+        let update_ms = tracer.last_update_ms();
+        b.take_times()?;
+        let hits = tracer.closest_hits(b, &rays)?;
+        // Shadow rays leave each hit a little off the surface, on the side
+        // the camera ray came from (the geometric normal's side depends on
+        // the triangle's winding), towards the sun.
+        let shadow: Vec<Ray> = rays
+            .iter()
+            .zip(&hits)
+            .filter(|(_, h)| h.is_hit())
+            .map(|(r, h)| {
+                let d = Vec3::from(r.dir).normalize();
+                let n = Vec3::from(h.normal);
+                let facing = if n.dot(d) < 0.0 { n } else { -n };
+                let x = Vec3::from(r.origin) + d * h.t + facing * 1e-3;
+                Ray::new(x.into(), sun.into())
+            })
+            .collect();
+        let shadowed = tracer.occluded(b, &shadow)?;
+        let trace_ms = b.take_times()?.get("trace");
+        println!(
+            "frame {frame}: {update} {update_ms:.3} ms, {} rays and {} shadow rays traced in {trace_ms:.3} ms, {} in shadow",
+            rays.len(),
+            shadow.len(),
+            shadowed.iter().filter(|&&s| s).count()
+        );
+        ensure!(shadow.len() > rays.len() / 2, "most rays should hit the waves");
+        let in_shadow = shadowed.iter().filter(|&&s| s).count();
+        ensure!(in_shadow > 0 && in_shadow < shadow.len() / 2, "{in_shadow} of {} points in shadow: the balls shade a part of the waves", shadow.len());
+    }
+    Ok(())
+}
+
 /// Rays that live on the GPU already (an engine's own `wgpu::Buffer`):
 /// traced in place, without a round trip through host memory.
 fn on_device(ctx: std::sync::Arc<GpuContext>) -> Result<()> {
@@ -115,16 +170,22 @@ fn on_device(ctx: std::sync::Arc<GpuContext>) -> Result<()> {
 
 fn main() -> Result<()> {
     if std::env::args().nth(1).as_deref() == Some("cpu") {
-        return run(&mut CpuBackend::new());
+        let b = &mut CpuBackend::new();
+        run(b)?;
+        return frame_loop(b, 8);
     }
     match GpuContext::new() {
         Ok(ctx) => {
-            run(&mut GpuBackend::new(ctx.clone()))?;
+            let b = &mut GpuBackend::new(ctx.clone());
+            run(b)?;
+            frame_loop(b, 8)?;
             on_device(ctx)
         }
         Err(e) => {
             eprintln!("note: {e}: running on the CPU runner instead");
-            run(&mut CpuBackend::new())
+            let b = &mut CpuBackend::new();
+            run(b)?;
+            frame_loop(b, 8)
         }
     }
 }
@@ -136,6 +197,7 @@ mod tests {
     #[test]
     fn runs_on_the_cpu_runner() {
         run(&mut CpuBackend::new()).unwrap();
+        frame_loop(&mut CpuBackend::new(), 4).unwrap();
     }
 
     /// With `CI` set, a machine without a usable adapter fails this test.
