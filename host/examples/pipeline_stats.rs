@@ -52,8 +52,6 @@ fn main() -> Result<()> {
             .push_next(&mut v12);
         let device = instance.create_device(pdev, &info, None).context("device without pipeline statistics")?;
         let stats = ash::khr::pipeline_executable_properties::Device::new(&instance, &device);
-        let words = ash::util::read_spv(&mut std::io::Cursor::new(treelet::runtime::gpu::context::SHADER_SPV))?;
-        let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
         // One layout that covers every kernel's bindings: storage buffers 0..16.
         let bindings: Vec<_> = (0..16)
             .map(|b| {
@@ -69,6 +67,9 @@ fn main() -> Result<()> {
         let layout = device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&sets), None)?;
         for name in &names {
             let cname = CString::new(name.as_str())?;
+            let Some(m) = treelet::runtime::gpu::shaders::module(name) else { bail!("no entry point `{name}`") };
+            let words = ash::util::read_spv(&mut std::io::Cursor::new(m.spirv))?;
+            let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
             let stage = vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::COMPUTE)
                 .module(module)
@@ -98,10 +99,10 @@ fn main() -> Result<()> {
             }
             println!("{line}");
             device.destroy_pipeline(pipeline, None);
+            device.destroy_shader_module(module, None);
         }
         device.destroy_pipeline_layout(layout, None);
         device.destroy_descriptor_set_layout(set, None);
-        device.destroy_shader_module(module, None);
         device.destroy_device(None);
         instance.destroy_instance(None);
     }

@@ -14,12 +14,7 @@ use anyhow::{bail, Context as _, Result};
 
 use crate::runtime::kernels::{Access, Kernel};
 
-/// The SPIR-V module of the `shader` crate: compiled by `build.rs` with
-/// feature `rebuild-shaders`, else the committed `host/shaders/treelet_shader.spv`.
-pub const SHADER_SPV: &[u8] = include_bytes!(env!("treelet_shader.spv"));
-/// Where the committed SPIR-V module lives (`host/shaders/`): what builds
-/// without feature `rebuild-shaders` use as [`SHADER_SPV`].
-pub const COMMITTED_SHADER_PATH: &str = env!("treelet_shader_committed.spv");
+use super::shaders::{self, SHADERS};
 
 pub struct Pipeline {
     pub pipeline: wgpu::ComputePipeline,
@@ -37,7 +32,6 @@ pub struct GpuContext {
     /// The adapter's largest device-local memory heap, in bytes (for lavapipe,
     /// the host's memory), if Vulkan says.
     pub device_memory: Option<u64>,
-    module: wgpu::ShaderModule,
     pipelines: Mutex<HashMap<Kernel, Arc<Pipeline>>>,
     /// The driver's compiled pipelines, kept on disk between runs.
     cache: Option<DiskCache>,
@@ -54,7 +48,8 @@ pub struct GpuContext {
 pub struct Startup {
     /// Vulkan instance, adapter and device.
     pub device_s: f64,
-    /// The SPIR-V module (passed through to the driver).
+    /// Reading the SPIR-V modules (one per entry point, passed through to
+    /// the driver as each pipeline is built).
     pub module_s: f64,
     /// Whether a pipeline cache from an earlier run was found.
     pub cache_loaded: bool,
@@ -83,7 +78,7 @@ fn cache_dir() -> Option<PathBuf> {
 /// build gets its own file, so that caches do not grow without end).
 fn cache_file(info: &wgpu::AdapterInfo) -> Option<PathBuf> {
     let key = wgpu::util::pipeline_cache_key(info)?;
-    let hash = SHADER_SPV.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3));
+    let hash = SHADERS.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3));
     Some(cache_dir()?.join(format!("{key}_{hash:016x}.bin")))
 }
 
@@ -189,7 +184,8 @@ impl GpuContext {
             .await
             .with_context(|| format!("could not open adapter `{}`", info.name))?;
         let device_s = start.elapsed().as_secs_f64();
-        let module = shader_module(&device);
+        // Unpacks the modules now, so that a damaged file fails here.
+        let _ = shaders::module("");
         let module_s = start.elapsed().as_secs_f64() - device_s;
         let mut startup = Startup { device_s, module_s, cache_loaded: false };
         let cache = cache_path.map(|path| {
@@ -203,7 +199,7 @@ impl GpuContext {
             };
             DiskCache { cache, path }
         });
-        Ok(Arc::new(Self { device, queue, info, limits, timestamps, device_memory, module, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
+        Ok(Arc::new(Self { device, queue, info, limits, timestamps, device_memory, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
     }
 
     /// The pipeline of `kernel`, built the first time it is asked for (the
@@ -215,7 +211,7 @@ impl GpuContext {
         }
         // Built without holding the map, so that several build at once.
         let start = Instant::now();
-        let p = Arc::new(build_pipeline(&self.device, &self.module, kernel, self.cache.as_ref().map(|c| &c.cache)));
+        let p = Arc::new(build_pipeline(&self.device, kernel, self.cache.as_ref().map(|c| &c.cache)));
         let seconds = start.elapsed().as_secs_f64();
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(first) = pipelines.get(&kernel) {
@@ -315,24 +311,25 @@ pub fn quiet_mesa_runtime_dir() {
     }
 }
 
-fn shader_module(device: &wgpu::Device) -> wgpu::ShaderModule {
-    let words = wgpu::util::make_spirv_raw(SHADER_SPV);
-    let entry_points: Vec<_> = Kernel::all()
-        .iter()
-        .map(|k| wgpu::PassthroughShaderEntryPoint { name: k.entry_point().into(), workgroup_size: (256, 1, 1) })
-        .collect();
+/// The module of `kernel`'s entry point alone (see [`shaders`]).
+fn shader_module(device: &wgpu::Device, kernel: Kernel) -> wgpu::ShaderModule {
+    let entry_point = kernel.entry_point();
+    let module = shaders::module(entry_point)
+        .unwrap_or_else(|| panic!("the SPIR-V built into treelet has no entry point `{entry_point}`"));
     // SAFETY: the module is rust-gpu output validated by spirv-val at build time.
     unsafe {
         device.create_shader_module_passthrough(wgpu::ShaderModuleDescriptorPassthrough {
-            label: Some("treelet_shader"),
-            entry_points: entry_points.into(),
-            spirv: Some(words),
+            label: Some(entry_point),
+            entry_points: vec![wgpu::PassthroughShaderEntryPoint { name: entry_point.into(), workgroup_size: (256, 1, 1) }]
+                .into(),
+            spirv: Some(wgpu::util::make_spirv_raw(module.spirv)),
             ..Default::default()
         })
     }
 }
 
-fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Kernel, cache: Option<&wgpu::PipelineCache>) -> Pipeline {
+fn build_pipeline(device: &wgpu::Device, kernel: Kernel, cache: Option<&wgpu::PipelineCache>) -> Pipeline {
+            let module = &shader_module(device, kernel);
             let entries: Vec<_> = kernel
                 .bindings()
                 .iter()
@@ -368,35 +365,9 @@ fn build_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, kernel: Ke
             Pipeline { pipeline, layout }
 }
 
-/// Size in 32-bit words of an entry point's function in the shader module
-/// (rust-gpu inlines everything a kernel calls into it), or None if the
-/// module has no such entry point: the code size of one kernel variant.
+/// Size in 32-bit words of an entry point's module, or None if there is no
+/// such entry point: the code size of one kernel variant (rust-gpu inlines
+/// everything a kernel calls into it).
 pub fn entry_point_words(name: &str) -> Option<usize> {
-    const OP_ENTRY_POINT: u32 = 15;
-    const OP_FUNCTION: u32 = 54;
-    const OP_FUNCTION_END: u32 = 56;
-    let words: Vec<u32> = SHADER_SPV.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-    let mut target = None;
-    let (mut i, mut start) = (5, None);
-    while i < words.len() {
-        let (count, op) = ((words[i] >> 16) as usize, words[i] & 0xffff);
-        if count == 0 {
-            return None;
-        }
-        let operands = &words[i + 1..(i + count).min(words.len())];
-        match op {
-            OP_ENTRY_POINT if operands.len() > 2 => {
-                let bytes: Vec<u8> = operands[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
-                let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
-                if &bytes[..end] == name.as_bytes() {
-                    target = Some(operands[1]);
-                }
-            }
-            OP_FUNCTION if operands.len() > 1 && Some(operands[1]) == target => start = Some(i),
-            OP_FUNCTION_END if start.is_some() => return start.map(|s| i + count - s),
-            _ => {}
-        }
-        i += count;
-    }
-    None
+    shaders::module(name).map(|m| m.words())
 }
