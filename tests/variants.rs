@@ -7,7 +7,8 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
-use treelet::bvh::tree::Accel;
+use treelet::bvh::choice::{cheaper_builder, Work};
+use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::{render, RenderResult, RenderSettings};
 use treelet::scene::{cornell, mesh_scene, random_scene, Scene};
 use treelet::render::variant::{plan, KernelChoice, SceneFeatures, LINEAR_MAX_CPU, TRIANGLE_SCAN_WEIGHT};
@@ -114,7 +115,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner);
+            let p = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
             if scene.materials.iter().any(|m| m.kind == treelet_core::geometry::buffers::GLASS) {
@@ -122,10 +123,28 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
             }
             let cost = scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len();
             assert_eq!(p.accel == Accel::None, cost <= LINEAR_MAX_CPU, "{}: scan cost {cost}, {:?}", scene.name, p.accel);
+            // Above it, the builder that finishes first by the measured trade-off.
+            if cost > LINEAR_MAX_CPU {
+                let n = scene.spheres.len() + scene.triangles.len();
+                let cpu = treelet::runtime::backend::DeviceClass::CpuRunner;
+                let expected = match cheaper_builder(cpu, n, Work::Paths(1 << 20)).0 {
+                    Builder::Trbvh => Accel::Trbvh,
+                    _ => Accel::Lbvh,
+                };
+                assert_eq!(p.accel, expected, "{}: {}", scene.name, p.accel_reason);
+            }
+        }
+        // On a GPU, a render long enough pays for the treelets, a short one does not.
+        if scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len() > LINEAR_MAX_CPU {
+            let gpu = treelet::runtime::backend::DeviceClass::Gpu;
+            assert_eq!(plan(&scene, 1, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu).accel, Accel::Lbvh);
+            let long = plan(&scene, 1 << 40, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu);
+            assert_eq!(long.accel, Accel::Trbvh, "{}", scene.name);
+            assert!(long.accel_reason.contains("pays for"), "{}", long.accel_reason);
         }
         // Forced choices stay as asked.
         use treelet::runtime::backend::DeviceClass::Gpu;
-        assert_eq!(plan(&scene, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu).accel, Accel::Sweep);
-        assert_eq!(plan(&scene, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu).layout, Layout::Cwbvh);
+        assert_eq!(plan(&scene, 1 << 40, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, 1, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu).layout, Layout::Cwbvh);
     }
 }

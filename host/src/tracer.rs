@@ -23,10 +23,11 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
+use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::refit;
 use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
-use crate::runtime::backend::Backend;
+use crate::runtime::backend::{Backend, DeviceClass};
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
 
@@ -81,14 +82,23 @@ pub enum Quality {
     /// The LBVH after treelet restructuring (Karras & Aila 2013): about ten
     /// times the build time, faster rays.
     High,
+    /// Whichever of the two gives the least build plus trace time when each
+    /// build serves this many rays, by the trade-off measured on the
+    /// device's class ([`crate::bvh::choice`]). An engine that builds every
+    /// frame passes one frame's rays; one that builds once, all the rays it
+    /// will trace. On the H100 the LBVH wins below about 8M rays a build
+    /// for any mesh, and below about 50M for a mesh of 1M triangles.
+    ForRays(u64),
 }
 
 impl Quality {
-    /// The builder this quality stands for.
-    pub fn builder(self) -> Builder {
+    /// The builder this quality stands for on a device of `class`, for
+    /// `prims` primitives.
+    pub fn builder(self, class: DeviceClass, prims: usize) -> Builder {
         match self {
             Quality::Fast => Builder::Lbvh,
             Quality::High => Builder::Trbvh,
+            Quality::ForRays(rays) => cheaper_builder(class, prims, Work::Rays(rays)).0,
         }
     }
 }
@@ -115,7 +125,7 @@ impl<B: Backend> Tracer<B> {
     pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> Result<Self> {
         let all = Primitives { spheres, triangles };
         all.check()?;
-        let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder())?) };
+        let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
         let mut tracer = Tracer {
             built,
             prims: PrimBuffers::upload(b, all)?,

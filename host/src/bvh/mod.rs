@@ -10,9 +10,11 @@
 //! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
 //! - [`tree`]: the tree a render or an engine asks for: the builder's
 //!   choice ([`tree::Accel`]), its binary tree, and that tree laid out;
+//! - [`choice`]: which builder finishes a render's or a frame's work first;
 //! - [`validate`], [`validate_layout`]: independent checks that share no
 //!   code with the kernels;
 //! - [`report`]: one build, timed and checked (the `treelet build` command).
+pub mod choice;
 pub mod layout;
 pub mod lbvh;
 pub mod refit;

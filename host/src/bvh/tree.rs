@@ -30,8 +30,9 @@ pub enum Builder {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Accel {
-    /// A linear scan for scenes below the measured crossover, else trbvh
-    /// (see `treelet::render::variant::plan`).
+    /// A linear scan for scenes below the measured crossover, else lbvh or
+    /// trbvh, whichever the measured costs say finishes the render first
+    /// (see `treelet::render::variant::plan`, `treelet::bvh::choice`).
     Auto,
     /// Test every primitive.
     None,

@@ -75,7 +75,7 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
 /// before its timed work: a fresh machine's driver compiles each for
 /// seconds, so all at once ([`Backend::prepare_kernels`]).
 pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
-    let plan = variant::plan(scene, settings.accel, settings.layout, settings.kernel, b.class());
+    let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class());
     let kernels = kernels(b, &plan);
     b.prepare_kernels(&kernels);
 }
@@ -115,7 +115,7 @@ impl<B: Backend> Prepared<B> {
                 );
             }
         }
-        let plan = variant::plan(scene, accel, layout, kernel, b.class());
+        let plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class());
         let (tree, buffers, build_ms) = traced_tree(b, all, plan.accel, plan.layout)?;
         let materials = b.upload("materials", &scene.materials)?;
         let table = light_table(all, &scene.materials);

@@ -68,6 +68,13 @@ pub struct RenderSettings {
     pub first_sample: u32,
 }
 
+impl RenderSettings {
+    /// Camera paths the render traces: pixels times samples.
+    pub fn paths(&self) -> u64 {
+        self.width as u64 * self.height as u64 * self.spp as u64
+    }
+}
+
 /// Camera paths per dispatch at most, so that no dispatch runs long enough
 /// for a driver to time it out, whatever the sample count.
 pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;

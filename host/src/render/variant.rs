@@ -7,8 +7,9 @@ use treelet_core::geometry::buffers::{DIFFUSE, GLASS, MIRROR};
 use treelet_core::geometry::features;
 use treelet_core::render::variants::VARIANTS;
 
+use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::Layout;
-use crate::bvh::tree::Accel;
+use crate::bvh::tree::{Accel, Builder};
 use crate::runtime::backend::DeviceClass;
 use crate::runtime::kernels::Method;
 use crate::scene::Scene;
@@ -158,10 +159,12 @@ pub struct Plan {
 }
 
 /// Chooses the acceleration structure, its layout and the kernel variant
-/// for `scene` on a device that `runs_on_cpu` or not. `Accel::Auto` picks
-/// the linear scan up to the measured crossover, else the treelet-optimized
-/// BVH; `Layout::Auto` the fastest measured layout.
-pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
+/// for rendering `paths` camera paths (pixels times samples) of `scene` on
+/// a device of `class`. `Accel::Auto` picks the linear scan up to the
+/// measured crossover, else the LBVH or the treelet-optimized BVH, whichever
+/// gives the least build plus render time ([`cheaper_builder`]);
+/// `Layout::Auto` the fastest measured layout.
+pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
     let features = SceneFeatures::of(scene);
     let (n, cost) = (features.primitives(), features.scan_cost());
     let runs_on_cpu = class != DeviceClass::Gpu;
@@ -173,12 +176,17 @@ pub fn plan(scene: &Scene, accel: Accel, layout: Layout, kernel: KernelChoice, c
                 "{n} primitives, scan cost {cost} (a triangle counts {TRIANGLE_SCAN_WEIGHT} spheres): a linear scan is faster than a BVH up to {linear_max} on {device}"
             ),
         ),
-        Accel::Auto => (
-            Accel::Trbvh,
-            format!(
-                "{n} primitives, scan cost {cost} (a triangle counts {TRIANGLE_SCAN_WEIGHT} spheres): above {linear_max} a BVH is faster on {device}; treelet-optimized"
-            ),
-        ),
+        Accel::Auto => {
+            let (builder, why) = cheaper_builder(class, n, Work::Paths(paths));
+            let accel = if builder == Builder::Trbvh { Accel::Trbvh } else { Accel::Lbvh };
+            (
+                accel,
+                format!(
+                    "{n} primitives, scan cost {cost} (a triangle counts {TRIANGLE_SCAN_WEIGHT} spheres): above {linear_max} a BVH is faster on {device}; {}: {why}",
+                    accel.name()
+                ),
+            )
+        }
         other => (other, "as asked (--accel)".to_string()),
     };
     let (layout, layout_reason) = match layout {

@@ -1,0 +1,8 @@
+for f in .gl/*.deb; do dpkg -x $f / ; done >/dev/null 2>&1; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json CI=true
+exec > >(tee $OUT/log.txt) 2>&1
+cd .dev
+nvidia-smi --query-gpu=name --format=csv,noheader
+timeout -s KILL 60 ./treelet render --scene terrain:1000000 --accel lbvh --width 256 --height 192 --spp 1 --out /tmp/w.png 2>&1 | tail -1
+for rep in 1 2; do for a in lbvh trbvh; do for s in 4 36; do echo "== $a spp $s"; timeout -s KILL 60 ./treelet render --scene terrain:1000000 --accel $a --width 1024 --height 768 --spp $s --out /tmp/t.png 2>&1 | tail -1; done; done; done
+echo "== rays"; timeout -s KILL 90 ./treelet bench rays --scene terrain:1000000 --mesh-only --layouts bvh2 --width 1920 --height 1080 --repeats 7 2>&1 | tail -4
