@@ -136,6 +136,9 @@ mod tests {
                 }
                 assert!(flips <= 1, "{class:?}: the choice flips {flips} times");
             }
+            // The extremes tests/tracer.rs relies on.
+            assert_eq!(cheaper_builder(class, 100_000, Work::Rays(1)).0, Builder::Lbvh);
+            assert_eq!(cheaper_builder(class, 100_000, Work::Rays(1 << 40)).0, Builder::Trbvh);
         }
     }
 
