@@ -159,7 +159,8 @@ pub struct Path {
     /// the light adds if the ray reaches `shadow_light` first: if an
     /// occlusion query finds nothing else up to `shadow_t`, where the ray
     /// meets the light (it stops at the first occluder, and the light is
-    /// never its own).
+    /// never its own); through a scan, if the light is its closest hit (see
+    /// [`ClosestHit::OCCLUSION_STOPS_EARLY`]).
     shadow_light: u32,
     shadow_t: f32,
     shadow_value: Vec3,
@@ -225,12 +226,16 @@ impl Path {
         }
         let nee = params.integrator == NEE && params.light_count > 0;
         let shadow = self.shadow_light != NO_LIGHT;
-        let query = if shadow { Query::occlusion(self.shadow_t, self.shadow_light) } else { Query::CLOSEST };
+        let occlusion = shadow && T::OCCLUSION_STOPS_EARLY;
+        let query = if occlusion { Query::occlusion(self.shadow_t, self.shadow_light) } else { Query::CLOSEST };
         let hit = trace::<T, F, S>(self.o, self.d, self.from, query, scene, stack, lane);
         if shadow {
             // Anything else first, glass too, occludes it: paths through
-            // glass reach a light by their bounces, at full weight.
-            if !hit.is_hit() {
+            // glass reach a light by their bounces, at full weight. (Through
+            // a scan, the shadow ray is a closest hit: it reaches the light
+            // if the light is what it hits.)
+            let reached = if T::OCCLUSION_STOPS_EARLY { !hit.is_hit() } else { hit.prim == self.shadow_light };
+            if reached {
                 self.result += self.shadow_value;
             }
             self.shadow_light = NO_LIGHT;
@@ -278,7 +283,9 @@ impl Path {
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
             if nee {
                 let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
-                if s.light != NO_LIGHT {
+                if s.light != NO_LIGHT && !T::OCCLUSION_STOPS_EARLY {
+                    (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                } else if s.light != NO_LIGHT {
                     // Where the shadow ray (as traced below) meets the light,
                     // by the test the traversal itself would make; a ray
                     // that grazes past it numerically carries nothing.

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use crate::geometry::buffers::Node;
 use crate::geometry::features::{self};
-use crate::geometry::intersect::{ray_box, safe_inverse};
+use crate::geometry::intersect::{MISS, ray_box, safe_inverse};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
@@ -25,6 +25,11 @@ impl Scan {
 }
 
 impl ClosestHit for Scan {
+    /// On the H100 (smallpt's room, 1024x768 at 1024 spp, kernel time) the
+    /// shadow ray as an occlusion query up to the light's distance took
+    /// 0.802 s, as a closest hit 0.756 s (before occlusion queries: 0.748).
+    const OCCLUSION_STOPS_EARLY: bool = false;
+
     #[inline]
     fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
         trace_linear::<F>(o, d, from, query, prims)
@@ -70,22 +75,32 @@ pub fn closest_hit_linear_for<const F: u32>(o: Vec3, d: Vec3, from: Origin, prim
 }
 
 /// [`closest_hit_linear_for`] for any [`Query`].
+///
+/// One loop, and no early stop for an occlusion query: the closest hit up
+/// to `t_max` other than `skip` answers it too, and a scan of the few
+/// primitives it is chosen for gains less by stopping than its loop loses
+/// by asking. On the H100 (smallpt's room, 1024x768 at 1024 spp, kernel
+/// time) a loop that stopped at an occlusion query's first hit took 0.882 s
+/// against 0.748 s before occlusion queries, and two loops (one per kind of
+/// query) 1.019 s.
 #[inline]
 pub fn trace_linear<const F: u32>(o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims) -> Hit {
-    let mut hit = query.start();
     let ray = WatertightRay::new(o, d);
-    let mut i = 0;
     let count = prims.count();
-    // An occlusion query stops at its first hit (by the condition, not a
-    // `return` from inside the loop: see `trace::bvh2`).
-    while i < count && !query.done(&hit) {
+    // In index order the first of equal distances stays (the lower index,
+    // as [`Hit::is_beaten_by`] picks) with a plain `<`; starting just past
+    // `t_max` keeps a hit at exactly `t_max` (the bound is inclusive).
+    let start = query.start();
+    let mut hit = Hit { t: if start.t < MISS { start.t.next_up() } else { start.t }, prim: u32::MAX };
+    let mut i = 0;
+    while i < count {
         let t = prims.distance::<F>(o, d, &ray, from, i, hit.t);
-        if i != query.skip && hit.is_beaten_by(t, i) {
+        if t < hit.t && i != query.skip {
             hit = Hit { t, prim: i };
         }
         i += 1;
     }
-    hit
+    if hit.is_hit() { hit } else { start }
 }
 
 /// Walks the BVH rooted at node 0 (`2 * count - 1` nodes), nearest child

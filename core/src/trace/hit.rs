@@ -11,6 +11,12 @@ use crate::geometry::prims::{Origin, Prims};
 /// [`crate::trace::cwbvh`]). The renderer and the ray-casting kernels are generic
 /// over it, so each layout gets kernels of its own.
 pub trait ClosestHit {
+    /// Whether an occlusion query pays here: a walk that stops at its first
+    /// hit saves the rest of the walk. The scan tests every primitive in any
+    /// case, so the renderer's shadow ray through it is a closest hit,
+    /// checked against the light (no test of the light's distance first).
+    const OCCLUSION_STOPS_EARLY: bool = true;
+
     /// What `query` asks of the ray `o + t d` (`d` of unit length) among the
     /// primitives: the closest hit up to `query.t_max`, ties to the lower
     /// index, or any hit up to it; `F` (see [`crate::geometry::features`])
