@@ -25,7 +25,7 @@ use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
 use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
-use crate::bvh::refit::refit;
+use crate::bvh::refit::refit_uploaded;
 use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
 use crate::runtime::backend::{Backend, DeviceClass};
 use crate::runtime::kernels::{Kernel, Method};
@@ -126,9 +126,20 @@ impl<B: Backend> Tracer<B> {
         let all = Primitives { spheres, triangles };
         all.check()?;
         let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
+        // The build's own upload of the primitives where it made one (as
+        // `bvh::tree::traced_tree` does): uploaded once, not twice.
+        let prims = match built.as_ref().and_then(|t| t.bvh.prims.clone()) {
+            Some((spheres, triangles)) => PrimBuffers {
+                spheres,
+                triangles,
+                sphere_count: all.spheres.len() as u32,
+                triangle_count: all.triangles.len() as u32,
+            },
+            None => PrimBuffers::upload(b, all)?,
+        };
         let mut tracer = Tracer {
             built,
-            prims: PrimBuffers::upload(b, all)?,
+            prims,
             tree: None,
             counts: (spheres.len(), triangles.len()),
             spheres: spheres.to_vec(),
@@ -157,12 +168,14 @@ impl<B: Backend> Tracer<B> {
         }
         let all = Primitives { spheres, triangles };
         all.check()?;
+        // Uploaded once, for the refit and for tracing.
+        self.prims = PrimBuffers::upload(b, all)?;
         let refit_ms = match &self.built {
-            Some(built) => refit(b, &built.bvh, all)?.total(),
+            Some(built) => refit_uploaded(b, &built.bvh, &self.prims)?.total(),
             None => 0.0,
         };
-        self.prims = PrimBuffers::upload(b, all)?;
-        (self.spheres, self.triangles) = (spheres.to_vec(), triangles.to_vec());
+        self.spheres.copy_from_slice(spheres);
+        self.triangles.copy_from_slice(triangles);
         self.update_ms = refit_ms + self.lay_out(b)?;
         Ok(())
     }

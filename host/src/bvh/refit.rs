@@ -8,7 +8,8 @@ use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::BuildParams;
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
+use crate::bvh::layout::PrimBuffers;
+use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
 use crate::scene::primitives::Primitives;
@@ -16,20 +17,28 @@ use crate::scene::primitives::Primitives;
 /// Rewrites the boxes of `bvh`'s nodes for `prims`, which must be the
 /// primitives it was built over (same count and order), moved.
 pub fn refit<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: Primitives) -> Result<StageTimes> {
+    if prims.len() != bvh.n as usize {
+        bail!("refit with {} primitives: the tree was built over {}", prims.len(), bvh.n);
+    }
+    let uploaded = PrimBuffers::upload(b, prims)?;
+    refit_uploaded(b, bvh, &uploaded)
+}
+
+/// [`refit`] from primitives already on the device (an engine's tracer
+/// uploads them once, for the refit and for tracing).
+pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
     let n = bvh.n;
-    if prims.len() != n as usize {
-        bail!("refit with {} primitives: the tree was built over {n}", prims.len());
+    if prims.sphere_count + prims.triangle_count != n {
+        bail!("refit with {} primitives: the tree was built over {n}", prims.sphere_count + prims.triangle_count);
     }
     if n == 0 {
         return Ok(StageTimes::default());
     }
     b.stage("bounds");
-    let params = BuildParams { n, spheres: prims.spheres.len() as u32, ..Default::default() };
+    let params = BuildParams { n, spheres: prims.sphere_count, ..Default::default() };
     let p = b.upload("refit params", &[params])?;
-    let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
-    let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
-    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &spheres, &triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
     b.stage("fit");
     let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
     let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
