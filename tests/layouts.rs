@@ -319,3 +319,41 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
         }
     }
 }
+
+/// The depth the device finds (`treelet::bvh::layout::tree_depth`, what the
+/// layouts check against the traversal stack) is a walk's of the tree read
+/// back: LBVH and TRBVH trees of random spheres and of spheres bunched
+/// ever closer along a line (deep radix trees), CPU runner and GPU.
+#[test]
+fn tree_depth_on_the_device_is_the_trees_depth() {
+    use treelet::bvh::layout::tree_depth;
+    use treelet::bvh::tree::{binary_tree, Builder};
+    let seed = treelet_tests::fresh_seed();
+    let random = random_spheres(3000, seed);
+    let bunched: Vec<Sphere> =
+        (0..200).map(|k| Sphere::new([1.0 - 0.9f32.powi(k), (k % 3) as f32 * 1e-3, 0.0], 1e-4)).chain(random.iter().take(100).copied()).collect();
+    fn walk(nodes: &[Node]) -> u32 {
+        let (mut deepest, mut stack) = (0, vec![(0usize, 0u32)]);
+        while let Some((i, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            if !nodes[i].is_leaf() {
+                stack.extend([(nodes[i].left as usize, d + 1), (nodes[i].right as usize, d + 1)]);
+            }
+        }
+        deepest
+    }
+    fn check<B: Backend>(b: &mut B, spheres: &[Sphere], what: &str) {
+        for builder in [Builder::Lbvh, Builder::Trbvh] {
+            let built = binary_tree(b, Primitives { spheres, triangles: &[] }, builder).unwrap();
+            let nodes: Vec<Node> = b.read(&built.bvh.nodes, built.bvh.node_count as usize).unwrap();
+            let expected = walk(&nodes);
+            assert_eq!(tree_depth(b, &built.bvh).unwrap(), expected, "{what}, {builder:?} on {}", b.adapter());
+        }
+    }
+    for (spheres, what) in [(&random, format!("random, seed {seed}")), (&bunched, "bunched".to_string())] {
+        check(&mut CpuBackend::new(), spheres, &what);
+        if let Some(ctx) = treelet_tests::gpu() {
+            check(&mut GpuBackend::new(ctx), spheres, &what);
+        }
+    }
+}

@@ -9,6 +9,7 @@
 pub mod bounds;
 pub mod bvh2;
 pub mod cwbvh;
+pub mod depth;
 pub mod fill;
 pub mod fit;
 pub mod morton;

@@ -98,6 +98,21 @@ pub fn exchange_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
+/// Raises a storage-buffer word to at least `value` with device scope,
+/// relaxed; returns the previous value.
+#[inline]
+pub fn max_device(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_u_max::<u32, DEVICE, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).fetch_max(value, Ordering::Relaxed)
+    }
+}
+
 /// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).
 #[inline]
 pub fn add_workgroup(slot: &mut u32, value: u32) -> u32 {

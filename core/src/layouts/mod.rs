@@ -10,5 +10,6 @@
 //! The seed's classic layout is the collapsed tree itself
 //! ([`crate::construct::collapse`]). Their traversals are in [`crate::trace`].
 pub mod bvh2;
+pub mod depth;
 pub mod cwbvh;
 pub mod cwbvh_build;

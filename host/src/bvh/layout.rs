@@ -5,7 +5,7 @@
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::geometry::aabb::Aabb;
-use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, Node, WideNode};
+use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, WideNode};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::layouts::cwbvh_build::{WIDE_NODE_COST, WIDE_PRIM_COST};
 use treelet_core::trace::hit::STACK_DEPTH;
@@ -166,21 +166,22 @@ pub fn lay_out<B: Backend>(
 /// Refuses trees deeper than the traversal stack (a wide tree is never
 /// deeper than the binary tree it is made from).
 fn check_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<()> {
-    let nodes = b.read::<Node>(&bvh.nodes, bvh.node_count as usize)?;
-    let mut deepest = 0;
-    let mut stack = vec![(0usize, 0usize)];
-    while let Some((i, d)) = stack.pop() {
-        deepest = deepest.max(d);
-        let n = &nodes[i];
-        if !n.is_leaf() {
-            stack.push((n.left as usize, d + 1));
-            stack.push((n.right as usize, d + 1));
-        }
-    }
-    if deepest + 1 > STACK_DEPTH {
+    b.stage("depth");
+    let deepest = tree_depth(b, bvh)?;
+    if deepest as usize + 1 > STACK_DEPTH {
         bail!("the BVH is {deepest} levels deep; traversal supports {}", STACK_DEPTH - 1);
     }
     Ok(())
+}
+
+/// The depth of `bvh` (the root's is 0), found on the device
+/// (`treelet_core::layouts::depth`): one word read back, not the tree.
+pub fn tree_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<u32> {
+    let params = LayoutParams { n: bvh.n, nodes: bvh.node_count, ..Default::default() };
+    let p = b.upload("depth params", &[params])?;
+    let deepest = b.zeroed("tree depth", 4)?;
+    b.dispatch(Kernel::TreeDepth, &[&p, &bvh.nodes, &bvh.parents, &deepest], groups_for(bvh.node_count, WORKGROUP_SIZE));
+    Ok(b.read::<u32>(&deepest, 1)?[0])
 }
 
 /// The wide DP's cost model: the defaults, or for developers tuning it,
@@ -215,13 +216,13 @@ pub fn kernels<B: Backend>(b: &B, layout: Layout) -> Vec<Kernel> {
     match layout {
         Layout::Cwbvh => {
             let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
-            let mut k = vec![Kernel::Fill, dp, Kernel::WideCount, Kernel::WidePlace, Kernel::WideEmit];
+            let mut k = vec![Kernel::Fill, Kernel::TreeDepth, dp, Kernel::WideCount, Kernel::WidePlace, Kernel::WideEmit];
             k.extend([Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep]);
             k
         }
         // Classic and bvh2 collapse the tree's leaves first (classic only when it has leaves to collapse).
-        Layout::Classic | Layout::Auto => trbvh::collapse_kernels(b),
-        Layout::Bvh2 => [trbvh::collapse_kernels(b), vec![Kernel::Bvh2Nodes, Kernel::LeafPrims]].concat(),
+        Layout::Classic | Layout::Auto => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth]].concat(),
+        Layout::Bvh2 => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth, Kernel::Bvh2Nodes, Kernel::LeafPrims]].concat(),
     }
 }
 

@@ -553,6 +553,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
         }
+        (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, parents, deepest) = (view(nodes), view(parents), view(deepest));
+            for id in ids(groups) {
+                treelet_core::layouts::depth::leaf_depth_kernel(id, p.nodes, nodes, parents, deepest);
+            }
+        }
         (Kernel::LeafPrims, [p, prim_indices, spheres, triangles, out]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (prim_indices, spheres, triangles, out) =

@@ -115,6 +115,8 @@ pub enum Kernel {
     Bvh2Nodes,
     /// Primitives in leaf order.
     LeafPrims,
+    /// The depth of a tree (each leaf climbs; the deepest counts).
+    TreeDepth,
     /// The compressed wide BVH: SAH DP over the binary tree (bottom up).
     WideDp,
     /// [`Kernel::WideDp`] with relaxed counters, for CPU adapters.
@@ -136,7 +138,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 39] = [
+    const FIXED: [Kernel; 40] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -165,6 +167,7 @@ impl Kernel {
         Kernel::Collapse,
         Kernel::Bvh2Nodes,
         Kernel::LeafPrims,
+        Kernel::TreeDepth,
         Kernel::WideDp,
         Kernel::WideDpRelaxed,
         Kernel::WideCount,
@@ -224,6 +227,7 @@ impl Kernel {
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
             Kernel::LeafPrims => "bvh2::leaf_prims_cs",
+            Kernel::TreeDepth => "depth::tree_depth_cs",
             Kernel::WideDp => "cwbvh::wide_dp_cs",
             Kernel::WideDpRelaxed => "cwbvh::wide_dp_relaxed_cs",
             Kernel::WideCount => "cwbvh::wide_count_cs",
@@ -272,6 +276,7 @@ impl Kernel {
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
+            Kernel::TreeDepth => &[Read, Read, Read, ReadWrite],
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
