@@ -37,8 +37,19 @@ fn parse(csv: &str) -> Option<Clocks> {
 pub(crate) fn describe(before: Option<Clocks>, after: Option<Clocks>) -> String {
     match (before, after) {
         (Some(b), Some(a)) => format!(
-            "clocks (nvidia-smi, first GPU): SM {} MHz before the benchmark, {} after (max {}), memory {} MHz",
-            b.sm_mhz, a.sm_mhz, a.sm_max_mhz, a.memory_mhz
+            "clocks (nvidia-smi, first GPU): SM {} MHz before the benchmark, {} after (max {}), memory {} MHz{}",
+            b.sm_mhz,
+            a.sm_mhz,
+            a.sm_max_mhz,
+            a.memory_mhz,
+            // A benchmark that leaves the GPU idle between its timed parts
+            // (host work) lets the driver lower the clock, and times slow
+            // work: say so beside the numbers.
+            if 5 * a.sm_mhz.min(b.sm_mhz) < 4 * a.sm_max_mhz {
+                "; the SM clock was below 80% of its maximum: device times here are slower than at full clock"
+            } else {
+                ""
+            }
         ),
         _ => "clocks: not known (no nvidia-smi; Vulkan does not report them)".into(),
     }
@@ -57,5 +68,13 @@ mod tests {
         assert_eq!(parse("[N/A], 1980, 2619\n"), None);
         assert_eq!(parse(""), None);
         assert_eq!(parse("1, 2\n"), None);
+    }
+
+    #[test]
+    fn a_fallen_clock_is_pointed_out() {
+        let c = |sm_mhz| Some(Clocks { sm_mhz, sm_max_mhz: 1980, memory_mhz: 2619 });
+        assert!(!describe(c(1980), c(1980)).contains("below 80%"));
+        assert!(describe(c(1980), c(345)).contains("below 80%"));
+        assert!(describe(c(1200), c(1980)).contains("below 80%"));
     }
 }

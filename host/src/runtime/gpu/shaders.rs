@@ -48,7 +48,8 @@ pub fn unpack(packed: &'static [u8]) -> Result<Vec<Module>, String> {
         let name_bytes = packed
             .get(4 * (at + 1)..4 * (at + 1) + name_len)
             .ok_or_else(|| format!("packed SPIR-V: module {} has its name cut off", modules.len()))?;
-        let entry_point = std::str::from_utf8(name_bytes).map_err(|e| format!("packed SPIR-V: a module's name: {e}"))?;
+        let entry_point =
+            std::str::from_utf8(name_bytes).map_err(|e| format!("packed SPIR-V: a module's name: {e}"))?;
         at += 1 + name_len.div_ceil(4);
         let len = word(at)? as usize;
         let spirv = packed
