@@ -103,6 +103,16 @@ impl Quality {
     }
 }
 
+/// The record of a device hit `(t, prim, b1, b2)` with its normal `(n, 0)`
+/// of ray `r` (traced from `t_min` on: see [`device_rays`]).
+fn hit_record(r: &Ray, [t, prim, b1, b2]: [f32; 4], [nx, ny, nz, _]: [f32; 4]) -> RayHit {
+    let prim = prim.to_bits();
+    if prim == u32::MAX {
+        return RayHit::MISS;
+    }
+    RayHit { t: t + r.t_min, prim, barycentrics: [b1, b2], normal: [nx, ny, nz] }
+}
+
 /// Rays a device batch holds per row (the cast kernels walk an image).
 const BATCH_WIDTH: u32 = 1024;
 
@@ -112,9 +122,6 @@ pub struct Tracer<B: Backend> {
     prims: PrimBuffers<B>,
     tree: Option<TracedTree<B>>,
     counts: (usize, usize),
-    /// The primitives on the host too, for the hits' normals.
-    spheres: Vec<Sphere>,
-    triangles: Vec<Triangle>,
     /// Device time of the last build or refit, layout included (ms).
     update_ms: f64,
 }
@@ -142,8 +149,6 @@ impl<B: Backend> Tracer<B> {
             prims,
             tree: None,
             counts: (spheres.len(), triangles.len()),
-            spheres: spheres.to_vec(),
-            triangles: triangles.to_vec(),
             update_ms: 0.0,
         };
         let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
@@ -174,8 +179,6 @@ impl<B: Backend> Tracer<B> {
             Some(built) => refit_uploaded(b, &built.bvh, &self.prims)?.total(),
             None => 0.0,
         };
-        self.spheres.copy_from_slice(spheres);
-        self.triangles.copy_from_slice(triangles);
         self.update_ms = refit_ms + self.lay_out(b)?;
         Ok(())
     }
@@ -211,29 +214,7 @@ impl<B: Backend> Tracer<B> {
         let buffer = b.upload("rays", &device_rays(rays)?)?;
         self.closest_hits_on_device(b, &buffer, rays.len())?;
         let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
-        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| self.hit_record(r, o[0])).collect())
-    }
-
-    /// The host's record of a device hit `(t, prim, b1, b2)` of ray `r`
-    /// (traced from `t_min` on: see [`device_rays`]).
-    fn hit_record(&self, r: &Ray, [t, prim, b1, b2]: [f32; 4]) -> RayHit {
-        let prim = prim.to_bits();
-        if prim == u32::MAX {
-            return RayHit::MISS;
-        }
-        let t = t + r.t_min;
-        let normal = match self.spheres.get(prim as usize) {
-            Some(s) => {
-                let x = glam::Vec3::from(r.origin) + glam::Vec3::from(r.dir).normalize() * t;
-                (x - glam::Vec3::from(s.center)).normalize_or_zero()
-            }
-            None => {
-                let tri = &self.triangles[prim as usize - self.spheres.len()];
-                let (a, b, c) = (glam::Vec3::from(tri.v0), glam::Vec3::from(tri.v1), glam::Vec3::from(tri.v2));
-                (b - a).cross(c - a).normalize_or_zero()
-            }
-        };
-        RayHit { t, prim, barycentrics: [b1, b2], normal: normal.into() }
+        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
     }
 
     /// Whether each ray hits anything up to its `t_max` (inclusive): an
@@ -257,8 +238,8 @@ impl<B: Backend> Tracer<B> {
     /// `rays[2k]` = (origin, t_max) and `rays[2k + 1]` = (direction, 1), as
     /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, b1,
     /// b2): a triangle's barycentric coordinates of the hit as in [`RayHit`]
-    /// (0 for a sphere; the normal is the engine's to take from its own
-    /// primitive). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0),
+    /// zeros for a miss. The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
     /// `count` must be zero. Submitted, not waited for.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_RAYS)

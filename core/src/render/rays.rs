@@ -51,7 +51,9 @@ pub const CAST_DIFFUSE_OCCLUDED: u32 = 5;
 ///   primitive it leaves);
 /// * [`CAST_DIFFUSE`]: casts that ray and writes its hit distance (or -1)
 ///   into `rays[2 id][3]`; [`CAST_DIFFUSE_OCCLUDED`] as an occlusion query;
-/// * [`CAST_RAYS`], [`CAST_OCCLUDED`]: the caller's rays.
+/// * [`CAST_RAYS`], [`CAST_OCCLUDED`]: the caller's rays (a closest hit
+///   writes `(t, prim, b1, b2)` into `rays[2 id]` and the unit geometric
+///   normal into `rays[2 id + 1]`).
 ///
 /// `F` (see [`crate::geometry::features`]) may leave out the tests of primitive kinds
 /// the scene lacks.
@@ -86,8 +88,11 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
                 [found as u32 as f32, 0.0, 0.0, 0.0]
             } else if found {
                 let (b1, b2) = barycentrics::<F>(&scene.prims, hit.prim, o, d / len);
+                let n = geometric_normal::<F>(&scene.prims, hit.prim, o + d / len * hit.t);
+                rays[j] = [n.x, n.y, n.z, 0.0];
                 [hit.t, f32::from_bits(hit.prim), b1, b2]
             } else {
+                rays[j] = [0.0; 4];
                 [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0]
             };
         }
@@ -118,6 +123,19 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
         let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
+    }
+}
+
+/// The unit geometric normal of primitive `prim` at `x`: a sphere's outward
+/// one, a triangle's `(v1 - v0) x (v2 - v0)`; zero where it has none.
+#[inline]
+fn geometric_normal<const F: u32>(prims: &Prims, prim: u32, x: Vec3) -> Vec3 {
+    if prims.is_sphere::<F>(prim) {
+        (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize_or_zero()
+    } else {
+        let t = &prims.triangles[(prim - prims.sphere_count) as usize];
+        let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
+        (b - a).cross(c - a).normalize_or_zero()
     }
 }
 
