@@ -10,7 +10,8 @@
 //! any Vulkan adapter, or the [`CpuBackend`], which runs the same kernels on
 //! CPU cores), refits it after they move, and finds the closest hits
 //! ([`RayHit`]) of batches of [`Ray`]s. [`Quality`] trades build time for
-//! faster rays.
+//! faster rays, or ([`Quality::ForRays`]) picks the builder that finishes a
+//! given number of rays per build first, by costs measured per device class.
 //!
 //! ```
 //! use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
