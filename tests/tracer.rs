@@ -244,3 +244,33 @@ fn occlusion_agrees_with_closest_hit() {
         }
     }
 }
+
+/// An engine may hold several tracers on one device: building or refitting
+/// one must not hand out another's buffers (the backend pools buffers
+/// between builds), and a tracer refit frame after frame must not make the
+/// pool grow.
+#[test]
+fn tracers_on_one_device_keep_their_own_trees() {
+    let Some(ctx) = gpu() else { return };
+    let b = &mut GpuBackend::new(ctx);
+    let grid = |z: f32| -> Vec<Triangle> {
+        (0..400).map(|k| {
+            let (x, y) = ((k % 20) as f32, (k / 20) as f32);
+            Triangle::new([x, y, z], [x + 1.0, y, z], [x, y + 1.0, z])
+        }).collect()
+    };
+    let ray = [Ray::new([0.25, 0.25, 0.0], [0.0, 0.0, 1.0])];
+    for quality in [Quality::Fast, Quality::High] {
+        let mut a = Tracer::build(b, &[], &grid(5.0), quality).unwrap();
+        let bt = Tracer::build(b, &[], &grid(9.0), quality).unwrap();
+        assert_eq!(a.closest_hits(b, &ray).unwrap()[0].t, 5.0, "{quality:?}: the first tracer after building a second");
+        assert_eq!(bt.closest_hits(b, &ray).unwrap()[0].t, 9.0, "{quality:?}: the second tracer");
+        let first = b.pooled_bytes();
+        for frame in 0..20 {
+            a.refit(b, &[], &grid(5.0 + frame as f32 * 0.125)).unwrap();
+        }
+        assert_eq!(a.closest_hits(b, &ray).unwrap()[0].t, 5.0 + 19.0 * 0.125, "{quality:?}: the first tracer after refits");
+        assert_eq!(bt.closest_hits(b, &ray).unwrap()[0].t, 9.0, "{quality:?}: the second tracer after the first's refits");
+        assert!(b.pooled_bytes() <= 2 * first.max(1 << 20), "{quality:?}: the pool grew from {first} to {} bytes over 20 refits", b.pooled_bytes());
+    }
+}

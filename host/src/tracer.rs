@@ -153,6 +153,7 @@ impl<B: Backend> Tracer<B> {
         };
         let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
         tracer.update_ms = build_ms + tracer.lay_out(b)?;
+        tracer.keep_buffers(b);
         Ok(tracer)
     }
 
@@ -173,6 +174,10 @@ impl<B: Backend> Tracer<B> {
         }
         let all = Primitives { spheres, triangles };
         all.check()?;
+        // The last update's temporaries go back to the pool (what this and
+        // other tracers hold was kept out of it), so that a tracer refit
+        // every frame does not make the pool grow.
+        b.begin_build();
         // Uploaded once, for the refit and for tracing.
         self.prims = PrimBuffers::upload(b, all)?;
         let refit_ms = match &self.built {
@@ -180,7 +185,22 @@ impl<B: Backend> Tracer<B> {
             None => 0.0,
         };
         self.update_ms = refit_ms + self.lay_out(b)?;
+        self.keep_buffers(b);
         Ok(())
+    }
+
+    /// Takes this tracer's buffers out of `b`'s pool, so that no later build
+    /// or refit on `b`, of this tracer or another, hands them out again.
+    fn keep_buffers(&self, b: &mut B) {
+        let mut kept = vec![&self.prims.spheres, &self.prims.triangles];
+        if let Some(built) = &self.built {
+            let bvh = &built.bvh;
+            kept.extend([&bvh.nodes, &bvh.parents, &bvh.prim_indices, &bvh.sorted_keys]);
+        }
+        if let Some(tree) = &self.tree {
+            kept.extend([&tree.nodes, &tree.prims]);
+        }
+        b.keep(&kept);
     }
 
     /// Device time of the last [`Tracer::build`] or [`Tracer::refit`], in

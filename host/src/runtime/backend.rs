@@ -112,8 +112,13 @@ pub trait Backend: Send {
         Ok(())
     }
     /// Starts a new build: buffers handed out for the previous one may be
-    /// handed out again (their results must have been read back).
+    /// handed out again (their results must have been read back), except
+    /// those given to [`Backend::keep`].
     fn begin_build(&mut self) {}
+    /// The caller keeps `buffers` (an engine's tracer its tree and
+    /// primitives): the backend never hands them out again, and forgets
+    /// them, so they are freed when the caller drops them.
+    fn keep(&mut self, _buffers: &[&Self::Buffer]) {}
     /// Builds the pipelines of `kernels` ahead of the work that uses them,
     /// several at once where the device compiles them (a GPU's driver);
     /// returns the wall seconds it took. Kernels left out are built when

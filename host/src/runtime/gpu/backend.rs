@@ -66,6 +66,12 @@ impl GpuBackend {
         self
     }
 
+    /// Bytes of the buffers the pool holds (handed out since the last
+    /// build, and free to hand out again).
+    pub fn pooled_bytes(&self) -> u64 {
+        self.used.iter().map(|(k, _)| k.1).sum::<u64>() + self.free.iter().map(|(k, v)| k.1 * v.len() as u64).sum::<u64>()
+    }
+
     pub fn context(&self) -> &Arc<GpuContext> {
         &self.ctx
     }
@@ -230,6 +236,13 @@ impl Backend for GpuBackend {
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
         crate::runtime::backend::check_fits(self, label, bytes)?;
         Ok(self.take_buffer(label, bytes.max(MIN_BUFFER).next_multiple_of(4)))
+    }
+
+    fn keep(&mut self, buffers: &[&wgpu::Buffer]) {
+        self.used.retain(|(_, b)| !buffers.contains(&b));
+        for list in self.free.values_mut() {
+            list.retain(|b| !buffers.contains(&b));
+        }
     }
 
     fn begin_build(&mut self) {
