@@ -6,14 +6,18 @@
 use crate::geometry::buffers::Node;
 use crate::gpu::atomics;
 
-/// Longest climb [`leaf_depth_kernel`] makes: any deeper leaf counts as
-/// this deep (a tree that deep is refused anyway), and a damaged parent
-/// chain cannot loop forever.
-pub const DEPTH_LIMIT: u32 = 1 << 12;
+/// Longest climb [`leaf_depth_kernel`] makes: one more level than the
+/// traversal stack holds (`crate::trace::hit::STACK_DEPTH`, which asserts
+/// it), so that a tree too deep for it is found, and any
+/// deeper leaf counts as this deep. It bounds the kernel's work by the leaf
+/// count times this (a chain of a million nodes would otherwise climb a
+/// million steps from each leaf), and a damaged parent chain cannot loop.
+pub const DEPTH_LIMIT: u32 = 65;
 
 /// Kernel, one invocation per node `i` of a tree of `node_count` nodes
 /// (root 0, `parents` its parent links): a leaf climbs to the root and
-/// raises `deepest[0]` (zeroed) to its depth (the root's is 0).
+/// raises `deepest[0]` (zeroed) to its depth (the root's is 0), or to
+/// [`DEPTH_LIMIT`] if it is deeper.
 pub fn leaf_depth_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32], deepest: &mut [u32]) {
     if i >= node_count || !nodes[i as usize].is_leaf() {
         return;
@@ -60,12 +64,14 @@ mod tests {
 
     #[test]
     fn chains_and_balanced_trees() {
-        // A chain: internal node k has children k + 1 and a leaf; 70 deep.
-        let k = 70u32;
-        let count = 2 * k as usize + 1;
-        let children: Vec<(u32, u32)> = (0..k).map(|i| (if i + 1 < k { i + 1 } else { k }, k + 1 + i)).collect();
-        let (nodes, parents) = tree(&children, count);
-        assert_eq!(depth(&nodes, &parents), k);
+        // A chain: internal node k has children k + 1 and a leaf; 70 deep,
+        // counted as the limit; 40 deep, counted.
+        for k in [70u32, 40] {
+            let count = 2 * k as usize + 1;
+            let children: Vec<(u32, u32)> = (0..k).map(|i| (if i + 1 < k { i + 1 } else { k }, k + 1 + i)).collect();
+            let (nodes, parents) = tree(&children, count);
+            assert_eq!(depth(&nodes, &parents), k.min(DEPTH_LIMIT));
+        }
         // Balanced over 8 leaves: 3 deep.
         let children = [(1, 2), (3, 4), (5, 6), (7, 8), (9, 10), (11, 12), (13, 14)];
         let (nodes, parents) = tree(&children, 15);

@@ -83,6 +83,7 @@ impl Query {
 /// radix tree over pathological keys) would skip subtrees, so the host
 /// refuses to trace such trees.
 pub const STACK_DEPTH: usize = 64;
+const _: () = assert!(crate::layouts::depth::DEPTH_LIMIT as usize == STACK_DEPTH + 1, "the depth check finds trees too deep for the stack");
 
 /// The closest hit: distance and sphere index (`MISS`, `u32::MAX` if none).
 #[derive(Clone, Copy)]

@@ -169,13 +169,14 @@ fn check_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<()> {
     b.stage("depth");
     let deepest = tree_depth(b, bvh)?;
     if deepest as usize + 1 > STACK_DEPTH {
-        bail!("the BVH is {deepest} levels deep; traversal supports {}", STACK_DEPTH - 1);
+        bail!("the BVH is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
     }
     Ok(())
 }
 
-/// The depth of `bvh` (the root's is 0), found on the device
-/// (`treelet_core::layouts::depth`): one word read back, not the tree.
+/// The depth of `bvh` (the root's is 0), up to
+/// `treelet_core::layouts::depth::DEPTH_LIMIT` (one more than traversal
+/// supports), found on the device: one word read back, not the tree.
 pub fn tree_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<u32> {
     let params = LayoutParams { n: bvh.n, nodes: bvh.node_count, ..Default::default() };
     let p = b.upload("depth params", &[params])?;
