@@ -133,15 +133,8 @@ impl<B: Backend> Tracer<B> {
         let all = Primitives { spheres, triangles };
         all.check()?;
         let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
-        // The build's own upload of the primitives where it made one (as
-        // `bvh::tree::traced_tree` does): uploaded once, not twice.
-        let prims = match built.as_ref().and_then(|t| t.bvh.prims.clone()) {
-            Some((spheres, triangles)) => PrimBuffers {
-                spheres,
-                triangles,
-                sphere_count: all.spheres.len() as u32,
-                triangle_count: all.triangles.len() as u32,
-            },
+        let prims = match &built {
+            Some(t) => t.prim_buffers(b, all)?,
             None => PrimBuffers::upload(b, all)?,
         };
         let mut tracer = Tracer {

@@ -92,17 +92,7 @@ pub fn traced_tree<B: Backend>(
         return Ok((tree, buffers, 0.0));
     };
     let built = binary_tree(b, all, builder)?;
-    // The build's own upload of the primitives, where it made one (a 940k-
-    // triangle mesh is 45 MB, uploaded once instead of twice).
-    let buffers = match built.bvh.prims.clone() {
-        Some((spheres, triangles)) => PrimBuffers {
-            spheres,
-            triangles,
-            sphere_count: all.spheres.len() as u32,
-            triangle_count: all.triangles.len() as u32,
-        },
-        None => PrimBuffers::upload(b, all)?,
-    };
+    let buffers = built.prim_buffers(b, all)?;
     let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
     Ok((tree, buffers, built.build_ms + layout_ms))
 }
@@ -138,6 +128,21 @@ pub struct BuiltTree<B: Backend> {
 }
 
 impl<B: Backend> BuiltTree<B> {
+    /// The primitives `all` (those the tree was built over) on the device:
+    /// the build's own upload where it made one (a 940k-triangle mesh is 45
+    /// MB, uploaded once instead of twice), else a fresh upload.
+    pub fn prim_buffers(&self, b: &mut B, all: Primitives) -> Result<PrimBuffers<B>> {
+        Ok(match self.bvh.prims.clone() {
+            Some((spheres, triangles)) => PrimBuffers {
+                spheres,
+                triangles,
+                sphere_count: all.spheres.len() as u32,
+                triangle_count: all.triangles.len() as u32,
+            },
+            None => PrimBuffers::upload(b, all)?,
+        })
+    }
+
     /// Lays the tree out (it stays usable for other layouts); returns the
     /// layout's device time (ms).
     pub fn lay_out(&self, b: &mut B, layout: Layout, prims: &PrimBuffers<B>) -> Result<(TracedTree<B>, f64)> {
