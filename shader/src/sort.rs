@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
 use treelet_core::construct::sort_multisplit::{
-    MULTISPLIT_SORT_ITEMS, MULTISPLIT_SORT_TILE, MultisplitPassLane, SUBGROUP_COUNTS, multisplit_pass_phase,
+    MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SUBGROUP_COUNTS, multisplit_pass_phase,
     multisplit_pass_phases, multisplit_pass_sync,
 };
 use treelet_core::gpu::subgroup::{Lane, apply};
@@ -137,7 +137,6 @@ pub fn sort_multisplit_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
     #[spirv(workgroup)] ticket: &mut [u32; 1],
     #[spirv(workgroup)] counts: &mut [u32; SUBGROUP_COUNTS],
-    #[spirv(workgroup)] ranks: &mut [u32; MULTISPLIT_SORT_TILE as usize],
     #[spirv(workgroup)] running: &mut [u32; WG],
     #[spirv(workgroup)] local_offsets: &mut [u32; WG],
     #[spirv(workgroup)] global_offsets: &mut [u32; WG],
@@ -155,7 +154,7 @@ pub fn sort_multisplit_cs(
         ($($phase:literal)*) => {
             const _: () = assert!([$($phase),*].len() as u32 == multisplit_pass_phases(MULTISPLIT_SORT_ITEMS));
             $(
-                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS, { MULTISPLIT_SORT_TILE as usize }>(
+                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS>(
                     $phase,
                     lid,
                     subgroup,
@@ -169,7 +168,6 @@ pub fn sort_multisplit_cs(
                     sort_state,
                     ticket,
                     counts,
-                    ranks,
                     running,
                     local_offsets,
                     global_offsets,
@@ -181,7 +179,7 @@ pub fn sort_multisplit_cs(
             )*
         };
     }
-    phases!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
+    phases!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25);
 }
 
 #[spirv(compute(threads(256)))]

@@ -53,10 +53,11 @@
 //! within the chunk four packed digits at a time ([`count_before`]). The
 //! result is identical on every device and on the CPU. A round takes two
 //! phases (barriers), its ranking sharing a phase with the next round's
-//! counting in a second set of counters: on the H100 the phases, not the
-//! memory traffic, bound a pass. [`super::sort_multisplit`] is the same pass
+//! counting in a second set of counters. On the H100 this pass is bound by
+//! its 21.8 KB of workgroup memory, which lets an SM hold only two of its
+//! workgroups (see [`super::sort_multisplit`], which measured it). [`super::sort_multisplit`] is the same pass
 //! ranked by subgroup ballots instead (Onesweep's own ranking), for devices
-//! with subgroups of 16 lanes or more; it shares [`tile_offset`] and
+//! with subgroups of 32 lanes or more; it shares [`tile_offset`] and
 //! [`write_tile`] with this one.
 //!
 //! Kernels are phase functions: see [`crate::gpu::workgroup`]. Hot reads and
@@ -457,7 +458,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
             }
         }
     } else {
-        write_tile(lid, base, valid, ITEMS, shift, counts, local_offsets, global_offsets, keys_in, values_in, keys_out, values_out);
+        write_tile::<_, false>(lid, base, valid, ITEMS, shift, counts, local_offsets, global_offsets, keys_in, values_in, keys_out, values_out);
     }
 }
 
@@ -506,11 +507,12 @@ pub fn tile_offset<const LOOK_BACK: bool>(
 }
 
 /// The tile's keys and values to the output, in the tile's order
-/// (`order[position]` = the key's index in the tile): consecutive
-/// invocations write consecutive places of a digit's run.
+/// (`order[position]` = the key's index in the tile; with `PACKED`, 16 bits
+/// each, two to a word): consecutive invocations write consecutive places
+/// of a digit's run.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn write_tile<const N: usize>(
+pub fn write_tile<const N: usize, const PACKED: bool>(
     lid: u32,
     base: u32,
     valid: u32,
@@ -527,7 +529,11 @@ pub fn write_tile<const N: usize>(
     for round in 0..items {
         let position = round * WORKGROUP_SIZE + lid;
         if position < valid {
-            let k = get(order, position as usize);
+            let k = if PACKED {
+                (get(order, (position / 2) as usize) >> (16 * (position % 2))) & 0xffff
+            } else {
+                get(order, position as usize)
+            };
             let key = at(keys_in, (base + k) as usize);
             let d = digit(key, shift) as usize;
             let dest = (get(global_offsets, d) + position - get(local_offsets, d)) as usize;

@@ -4,19 +4,19 @@
 //! [`MIN_SUBGROUP_SIZE`] lanes.
 //!
 //! [`super::sort::onesweep_phase`] ranks a tile's keys in workgroup memory,
-//! two barriers per round of 256 keys; on the H100 those barriers, not the
-//! memory traffic, bound a pass. Here each subgroup ranks a contiguous run
-//! of the tile's keys, `ITEMS` per lane, without a workgroup barrier:
+//! two barriers per round of 256 keys. Here each subgroup ranks a
+//! contiguous run of the tile's keys, `ITEMS` per lane, without a
+//! workgroup barrier:
 //!
 //! 1. for each of its keys in order, a lane finds the lanes of its subgroup
 //!    holding the same digit ([`OP_MATCH_BYTE`]); the highest of them (the
-//!    leader) reads the subgroup's count of that digit so far from the
-//!    subgroup's own row of counters and adds the peers to it, and hands the
-//!    old count to its peers ([`OP_SHUFFLE`]); a key's rank within its
-//!    subgroup's keys of its digit is that count plus its peers below it;
-//! 2. after one workgroup barrier, invocation `d` scans digit `d`'s counts
-//!    over the subgroups (so each subgroup's keys of a digit follow the
-//!    earlier subgroups'), giving the tile's digit counts;
+//!    leader) adds the peers to the subgroup's count of that digit so far,
+//!    in the subgroup's own row of counters, and hands the old count to its
+//!    peers ([`OP_SHUFFLE`]); a key's rank within its subgroup's keys of its
+//!    digit is that count plus its peers below it;
+//! 2. after one workgroup barrier, the counters are scanned over the
+//!    subgroups (so each subgroup's keys of a digit follow the earlier
+//!    subgroups'), giving the tile's digit counts;
 //! 3. from there as in Onesweep's pass: the tile's offsets by look-back
 //!    ([`super::sort::tile_offset`]), the digits' offsets within the tile,
 //!    each key's place, the keys written out digit run by digit run
@@ -25,12 +25,24 @@
 //! Subgroup `s` of `S` lanes takes keys `s * S * ITEMS ..` of the tile, lane
 //! `l` its keys `s * S * ITEMS + i * S + l` for `i` in `0..ITEMS`: so keys are
 //! ranked in the order they came (the sort stays stable) and each load of
-//! a subgroup is one contiguous stretch. The counters are one row of
-//! [`RADIX`] per subgroup: [`SUBGROUP_COUNTS`] words hold a workgroup of
-//! subgroups of [`MIN_SUBGROUP_SIZE`] or more lanes; devices with smaller
-//! ones (lavapipe: 8) keep [`super::sort::onesweep_phase`], which runs at any
-//! size. The result is the same stable order on every device, at every
-//! subgroup size, and on the CPU runner.
+//! a subgroup is one contiguous stretch.
+//!
+//! **Workgroup memory is what bounds this pass on the H100.** A probe that
+//! counted the workgroups resident at once (an atomic counter up at a
+//! workgroup's start, down at its end) found 2 per SM for the workgroup-ranked
+//! pass with 21.8 KB of workgroup memory and 3 for its small-tile form with
+//! 15.7 KB, where 256 invocations of 24 registers would allow 8: NVIDIA's
+//! Vulkan driver gives the SM's shared memory a carve-out of about 48 KB.
+//! So the pass keeps each key's rank and place in its lane's registers
+//! ([`MultisplitPassLane::ranks`]), counters are 16 bits, two to a word, a
+//! row of [`ROW_WORDS`] per subgroup of at least [`MIN_SUBGROUP_SIZE`]
+//! lanes, and the same words then hold the tile's order, 16 bits per key:
+//! 7.2 KB in all (27.7 KB before), which took its 8 passes from 0.66 to
+//! 0.35 ms at 1M keys and from 9.8 to 3.25 ms at 16M. Devices with smaller
+//! subgroups (lavapipe: 8; some of Intel's: 16) keep
+//! [`super::sort::onesweep_phase`], which runs at any size. The result is
+//! the same stable order on every device, at every subgroup size, and on
+//! the CPU runner.
 //!
 //! Written in the phases of [`crate::gpu::subgroup`], each ending in the
 //! synchronisation code [`multisplit_pass_sync`] gives.
@@ -45,17 +57,24 @@ use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{small_scan_phase, SMALL_SCAN_PHASES, WG, WORKGROUP_SIZE};
 
 /// Fewest lanes per subgroup this pass runs with (the counters' size).
-pub const MIN_SUBGROUP_SIZE: u32 = 16;
+/// 32, not less: the counters are most of the pass's workgroup memory, and
+/// on the H100 workgroup memory is what bounds how many workgroups an SM
+/// keeps in flight (see the module documentation).
+pub const MIN_SUBGROUP_SIZE: u32 = 32;
 /// Most subgroups in a workgroup.
 pub const MAX_SUBGROUPS: u32 = WORKGROUP_SIZE / MIN_SUBGROUP_SIZE;
-/// Words of digit counters, a row of [`RADIX`] per subgroup; after ranking
-/// they hold the tile's key order, so a tile has at most this many keys.
-pub const SUBGROUP_COUNTS: usize = (MAX_SUBGROUPS * RADIX) as usize;
+/// Digit counters packed two to a word (16 bits each: a subgroup's count
+/// of a digit is at most `64 * ITEMS`, a tile's at most its size).
+pub const ROW_WORDS: u32 = RADIX / 2;
+/// Words of digit counters, a row of [`ROW_WORDS`] per subgroup; after
+/// ranking they hold the tile's key order, 16 bits per key, so a tile has
+/// at most twice this many keys.
+pub const SUBGROUP_COUNTS: usize = (MAX_SUBGROUPS * ROW_WORDS) as usize;
 /// Keys per lane (rounds of a workgroup) of a tile.
 pub const MULTISPLIT_SORT_ITEMS: u32 = 8;
 /// Keys per workgroup.
 pub const MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * MULTISPLIT_SORT_ITEMS;
-const _: () = assert!(MULTISPLIT_SORT_TILE as usize <= SUBGROUP_COUNTS, "the counters hold the tile's order");
+const _: () = assert!(MULTISPLIT_SORT_TILE as usize <= 2 * SUBGROUP_COUNTS, "the counters hold the tile's order");
 /// Most keys per lane: a lane keeps its digits in one 64-bit word.
 pub const MAX_MULTISPLIT_ITEMS: u32 = 8;
 
@@ -69,14 +88,40 @@ pub struct MultisplitPassLane {
     pub digit: u32,
     /// Its peers: the lanes holding a key of the same digit.
     pub peers: u64,
+    /// 16 bits per key: its rank among its subgroup's keys of its digit,
+    /// then its place in the tile; keys 0..4, then 4..8. Kept here, not in
+    /// workgroup memory, so that more workgroups fit an SM.
+    pub ranks: [u64; 2],
+}
+
+impl MultisplitPassLane {
+    /// The 16-bit rank (or place) of key `item`.
+    #[inline]
+    fn rank(&self, item: u32) -> u32 {
+        let word = if item < 4 { self.ranks[0] } else { self.ranks[1] };
+        (word >> (16 * (item % 4))) as u32 & 0xffff
+    }
+
+    /// Sets the 16-bit rank (or place) of key `item` (`value` < 65 536).
+    #[inline]
+    fn set_rank(&mut self, item: u32, value: u32) {
+        let shift = 16 * (item % 4);
+        let keep = !(0xffffu64 << shift);
+        let v = (value as u64) << shift;
+        if item < 4 {
+            self.ranks[0] = self.ranks[0] & keep | v;
+        } else {
+            self.ranks[1] = self.ranks[1] & keep | v;
+        }
+    }
 }
 
 /// Phases with `items` keys per lane: clear; two per key (match, then
 /// count and shuffle); the last key's rank; the scan over subgroups;
-/// look-back with the first scan step; two more scan steps; places; order;
-/// write.
+/// look-back with the first scan step; two more scan steps; places; clear;
+/// order; write.
 pub const fn multisplit_pass_phases(items: u32) -> u32 {
-    2 * items + 6 + SMALL_SCAN_PHASES
+    2 * items + 7 + SMALL_SCAN_PHASES
 }
 
 /// The synchronisation code (see [`crate::gpu::subgroup`]) after phase
@@ -98,19 +143,18 @@ fn key_index(subgroup: u32, lane: u32, size: u32, items: u32, item: u32) -> u32 
     (subgroup * items + item) * size + lane
 }
 
-/// Kernel: one pass over one tile of `ITEMS` keys per invocation, `TILE` =
-/// `ITEMS * WORKGROUP_SIZE`, with look-back (`sort_state` as laid out in
+/// Kernel: one pass over one tile of `ITEMS` keys per invocation
+/// (`ITEMS * WORKGROUP_SIZE` keys), with look-back (`sort_state` as laid out in
 /// [`state`]). Invocation `lid` is lane `lane` of subgroup `subgroup`, whose
 /// subgroups have `size` lanes (at least [`MIN_SUBGROUP_SIZE`]).
 ///
 /// Workgroup memory: `ticket`, the tile this workgroup sorts; `counts`, a
-/// row of digit counters per subgroup, then the tile's keys in order;
-/// `ranks`, each key's rank among its subgroup's keys of its digit and the
-/// digit (`rank | digit << 16`), then its place in the tile; `running`, the
+/// row of digit counters per subgroup, then the tile's keys in order
+/// (each key's rank, then its place, stays in its lane's `me`); `running`, the
 /// tile's digit counts; `local_offsets` and `global_offsets`, where each
 /// digit's keys start in the tile and in the output; `scan_sums`, scratch.
 #[allow(clippy::too_many_arguments)]
-pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
+pub fn multisplit_pass_phase<const ITEMS: u32>(
     phase: u32,
     lid: u32,
     subgroup: u32,
@@ -124,7 +168,6 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
     sort_state: &mut [u32],
     ticket: &mut [u32; 1],
     counts: &mut [u32; SUBGROUP_COUNTS],
-    ranks: &mut [u32; TILE],
     running: &mut [u32; WG],
     local_offsets: &mut [u32; WG],
     global_offsets: &mut [u32; WG],
@@ -147,10 +190,11 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
     if tile >= params.tiles {
         return; // A workgroup of the dispatch grid's padding.
     }
-    let base = tile * TILE as u32;
+    let tile_keys = ITEMS * WORKGROUP_SIZE;
+    let base = tile * tile_keys;
     // Keys of the tile: 0..valid (only the last tile is short).
-    let valid = (params.n - base).min(TILE as u32);
-    let row = subgroup * RADIX;
+    let valid = (params.n - base).min(tile_keys);
+    let row = subgroup * ROW_WORDS;
     let ranked = 2 * ITEMS + 1; // The phase that ranks the last key.
     if phase <= ranked {
         let item = (phase - 1) / 2;
@@ -161,7 +205,7 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
                 let k = key_index(subgroup, lane, size, ITEMS, item - 1);
                 if k < valid {
                     let rank = io.output as u32 + popcount(me.peers & lanes_below(lane));
-                    set(ranks, k as usize, rank | me.digit << 16);
+                    me.set_rank(item - 1, rank);
                 }
             }
             if item == 0 {
@@ -187,10 +231,11 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
             let leader = if me.peers == 0 { lane } else { highest_lane(me.peers) };
             io.input = 0;
             if me.peers != 0 && leader == lane {
-                let counter = (row + me.digit) as usize;
-                let before = get(counts, counter);
-                set(counts, counter, before + popcount(me.peers));
-                io.input = before;
+                // Atomic: the leader of the digit that shares the word may
+                // be adding at the same time.
+                let half = 16 * (me.digit % 2);
+                let word = &mut counts[(row + me.digit / 2) as usize];
+                io.input = (atomics::add_workgroup(word, popcount(me.peers) << half) >> half) & 0xffff;
             }
             io.arg = leader;
         }
@@ -199,15 +244,20 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
     let subgroups = WORKGROUP_SIZE / size;
     let look_back_phase = ranked + 2;
     if phase == ranked + 1 {
-        // Digit `lid`'s counts over the subgroups, scanned in place.
-        let mut sum = 0;
-        for s in 0..subgroups {
-            let i = (s * RADIX + lid) as usize;
-            let c = get(counts, i);
-            set(counts, i, sum);
-            sum += c;
+        // Digits `2 lid` and `2 lid + 1`: their counts over the subgroups,
+        // scanned in place, both halves of a word at once (no half's sum
+        // passes the tile's size, so none carries into the other).
+        if lid < ROW_WORDS {
+            let mut sum = 0;
+            for s in 0..subgroups {
+                let i = (s * ROW_WORDS + lid) as usize;
+                let c = get(counts, i);
+                set(counts, i, sum);
+                sum += c;
+            }
+            running[2 * l] = sum & 0xffff;
+            running[2 * l + 1] = sum >> 16;
         }
-        running[l] = sum;
         return;
     }
     if phase == look_back_phase {
@@ -221,22 +271,27 @@ pub fn multisplit_pass_phase<const ITEMS: u32, const TILE: usize>(
         for item in 0..ITEMS {
             let k = key_index(subgroup, lane, size, ITEMS, item);
             if k < valid {
-                let r = get(ranks, k as usize);
-                let d = r >> 16;
-                let place = get(local_offsets, d as usize) + get(counts, (row + d) as usize) + (r & 0xffff);
-                set(ranks, k as usize, place);
+                let d = (me.digits >> (8 * item)) as u32 & 0xff;
+                let below = (get(counts, (row + d / 2) as usize) >> (16 * (d % 2))) & 0xffff;
+                me.set_rank(item, get(local_offsets, d as usize) + below + me.rank(item));
             }
         }
     } else if scan_step == SMALL_SCAN_PHASES + 1 {
-        // The tile's order, in the counters (all read by now).
+        // The counters are all read: cleared for the tile's order.
+        for c in 0..SUBGROUP_COUNTS / WG {
+            set(counts, c * WG + l, 0);
+        }
+    } else if scan_step == SMALL_SCAN_PHASES + 2 {
+        // The tile's order, two keys to a word.
         for item in 0..ITEMS {
             let k = key_index(subgroup, lane, size, ITEMS, item);
             if k < valid {
-                set(counts, get(ranks, k as usize) as usize, k);
+                let place = me.rank(item);
+                atomics::or_workgroup(&mut counts[(place / 2) as usize], k << (16 * (place % 2)));
             }
         }
     } else {
-        write_tile(
+        write_tile::<_, true>(
             lid,
             base,
             valid,

@@ -15,10 +15,11 @@ use crate::runtime::kernels::Kernel;
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep];
     if b.look_back_works() {
-        k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweep, Kernel::SortOnesweepSmall]);
-        if SortTiles::Auto.resolve(u32::MAX) == SortTiles::Multisplit && multisplit_runs_on(b) {
-            k.push(Kernel::SortMultisplit);
-        }
+        k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
+        k.push(match SortTiles::Auto.resolve(u32::MAX, multisplit_runs_on(b)) {
+            SortTiles::Multisplit => Kernel::SortMultisplit,
+            _ => Kernel::SortOnesweep,
+        });
     } else {
         k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
     }
@@ -57,14 +58,16 @@ pub enum SortTiles {
 }
 
 impl SortTiles {
-    /// The tiles a sort of `n` keys takes.
+    /// The tiles a sort of `n` keys takes (`multisplit`: whether the device
+    /// runs the pass ranked by subgroups, [`multisplit_runs_on`]).
     ///
-    /// Never the tiles ranked by subgroups unless asked: on the H100 (one
-    /// machine, `bench build --per-kernel`, medians of 11) their pass takes
-    /// 0.188 / 0.660 / 2.58 / 9.80 ms at 65 536 / 1M / 4M / 16M keys, where
-    /// small tiles take 0.137 / 0.578 / 2.15 / 8.34 and large ones 0.273 (65 536)
-    /// and 0.583 / 2.18 / 7.96 ms (their loop over phases not yet unrolled).
-    fn resolve(self, n: u32) -> SortTiles {
+    /// Small tiles up to [`SMALL_TILES_UP_TO`] keys, then tiles ranked by
+    /// subgroups where the device runs them: on the H100 (one machine,
+    /// `bench build --per-kernel`, medians of 11, 2026-11-26) their 8
+    /// passes take 0.202 / 0.351 / 0.990 / 3.25 ms at 65 536 / 1M / 4M /
+    /// 16M keys, small tiles 0.135 / 0.582 / 2.15 / 8.29 and large ones
+    /// 0.224 / 0.480 / 1.79 / 6.55.
+    fn resolve(self, n: u32, multisplit: bool) -> SortTiles {
         if self != SortTiles::Auto {
             return self;
         }
@@ -73,6 +76,7 @@ impl SortTiles {
             Ok("large") => SortTiles::Large,
             Ok("multisplit") => SortTiles::Multisplit,
             _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
+            _ if multisplit => SortTiles::Multisplit,
             _ => SortTiles::Large,
         }
     }
@@ -83,8 +87,6 @@ impl SortTiles {
 pub fn multisplit_runs_on<B: Backend>(b: &B) -> bool {
     b.look_back_works() && b.min_subgroup_size() >= MIN_SUBGROUP_SIZE
 }
-
-
 
 /// Largest sort that takes small tiles by default: on the H100 small tiles
 /// sorted 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
@@ -124,7 +126,7 @@ pub fn radix_sort_tiled<B: Backend>(
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
     let passes = passes_for(key_bits);
     // Small tiles where large ones would leave the GPU idle (look-back only).
-    let tile_size = if b.look_back_works() { tile_size.resolve(n) } else { SortTiles::Large };
+    let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_runs_on(b)) } else { SortTiles::Large };
     if tile_size == SortTiles::Multisplit && !multisplit_runs_on(b) {
         anyhow::bail!(
             "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",

@@ -361,13 +361,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let size = subgroup_size;
             let mut ticket = [0u32; 1];
             let mut counts = [0u32; SUBGROUP_COUNTS];
-            let mut ranks = [0u32; MULTISPLIT_SORT_TILE as usize];
             let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
             let mut lanes = [MultisplitPassLane::default(); WG];
             let phases = multisplit_pass_phases(MULTISPLIT_SORT_ITEMS);
             let sync = |phase| multisplit_pass_sync(phase, MULTISPLIT_SORT_ITEMS);
             subgroup_workgroups(groups, phases, size, sync, |_, phase, lid, io| {
-                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS, { MULTISPLIT_SORT_TILE as usize }>(
+                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS>(
                     phase,
                     lid,
                     lid / size,
@@ -381,7 +380,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     sort_state,
                     &mut ticket,
                     &mut counts,
-                    &mut ranks,
                     &mut running,
                     &mut local_offsets,
                     &mut global_offsets,
