@@ -106,13 +106,22 @@ pub fn treelet_restructure_cs(
     let group = linear_group(group.x, group.y, groups.x);
     // Read once: each phase would load it again after its barrier.
     let params = *params;
-    for phase in 0..RESTRUCTURE_PHASES {
-        treelet_restructure_phase(
-            phase, lid, group, &params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage, cost,
-            parts, order, votes,
-        );
-        barrier();
+    // The phases unrolled, each with its number a constant, so that the
+    // driver's compiler keeps only that phase's branch (as the sort pass
+    // does: see `sort::sort_multisplit_cs`).
+    macro_rules! phases {
+        ($($phase:literal)*) => {
+            const _: () = assert!([$($phase),*].len() as u32 == RESTRUCTURE_PHASES);
+            $(
+                treelet_restructure_phase(
+                    $phase, lid, group, &params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage,
+                    cost, parts, order, votes,
+                );
+                barrier();
+            )*
+        };
     }
+    phases!(0 1 2 3 4 5 6 7 8);
 }
 
 /// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
