@@ -1,0 +1,12 @@
+for f in .gl/*.deb; do dpkg -x $f / ; done >/dev/null 2>&1; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json CI=true
+exec > >(tee $OUT/log.txt) 2>&1
+cd .dev
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv
+echo "== warm-up"; timeout -s KILL 40 ./treelet bench build --sizes 1000000 --repeats 5 2>&1 | tail -1
+for a in 0 32 64 1 2 4 6 8 16 31 63 0; do
+  echo "== ablate $a"
+  TREELET_SORT_ABLATE=$a TREELET_SORT_TILES=large timeout -s KILL 30 ./treelet bench build --sizes 1000000,16000000 --repeats 11 --per-kernel --json ablate_$a.json 2>&1 | tail -2
+done
+echo "== multisplit"; TREELET_SORT_TILES=multisplit timeout -s KILL 60 ./treelet bench build --sizes 1000000,16000000 --repeats 11 --per-kernel 2>&1 | tail -3
+cp ablate_*.json $OUT/ 2>/dev/null
