@@ -244,6 +244,57 @@ fn skipping_kept_treelets_changes_nothing() {
     }
 }
 
+/// Treelets restructured one invocation each give the very tree that teams
+/// of lanes give, at every split between the two (on the CPU runner, and on
+/// the GPU where it fuses Fma, against the CPU's teams).
+#[test]
+fn single_invocation_treelets_equal_team_treelets() {
+    use treelet::runtime::backend::Backend;
+    use treelet::runtime::cpu_runner::CpuBackend;
+    use treelet::runtime::gpu::GpuBackend;
+    use treelet::bvh::lbvh::{build_on_device, Bvh};
+    use treelet::bvh::trbvh::{optimize, root_box, TreeletConfig};
+
+    fn run<B: Backend>(b: &mut B, spheres: &[treelet_core::Sphere], gamma: u32, single_heights: u32) -> Bvh {
+        let (dbvh, _) = build_on_device(b, spheres).unwrap();
+        let rb = root_box(b, &dbvh).unwrap();
+        let config = TreeletConfig { gamma, single_heights, verify: true, ..Default::default() };
+        optimize(b, dbvh, &rb, &config).unwrap().0.read(b).unwrap()
+    }
+    let seed = treelet_tests::fresh_seed();
+    for (n, gamma) in [(20_000usize, 1), (30_000, 3), (5000, 7)] {
+        let spheres = treelet::scene::random_spheres(n, seed.wrapping_add(n as u64));
+        let teams = run(&mut CpuBackend::new(), &spheres, gamma, 0);
+        assert!(validate(&spheres, &teams.nodes, &teams.parents, &teams.prim_indices).is_valid());
+        for single_heights in [2, 4, u32::MAX] {
+            let single = run(&mut CpuBackend::new(), &spheres, gamma, single_heights);
+            assert!(
+                single.nodes == teams.nodes && single.parents == teams.parents && single.prim_indices == teams.prim_indices,
+                "cpu, n = {n}, gamma {gamma}, single up to height {single_heights}: not the teams' tree (seed {seed})"
+            );
+        }
+        let Some(ctx) = treelet_tests::gpu() else { continue };
+        let mut gpu = GpuBackend::new(ctx);
+        if gpu.runs_on_cpu() {
+            // Unfused Fma there: near-ties may differ from the CPU's (see
+            // above); the single-invocation kernel still runs, and its tree
+            // must be valid and as good.
+            let g = run(&mut gpu, &spheres, gamma, u32::MAX);
+            assert!(validate(&spheres, &g.nodes, &g.parents, &g.prim_indices).is_valid(), "gpu, n = {n}");
+            let (gs, cs) = (sah_cost(&g.nodes, SahCosts::KARRAS_AILA), sah_cost(&teams.nodes, SahCosts::KARRAS_AILA));
+            assert!((gs - cs).abs() <= 1e-3 * cs, "gpu, n = {n}: SAH {gs} against the teams' {cs}");
+            continue;
+        }
+        for single_heights in [3, u32::MAX] {
+            let g = run(&mut gpu, &spheres, gamma, single_heights);
+            assert!(
+                g.nodes == teams.nodes && g.parents == teams.parents && g.prim_indices == teams.prim_indices,
+                "gpu, n = {n}, gamma {gamma}, single up to height {single_heights}: not the CPU teams' tree (seed {seed})"
+            );
+        }
+    }
+}
+
 /// The collapse alone on hand-made trees: identical spheres collapse into
 /// full leaves; with `max_leaf` 1 a tree is only reordered (same SAH).
 #[test]

@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_scatter_phase};
+use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
 
@@ -141,4 +141,23 @@ pub fn collapse_cs(
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     collapse_kernel(id, params.n, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims);
+}
+
+/// Restructures the treelets of one height, one invocation each (heights
+/// of many small treelets).
+#[spirv(compute(threads(256)))]
+pub fn treelet_restructure_single_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] marks: &mut [u32],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    treelet_restructure_single(id, params, roots, nodes, parents, counts, costs, heights, marks);
 }

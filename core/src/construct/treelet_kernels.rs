@@ -27,7 +27,7 @@
 //! check's branch kept the GPU from issuing the next load before the last
 //! one returned, which made forming 12 µs.
 use crate::construct::climb::Climb;
-use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
+use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, optimize, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, set};
@@ -431,6 +431,64 @@ pub fn treelet_restructure_phase(
         // A new subtree, not solved as a treelet root yet.
         marks[stage[b + T_INTERNALS + lane as usize] as usize] = mark(round, false);
     }
+}
+
+/// Kernel: restructures treelet `id` of `roots[level_offset..][..level_count]`
+/// in one invocation, with the same decisions as
+/// [`treelet_restructure_phase`] (the same marks, and the same DP:
+/// [`crate::construct::treelet::optimize`], which the team's phases split
+/// over lanes; `tests/treelet.rs` checks that they agree node for node).
+///
+/// For heights of many small treelets (near the leaves a treelet has few
+/// leaves, and there are hundreds of thousands of them): a team of
+/// [`TEAM`] lanes through [`RESTRUCTURE_PHASES`] barriers is latency per
+/// treelet, where one invocation per treelet keeps the GPU full. Its DP
+/// tables live in the invocation's private memory.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_restructure_single(
+    id: u32,
+    params: &TreeletParams,
+    roots: &[u32],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    counts: &mut [u32],
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+    marks: &mut [u32],
+) {
+    if id >= params.level_count {
+        return;
+    }
+    let round = params.round;
+    let root = at(roots, (params.level_offset + id) as usize);
+    let r = at(nodes, root as usize);
+    let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
+    let old = at(marks, root as usize);
+    if params.skip_kept == 1 && old & 1 == 1 && !below {
+        return; // As in the team kernel: kept, and nothing under it changed.
+    }
+    let changed = if below { round } else { old >> 1 };
+    let costs = params.costs();
+    let mut stage = [0u32; TREELET_WORDS];
+    let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, &mut stage, 0);
+    if f.leaf_count >= 3 {
+        let sol = optimize(&stage, 0, &costs);
+        if improves(sol.cost[(1usize << f.leaf_count) - 1], f.current) {
+            plan_rewire(&mut stage, 0, &sol.parts, 0);
+            let mut k = 0;
+            while k + 1 < f.leaf_count as usize {
+                rewire_internal(k, &stage, 0, &sol.cost, 0, nodes, parents, counts, node_costs, heights);
+                // A new subtree, not solved as a treelet root yet.
+                marks[stage[T_INTERNALS + k] as usize] = mark(round, false);
+                k += 1;
+            }
+            return;
+        }
+    }
+    // Two leaves (only one tree), or nothing cheaper.
+    node_costs[root as usize] = f.current;
+    heights[root as usize] = f.height;
+    marks[root as usize] = mark(changed, true);
 }
 
 #[cfg(test)]

@@ -46,12 +46,29 @@ pub struct TreeletConfig {
     /// round) match; an error if not. For tests.
     #[serde(skip)]
     pub verify: bool,
+    /// Treelets of subtrees this high or lower are restructured one
+    /// invocation each, higher ones by a team of lanes each (the same tree
+    /// either way; see [`SINGLE_INVOCATION_HEIGHTS`]).
+    #[serde(skip, default = "single_invocation_heights")]
+    pub single_heights: u32,
 }
 
 impl Default for TreeletConfig {
     fn default() -> Self {
-        Self { rounds: 3, gamma: 3, max_leaf: 8, skip_kept: true, verify: false }
+        Self {
+            rounds: 3,
+            gamma: 3,
+            max_leaf: 8,
+            skip_kept: true,
+            verify: false,
+            single_heights: single_invocation_heights(),
+        }
     }
+}
+
+/// [`SINGLE_INVOCATION_HEIGHTS`], or `TREELET_SINGLE_HEIGHTS` (to measure).
+fn single_invocation_heights() -> u32 {
+    std::env::var("TREELET_SINGLE_HEIGHTS").ok().and_then(|v| v.parse().ok()).unwrap_or(SINGLE_INVOCATION_HEIGHTS)
 }
 
 /// Per-node scratch the passes share.
@@ -97,6 +114,16 @@ pub fn restructure<B: Backend>(
     Ok((bvh, b.take_times()?))
 }
 
+/// Treelets of subtrees this high or lower are restructured one invocation
+/// each (`treelet_core::construct::treelet_kernels::treelet_restructure_single`),
+/// higher ones by a team of lanes each; `TREELET_SINGLE_HEIGHTS` overrides it
+/// (to measure). Both give the same tree. On the H100 (1M random spheres,
+/// gamma 3) the 225 526 treelets of height 2 took 0.497 ms one invocation
+/// each against 0.823 by teams, but height 3 took 1.038 against 0.937 and
+/// height 4 0.830 against 0.848: TRBVH 10.19 -> 9.87 ms with 2, 10.09 with
+/// 3, 10.35 with 4 (`docs/results/h100-sort-occupancy/log_single_heights.txt`).
+pub const SINGLE_INVOCATION_HEIGHTS: u32 = 2;
+
 /// The rounds, in place; returns the tree, the per-node scratch and the
 /// parameters the collapse goes on with.
 fn rounds<B: Backend>(
@@ -117,6 +144,7 @@ fn rounds<B: Backend>(
     let profile_levels = std::env::var_os("TREELET_PROFILE_LEVELS").is_some();
     // ... and with `empty`, an empty launch after each height.
     let profile_empty = std::env::var("TREELET_PROFILE_LEVELS").is_ok_and(|v| v == "empty");
+    let single_heights = config.single_heights;
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
         if round == 0 {
@@ -166,9 +194,16 @@ fn rounds<B: Backend>(
                 // `bench build`: what a height costs against its treelets.
                 b.stage(Box::leak(format!("r{round} h{level:02} n{count}").into_boxed_str()));
             }
+            let single = level as u32 <= single_heights;
             let restructure = |b: &mut B, p: &B::Buffer| {
-                let buffers = [p, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
-                b.dispatch(Kernel::TreeletRestructure, &buffers, count.div_ceil(TEAMS));
+                if single {
+                    let buffers = [p, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
+                    b.dispatch(Kernel::TreeletRestructureSingle, &buffers, groups_for(count, WORKGROUP_SIZE));
+                } else {
+                    let buffers =
+                        [p, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
+                    b.dispatch(Kernel::TreeletRestructure, &buffers, count.div_ceil(TEAMS));
+                }
             };
             restructure(b, &lp);
             if profile_empty {
@@ -293,7 +328,12 @@ fn collapse_pass<B: Backend>(
 /// question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = collapse_kernels(b);
-    k.extend([Kernel::TreeletHistogram, Kernel::TreeletScatter, Kernel::TreeletRestructure]);
+    k.extend([
+        Kernel::TreeletHistogram,
+        Kernel::TreeletScatter,
+        Kernel::TreeletRestructure,
+        Kernel::TreeletRestructureSingle,
+    ]);
     k
 }
 

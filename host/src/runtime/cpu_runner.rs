@@ -544,6 +544,14 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 );
             });
         }
+        (Kernel::TreeletRestructureSingle, [p, roots, nodes, parents, counts, costs, heights, marks]) => {
+            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
+            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
+            let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
+            for id in ids(groups) {
+                treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);
+            }
+        }
         (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, parents, out) = (view(nodes), view(parents), view(out));

@@ -109,6 +109,8 @@ pub enum Kernel {
     TreeletScatter,
     /// Treelet optimization: restructure the treelets of one height, a team of lanes each.
     TreeletRestructure,
+    /// Treelet optimization: restructure the treelets of one height, one invocation each.
+    TreeletRestructureSingle,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
     /// The two-box binary layout from a collapsed tree.
@@ -138,7 +140,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 40] = [
+    const FIXED: [Kernel; 41] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -164,6 +166,7 @@ impl Kernel {
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
+        Kernel::TreeletRestructureSingle,
         Kernel::Collapse,
         Kernel::Bvh2Nodes,
         Kernel::LeafPrims,
@@ -224,6 +227,7 @@ impl Kernel {
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
+            Kernel::TreeletRestructureSingle => "treelet::treelet_restructure_single_cs",
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
             Kernel::LeafPrims => "bvh2::leaf_prims_cs",
@@ -272,6 +276,9 @@ impl Kernel {
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::TreeletRestructure => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+            }
+            Kernel::TreeletRestructureSingle => {
+                &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
