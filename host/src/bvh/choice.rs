@@ -34,10 +34,13 @@ impl TreeletTradeOff {
     ///   path with the LBVH and 5.50 with the treelet-optimized tree;
     ///   `bench rays --mesh-only` at 1920x1080: diffuse rays at 602 against
     ///   679 M/s, 0.19 ns a ray saved (at 16 384 triangles 0.085 ns).
-    ///   `bench build`, LBVH against treelet-optimized: 0.18 / 0.23 / 0.42 /
-    ///   0.95 ms against 1.51 / 2.36 / 4.20 / 11.02 ms at 4 096 / 65 536 /
-    ///   262 144 / 1M primitives: 1.5 ms plus 8.5 ns a primitive more (the
-    ///   layouts: 0.72 against 0.56 ms at 1M, left out).
+    ///   `bench build`, LBVH against treelet-optimized, measured again after
+    ///   the faster sort and treelet kernels (`log_builds_after_sort.txt`):
+    ///   0.18 / 0.23 / 0.40 / 0.81 ms against 1.43 / 2.20 / 3.81 / 9.81 ms at
+    ///   4 096 / 65 536 / 262 144 / 1M primitives: 1.4 ms plus 7.6 ns a
+    ///   primitive more, a least-squares line within 0.16 ms of each (it
+    ///   was 1.5 ms plus 8.5 ns; the layouts: 0.72 against 0.56 ms at 1M,
+    ///   left out).
     /// - CPU Vulkan adapter (lavapipe on two cores, `cwbvh`):
     ///   `terrain:50000` in the room, 128x96 at 4 and 20 spp: 5.04 against
     ///   4.88 µs a path; builds 47 ms against 2 567 ms; `bench rays` at
@@ -52,8 +55,8 @@ impl TreeletTradeOff {
     pub fn of(class: DeviceClass) -> Self {
         match class {
             DeviceClass::Gpu => TreeletTradeOff {
-                extra_build_ms: 1.5,
-                extra_build_ns_per_prim: 8.5,
+                extra_build_ms: 1.4,
+                extra_build_ns_per_prim: 7.6,
                 saved_ns_per_path: 1.66,
                 saved_ns_per_ray: 0.19,
             },
