@@ -2,8 +2,9 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
+use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
+use treelet_core::gpu::subgroup::subgroup_barrier;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
 
 /// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
@@ -84,6 +85,7 @@ pub fn treelet_scatter_cs(
 #[spirv(compute(threads(256)))]
 pub fn treelet_restructure_cs(
     #[spirv(local_invocation_index)] lid: u32,
+    #[spirv(subgroup_size)] subgroup_size: u32,
     #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
@@ -104,6 +106,11 @@ pub fn treelet_restructure_cs(
     let group = linear_group(group.x, group.y, groups.x);
     // Read once: each phase would load it again after its barrier.
     let params = *params;
+    // After the first phase (which fills the shared subset order), a team
+    // shares workgroup memory only within itself: where a team lies within
+    // one subgroup, a subgroup barrier suffices, and a team goes on without
+    // waiting for the workgroup's slowest.
+    let team_in_subgroup = subgroup_size >= TEAM;
     // The phases unrolled, each with its number a constant, so that the
     // driver's compiler keeps only that phase's branch (as the sort pass
     // does: see `sort::sort_multisplit_cs`).
@@ -115,7 +122,11 @@ pub fn treelet_restructure_cs(
                     $phase, lid, group, &params, roots, subsets, nodes, parents, counts, costs, heights, marks, stage,
                     cost, parts, order, votes,
                 );
-                barrier();
+                if $phase == 0 || !team_in_subgroup {
+                    barrier();
+                } else {
+                    subgroup_barrier();
+                }
             )*
         };
     }

@@ -90,7 +90,6 @@ pub fn apply(sync: u32, lane: &mut Lane) {
     use spirv_std::arch::{
         subgroup_ballot, subgroup_exclusive_i_add, subgroup_i_add, subgroup_inclusive_i_add, subgroup_shuffle,
     };
-    use spirv_std::memory::{Scope, Semantics};
     let op = sync & OP_MASK;
     if op == OP_MATCH_BYTE {
         let mut peers = ballot_mask(subgroup_ballot(lane.arg != 0));
@@ -114,14 +113,28 @@ pub fn apply(sync: u32, lane: &mut Lane) {
         lane.output = subgroup_i_add(lane.input) as u64;
     }
     if sync & THEN_SUBGROUP_BARRIER != 0 {
+        subgroup_barrier();
+    }
+    if sync & THEN_WORKGROUP_BARRIER != 0 {
+        super::workgroup::barrier();
+    }
+}
+
+/// A barrier across the subgroup that makes the workgroup memory its lanes
+/// wrote visible to each other (GLSL's `subgroupBarrier`): for kernels whose
+/// teams of lanes, each within one subgroup, share workgroup memory only
+/// among themselves. Nothing to do on the CPU runner, which runs a phase
+/// for every lane before the next.
+#[inline]
+pub fn subgroup_barrier() {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::memory::{Scope, Semantics};
         spirv_std::arch::control_barrier::<
             { Scope::Subgroup as u32 },
             { Scope::Subgroup as u32 },
             { Semantics::WORKGROUP_MEMORY.bits() | Semantics::ACQUIRE_RELEASE.bits() },
         >();
-    }
-    if sync & THEN_WORKGROUP_BARRIER != 0 {
-        super::workgroup::barrier();
     }
 }
 
