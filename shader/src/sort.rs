@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
 use treelet_core::construct::sort_multisplit::{
-    MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SUBGROUP_COUNTS, multisplit_pass_phase,
+    MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
     multisplit_pass_phases, multisplit_pass_sync,
 };
 use treelet_core::gpu::subgroup::{Lane, apply};
@@ -118,41 +118,42 @@ onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 
 onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11]);
 onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23]);
 
-/// A sort pass ranked by subgroups: each lane's state stays in registers,
-/// and only the phases that need it end in a workgroup barrier.
-#[spirv(compute(threads(256)))]
-#[allow(clippy::too_many_arguments)]
-pub fn sort_multisplit_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(subgroup_id)] subgroup: u32,
-    #[spirv(subgroup_local_invocation_id)] lane: u32,
-    #[spirv(subgroup_size)] size: u32,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
-    #[spirv(workgroup)] ticket: &mut [u32; 1],
-    #[spirv(workgroup)] counts: &mut [u32; SUBGROUP_COUNTS],
-    #[spirv(workgroup)] running: &mut [u32; WG],
-    #[spirv(workgroup)] local_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] global_offsets: &mut [u32; WG],
-    #[spirv(workgroup)] scan_sums: &mut [u32; 16],
-) {
-    // A private copy, kept in registers across the barriers instead of
-    // read from the storage buffer again in each phase (H200: 1% off the sort).
-    let params = &{ *params };
-    let mut me = MultisplitPassLane::default();
-    let mut io = Lane::default();
-    // The phases unrolled, each with its number a constant, so that the
-    // driver's compiler keeps only that phase's branch of the function
-    // (a loop over phases pays for the whole function in every phase).
-    macro_rules! phases {
-        ($($phase:literal)*) => {
-            const _: () = assert!([$($phase),*].len() as u32 == multisplit_pass_phases(MULTISPLIT_SORT_ITEMS));
+/// A sort pass ranked by subgroups, `$items` keys per lane: each lane's
+/// state stays in registers, and only the phases that need it end in a
+/// workgroup barrier. The phases unrolled, each with its number a
+/// constant, so that the driver's compiler keeps only that phase's branch
+/// of the function (a loop over phases pays for the whole function in
+/// every phase).
+macro_rules! multisplit_kernel {
+    ($name:ident, $items:expr, [$($phase:literal)*]) => {
+        #[spirv(compute(threads(256)))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $name(
+            #[spirv(local_invocation_index)] lid: u32,
+            #[spirv(subgroup_id)] subgroup: u32,
+            #[spirv(subgroup_local_invocation_id)] lane: u32,
+            #[spirv(subgroup_size)] size: u32,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys_in: &[u64],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values_in: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] keys_out: &mut [u64],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] values_out: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] sort_state: &mut [u32],
+            #[spirv(workgroup)] ticket: &mut [u32; 1],
+            #[spirv(workgroup)] counts: &mut [u32; SUBGROUP_COUNTS],
+            #[spirv(workgroup)] running: &mut [u32; WG],
+            #[spirv(workgroup)] local_offsets: &mut [u32; WG],
+            #[spirv(workgroup)] global_offsets: &mut [u32; WG],
+            #[spirv(workgroup)] scan_sums: &mut [u32; 16],
+        ) {
+            // A private copy, kept in registers across the barriers instead of
+            // read from the storage buffer again in each phase (H200: 1% off the sort).
+            let params = &{ *params };
+            let mut me = MultisplitPassLane::default();
+            let mut io = Lane::default();
+            const _: () = assert!([$($phase),*].len() as u32 == multisplit_pass_phases($items));
             $(
-                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS>(
+                multisplit_pass_phase::<{ $items }>(
                     $phase,
                     lid,
                     subgroup,
@@ -173,12 +174,14 @@ pub fn sort_multisplit_cs(
                     &mut me,
                     &mut io,
                 );
-                apply(multisplit_pass_sync($phase, MULTISPLIT_SORT_ITEMS), &mut io);
+                apply(multisplit_pass_sync($phase, $items), &mut io);
             )*
-        };
-    }
-    phases!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25);
+        }
+    };
 }
+
+multisplit_kernel!(sort_multisplit_cs, MULTISPLIT_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
+multisplit_kernel!(sort_multisplit_small_cs, SMALL_MULTISPLIT_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(

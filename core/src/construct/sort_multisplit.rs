@@ -74,6 +74,12 @@ pub const SUBGROUP_COUNTS: usize = (MAX_SUBGROUPS * ROW_WORDS) as usize;
 pub const MULTISPLIT_SORT_ITEMS: u32 = 8;
 /// Keys per workgroup.
 pub const MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * MULTISPLIT_SORT_ITEMS;
+/// Keys per lane of the small-tile form: twice the tiles, half the keys
+/// each lane ranks one after another (faster for sorts that fill the GPU
+/// less than twice over; the counters are sized for the larger tiles).
+pub const SMALL_MULTISPLIT_SORT_ITEMS: u32 = 4;
+/// Keys per workgroup of the small-tile form.
+pub const SMALL_MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * SMALL_MULTISPLIT_SORT_ITEMS;
 const _: () = assert!(MULTISPLIT_SORT_TILE as usize <= 2 * SUBGROUP_COUNTS, "the counters hold the tile's order");
 /// Most keys per lane: a lane keeps its digits in one 64-bit word.
 pub const MAX_MULTISPLIT_ITEMS: u32 = 8;

@@ -3,7 +3,7 @@
 use anyhow::Result;
 use treelet_core::construct::scan::SCAN_TILE;
 use treelet_core::construct::sort::{MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE, histogram_tile, passes_for, state};
-use treelet_core::construct::sort_multisplit::{MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE};
+use treelet_core::construct::sort_multisplit::{MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE, SMALL_MULTISPLIT_SORT_TILE};
 use treelet_core::geometry::buffers::{ScanParams, SortParams};
 use treelet_core::gpu::workgroup::groups_for;
 
@@ -16,10 +16,11 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep];
     if b.look_back_works() {
         k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
-        k.push(match SortTiles::Auto.resolve(u32::MAX, multisplit_by_default(b)) {
-            SortTiles::Multisplit => Kernel::SortMultisplit,
-            _ => Kernel::SortOnesweep,
-        });
+        if multisplit_by_default(b) {
+            k.extend([Kernel::SortMultisplitSmall, Kernel::SortMultisplit]);
+        } else {
+            k.push(Kernel::SortOnesweep);
+        }
     } else {
         k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
     }
@@ -44,7 +45,7 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
 /// large tiles ranked in workgroup memory).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SortTiles {
-    /// By size and device: `TREELET_SORT_TILES=small|large|multisplit`
+    /// By size and device: `TREELET_SORT_TILES=small|large|multisplit|multisplit-small`
     /// overrides it (to measure).
     Auto,
     /// `treelet_core::construct::sort::SMALL_SORT_TILE` keys per workgroup.
@@ -55,6 +56,8 @@ pub enum SortTiles {
     /// (`treelet_core::construct::sort_multisplit`), on devices whose
     /// subgroups have at least `MIN_SUBGROUP_SIZE` lanes.
     Multisplit,
+    /// The same with half the keys per lane (`SMALL_MULTISPLIT_SORT_TILE`).
+    MultisplitSmall,
 }
 
 impl SortTiles {
@@ -62,11 +65,15 @@ impl SortTiles {
     /// take the pass ranked by subgroups, [`multisplit_by_default`]).
     ///
     /// Small tiles up to [`SMALL_TILES_UP_TO`] keys, then tiles ranked by
-    /// subgroups where the device runs them: on the H100 (one machine,
-    /// `bench build --per-kernel`, medians of 11, 2026-11-26) their 8
-    /// passes take 0.202 / 0.351 / 0.990 / 3.25 ms at 65 536 / 1M / 4M /
-    /// 16M keys, small tiles 0.135 / 0.582 / 2.15 / 8.29 and large ones
-    /// 0.224 / 0.480 / 1.79 / 6.55.
+    /// subgroups where the device runs them, small ones up to
+    /// [`SMALL_MULTISPLIT_UP_TO`]: on the H100 (one machine, `bench build
+    /// --per-kernel`, medians of 11 and 21, 2026-11-26) the 8 passes ranked
+    /// by subgroups take 0.202 / 0.351 / 0.990 / 3.25 ms at 65 536 / 1M /
+    /// 4M / 16M keys, small tiles 0.135 / 0.582 / 2.15 / 8.29 and large
+    /// ones 0.224 / 0.480 / 1.79 / 6.55; with half the keys per lane
+    /// 0.153 / 0.194 / 0.251 / 0.368 / 1.10 ms at 65 536 / 262 144 /
+    /// 524 288 / 1M / 4M against 0.202 / 0.226 / 0.263 / 0.350 / 1.01
+    /// (`docs/results/h100-sort-occupancy/log_4_keys_per_lane.txt`).
     fn resolve(self, n: u32, multisplit: bool) -> SortTiles {
         if self != SortTiles::Auto {
             return self;
@@ -75,7 +82,9 @@ impl SortTiles {
             Ok("small") => SortTiles::Small,
             Ok("large") => SortTiles::Large,
             Ok("multisplit") => SortTiles::Multisplit,
+            Ok("multisplit-small") => SortTiles::MultisplitSmall,
             _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
+            _ if multisplit && n <= SMALL_MULTISPLIT_UP_TO => SortTiles::MultisplitSmall,
             _ if multisplit => SortTiles::Multisplit,
             _ => SortTiles::Large,
         }
@@ -95,6 +104,12 @@ pub fn multisplit_runs_on<B: Backend>(b: &B) -> bool {
 fn multisplit_by_default<B: Backend>(b: &B) -> bool {
     multisplit_runs_on(b) && !b.runs_on_cpu()
 }
+
+/// Largest sort that takes the small tiles ranked by subgroups by default
+/// (where large sorts take tiles ranked by subgroups): on the H100 they
+/// were 14% faster at 262 144 keys, 5% at 524 288, 1.6% slower at 750 000
+/// (`docs/results/h100-sort-occupancy/log_small_multisplit.txt`).
+const SMALL_MULTISPLIT_UP_TO: u32 = 600_000;
 
 /// Largest sort that takes small tiles by default: on the H100 small tiles
 /// sorted 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
@@ -135,7 +150,8 @@ pub fn radix_sort_tiled<B: Backend>(
     let passes = passes_for(key_bits);
     // Small tiles where large ones would leave the GPU idle (look-back only).
     let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_by_default(b)) } else { SortTiles::Large };
-    if tile_size == SortTiles::Multisplit && !multisplit_runs_on(b) {
+    let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall);
+    if multisplit && !multisplit_runs_on(b) {
         anyhow::bail!(
             "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",
             b.adapter(),
@@ -146,6 +162,7 @@ pub fn radix_sort_tiled<B: Backend>(
     let (kernel, tile) = match tile_size {
         SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
         SortTiles::Multisplit => (Kernel::SortMultisplit, MULTISPLIT_SORT_TILE),
+        SortTiles::MultisplitSmall => (Kernel::SortMultisplitSmall, SMALL_MULTISPLIT_SORT_TILE),
         _ => (Kernel::SortOnesweep, SORT_TILE),
     };
     let tiles = groups_for(n, tile);

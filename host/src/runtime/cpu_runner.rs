@@ -164,6 +164,45 @@ fn render_all<T: ClosestHit + Sync>(
         .for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene, lights)));
 }
 
+/// The sort pass ranked by subgroups (`ITEMS` keys per lane), its
+/// workgroups one after another, each subgroup's operations emulated.
+fn multisplit_sort_pass<const ITEMS: u32>(
+    p: &treelet_core::SortParams,
+    (keys_in, values_in, keys_out, values_out, sort_state): (&[u64], &[u32], &mut [u64], &mut [u32], &mut [u32]),
+    groups: u32,
+    size: u32,
+) {
+    use treelet_core::construct::sort_multisplit::*;
+    let mut ticket = [0u32; 1];
+    let mut counts = [0u32; SUBGROUP_COUNTS];
+    let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
+    let mut lanes = [MultisplitPassLane::default(); WG];
+    let sync = |phase| multisplit_pass_sync(phase, ITEMS);
+    subgroup_workgroups(groups, multisplit_pass_phases(ITEMS), size, sync, |_, phase, lid, io| {
+        multisplit_pass_phase::<ITEMS>(
+            phase,
+            lid,
+            lid / size,
+            lid % size,
+            size,
+            p,
+            keys_in,
+            values_in,
+            keys_out,
+            values_out,
+            sort_state,
+            &mut ticket,
+            &mut counts,
+            &mut running,
+            &mut local_offsets,
+            &mut global_offsets,
+            &mut scan_sums,
+            &mut lanes[lid as usize],
+            &mut io[lid as usize],
+        )
+    });
+}
+
 /// A sort pass kernel's workgroups, one after another: every earlier
 /// ticket's tile is done when a look-back reads it, so it never waits.
 fn onesweep<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize>(
@@ -354,40 +393,16 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             });
         }
         (Kernel::SortMultisplit, [p, keys_in, values_in, keys_out, values_out, sort_state]) => {
-            use treelet_core::construct::sort_multisplit::*;
+            use treelet_core::construct::sort_multisplit::MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
-            let (keys_in, values_in, sort_state) = (view(keys_in), view(values_in), view(sort_state));
-            let (keys_out, values_out) = (view(keys_out), view(values_out));
-            let size = subgroup_size;
-            let mut ticket = [0u32; 1];
-            let mut counts = [0u32; SUBGROUP_COUNTS];
-            let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
-            let mut lanes = [MultisplitPassLane::default(); WG];
-            let phases = multisplit_pass_phases(MULTISPLIT_SORT_ITEMS);
-            let sync = |phase| multisplit_pass_sync(phase, MULTISPLIT_SORT_ITEMS);
-            subgroup_workgroups(groups, phases, size, sync, |_, phase, lid, io| {
-                multisplit_pass_phase::<MULTISPLIT_SORT_ITEMS>(
-                    phase,
-                    lid,
-                    lid / size,
-                    lid % size,
-                    size,
-                    &p,
-                    keys_in,
-                    values_in,
-                    keys_out,
-                    values_out,
-                    sort_state,
-                    &mut ticket,
-                    &mut counts,
-                    &mut running,
-                    &mut local_offsets,
-                    &mut global_offsets,
-                    &mut scan_sums,
-                    &mut lanes[lid as usize],
-                    &mut io[lid as usize],
-                )
-            });
+            let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
+            multisplit_sort_pass::<MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size);
+        }
+        (Kernel::SortMultisplitSmall, [p, keys_in, values_in, keys_out, values_out, sort_state]) => {
+            use treelet_core::construct::sort_multisplit::SMALL_MULTISPLIT_SORT_ITEMS;
+            let p: treelet_core::SortParams = params(p);
+            let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
+            multisplit_sort_pass::<SMALL_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size);
         }
         (Kernel::SortTileCounts, [p, keys, tile_counts]) => {
             let p: treelet_core::SortParams = params(p);

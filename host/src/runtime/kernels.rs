@@ -81,6 +81,8 @@ pub enum Kernel {
     /// Radix sort: one pass ranked by subgroups (Onesweep's warp-level
     /// multisplit; `treelet_core::construct::sort_multisplit`).
     SortMultisplit,
+    /// The same with half the keys per lane (small tiles).
+    SortMultisplitSmall,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -140,7 +142,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 41] = [
+    const FIXED: [Kernel; 42] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -150,6 +152,7 @@ impl Kernel {
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
+        Kernel::SortMultisplitSmall,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
@@ -211,6 +214,7 @@ impl Kernel {
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
+            Kernel::SortMultisplitSmall => "sort::sort_multisplit_small_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit::multisplit_cs",
@@ -261,7 +265,11 @@ impl Kernel {
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
-            Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned | Kernel::SortMultisplit => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SortOnesweep
+            | Kernel::SortOnesweepSmall
+            | Kernel::SortOnesweepScanned
+            | Kernel::SortMultisplit
+            | Kernel::SortMultisplitSmall => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
