@@ -268,6 +268,38 @@ fn mark(changed_round: u32, kept: bool) -> u32 {
     (changed_round << 1) | kept as u32
 }
 
+/// Whether treelet `root` is solved this round (`params.round`): `None`
+/// where it was kept in an earlier round and nothing under it changed
+/// since (with `params.skip_kept`), else the round its subtree last
+/// changed in: this one if anything under it did.
+#[inline]
+fn changed_round(root: u32, params: &TreeletParams, nodes: &[Node], marks: &[u32]) -> Option<u32> {
+    let round = params.round;
+    let r = at(nodes, root as usize);
+    let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
+    let old = at(marks, root as usize);
+    if params.skip_kept == 1 && old & 1 == 1 && !below {
+        return None;
+    }
+    Some(if below { round } else { old >> 1 })
+}
+
+/// Keeps treelet `root` as it is: its current cost and height, marked kept.
+#[inline]
+fn keep(
+    root: u32,
+    cost: f32,
+    height: u32,
+    changed: u32,
+    node_costs: &mut [f32],
+    heights: &mut [u32],
+    marks: &mut [u32],
+) {
+    node_costs[root as usize] = cost;
+    heights[root as usize] = height;
+    marks[root as usize] = mark(changed, true);
+}
+
 // Phases of [`treelet_restructure_phase`]: form; one per subset size 2..=7
 // (the whole treelet's partitions dealt to all lanes); choose the whole
 // treelet's best partition and plan the rewiring; rewire.
@@ -338,21 +370,14 @@ pub fn treelet_restructure_phase(
             return;
         }
         let root = at(roots, (params.level_offset + index) as usize);
-        let r = at(nodes, root as usize);
-        let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
-        let old = at(marks, root as usize);
-        if params.skip_kept == 1 && old & 1 == 1 && !below {
+        let Some(changed) = changed_round(root, params, nodes, marks) else {
             return; // kept, and nothing under it changed: it would be kept again
-        }
-        // Changed this round if anything under it did; kept (so far).
-        let changed = if below { round } else { old >> 1 };
+        };
         stage[b + T_CHANGED] = changed;
         let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, stage, b);
         if f.leaf_count < 3 {
             // Two leaves: only one tree, nothing for the team to solve.
-            node_costs[root as usize] = f.current;
-            heights[root as usize] = f.height;
-            marks[root as usize] = mark(changed, true);
+            keep(root, f.current, f.height, changed, node_costs, heights, marks);
             stage[b + T_COUNT] = 0;
             return;
         }
@@ -417,10 +442,8 @@ pub fn treelet_restructure_phase(
             if rewire {
                 plan_rewire(stage, b, parts, pb);
             } else {
-                let root = stage[b + T_INTERNALS] as usize;
-                node_costs[root] = current;
-                heights[root] = stage[b + T_HEIGHT];
-                marks[root] = mark(stage[b + T_CHANGED], true);
+                let root = stage[b + T_INTERNALS];
+                keep(root, current, stage[b + T_HEIGHT], stage[b + T_CHANGED], node_costs, heights, marks);
             }
             stage[b + T_REWIRE] = rewire as u32;
         }
@@ -459,15 +482,10 @@ pub fn treelet_restructure_single(
     if id >= params.level_count {
         return;
     }
-    let round = params.round;
     let root = at(roots, (params.level_offset + id) as usize);
-    let r = at(nodes, root as usize);
-    let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
-    let old = at(marks, root as usize);
-    if params.skip_kept == 1 && old & 1 == 1 && !below {
-        return; // As in the team kernel: kept, and nothing under it changed.
-    }
-    let changed = if below { round } else { old >> 1 };
+    let Some(changed) = changed_round(root, params, nodes, marks) else {
+        return; // kept, and nothing under it changed: it would be kept again
+    };
     let costs = params.costs();
     let mut stage = [0u32; TREELET_WORDS];
     let f = form_treelet(root, nodes, counts, node_costs, heights, &costs, &mut stage, 0);
@@ -479,16 +497,14 @@ pub fn treelet_restructure_single(
             while k + 1 < f.leaf_count as usize {
                 rewire_internal(k, &stage, 0, &sol.cost, 0, nodes, parents, counts, node_costs, heights);
                 // A new subtree, not solved as a treelet root yet.
-                marks[stage[T_INTERNALS + k] as usize] = mark(round, false);
+                marks[stage[T_INTERNALS + k] as usize] = mark(params.round, false);
                 k += 1;
             }
             return;
         }
     }
     // Two leaves (only one tree), or nothing cheaper.
-    node_costs[root as usize] = f.current;
-    heights[root as usize] = f.height;
-    marks[root as usize] = mark(changed, true);
+    keep(root, f.current, f.height, changed, node_costs, heights, marks);
 }
 
 #[cfg(test)]
