@@ -40,6 +40,10 @@ fn rebuild() -> Result<(), Box<dyn std::error::Error>> {
         .capability(Capability::GroupNonUniformBallot)
         .capability(Capability::GroupNonUniformShuffle)
         .capability(Capability::GroupNonUniformArithmetic)
+        // NVIDIA's partition instruction (the sort's digit match), kept only
+        // in the modules that use it (see `strip_unused_partitioned`).
+        .capability(Capability::GroupNonUniformPartitionedNV)
+        .extension("SPV_NV_shader_subgroup_partitioned")
         .multimodule(true);
     builder.release = true;
     builder.build_script.defaults = true;
@@ -54,6 +58,9 @@ fn rebuild() -> Result<(), Box<dyn std::error::Error>> {
         if bytes.len() % 4 != 0 {
             return Err(format!("{}: not whole SPIR-V words", path.display()).into());
         }
+        let module: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let module = strip_unused_partitioned(&module).map_err(|e| format!("{}: {e}", path.display()))?;
+        let bytes: Vec<u8> = module.iter().flat_map(|w| w.to_le_bytes()).collect();
         let mut padded = name.as_bytes().to_vec();
         padded.resize(name.len().div_ceil(4) * 4, 0);
         words.push(name.len() as u32);
@@ -65,4 +72,46 @@ fn rebuild() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(&out, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())?;
     println!("cargo:rustc-env=treelet_shaders.bin={}", out.display());
     Ok(())
+}
+
+/// `module` without the partitioned capability and extension where it has
+/// no partition instruction: every module declares what the builder was
+/// given, and a device without the extension (lavapipe) must still load
+/// the modules that do not need it.
+#[cfg(feature = "rebuild-shaders")]
+fn strip_unused_partitioned(module: &[u32]) -> Result<Vec<u32>, String> {
+    const OP_EXTENSION: u32 = 10;
+    const OP_CAPABILITY: u32 = 17;
+    const OP_PARTITION: u32 = 5296;
+    const CAPABILITY_PARTITIONED: u32 = 5297;
+    const EXTENSION: &[u8] = b"SPV_NV_shader_subgroup_partitioned";
+    if module.len() < 5 || module[0] != 0x0723_0203 {
+        return Err("not a SPIR-V module".into());
+    }
+    let mut instructions = Vec::new();
+    let mut at = 5;
+    while at < module.len() {
+        let count = (module[at] >> 16) as usize;
+        if count == 0 || at + count > module.len() {
+            return Err(format!("malformed instruction at word {at}"));
+        }
+        instructions.push(&module[at..at + count]);
+        at += count;
+    }
+    if instructions.iter().any(|i| i[0] & 0xffff == OP_PARTITION) {
+        return Ok(module.to_vec());
+    }
+    let is_extension = |i: &[u32]| {
+        let bytes: Vec<u8> = i[1..].iter().flat_map(|w| w.to_le_bytes()).collect();
+        bytes.split(|&b| b == 0).next() == Some(EXTENSION)
+    };
+    let mut out = module[..5].to_vec();
+    for i in instructions {
+        let op = i[0] & 0xffff;
+        let drop = (op == OP_CAPABILITY && i[1] == CAPABILITY_PARTITIONED) || (op == OP_EXTENSION && is_extension(i));
+        if !drop {
+            out.extend_from_slice(i);
+        }
+    }
+    Ok(out)
 }

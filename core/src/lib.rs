@@ -38,6 +38,7 @@
 //! ```
 //! The host crate (`treelet`) runs these stages on a device: see its
 //! `Tracer` for building a tree and finding closest hits from an engine.
+#![cfg_attr(target_arch = "spirv", feature(asm_experimental_arch))]
 #![no_std]
 
 pub mod construct;

@@ -5,7 +5,7 @@ use treelet_core::construct::sort_multisplit::{
     MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
     multisplit_pass_phases, multisplit_pass_sync,
 };
-use treelet_core::gpu::subgroup::{Lane, apply};
+use treelet_core::gpu::subgroup::{Lane, apply_with};
 use treelet_core::geometry::buffers::SortParams;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
@@ -125,7 +125,7 @@ onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS, [0 1 2 3 4 5
 /// of the function (a loop over phases pays for the whole function in
 /// every phase).
 macro_rules! multisplit_kernel {
-    ($name:ident, $items:expr, [$($phase:literal)*]) => {
+    ($name:ident, $items:expr, $partitioned:literal, [$($phase:literal)*]) => {
         #[spirv(compute(threads(256)))]
         #[allow(clippy::too_many_arguments)]
         pub fn $name(
@@ -174,14 +174,18 @@ macro_rules! multisplit_kernel {
                     &mut me,
                     &mut io,
                 );
-                apply(multisplit_pass_sync($phase, $items), &mut io);
+                apply_with::<$partitioned>(multisplit_pass_sync($phase, $items, $partitioned), &mut io);
             )*
         }
     };
 }
 
-multisplit_kernel!(sort_multisplit_cs, MULTISPLIT_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
-multisplit_kernel!(sort_multisplit_small_cs, SMALL_MULTISPLIT_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
+multisplit_kernel!(sort_multisplit_cs, MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
+multisplit_kernel!(sort_multisplit_small_cs, SMALL_MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
+// The same passes with the byte match by NVIDIA's partition instruction,
+// for devices on which the host enabled `VK_NV_shader_subgroup_partitioned`.
+multisplit_kernel!(sort_multisplit_partitioned_cs, MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
+multisplit_kernel!(sort_multisplit_small_partitioned_cs, SMALL_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(

@@ -50,7 +50,7 @@ use crate::construct::sort::{digit, state, tile_offset, write_tile, RADIX, RADIX
 use crate::geometry::buffers::SortParams;
 use crate::gpu::atomics;
 use crate::gpu::subgroup::{
-    highest_lane, lanes_below, popcount, Lane, OP_MATCH_BYTE, OP_NONE, OP_SHUFFLE, THEN_SUBGROUP_BARRIER,
+    highest_lane, lanes_below, popcount, Lane, OP_MATCH_BYTE, OP_MATCH_BYTE_PARTITIONED, OP_NONE, OP_SHUFFLE, THEN_SUBGROUP_BARRIER,
     THEN_WORKGROUP_BARRIER,
 };
 use crate::gpu::unchecked::{at, get, set};
@@ -131,12 +131,18 @@ pub const fn multisplit_pass_phases(items: u32) -> u32 {
 }
 
 /// The synchronisation code (see [`crate::gpu::subgroup`]) after phase
-/// `phase` of a pass with `items` keys per lane.
-pub const fn multisplit_pass_sync(phase: u32, items: u32) -> u32 {
+/// `phase` of a pass with `items` keys per lane; `partitioned`: the byte
+/// match by NVIDIA's partition instruction ([`OP_MATCH_BYTE_PARTITIONED`],
+/// the same result) instead of ballots.
+pub const fn multisplit_pass_sync(phase: u32, items: u32, partitioned: bool) -> u32 {
     if phase == 0 || phase > 2 * items {
         OP_NONE | THEN_WORKGROUP_BARRIER
     } else if phase % 2 == 1 {
-        OP_MATCH_BYTE
+        if partitioned {
+            OP_MATCH_BYTE_PARTITIONED
+        } else {
+            OP_MATCH_BYTE
+        }
     } else {
         // The leader's count must be seen by the next key's leader.
         OP_SHUFFLE | THEN_SUBGROUP_BARRIER

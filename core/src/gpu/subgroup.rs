@@ -56,6 +56,13 @@ pub const OP_ADD: u32 = 5;
 /// instruction (NVIDIA's partitioned extension is not core), so the GPU
 /// builds it from nine ballots, as Onesweep's multisplit does.
 pub const OP_MATCH_BYTE: u32 = 6;
+/// [`OP_MATCH_BYTE`] by one instruction, `OpGroupNonUniformPartitionNV`
+/// (`SPV_NV_shader_subgroup_partitioned`, NVIDIA's `MATCH.ANY`), for
+/// kernels dispatched only on devices whose Vulkan driver has the
+/// extension and on which the host enabled it. The same result as
+/// [`OP_MATCH_BYTE`] (the CPU runner computes both alike): on the H100 the
+/// nine ballots and their mask logic are what bound the sort's ranking.
+pub const OP_MATCH_BYTE_PARTITIONED: u32 = 7;
 
 /// The operation part of a phase's synchronisation code.
 pub const OP_MASK: u32 = 0xff;
@@ -87,6 +94,15 @@ pub struct Lane {
 #[cfg(target_arch = "spirv")]
 #[inline]
 pub fn apply(sync: u32, lane: &mut Lane) {
+    apply_with::<false>(sync, lane)
+}
+
+/// [`apply`], also for [`OP_MATCH_BYTE_PARTITIONED`] when `PARTITIONED`
+/// (a kernel whose codes are not constants would otherwise carry the
+/// partition instruction, and need its extension, for nothing).
+#[cfg(target_arch = "spirv")]
+#[inline]
+pub fn apply_with<const PARTITIONED: bool>(sync: u32, lane: &mut Lane) {
     use spirv_std::arch::{
         subgroup_ballot, subgroup_exclusive_i_add, subgroup_i_add, subgroup_inclusive_i_add, subgroup_shuffle,
     };
@@ -119,6 +135,11 @@ pub fn apply(sync: u32, lane: &mut Lane) {
             }
             lane.output = if lane.arg != 0 { peers } else { 0 };
         }
+    } else if PARTITIONED && op == OP_MATCH_BYTE_PARTITIONED {
+        // Lanes not taking part share a value no byte has (and get 0).
+        let value = if lane.arg != 0 { lane.input & 0xff } else { 0x100 };
+        let peers = ballot_mask(partition(value));
+        lane.output = if lane.arg != 0 { peers } else { 0 };
     } else if op == OP_BALLOT {
         lane.output = ballot_mask(subgroup_ballot(lane.input != 0));
     } else if op == OP_SHUFFLE {
@@ -156,6 +177,26 @@ pub fn subgroup_barrier() {
     }
 }
 
+/// The mask of the lanes whose `value` equals this lane's
+/// (`OpGroupNonUniformPartitionNV`; rspirv spells the same opcode with EXT).
+#[cfg(target_arch = "spirv")]
+#[inline]
+fn partition(value: u32) -> spirv_std::glam::UVec4 {
+    let mut result = spirv_std::glam::UVec4::ZERO;
+    // SAFETY: one subgroup instruction on a plain value; dispatched only
+    // where the device has the extension (see `OP_MATCH_BYTE_PARTITIONED`).
+    unsafe {
+        core::arch::asm!(
+            "%value = OpLoad _ {value}",
+            "%result = OpGroupNonUniformPartitionEXT typeof*{result} %value",
+            "OpStore {result} %result",
+            value = in(reg) &value,
+            result = in(reg) &mut result,
+        );
+    }
+    result
+}
+
 /// A ballot's lanes as a 64-bit mask.
 #[cfg(target_arch = "spirv")]
 #[inline]
@@ -172,7 +213,7 @@ pub fn emulate(sync: u32, lanes: &mut [Lane]) {
     let n = lanes.len();
     let op = sync & OP_MASK;
     match op {
-        OP_MATCH_BYTE => {
+        OP_MATCH_BYTE | OP_MATCH_BYTE_PARTITIONED => {
             let mut bytes = [0u32; MAX_SUBGROUP_SIZE as usize];
             for l in 0..n {
                 bytes[l] = if lanes[l].arg != 0 { lanes[l].input & 0xff } else { u32::MAX };

@@ -17,7 +17,11 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     if b.look_back_works() {
         k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
         if multisplit_by_default(b) {
-            k.extend([Kernel::SortMultisplitSmall, Kernel::SortMultisplit]);
+            k.extend(if b.subgroup_partitioned() {
+                [Kernel::SortMultisplitSmallPartitioned, Kernel::SortMultisplitPartitioned]
+            } else {
+                [Kernel::SortMultisplitSmall, Kernel::SortMultisplit]
+            });
         } else {
             k.push(Kernel::SortOnesweep);
         }
@@ -161,7 +165,11 @@ pub fn radix_sort_tiled<B: Backend>(
     }
     let (kernel, tile) = match tile_size {
         SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
+        SortTiles::Multisplit if b.subgroup_partitioned() => (Kernel::SortMultisplitPartitioned, MULTISPLIT_SORT_TILE),
         SortTiles::Multisplit => (Kernel::SortMultisplit, MULTISPLIT_SORT_TILE),
+        SortTiles::MultisplitSmall if b.subgroup_partitioned() => {
+            (Kernel::SortMultisplitSmallPartitioned, SMALL_MULTISPLIT_SORT_TILE)
+        }
         SortTiles::MultisplitSmall => (Kernel::SortMultisplitSmall, SMALL_MULTISPLIT_SORT_TILE),
         _ => (Kernel::SortOnesweep, SORT_TILE),
     };

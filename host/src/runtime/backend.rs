@@ -84,6 +84,13 @@ pub trait Backend: Send {
     fn min_subgroup_size(&self) -> u32 {
         1
     }
+    /// Whether kernels may use NVIDIA's subgroup partition instruction
+    /// (`VK_NV_shader_subgroup_partitioned`, enabled when the device was
+    /// opened): the sort's digit match in one instruction instead of nine
+    /// ballots. The CPU runner computes both forms alike.
+    fn subgroup_partitioned(&self) -> bool {
+        false
+    }
     /// Largest buffer this device accepts in one binding, in bytes.
     fn max_buffer_bytes(&self) -> u64;
     /// The device's own memory, in bytes, where it has one apart from the

@@ -171,13 +171,14 @@ fn multisplit_sort_pass<const ITEMS: u32>(
     (keys_in, values_in, keys_out, values_out, sort_state): (&[u64], &[u32], &mut [u64], &mut [u32], &mut [u32]),
     groups: u32,
     size: u32,
+    partitioned: bool,
 ) {
     use treelet_core::construct::sort_multisplit::*;
     let mut ticket = [0u32; 1];
     let mut counts = [0u32; SUBGROUP_COUNTS];
     let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
     let mut lanes = [MultisplitPassLane::default(); WG];
-    let sync = |phase| multisplit_pass_sync(phase, ITEMS);
+    let sync = |phase| multisplit_pass_sync(phase, ITEMS, partitioned);
     subgroup_workgroups(groups, multisplit_pass_phases(ITEMS), size, sync, |_, phase, lid, io| {
         multisplit_pass_phase::<ITEMS>(
             phase,
@@ -392,17 +393,25 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 multisplit_phase(phase, id, g, lid % size, size, &p, keys, ranks, counts, sizes, &mut states[l], &mut lanes[l]);
             });
         }
-        (Kernel::SortMultisplit, [p, keys_in, values_in, keys_out, values_out, sort_state]) => {
+        (
+            Kernel::SortMultisplit | Kernel::SortMultisplitPartitioned,
+            [p, keys_in, values_in, keys_out, values_out, sort_state],
+        ) => {
             use treelet_core::construct::sort_multisplit::MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
             let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
-            multisplit_sort_pass::<MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size);
+            let partitioned = kernel == Kernel::SortMultisplitPartitioned;
+            multisplit_sort_pass::<MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size, partitioned);
         }
-        (Kernel::SortMultisplitSmall, [p, keys_in, values_in, keys_out, values_out, sort_state]) => {
+        (
+            Kernel::SortMultisplitSmall | Kernel::SortMultisplitSmallPartitioned,
+            [p, keys_in, values_in, keys_out, values_out, sort_state],
+        ) => {
             use treelet_core::construct::sort_multisplit::SMALL_MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
             let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
-            multisplit_sort_pass::<SMALL_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size);
+            let partitioned = kernel == Kernel::SortMultisplitSmallPartitioned;
+            multisplit_sort_pass::<SMALL_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size, partitioned);
         }
         (Kernel::SortTileCounts, [p, keys, tile_counts]) => {
             let p: treelet_core::SortParams = params(p);

@@ -83,6 +83,13 @@ pub enum Kernel {
     SortMultisplit,
     /// The same with half the keys per lane (small tiles).
     SortMultisplitSmall,
+    /// [`Kernel::SortMultisplit`] matching digits by NVIDIA's partition
+    /// instruction instead of ballots (devices with
+    /// `VK_NV_shader_subgroup_partitioned`, see
+    /// `Backend::subgroup_partitioned`).
+    SortMultisplitPartitioned,
+    /// [`Kernel::SortMultisplitSmall`] likewise.
+    SortMultisplitSmallPartitioned,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -142,7 +149,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 42] = [
+    const FIXED: [Kernel; 44] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -153,6 +160,8 @@ impl Kernel {
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
         Kernel::SortMultisplitSmall,
+        Kernel::SortMultisplitPartitioned,
+        Kernel::SortMultisplitSmallPartitioned,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
@@ -215,6 +224,8 @@ impl Kernel {
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
             Kernel::SortMultisplitSmall => "sort::sort_multisplit_small_cs",
+            Kernel::SortMultisplitPartitioned => "sort::sort_multisplit_partitioned_cs",
+            Kernel::SortMultisplitSmallPartitioned => "sort::sort_multisplit_small_partitioned_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit::multisplit_cs",
@@ -269,7 +280,9 @@ impl Kernel {
             | Kernel::SortOnesweepSmall
             | Kernel::SortOnesweepScanned
             | Kernel::SortMultisplit
-            | Kernel::SortMultisplitSmall => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            | Kernel::SortMultisplitSmall
+            | Kernel::SortMultisplitPartitioned
+            | Kernel::SortMultisplitSmallPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],

@@ -206,6 +206,10 @@ impl Backend for GpuBackend {
         // wgpu reports 4 where the device does not say.
         self.ctx.info.subgroup_min_size
     }
+    fn subgroup_partitioned(&self) -> bool {
+        // TREELET_SORT_MATCH=ballots keeps the ballots (to measure).
+        self.ctx.subgroup_partitioned && std::env::var("TREELET_SORT_MATCH").map_or(true, |v| v != "ballots")
+    }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_binding_bytes()
     }

@@ -32,6 +32,9 @@ pub struct GpuContext {
     /// The adapter's largest device-local memory heap, in bytes (for lavapipe,
     /// the host's memory), if Vulkan says.
     pub device_memory: Option<u64>,
+    /// Whether `VK_NV_shader_subgroup_partitioned` was enabled (the device
+    /// has it and runs partition operations in compute shaders).
+    pub subgroup_partitioned: bool,
     pipelines: Mutex<HashMap<Kernel, Arc<Pipeline>>>,
     /// The driver's compiled pipelines, kept on disk between runs.
     cache: Option<DiskCache>,
@@ -116,6 +119,70 @@ fn device_local_bytes(adapter: &wgpu::Adapter) -> Option<u64> {
         .max()
 }
 
+/// The device extension of NVIDIA's subgroup partition instruction.
+const PARTITIONED: &std::ffi::CStr = c"VK_NV_shader_subgroup_partitioned";
+
+/// Whether `adapter` has [`PARTITIONED`] and runs partition operations in
+/// compute shaders (`TREELET_SUBGROUP_PARTITIONED=0` says no, to measure).
+fn subgroup_partitioned_supported(adapter: &wgpu::Adapter) -> bool {
+    if std::env::var("TREELET_SUBGROUP_PARTITIONED").is_ok_and(|v| v == "0") {
+        return false;
+    }
+    // SAFETY: queries of the physical device only; the adapter, and with it
+    // the instance, outlives the calls.
+    let Some(hal) = (unsafe { adapter.as_hal::<wgpu::hal::api::Vulkan>() }) else {
+        return false;
+    };
+    let instance = hal.shared_instance().raw_instance();
+    let device = hal.raw_physical_device();
+    let has_extension = unsafe { instance.enumerate_device_extension_properties(device) }
+        .is_ok_and(|e| e.iter().any(|p| p.extension_name_as_c_str() == Ok(PARTITIONED)));
+    if !has_extension {
+        return false;
+    }
+    let mut subgroup = ash::vk::PhysicalDeviceSubgroupProperties::default();
+    let mut props = ash::vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+    unsafe { instance.get_physical_device_properties2(device, &mut props) };
+    subgroup.supported_operations.contains(ash::vk::SubgroupFeatureFlags::PARTITIONED_NV)
+        && subgroup.supported_stages.contains(ash::vk::ShaderStageFlags::COMPUTE)
+}
+
+/// Opens `adapter` as `request_device` does, with [`PARTITIONED`] enabled
+/// as well (wgpu knows no such feature, so through wgpu-hal); whether it
+/// was (if not, with a note, the device as `request_device` opens it).
+fn open_with_partitioned(
+    adapter: &wgpu::Adapter,
+    descriptor: &wgpu::DeviceDescriptor,
+) -> std::result::Result<((wgpu::Device, wgpu::Queue), bool), wgpu::RequestDeviceError> {
+    // SAFETY: the device is opened from this adapter with exactly the
+    // features and limits of `descriptor` (plus one extension wgpu does not
+    // see), then handed to wgpu, which owns it from there.
+    unsafe {
+        let hal = adapter.as_hal::<wgpu::hal::api::Vulkan>().expect("a Vulkan adapter");
+        let callback = |args: wgpu::hal::vulkan::CreateDeviceCallbackArgs| {
+            if !args.extensions.contains(&PARTITIONED) {
+                args.extensions.push(PARTITIONED);
+            }
+        };
+        let open = hal
+            .open_with_callback(
+                descriptor.required_features,
+                &descriptor.required_limits,
+                &descriptor.memory_hints,
+                Some(Box::new(callback)),
+            )
+            .map_err(|e| {
+                eprintln!("note: opening the device with {PARTITIONED:?} failed ({e}); without it");
+                e
+            });
+        drop(hal);
+        match open {
+            Ok(open) => adapter.create_device_from_hal(open, descriptor).map(|d| (d, true)),
+            Err(_) => pollster::block_on(adapter.request_device(descriptor)).map(|d| (d, false)),
+        }
+    }
+}
+
 impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred) and
     /// loads the shader module. Fails with a clear message when there is none.
@@ -172,17 +239,20 @@ impl GpuContext {
         let features = optional.iter().filter(|o| o.0).fold(needed, |f, o| f | o.1);
         // Ask for everything the adapter offers: large scenes need large buffers.
         let limits = adapter.limits();
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("treelet"),
-                required_features: features,
-                required_limits: limits.clone(),
-                experimental_features: unsafe { wgpu::ExperimentalFeatures::enabled() },
-                memory_hints: wgpu::MemoryHints::Performance,
-                trace: wgpu::Trace::Off,
-            })
-            .await
-            .with_context(|| format!("could not open adapter `{}`", info.name))?;
+        let descriptor = wgpu::DeviceDescriptor {
+            label: Some("treelet"),
+            required_features: features,
+            required_limits: limits.clone(),
+            experimental_features: unsafe { wgpu::ExperimentalFeatures::enabled() },
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let ((device, queue), partitioned) = if subgroup_partitioned_supported(&adapter) {
+            open_with_partitioned(&adapter, &descriptor)
+        } else {
+            adapter.request_device(&descriptor).await.map(|d| (d, false))
+        }
+        .with_context(|| format!("could not open adapter `{}`", info.name))?;
         let device_s = start.elapsed().as_secs_f64();
         // Unpacks the modules now, so that a damaged file fails here.
         let _ = shaders::module("");
@@ -199,7 +269,15 @@ impl GpuContext {
             };
             DiskCache { cache, path }
         });
-        Ok(Arc::new(Self { device, queue, info, limits, timestamps, device_memory, pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
+        Ok(Arc::new(Self {
+            device,
+            queue,
+            info,
+            limits,
+            timestamps,
+            device_memory,
+            subgroup_partitioned: partitioned,
+            pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
     }
 
     /// The pipeline of `kernel`, built the first time it is asked for (the
