@@ -442,7 +442,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
         return;
     }
     if phase == look_back_phase {
-        global_offsets[l] = tile_offset::<LOOK_BACK, false>(lid, tile, params, sort_state, running[l]);
+        global_offsets[l] = tile_offset::<LOOK_BACK>(lid, tile, params, sort_state, running[l]);
     }
     let scan_step = phase - look_back_phase;
     if scan_step < SMALL_SCAN_PHASES {
@@ -469,7 +469,7 @@ pub fn onesweep_phase<const LOOK_BACK: bool, const ITEMS: u32, const TILE: usize
 /// without, read from the scanned [`tile_counts_phase`] counts that
 /// `sort_state` holds then.
 #[inline]
-pub fn tile_offset<const LOOK_BACK: bool, const PUBLISHED: bool>(
+pub fn tile_offset<const LOOK_BACK: bool>(
     lid: u32,
     tile: u32,
     params: &SortParams,
@@ -484,9 +484,7 @@ pub fn tile_offset<const LOOK_BACK: bool, const PUBLISHED: bool>(
     if tile == 0 {
         prefix = sort_state[(state::COUNTS + params.pass * RADIX + lid) as usize];
     } else {
-        if !PUBLISHED {
-            atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
-        }
+        atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
         let mut earlier = tile - 1;
         // Until a tile's inclusive count, add up aggregates; a tile that
         // has published nothing yet is read again (its workgroup is
@@ -506,20 +504,6 @@ pub fn tile_offset<const LOOK_BACK: bool, const PUBLISHED: bool>(
     // The next pass uses the other region: clear this tile's row of it.
     atomics::store_u32(&mut sort_state[state::status(params.tiles, params.pass + 1, tile, lid)], 0);
     prefix
-}
-
-/// Publishes tile `tile`'s count of digit `lid` before its look-back (for
-/// [`tile_offset`] with `PUBLISHED`): as an aggregate, or for the first
-/// tile, whose offsets are the pass's, at once as its inclusive count.
-#[inline]
-pub fn publish_counts(lid: u32, tile: u32, params: &SortParams, sort_state: &mut [u32], count: u32) {
-    let own = state::status(params.tiles, params.pass, tile, lid);
-    if tile == 0 {
-        let offset = sort_state[(state::COUNTS + params.pass * RADIX + lid) as usize];
-        atomics::store_u32(&mut sort_state[own], INCLUSIVE | (offset + count));
-    } else {
-        atomics::store_u32(&mut sort_state[own], AGGREGATE | count);
-    }
 }
 
 /// The tile's keys and values to the output, in the tile's order

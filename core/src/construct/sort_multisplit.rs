@@ -46,7 +46,7 @@
 //!
 //! Written in the phases of [`crate::gpu::subgroup`], each ending in the
 //! synchronisation code [`multisplit_pass_sync`] gives.
-use crate::construct::sort::{digit, publish_counts, state, tile_offset, write_tile, RADIX, RADIX_BITS};
+use crate::construct::sort::{digit, state, tile_offset, write_tile, RADIX, RADIX_BITS};
 use crate::geometry::buffers::SortParams;
 use crate::gpu::atomics;
 use crate::gpu::subgroup::{
@@ -122,13 +122,12 @@ impl MultisplitPassLane {
     }
 }
 
-/// Phases with `items` keys per lane: clear; load and count the tile's
-/// digits; two per key (match, then count and shuffle; the first also
-/// publishes the tile's counts); the last key's rank; the scan over
-/// subgroups; look-back with the first scan step; two more scan steps;
-/// places; clear; order; write.
+/// Phases with `items` keys per lane: clear; two per key (match, then
+/// count and shuffle); the last key's rank; the scan over subgroups;
+/// look-back with the first scan step; two more scan steps; places; clear;
+/// order; write.
 pub const fn multisplit_pass_phases(items: u32) -> u32 {
-    2 * items + 8 + SMALL_SCAN_PHASES
+    2 * items + 7 + SMALL_SCAN_PHASES
 }
 
 /// The synchronisation code (see [`crate::gpu::subgroup`]) after phase
@@ -136,12 +135,7 @@ pub const fn multisplit_pass_phases(items: u32) -> u32 {
 /// match by NVIDIA's partition instruction ([`OP_MATCH_BYTE_PARTITIONED`],
 /// the same result) instead of ballots.
 pub const fn multisplit_pass_sync(phase: u32, items: u32, partitioned: bool) -> u32 {
-    // Phase 1 (the tile's digit counts) was added before the ranking.
-    if phase <= 1 {
-        return OP_NONE | THEN_WORKGROUP_BARRIER;
-    }
-    let phase = phase - 1;
-    if phase > 2 * items {
+    if phase == 0 || phase > 2 * items {
         OP_NONE | THEN_WORKGROUP_BARRIER
     } else if phase % 2 == 1 {
         if partitioned {
@@ -202,7 +196,6 @@ pub fn multisplit_pass_phase<const ITEMS: u32>(
         for c in 0..SUBGROUP_COUNTS / WG {
             set(counts, c * WG + l, 0);
         }
-        running[l] = 0;
         return;
     }
     let tile = ticket[0];
@@ -213,27 +206,6 @@ pub fn multisplit_pass_phase<const ITEMS: u32>(
     let base = tile * tile_keys;
     // Keys of the tile: 0..valid (only the last tile is short).
     let valid = (params.n - base).min(tile_keys);
-    if phase == 1 {
-        // The lane's digits, loaded at once so that the loads overlap, and
-        // the tile's digit counts, so that the tile publishes them before
-        // it ranks (Onesweep's early counts): later tiles' look-backs then
-        // find them sooner.
-        me.digits = 0;
-        for i in 0..ITEMS {
-            let k = key_index(subgroup, lane, size, ITEMS, i);
-            if k < valid {
-                let d = digit(at(keys_in, (base + k) as usize), shift);
-                me.digits |= (d as u64) << (8 * i);
-                atomics::add_workgroup(&mut running[d as usize], 1);
-            }
-        }
-        return;
-    }
-    // From here, the phases of the ranking onwards, numbered from 1.
-    let phase = phase - 1;
-    if phase == 1 {
-        publish_counts(lid, tile, params, sort_state, running[l]);
-    }
     let row = subgroup * ROW_WORDS;
     let ranked = 2 * ITEMS + 1; // The phase that ranks the last key.
     if phase <= ranked {
@@ -246,6 +218,15 @@ pub fn multisplit_pass_phase<const ITEMS: u32>(
                 if k < valid {
                     let rank = io.output as u32 + popcount(me.peers & lanes_below(lane));
                     me.set_rank(item - 1, rank);
+                }
+            }
+            if item == 0 {
+                me.digits = 0;
+                for i in 0..ITEMS {
+                    let k = key_index(subgroup, lane, size, ITEMS, i);
+                    if k < valid {
+                        me.digits |= (digit(at(keys_in, (base + k) as usize), shift) as u64) << (8 * i);
+                    }
                 }
             }
             if item < ITEMS {
@@ -292,7 +273,7 @@ pub fn multisplit_pass_phase<const ITEMS: u32>(
         return;
     }
     if phase == look_back_phase {
-        global_offsets[l] = tile_offset::<true, true>(lid, tile, params, sort_state, running[l]);
+        global_offsets[l] = tile_offset::<true>(lid, tile, params, sort_state, running[l]);
     }
     let scan_step = phase - look_back_phase;
     if scan_step < SMALL_SCAN_PHASES {
