@@ -1,4 +1,4 @@
-use spirv_std::glam::UVec3;
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, Node, Sphere};
 use treelet_core::geometry::triangle::Triangle;
@@ -12,7 +12,7 @@ pub fn bvh2_nodes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Bvh2Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, nodes, parents, out);

@@ -1,9 +1,9 @@
-use spirv_std::glam::UVec3;
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::BuildParams;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
-use treelet_core::{Aabb, Sphere};
+use treelet_core::Sphere;
 
 #[spirv(compute(threads(256)))]
 pub fn primitive_boxes_cs(
@@ -12,7 +12,7 @@ pub fn primitive_boxes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] boxes: &mut [Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] boxes: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     treelet_core::construct::primitive_boxes::primitive_boxes_kernel(id, params.n, params.spheres, spheres, triangles, boxes);

@@ -1,4 +1,4 @@
-use spirv_std::glam::UVec3;
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
@@ -144,7 +144,7 @@ pub fn collapse_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] tree_leaves: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] prims: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_nodes: &mut [Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_nodes: &mut [Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out_parents: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] out_prims: &mut [u32],
 ) {

@@ -20,13 +20,14 @@
 //! So one invocation per primitive climbs to the root twice: once to sum its
 //! offsets, once to write every output node whose leftmost primitive it is.
 //! No atomics and no ordering between invocations are needed.
+use crate::gpu::vector_store::RecordStore;
 use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
 
 /// Kernel, one invocation per primitive slot `i < n`: writes its primitive
 /// index into `out_prims`, and the output nodes (and parent links) of which
 /// it is the leftmost primitive. The output has `2 * tree_leaves[0] - 1` nodes.
 #[allow(clippy::too_many_arguments)]
-pub fn collapse_kernel(
+pub fn collapse_kernel<O: RecordStore<Node> + ?Sized>(
     i: u32,
     n: u32,
     nodes: &[Node],
@@ -34,7 +35,7 @@ pub fn collapse_kernel(
     counts: &[u32],
     tree_leaves: &[u32],
     prims: &[u32],
-    out_nodes: &mut [Node],
+    out_nodes: &mut O,
     out_parents: &mut [u32],
     out_prims: &mut [u32],
 ) {
@@ -86,7 +87,7 @@ pub fn collapse_kernel(
                 out.left = index + 1;
                 out.right = index + 2 * tree_leaves[src.left as usize];
             }
-            out_nodes[index as usize] = out;
+            out_nodes.store(index as usize, &out);
             out_parents[index as usize] = if current == 0 { INVALID } else { node_pos - node_below - node_step };
         }
         if current == 0 {

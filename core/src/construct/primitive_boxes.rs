@@ -3,20 +3,26 @@
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::Sphere;
 use crate::geometry::triangle::Triangle;
+use crate::gpu::unchecked::at;
+use crate::gpu::vector_store::RecordStore;
 
 /// Kernel: the box of primitive `id`: sphere `id` below `spheres`, else
-/// triangle `id - spheres`.
-pub fn primitive_boxes_kernel(
+/// triangle `id - spheres`. `boxes` as records or as vectors (see
+/// [`crate::gpu::vector_store`]).
+pub fn primitive_boxes_kernel<B: RecordStore<Aabb> + ?Sized>(
     id: u32,
     n: u32,
     spheres: u32,
     sphere_data: &[Sphere],
     triangles: &[Triangle],
-    boxes: &mut [Aabb],
+    boxes: &mut B,
 ) {
-    if id < spheres {
-        boxes[id as usize] = sphere_data[id as usize].aabb();
+    let b = if id < spheres {
+        at(sphere_data, id as usize).aabb()
     } else if id < n {
-        boxes[id as usize] = triangles[(id - spheres) as usize].aabb();
-    }
+        at(triangles, (id - spheres) as usize).aabb()
+    } else {
+        return;
+    };
+    boxes.store(id as usize, &b);
 }

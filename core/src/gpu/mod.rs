@@ -13,4 +13,5 @@ pub mod atomics;
 pub mod rng;
 pub mod subgroup;
 pub mod unchecked;
+pub mod vector_store;
 pub mod workgroup;

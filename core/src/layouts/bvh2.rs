@@ -12,6 +12,7 @@
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
 //! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use crate::gpu::vector_store::RecordStore;
 use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
 use crate::geometry::triangle::Triangle;
@@ -21,7 +22,13 @@ use crate::geometry::triangle::Triangle;
 /// right child `right = i + 2 L` where `L` is its left sibling's leaf
 /// count): each internal node writes its [`Bvh2Node`]. A tree of one leaf
 /// gets a root whose second child is an empty box.
-pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32], out: &mut [Bvh2Node]) {
+pub fn bvh2_node_kernel<O: RecordStore<Bvh2Node> + ?Sized>(
+    i: u32,
+    node_count: u32,
+    nodes: &[Node],
+    parents: &[u32],
+    out: &mut O,
+) {
     if i >= node_count {
         return;
     }
@@ -32,7 +39,7 @@ pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32]
             (root.left_min, root.left_max) = (node.min, node.max);
             (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
             root.right_count = 1; // a leaf that no ray reaches
-            out[0] = root;
+            out.store(0, &root);
         }
         return;
     }
@@ -49,7 +56,7 @@ pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32]
     let (l, r) = (nodes[node.left as usize], nodes[node.right as usize]);
     let (left, left_count) = child_ref(&l, index + 1);
     let (right, right_count) = child_ref(&r, index + (node.right - i) / 2);
-    out[index as usize] = Bvh2Node {
+    let record = Bvh2Node {
         left_min: l.min,
         left,
         left_max: l.max,
@@ -59,6 +66,7 @@ pub fn bvh2_node_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32]
         right_max: r.max,
         right_count,
     };
+    out.store(index as usize, &record);
 }
 
 /// A child as its parent refers to it: a leaf by its first primitive and

@@ -347,7 +347,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (spheres, triangles, boxes) = (view(spheres), view(triangles), view(boxes));
+            let (spheres, triangles, boxes) = (view(spheres), view(triangles), view::<treelet_core::Aabb>(boxes));
             for id in ids(groups) {
                 primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
             }
@@ -509,7 +509,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (nodes, parents, counts, tree_leaves) = (view(nodes), view(parents), view(counts), view(tree_leaves));
             let (prims, out_nodes, out_parents, out_prims) =
-                (view(prims), view(out_nodes), view(out_parents), view(out_prims));
+                (view(prims), view::<treelet_core::Node>(out_nodes), view(out_parents), view(out_prims));
             for id in ids(groups) {
                 collapse::collapse_kernel(
                     id,
@@ -578,7 +578,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, out) = (view(nodes), view(parents), view(out));
+            let (nodes, parents, out) = (view(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
             for id in ids(groups) {
                 bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
