@@ -1,0 +1,10 @@
+for f in .gl/*.deb; do dpkg -x $f / ; done >/dev/null 2>&1; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json CI=true
+exec > >(tee $OUT/log.txt) 2>&1
+cd .dev
+for v in vec unchecked; do echo "== tests $v"; TREELET_BOXES=$v timeout -s KILL 120 ./gpu_vs_cpu --test-threads 2 lbvh agglomer repeated 2>&1 | grep -E "test result|FAILED|panicked" | head -5; done
+echo "== warm-up"; timeout -s KILL 40 ./treelet bench build --sizes 1000000 --repeats 5 2>&1 | tail -1
+for r in 1 2; do for v in struct vec unchecked; do
+  echo "== $v"; TREELET_BOXES=$v timeout -s KILL 60 ./treelet bench build --sizes 1000000,4000000,16000000 --repeats 11 --per-kernel 2>&1 | tail -3
+done; done
+nvidia-smi --query-gpu=clocks.sm --format=csv
