@@ -42,6 +42,23 @@ use crate::gpu::atomics;
 use crate::gpu::unchecked::{get, set};
 use crate::layouts::cwbvh::{MAX_LEAF_PRIMS, META_INTERNAL, WIDTH, grid_exponent, grid_step, quantize_hi, quantize_lo};
 
+/// `$body` once for each of the eight values of `$i` (0 to 7), a constant
+/// in each copy: loops over slots unrolled, so that the arrays they index
+/// stay in registers (an array indexed at run time lives in local memory on
+/// the H100).
+macro_rules! unrolled {
+    ($i:ident, $body:block) => {
+        unrolled!(@each $i, $body, 0 1 2 3 4 5 6 7)
+    };
+    (@each $i:ident, $body:block, $($v:literal)*) => {
+        $({
+            let $i: usize = $v;
+            $body
+        })*
+    };
+}
+const _: () = assert!(WIDTH == 8, "`unrolled!` lists the slots");
+
 /// Decision byte: `C(n, i)` is `C(n, i - 1)`.
 const FEWER: u32 = 0;
 /// Decision byte of `i = 1`: the subtree is one leaf child (else its low
@@ -104,51 +121,54 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
         let (l, r) = (p.left as usize, p.right as usize);
         let mut left = [0f32; WIDTH];
         let mut right = [0f32; WIDTH];
-        for i in 0..WIDTH {
+        unrolled!(i, {
             left[i] = atomics::load_f32(&costs[l * WIDTH + i]);
             right[i] = atomics::load_f32(&costs[r * WIDTH + i]);
-        }
+        });
         let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
         let area = model.area(&p.aabb());
-        // D(parent, i) for i = 2..=8 and its first cheapest split.
-        let mut distribute = [0f32; WIDTH + 1];
-        let mut split = [0u32; WIDTH + 1];
-        let mut i = 2;
-        while i <= WIDTH {
-            let (mut best, mut best_k) = (f32::MAX, 1u32);
-            let mut k = 1;
-            while k < i {
-                let c = get(&left, k - 1) + get(&right, i - k - 1);
-                if c < best {
-                    (best, best_k) = (c, k as u32);
-                }
-                k += 1;
+        // D(parent, i) for i = 2..=8 and its first cheapest split (slot
+        // `i - 1` of each array; every loop unrolled, every index constant).
+        let mut distribute = [0f32; WIDTH];
+        let mut split = [0u32; WIDTH];
+        unrolled!(j, {
+            let i = j + 1;
+            if i >= 2 {
+                let (mut best, mut best_k) = (f32::MAX, 1u32);
+                unrolled!(m, {
+                    let k = m + 1;
+                    if k < i {
+                        let c = left[k - 1] + right[i - k - 1];
+                        if c < best {
+                            (best, best_k) = (c, k as u32);
+                        }
+                    }
+                });
+                distribute[j] = best;
+                split[j] = best_k;
             }
-            set(&mut distribute, i, best);
-            set(&mut split, i, best_k);
-            i += 1;
-        }
-        let internal = libm::fmaf(model.node, area, distribute[WIDTH]);
+        });
+        let internal = libm::fmaf(model.node, area, distribute[WIDTH - 1]);
         let as_leaf = if count <= MAX_LEAF_PRIMS { model.prim * area * count as f32 } else { f32::MAX };
         let mut c = [0f32; WIDTH];
         let mut bytes = [0u32; WIDTH];
         if as_leaf <= internal {
             (c[0], bytes[0]) = (as_leaf, LEAF);
         } else {
-            (c[0], bytes[0]) = (internal, split[WIDTH]);
+            (c[0], bytes[0]) = (internal, split[WIDTH - 1]);
         }
-        let mut i = 2;
-        while i <= WIDTH {
-            if get(&distribute, i) < get(&c, i - 2) {
-                set(&mut c, i - 1, get(&distribute, i));
-                set(&mut bytes, i - 1, get(&split, i));
-            } else {
-                let fewer = get(&c, i - 2);
-                set(&mut c, i - 1, fewer);
-                set(&mut bytes, i - 1, FEWER);
+        unrolled!(j, {
+            // Slot `j` of `c` and `bytes` is the choice for `i = j + 1`.
+            if j >= 1 {
+                if distribute[j] < c[j - 1] {
+                    c[j] = distribute[j];
+                    bytes[j] = split[j];
+                } else {
+                    c[j] = c[j - 1];
+                    bytes[j] = FEWER;
+                }
             }
-            i += 1;
-        }
+        });
         let parent_index = parent as usize;
         atomics::store_u32(&mut counts[parent_index], count);
         for i in 0..WIDTH {
@@ -316,46 +336,65 @@ pub fn wide_count_kernel(
 /// children nearest the corner a ray of octant `s` comes from), assigned
 /// greedily by the cost `(child centre - node centre) · ds`, cheapest
 /// pair first (ties to the lower slot, then child).
+///
+/// Written so that no array is indexed by a value known only at run time
+/// (every loop over slots and children is unrolled, free slots and
+/// children are bit masks, costs are recomputed from the offsets): such
+/// arrays live in local memory on the H100, which made this the layout's
+/// slowest step.
 #[inline]
+#[allow(unused_assignments)] // the last unrolled copy's choice is read by none
 pub fn assign_slots(w_box: &Aabb, children: &[u32; WIDTH], count: usize, nodes: &[Node], slots: &mut [u32; WIDTH]) {
     let centre = w_box.centroid();
-    let mut cost = [0f32; WIDTH * WIDTH];
-    for c in 0..WIDTH {
-        let offset = if c < count {
-            nodes[(children[c] & !CHILD_LEAF) as usize].aabb().centroid() - centre
-        } else {
-            glam::Vec3::ZERO
-        };
-        for s in 0..WIDTH {
-            // ds = (±1, ±1, ±1), minus where slot bit 2, 1, 0 is set.
-            let x = if s & 4 != 0 { -offset.x } else { offset.x };
-            let y = if s & 2 != 0 { -offset.y } else { offset.y };
-            let z = if s & 1 != 0 { -offset.z } else { offset.z };
-            cost[s * WIDTH + c] = x + y + z;
+    let mut offsets = [glam::Vec3::ZERO; WIDTH];
+    unrolled!(c, {
+        if c < count {
+            offsets[c] = nodes[(children[c] & !CHILD_LEAF) as usize].aabb().centroid() - centre;
         }
-    }
-    let mut slot_of = [u32::MAX; WIDTH];
-    for s in 0..WIDTH {
-        slots[s] = u32::MAX;
-    }
+    });
+    // The cost of child offset `o` in slot `s`: ds = (±1, ±1, ±1), minus
+    // where slot bit 2, 1, 0 is set.
+    let cost = |s: usize, o: glam::Vec3| {
+        let x = if s & 4 != 0 { -o.x } else { o.x };
+        let y = if s & 2 != 0 { -o.y } else { o.y };
+        let z = if s & 1 != 0 { -o.z } else { o.z };
+        x + y + z
+    };
+    let (mut free_slots, mut free_children) = (0xffu32, (1u32 << count) - 1);
+    let mut child_in = [u32::MAX; WIDTH];
     let mut round = 0;
     while round < count {
-        let (mut best, mut best_s, mut best_c) = (f32::MAX, 0usize, 0usize);
+        // The cheapest free pair, the first in (slot, child) order on ties.
+        let (mut best, mut best_s, mut best_c) = (f32::MAX, 0u32, 0u32);
         let mut found = false;
-        for s in 0..WIDTH {
-            for c in 0..count {
-                if get(slots, s) == u32::MAX && get(&slot_of, c) == u32::MAX {
-                    let v = get(&cost, s * WIDTH + c);
+        unrolled!(s, {
+            unrolled!(c, {
+                if free_slots & (1 << s) != 0 && free_children & (1 << c) != 0 {
+                    let v = cost(s, offsets[c]);
                     if !found || v < best {
-                        (best, best_s, best_c, found) = (v, s, c, true);
+                        (best, best_s, best_c, found) = (v, s as u32, c as u32, true);
                     }
                 }
+            });
+        });
+        free_slots &= !(1 << best_s);
+        free_children &= !(1 << best_c);
+        unrolled!(s, {
+            if s as u32 == best_s {
+                child_in[s] = best_c;
             }
-        }
-        set(slots, best_s, get(children, best_c));
-        set(&mut slot_of, best_c, best_s as u32);
+        });
         round += 1;
     }
+    unrolled!(s, {
+        let mut slot = u32::MAX;
+        unrolled!(c, {
+            if child_in[s] == c as u32 {
+                slot = children[c];
+            }
+        });
+        slots[s] = slot;
+    });
 }
 
 /// Kernel, one invocation per binary internal node `m`: a wide node writes
