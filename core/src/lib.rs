@@ -41,6 +41,22 @@
 #![cfg_attr(target_arch = "spirv", feature(asm_experimental_arch))]
 #![no_std]
 
+/// `$body` once for each of the eight values of `$i` (0 to 7), a constant
+/// in each copy. For loops whose arrays must stay in registers (an array
+/// indexed at run time lives in local memory on the H100) or whose loads
+/// must all be in flight at once.
+macro_rules! unrolled_8 {
+    ($i:ident, $body:block) => {
+        unrolled_8!(@each $i, $body, 0 1 2 3 4 5 6 7)
+    };
+    (@each $i:ident, $body:block, $($v:literal)*) => {
+        $({
+            let $i: usize = $v;
+            $body
+        })*
+    };
+}
+
 pub mod construct;
 pub mod geometry;
 pub mod gpu;

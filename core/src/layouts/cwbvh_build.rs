@@ -42,22 +42,9 @@ use crate::gpu::atomics;
 use crate::gpu::unchecked::{get, set};
 use crate::layouts::cwbvh::{MAX_LEAF_PRIMS, META_INTERNAL, WIDTH, grid_exponent, grid_step, quantize_hi, quantize_lo};
 
-/// `$body` once for each of the eight values of `$i` (0 to 7), a constant
-/// in each copy: loops over slots unrolled, so that the arrays they index
-/// stay in registers (an array indexed at run time lives in local memory on
-/// the H100).
-macro_rules! unrolled {
-    ($i:ident, $body:block) => {
-        unrolled!(@each $i, $body, 0 1 2 3 4 5 6 7)
-    };
-    (@each $i:ident, $body:block, $($v:literal)*) => {
-        $({
-            let $i: usize = $v;
-            $body
-        })*
-    };
-}
-const _: () = assert!(WIDTH == 8, "`unrolled!` lists the slots");
+// Loops over slots are unrolled (`unrolled_8!`): their arrays stay in
+// registers.
+const _: () = assert!(WIDTH == 8, "`unrolled_8!` lists the slots");
 
 /// Decision byte: `C(n, i)` is `C(n, i - 1)`.
 const FEWER: u32 = 0;
@@ -121,7 +108,7 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
         let (l, r) = (p.left as usize, p.right as usize);
         let mut left = [0f32; WIDTH];
         let mut right = [0f32; WIDTH];
-        unrolled!(i, {
+        unrolled_8!(i, {
             left[i] = atomics::load_f32(&costs[l * WIDTH + i]);
             right[i] = atomics::load_f32(&costs[r * WIDTH + i]);
         });
@@ -131,11 +118,11 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
         // `i - 1` of each array; every loop unrolled, every index constant).
         let mut distribute = [0f32; WIDTH];
         let mut split = [0u32; WIDTH];
-        unrolled!(j, {
+        unrolled_8!(j, {
             let i = j + 1;
             if i >= 2 {
                 let (mut best, mut best_k) = (f32::MAX, 1u32);
-                unrolled!(m, {
+                unrolled_8!(m, {
                     let k = m + 1;
                     if k < i {
                         let c = left[k - 1] + right[i - k - 1];
@@ -157,7 +144,7 @@ pub fn wide_dp_kernel<const ORDERED: bool>(
         } else {
             (c[0], bytes[0]) = (internal, split[WIDTH - 1]);
         }
-        unrolled!(j, {
+        unrolled_8!(j, {
             // Slot `j` of `c` and `bytes` is the choice for `i = j + 1`.
             if j >= 1 {
                 if distribute[j] < c[j - 1] {
@@ -347,7 +334,7 @@ pub fn wide_count_kernel(
 pub fn assign_slots(w_box: &Aabb, children: &[u32; WIDTH], count: usize, nodes: &[Node], slots: &mut [u32; WIDTH]) {
     let centre = w_box.centroid();
     let mut offsets = [glam::Vec3::ZERO; WIDTH];
-    unrolled!(c, {
+    unrolled_8!(c, {
         if c < count {
             offsets[c] = nodes[(children[c] & !CHILD_LEAF) as usize].aabb().centroid() - centre;
         }
@@ -367,8 +354,8 @@ pub fn assign_slots(w_box: &Aabb, children: &[u32; WIDTH], count: usize, nodes: 
         // The cheapest free pair, the first in (slot, child) order on ties.
         let (mut best, mut best_s, mut best_c) = (f32::MAX, 0u32, 0u32);
         let mut found = false;
-        unrolled!(s, {
-            unrolled!(c, {
+        unrolled_8!(s, {
+            unrolled_8!(c, {
                 if free_slots & (1 << s) != 0 && free_children & (1 << c) != 0 {
                     let v = cost(s, offsets[c]);
                     if !found || v < best {
@@ -379,16 +366,16 @@ pub fn assign_slots(w_box: &Aabb, children: &[u32; WIDTH], count: usize, nodes: 
         });
         free_slots &= !(1 << best_s);
         free_children &= !(1 << best_c);
-        unrolled!(s, {
+        unrolled_8!(s, {
             if s as u32 == best_s {
                 child_in[s] = best_c;
             }
         });
         round += 1;
     }
-    unrolled!(s, {
+    unrolled_8!(s, {
         let mut slot = u32::MAX;
-        unrolled!(c, {
+        unrolled_8!(c, {
             if child_in[s] == c as u32 {
                 slot = children[c];
             }
