@@ -1,6 +1,6 @@
-use spirv_std::glam::UVec3;
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
+use treelet_core::geometry::buffers::{LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
 use treelet_core::geometry::features::{ALL, TRIANGLES};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
@@ -13,6 +13,8 @@ use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
 /// `treelet_core::for_each_render_variant!`). The stack stays private.
+/// The `bvh2` layout's records are bound as 16-byte vectors, read one
+/// vector per load (`treelet_core::gpu::vector_store`).
 macro_rules! render_kernel {
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
@@ -47,7 +49,7 @@ macro_rules! render_entry_points {
             pub mod $name {
                 use super::*;
                 render_kernel!(linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
-                render_kernel!(bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, 0 $(| $f)*);
+                render_kernel!(bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
                 render_kernel!(cwbvh_cs, WideNode, LeafPrim, WideTree::new, 0 $(| $f)*);
             }
         )*
@@ -85,10 +87,10 @@ macro_rules! cast_kernel {
 
 // Every kind of primitive, and triangles alone (meshes).
 cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new, ALL);
-cast_kernel!(cast_bvh2_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, ALL);
+cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
 cast_kernel!(cast_cwbvh_cs, WideNode, LeafPrim, WideTree::new, ALL);
 cast_kernel!(cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
-cast_kernel!(cast_bvh2_triangles_cs, Bvh2Node, LeafPrim, Bvh2Tree::new, TRIANGLES);
+cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
 cast_kernel!(cast_cwbvh_triangles_cs, WideNode, LeafPrim, WideTree::new, TRIANGLES);
 
 /// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.

@@ -8,8 +8,8 @@
 //! writes through [`RecordStore`], so that one source serves both: the
 //! shader binds the buffer as vectors, the CPU runner as records.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, Node};
-use crate::gpu::unchecked::put;
+use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node};
+use crate::gpu::unchecked::{at, put};
 use glam::Vec4;
 
 /// A buffer of `T` records, bound as records or as 16-byte vectors.
@@ -57,6 +57,47 @@ impl RecordStore<Bvh2Node> for [Vec4] {
     }
 }
 
+/// A buffer of `T` records read as records or as 16-byte vectors (for
+/// the same reason as [`RecordStore`]: one load per vector).
+pub trait RecordLoad<T> {
+    /// Record `i`.
+    fn load(&self, i: usize) -> T;
+}
+
+impl<T: Copy> RecordLoad<T> for [T] {
+    #[inline]
+    fn load(&self, i: usize) -> T {
+        at(self, i)
+    }
+}
+
+/// The three floats and the word of other bits of `v`.
+#[inline]
+fn parts(v: Vec4) -> ([f32; 3], u32) {
+    ([v.x, v.y, v.z], v.w.to_bits())
+}
+
+impl RecordLoad<Bvh2Node> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> Bvh2Node {
+        let (left_min, left) = parts(at(self, 4 * i));
+        let (left_max, right) = parts(at(self, 4 * i + 1));
+        let (right_min, left_count) = parts(at(self, 4 * i + 2));
+        let (right_max, right_count) = parts(at(self, 4 * i + 3));
+        Bvh2Node { left_min, left, left_max, right, right_min, left_count, right_max, right_count }
+    }
+}
+
+impl RecordLoad<LeafPrim> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> LeafPrim {
+        let (p0, prim) = parts(at(self, 3 * i));
+        let (p1, _pad1) = parts(at(self, 3 * i + 1));
+        let (p2, _pad2) = parts(at(self, 3 * i + 2));
+        LeafPrim { p0, prim, p1, _pad1, p2, _pad2 }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -85,5 +126,17 @@ mod tests {
         let words: Vec<u32> = (0..16).map(|k| 0x9e37_79b9u32.wrapping_mul(k + 1)).collect();
         same_bytes(*bytemuck::from_bytes::<Node>(bytemuck::cast_slice(&words[..8])), 2);
         same_bytes(*bytemuck::from_bytes::<Bvh2Node>(bytemuck::cast_slice(&words[..16])), 4);
+    }
+
+    #[test]
+    fn both_forms_read_the_same_records() {
+        let words: Vec<u32> = (0..24).map(|k| 0x85eb_ca6bu32.wrapping_mul(k + 7) >> 1).collect();
+        let vectors: Vec<Vec4> = words.chunks(4).map(|w| Vec4::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3]))).collect();
+        let nodes: &[Bvh2Node] = bytemuck::cast_slice(&words[..16]);
+        let leaf_prims: &[LeafPrim] = bytemuck::cast_slice(&words);
+        let loaded: Bvh2Node = vectors[..].load(0);
+        assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&nodes[0]));
+        let loaded: LeafPrim = vectors[..].load(1);
+        assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&leaf_prims[1]));
     }
 }

@@ -19,23 +19,27 @@ use crate::geometry::features;
 use crate::geometry::intersect::{SlabRay, slab_interval};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
-use crate::gpu::unchecked::{at, get, set};
+use crate::gpu::unchecked::{get, set};
+use crate::gpu::vector_store::RecordLoad;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
-/// A tree in the layout of this module.
-pub struct Bvh2Tree<'a> {
-    pub nodes: &'a [Bvh2Node],
-    pub leaf_prims: &'a [LeafPrim],
+/// A tree in the layout of this module: its nodes and leaf primitives as
+/// records (`[Bvh2Node]`, `[LeafPrim]`) or as the 16-byte vectors of their
+/// bytes (`[Vec4]`, how the GPU kernels bind them: see
+/// [`crate::gpu::vector_store`]).
+pub struct Bvh2Tree<'a, N: ?Sized = [Bvh2Node], P: ?Sized = [LeafPrim]> {
+    pub nodes: &'a N,
+    pub leaf_prims: &'a P,
 }
 
-impl<'a> Bvh2Tree<'a> {
+impl<'a, N: RecordLoad<Bvh2Node> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> Bvh2Tree<'a, N, P> {
     #[inline]
-    pub fn new(nodes: &'a [Bvh2Node], leaf_prims: &'a [LeafPrim]) -> Self {
+    pub fn new(nodes: &'a N, leaf_prims: &'a P) -> Self {
         Bvh2Tree { nodes, leaf_prims }
     }
 }
 
-impl ClosestHit for Bvh2Tree<'_> {
+impl<N: RecordLoad<Bvh2Node> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> ClosestHit for Bvh2Tree<'_, N, P> {
     #[inline]
     fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
         trace_bvh2::<F>(o, d, from, query, prims, self.nodes, self.leaf_prims)
@@ -55,11 +59,11 @@ fn leaf<const F: u32>(
     query: &Query,
     ray: &WatertightRay,
     prims: &Prims,
-    leaf_prims: &[LeafPrim],
+    leaf_prims: &(impl RecordLoad<LeafPrim> + ?Sized),
 ) {
     let mut k = 0;
     while k < count && !query.done(hit) {
-        let p = at(leaf_prims, (first + k) as usize);
+        let p = leaf_prims.load((first + k) as usize);
         let t = prims.leaf_distance::<F>(o, d, ray, from, &p, hit.t);
         if p.prim != query.skip && hit.is_beaten_by(t, p.prim) {
             *hit = Hit { t, prim: p.prim };
@@ -91,8 +95,8 @@ pub fn trace_bvh2<const F: u32>(
     from: Origin,
     query: Query,
     prims: &Prims,
-    nodes: &[Bvh2Node],
-    leaf_prims: &[LeafPrim],
+    nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
+    leaf_prims: &(impl RecordLoad<LeafPrim> + ?Sized),
 ) -> Hit {
     let mut hit = query.start();
     if prims.count() == 0 {
@@ -106,7 +110,7 @@ pub fn trace_bvh2<const F: u32>(
     let mut top = 0usize;
     let mut node = 0u32;
     loop {
-        let n = at(nodes, node as usize);
+        let n = nodes.load(node as usize);
         let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
         let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);

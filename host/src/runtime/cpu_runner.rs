@@ -671,7 +671,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
                 Kernel::Cast(Method::Bvh2, tri) => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::<[treelet_core::Bvh2Node], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::Cast(Method::Cwbvh, tri) => {
@@ -702,7 +702,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Bvh2 => {
-                    let tree = Bvh2Tree::new(view(nodes), view(prims));
+                    let tree = Bvh2Tree::<[treelet_core::Bvh2Node], [treelet_core::LeafPrim]>::new(view(nodes), view(prims));
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Cwbvh => {
