@@ -1,6 +1,6 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{LeafPrim, Material, Node, RenderParams, Sphere, WideNode};
+use treelet_core::geometry::buffers::{Material, Node, RenderParams, Sphere};
 use treelet_core::geometry::features::{ALL, TRIANGLES};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
@@ -13,7 +13,7 @@ use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
 /// `treelet_core::for_each_render_variant!`). The stack stays private.
-/// The `bvh2` layout's records are bound as 16-byte vectors, read one
+/// The `bvh2` and `cwbvh` layouts' records are bound as 16-byte vectors, read one
 /// vector per load (`treelet_core::gpu::vector_store`).
 macro_rules! render_kernel {
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
@@ -50,7 +50,7 @@ macro_rules! render_entry_points {
                 use super::*;
                 render_kernel!(linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
                 render_kernel!(bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
-                render_kernel!(cwbvh_cs, WideNode, LeafPrim, WideTree::new, 0 $(| $f)*);
+                render_kernel!(cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
             }
         )*
     };
@@ -88,10 +88,10 @@ macro_rules! cast_kernel {
 // Every kind of primitive, and triangles alone (meshes).
 cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new, ALL);
 cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
-cast_kernel!(cast_cwbvh_cs, WideNode, LeafPrim, WideTree::new, ALL);
+cast_kernel!(cast_cwbvh_cs, Vec4, Vec4, WideTree::new, ALL);
 cast_kernel!(cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
 cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
-cast_kernel!(cast_cwbvh_triangles_cs, WideNode, LeafPrim, WideTree::new, TRIANGLES);
+cast_kernel!(cast_cwbvh_triangles_cs, Vec4, Vec4, WideTree::new, TRIANGLES);
 
 /// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.
 #[spirv(compute(threads(256)))]
@@ -102,8 +102,8 @@ pub fn cast_cwbvh_workgroup_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[WideNode],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[LeafPrim],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
     #[spirv(workgroup)] stack: &mut [u32; WORKGROUP_STACK_WORDS],

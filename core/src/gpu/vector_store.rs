@@ -8,7 +8,7 @@
 //! writes through [`RecordStore`], so that one source serves both: the
 //! shader binds the buffer as vectors, the CPU runner as records.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node};
+use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, WideNode};
 use crate::gpu::unchecked::{at, put};
 use glam::Vec4;
 
@@ -98,6 +98,31 @@ impl RecordLoad<LeafPrim> for [Vec4] {
     }
 }
 
+impl RecordLoad<WideNode> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> WideNode {
+        let bits = |v: Vec4| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits(), v.w.to_bits()];
+        let (origin, exp_imask) = parts(at(self, 5 * i));
+        let [child_base, prim_base, m0, m1] = bits(at(self, 5 * i + 1));
+        let [lx0, lx1, ly0, ly1] = bits(at(self, 5 * i + 2));
+        let [lz0, lz1, hx0, hx1] = bits(at(self, 5 * i + 3));
+        let [hy0, hy1, hz0, hz1] = bits(at(self, 5 * i + 4));
+        WideNode {
+            origin,
+            exp_imask,
+            child_base,
+            prim_base,
+            meta: [m0, m1],
+            lo_x: [lx0, lx1],
+            lo_y: [ly0, ly1],
+            lo_z: [lz0, lz1],
+            hi_x: [hx0, hx1],
+            hi_y: [hy0, hy1],
+            hi_z: [hz0, hz1],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -138,5 +163,8 @@ mod tests {
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&nodes[0]));
         let loaded: LeafPrim = vectors[..].load(1);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&leaf_prims[1]));
+        let wide: &[WideNode] = bytemuck::cast_slice(&words[..20]);
+        let loaded: WideNode = vectors[..].load(0);
+        assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&wide[0]));
     }
 }

@@ -34,13 +34,14 @@
 //!
 //! The stack is a private array: see [`STACK_KINDS`] for the measured
 //! alternatives.
+use crate::gpu::vector_store::RecordLoad;
 use glam::Vec3;
 
 use crate::geometry::buffers::{LeafPrim, WideNode};
 use crate::geometry::intersect::SlabRay;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
-use crate::gpu::unchecked::{at, get, set};
+use crate::gpu::unchecked::{get, set};
 use crate::layouts::cwbvh::grid_step;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
@@ -138,19 +139,22 @@ fn hit_bits(x: &Axis, y: &Axis, z: &Axis, meta: u32, word: usize, oct_inv4: u32,
 }
 
 /// A tree in this layout: nodes (root 0) and leaf primitives.
-pub struct WideTree<'a> {
-    pub nodes: &'a [WideNode],
-    pub leaf_prims: &'a [LeafPrim],
+/// Its nodes and leaf primitives as records or as the 16-byte vectors of
+/// their bytes (how the GPU kernels bind them: see
+/// [`crate::gpu::vector_store`]).
+pub struct WideTree<'a, N: ?Sized = [WideNode], P: ?Sized = [LeafPrim]> {
+    pub nodes: &'a N,
+    pub leaf_prims: &'a P,
 }
 
-impl<'a> WideTree<'a> {
+impl<'a, N: RecordLoad<WideNode> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> WideTree<'a, N, P> {
     #[inline]
-    pub fn new(nodes: &'a [WideNode], leaf_prims: &'a [LeafPrim]) -> Self {
+    pub fn new(nodes: &'a N, leaf_prims: &'a P) -> Self {
         WideTree { nodes, leaf_prims }
     }
 }
 
-impl ClosestHit for WideTree<'_> {
+impl<N: RecordLoad<WideNode> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> ClosestHit for WideTree<'_, N, P> {
     #[inline]
     fn trace<const F: u32, const S: usize>(
         &self,
@@ -226,8 +230,8 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
     from: Origin,
     query: Query,
     prims: &Prims,
-    nodes: &[WideNode],
-    leaf_prims: &[LeafPrim],
+    nodes: &(impl RecordLoad<WideNode> + ?Sized),
+    leaf_prims: &(impl RecordLoad<LeafPrim> + ?Sized),
     private: &mut [u32; 2 * WIDE_STACK],
     shared: &mut [u32; SHARED],
     lane: usize,
@@ -260,7 +264,7 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
             if node_hits > 0x00FF_FFFF {
                 push(private, shared, lane, shared_entries, &mut top, node_base, node_hits);
             }
-            let n = at(nodes, index as usize);
+            let n = nodes.load(index as usize);
             let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0]);
             let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1]);
             let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2]);
@@ -276,7 +280,7 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
         while prim_hits != 0 && !query.done(&hit) {
             let bit = 31 - prim_hits.leading_zeros();
             prim_hits &= !(1u32 << bit);
-            let p = at(leaf_prims, (prim_base + bit) as usize);
+            let p = leaf_prims.load((prim_base + bit) as usize);
             let t = prims.leaf_distance::<F>(o, d, &ray, from, &p, hit.t);
             if p.prim != query.skip && hit.is_beaten_by(t, p.prim) {
                 hit = Hit { t, prim: p.prim };

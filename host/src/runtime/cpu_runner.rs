@@ -676,12 +676,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
                 Kernel::Cast(Method::Cwbvh, tri) => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::CastWideWorkgroupStack => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
                     cast_all::<_, { treelet_core::geometry::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
                 }
                 _ => panic!("{kernel:?}: no such cast kernel"),
@@ -706,7 +706,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Cwbvh => {
-                    let tree = WideTree::new(view(nodes), view(prims));
+                    let tree = WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims));
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
             }
