@@ -52,7 +52,7 @@ pub const OP_ADD: u32 = 5;
 
 /// `output` = the mask of the lanes whose `arg` is not zero and whose
 /// `input` has the same low 8 bits as this lane's (0 where this lane's `arg`
-/// is zero): CUDA's `__match_any_sync` over a byte. Vulkan has no match
+/// is zero): CUDA's `__match_any_sync` over a byte. Core Vulkan has no match
 /// instruction (NVIDIA's partitioned extension is not core), so the GPU
 /// builds it from nine ballots, as Onesweep's multisplit does.
 pub const OP_MATCH_BYTE: u32 = 6;
