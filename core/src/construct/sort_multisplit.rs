@@ -61,8 +61,8 @@ use crate::construct::sort::{digit, state, tile_offset, write_tile, RADIX, RADIX
 use crate::geometry::buffers::SortParams;
 use crate::gpu::atomics;
 use crate::gpu::subgroup::{
-    highest_lane, lanes_below, popcount, Lane, OP_MATCH_BYTE, OP_MATCH_BYTE_PARTITIONED, OP_NONE, OP_SHUFFLE, THEN_SUBGROUP_BARRIER,
-    THEN_WORKGROUP_BARRIER,
+    highest_lane, lanes_below, popcount, Lane, OP_MATCH_BYTE, OP_MATCH_BYTE_PARTITIONED, OP_NONE, OP_SHUFFLE,
+    THEN_SUBGROUP_BARRIER, THEN_WORKGROUP_BARRIER,
 };
 use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{small_scan_phase, SMALL_SCAN_PHASES, WG, WORKGROUP_SIZE};

@@ -156,7 +156,10 @@ mod tests {
     #[test]
     fn both_forms_read_the_same_records() {
         let words: Vec<u32> = (0..24).map(|k| 0x85eb_ca6bu32.wrapping_mul(k + 7) >> 1).collect();
-        let vectors: Vec<Vec4> = words.chunks(4).map(|w| Vec4::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3]))).collect();
+        let vectors: Vec<Vec4> = words
+            .chunks(4)
+            .map(|w| Vec4::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3])))
+            .collect();
         let nodes: &[Bvh2Node] = bytemuck::cast_slice(&words[..16]);
         let leaf_prims: &[LeafPrim] = bytemuck::cast_slice(&words);
         let loaded: Bvh2Node = vectors[..].load(0);
