@@ -1,6 +1,6 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, Node, Sphere};
+use treelet_core::geometry::buffers::{LayoutParams, Node, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 
@@ -27,7 +27,7 @@ pub fn leaf_prims_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] prim_indices: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [LeafPrim],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);

@@ -1,6 +1,6 @@
-use spirv_std::glam::UVec3;
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{LayoutParams, LeafPrim, Node, Sphere, WideNode};
+use treelet_core::geometry::buffers::{LayoutParams, Node, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::layouts::cwbvh_build::{wide_count_kernel, wide_dp_kernel, wide_emit_kernel, wide_place_kernel};
@@ -89,8 +89,8 @@ pub fn wide_emit_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] prim_indices: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_nodes: &mut [WideNode],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] out_prims: &mut [LeafPrim],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_nodes: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] out_prims: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     wide_emit_kernel(

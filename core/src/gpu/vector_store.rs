@@ -57,6 +57,29 @@ impl RecordStore<Bvh2Node> for [Vec4] {
     }
 }
 
+impl RecordStore<LeafPrim> for [Vec4] {
+    #[inline]
+    fn store(&mut self, i: usize, p: &LeafPrim) {
+        put(self, 3 * i, vector(p.p0, p.prim));
+        put(self, 3 * i + 1, vector(p.p1, p._pad1));
+        put(self, 3 * i + 2, vector(p.p2, p._pad2));
+    }
+}
+
+impl RecordStore<WideNode> for [Vec4] {
+    #[inline]
+    fn store(&mut self, i: usize, n: &WideNode) {
+        let words = |a: u32, b: u32, c: u32, d: u32| {
+            Vec4::new(f32::from_bits(a), f32::from_bits(b), f32::from_bits(c), f32::from_bits(d))
+        };
+        put(self, 5 * i, vector(n.origin, n.exp_imask));
+        put(self, 5 * i + 1, words(n.child_base, n.prim_base, n.meta[0], n.meta[1]));
+        put(self, 5 * i + 2, words(n.lo_x[0], n.lo_x[1], n.lo_y[0], n.lo_y[1]));
+        put(self, 5 * i + 3, words(n.lo_z[0], n.lo_z[1], n.hi_x[0], n.hi_x[1]));
+        put(self, 5 * i + 4, words(n.hi_y[0], n.hi_y[1], n.hi_z[0], n.hi_z[1]));
+    }
+}
+
 /// A buffer of `T` records read as records or as 16-byte vectors (for
 /// the same reason as [`RecordStore`]: one load per vector).
 pub trait RecordLoad<T> {
@@ -151,6 +174,9 @@ mod tests {
         let words: Vec<u32> = (0..16).map(|k| 0x9e37_79b9u32.wrapping_mul(k + 1)).collect();
         same_bytes(*bytemuck::from_bytes::<Node>(bytemuck::cast_slice(&words[..8])), 2);
         same_bytes(*bytemuck::from_bytes::<Bvh2Node>(bytemuck::cast_slice(&words[..16])), 4);
+        same_bytes(*bytemuck::from_bytes::<LeafPrim>(bytemuck::cast_slice(&words[..12])), 3);
+        let more: Vec<u32> = (0..20).map(|k| 0x27d4_eb2fu32.wrapping_mul(k + 3)).collect();
+        same_bytes(*bytemuck::from_bytes::<WideNode>(bytemuck::cast_slice(&more)), 5);
     }
 
     #[test]

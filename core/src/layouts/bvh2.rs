@@ -82,19 +82,19 @@ fn child_ref(c: &Node, internal_index: u32) -> (u32, u32) {
 
 /// Kernel, one invocation per primitive slot `j < n`: the primitive of
 /// slot `j` (`prim_indices[j]`, in leaf order) as its leaf stores it.
-pub fn leaf_prims_kernel(
+pub fn leaf_prims_kernel<O: RecordStore<LeafPrim> + ?Sized>(
     j: u32,
     n: u32,
     sphere_count: u32,
     prim_indices: &[u32],
     spheres: &[Sphere],
     triangles: &[Triangle],
-    out: &mut [LeafPrim],
+    out: &mut O,
 ) {
     if j >= n {
         return;
     }
     let prims = Prims { spheres, sphere_count, triangles, triangle_count: n - sphere_count };
-    out[j as usize] = prims.leaf_prim(prim_indices[j as usize]);
+    out.store(j as usize, &prims.leaf_prim(prim_indices[j as usize]));
 }
 

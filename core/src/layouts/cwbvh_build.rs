@@ -32,6 +32,7 @@
 //!
 //! No step depends on the order invocations run in, so the CPU runner
 //! builds the same tree (up to the rounding of the DP's sums, fused or not).
+use crate::gpu::vector_store::RecordStore;
 use crate::construct::climb::Climb;
 use crate::construct::treelet::TreeletCosts;
 use crate::geometry::aabb::Aabb;
@@ -426,7 +427,7 @@ pub fn wide_place_kernel(
 /// from `prim_offsets[m]` on, in slot order (`slots`, as
 /// [`wide_place_kernel`] left them).
 #[allow(clippy::too_many_arguments)]
-pub fn wide_emit_kernel(
+pub fn wide_emit_kernel<W: RecordStore<WideNode> + ?Sized, L: RecordStore<LeafPrim> + ?Sized>(
     m: u32,
     params: &LayoutParams,
     nodes: &[Node],
@@ -438,8 +439,8 @@ pub fn wide_emit_kernel(
     prim_indices: &[u32],
     spheres: &[Sphere],
     triangles: &[Triangle],
-    out_nodes: &mut [WideNode],
-    out_prims: &mut [LeafPrim],
+    out_nodes: &mut W,
+    out_prims: &mut L,
 ) {
     if m >= params.n.max(2) - 1 || is_wide[m as usize] == 0 {
         return;
@@ -492,7 +493,7 @@ pub fn wide_emit_kernel(
                 let x = nodes[get(&stack, top) as usize];
                 if x.is_leaf() {
                     let slot = out.prim_base + prim_offset;
-                    out_prims[slot as usize] = prims.leaf_prim(prim_indices[x.left as usize]);
+                    out_prims.store(slot as usize, &prims.leaf_prim(prim_indices[x.left as usize]));
                     prim_offset += 1;
                 } else if top + 2 <= 4 {
                     set(&mut stack, top, x.right);
@@ -506,5 +507,5 @@ pub fn wide_emit_kernel(
         out.meta[word] |= meta << shift;
     }
     out.exp_imask = e[0] | e[1] << 8 | e[2] << 16 | imask << 24;
-    out_nodes[positions[m as usize] as usize] = out;
+    out_nodes.store(positions[m as usize] as usize, &out);
 }

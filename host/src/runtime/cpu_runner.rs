@@ -593,7 +593,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         (Kernel::LeafPrims, [p, prim_indices, spheres, triangles, out]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (prim_indices, spheres, triangles, out) =
-                (view(prim_indices), view(spheres), view(triangles), view(out));
+                (view(prim_indices), view(spheres), view(triangles), view::<treelet_core::LeafPrim>(out));
             for id in ids(groups) {
                 bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, triangles, out);
             }
@@ -640,7 +640,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (nodes, slots, is_wide) = (view(nodes), view(slots), view(is_wide));
             let (child_offsets, prim_offsets, positions) = (view(child_offsets), view(prim_offsets), view(positions));
             let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
-            let (out_nodes, out_prims) = (view(out_nodes), view(out_prims));
+            let (out_nodes, out_prims) = (view::<treelet_core::WideNode>(out_nodes), view::<treelet_core::LeafPrim>(out_prims));
             for id in ids(groups) {
                 cwbvh_build::wide_emit_kernel(
                     id,
