@@ -14,7 +14,7 @@ use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
 /// `treelet_core::for_each_render_variant!`). The stack stays private.
 /// The `bvh2` and `cwbvh` layouts' records are bound as 16-byte vectors, read one
-/// vector per load (`treelet_core::gpu::vector_store`).
+/// vector per load (`treelet_core::geometry::records`).
 macro_rules! render_kernel {
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]

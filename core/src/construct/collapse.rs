@@ -20,7 +20,7 @@
 //! So one invocation per primitive climbs to the root twice: once to sum its
 //! offsets, once to write every output node whose leftmost primitive it is.
 //! No atomics and no ordering between invocations are needed.
-use crate::gpu::vector_store::RecordStore;
+use crate::geometry::records::RecordStore;
 use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
 
 /// Kernel, one invocation per primitive slot `i < n`: writes its primitive

@@ -4,11 +4,11 @@ use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::gpu::unchecked::at;
-use crate::gpu::vector_store::RecordStore;
+use crate::geometry::records::RecordStore;
 
 /// Kernel: the box of primitive `id`: sphere `id` below `spheres`, else
 /// triangle `id - spheres`. `boxes` as records or as vectors (see
-/// [`crate::gpu::vector_store`]).
+/// [`crate::geometry::records`]).
 pub fn primitive_boxes_kernel<B: RecordStore<Aabb> + ?Sized>(
     id: u32,
     n: u32,

@@ -12,4 +12,5 @@ pub mod buffers;
 pub mod features;
 pub mod intersect;
 pub mod prims;
+pub mod records;
 pub mod triangle;

@@ -13,5 +13,4 @@ pub mod atomics;
 pub mod rng;
 pub mod subgroup;
 pub mod unchecked;
-pub mod vector_store;
 pub mod workgroup;

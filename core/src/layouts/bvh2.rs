@@ -12,7 +12,7 @@
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
 //! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
-use crate::gpu::vector_store::RecordStore;
+use crate::geometry::records::RecordStore;
 use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
 use crate::geometry::triangle::Triangle;

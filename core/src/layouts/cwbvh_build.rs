@@ -32,7 +32,7 @@
 //!
 //! No step depends on the order invocations run in, so the CPU runner
 //! builds the same tree (up to the rounding of the DP's sums, fused or not).
-use crate::gpu::vector_store::RecordStore;
+use crate::geometry::records::RecordStore;
 use crate::construct::climb::Climb;
 use crate::construct::treelet::TreeletCosts;
 use crate::geometry::aabb::Aabb;

@@ -20,13 +20,13 @@ use crate::geometry::intersect::{SlabRay, slab_interval};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
 use crate::gpu::unchecked::{get, set};
-use crate::gpu::vector_store::RecordLoad;
+use crate::geometry::records::RecordLoad;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
 /// A tree in the layout of this module: its nodes and leaf primitives as
 /// records (`[Bvh2Node]`, `[LeafPrim]`) or as the 16-byte vectors of their
 /// bytes (`[Vec4]`, how the GPU kernels bind them: see
-/// [`crate::gpu::vector_store`]).
+/// [`crate::geometry::records`]).
 pub struct Bvh2Tree<'a, N: ?Sized = [Bvh2Node], P: ?Sized = [LeafPrim]> {
     pub nodes: &'a N,
     pub leaf_prims: &'a P,

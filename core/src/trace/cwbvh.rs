@@ -34,7 +34,7 @@
 //!
 //! The stack is a private array: see [`STACK_KINDS`] for the measured
 //! alternatives.
-use crate::gpu::vector_store::RecordLoad;
+use crate::geometry::records::RecordLoad;
 use glam::Vec3;
 
 use crate::geometry::buffers::{LeafPrim, WideNode};
@@ -141,7 +141,7 @@ fn hit_bits(x: &Axis, y: &Axis, z: &Axis, meta: u32, word: usize, oct_inv4: u32,
 /// A tree in this layout: nodes (root 0) and leaf primitives.
 /// Its nodes and leaf primitives as records or as the 16-byte vectors of
 /// their bytes (how the GPU kernels bind them: see
-/// [`crate::gpu::vector_store`]).
+/// [`crate::geometry::records`]).
 pub struct WideTree<'a, N: ?Sized = [WideNode], P: ?Sized = [LeafPrim]> {
     pub nodes: &'a N,
     pub leaf_prims: &'a P,
