@@ -1,4 +1,4 @@
-use spirv_std::glam::{UVec3, Vec4};
+use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::Aabb;
 use treelet_core::construct::bounds;
@@ -11,7 +11,7 @@ pub fn reduce_bounds_cs(
     #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] input: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] input: &[Aabb],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] output: &mut [Aabb],
     #[spirv(workgroup)] shared: &mut [Aabb; WG],
 ) {

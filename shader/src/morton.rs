@@ -1,5 +1,6 @@
-use spirv_std::glam::{UVec3, Vec4};
+use spirv_std::glam::UVec3;
 use spirv_std::spirv;
+use treelet_core::Aabb;
 use treelet_core::geometry::buffers::BuildParams;
 use treelet_core::gpu::workgroup::linear_id;
 
@@ -8,7 +9,7 @@ pub fn morton_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] boxes: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] boxes: &[Aabb],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] keys: &mut [u64],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] values: &mut [u32],
 ) {

@@ -4,7 +4,6 @@
 //! *centroids* of the primitive boxes (the Morton frame), later ones boxes.
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::BuildParams;
-use crate::geometry::records::RecordLoad;
 use crate::gpu::workgroup::{WG, WG_LOG2, WORKGROUP_SIZE, reduction_stride};
 
 /// Boxes each invocation reads.
@@ -17,12 +16,12 @@ pub const REDUCE_PHASES: u32 = 2 + WG_LOG2;
 
 /// Kernel: `output[group] = union of input[group's tile]` (of centroids
 /// when `params.reduce_centroids != 0`).
-pub fn reduce_bounds_phase<I: RecordLoad<Aabb> + ?Sized>(
+pub fn reduce_bounds_phase(
     phase: u32,
     lid: u32,
     group: u32,
     params: &BuildParams,
-    input: &I,
+    input: &[Aabb],
     output: &mut [Aabb],
     shared: &mut [Aabb; WG],
 ) {
@@ -31,7 +30,7 @@ pub fn reduce_bounds_phase<I: RecordLoad<Aabb> + ?Sized>(
         for k in 0..REDUCE_ITEMS {
             let i = group * REDUCE_TILE + k * WORKGROUP_SIZE + lid;
             if i < params.reduce_len {
-                let b = input.load(i as usize);
+                let b = input[i as usize];
                 let b = if params.reduce_centroids != 0 { Aabb::point(b.centroid()) } else { b };
                 acc = acc.union(&b);
             }

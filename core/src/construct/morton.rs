@@ -17,7 +17,6 @@ use glam::{UVec3, Vec3};
 
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::BuildParams;
-use crate::geometry::records::RecordLoad;
 
 /// Quantization bits per axis.
 pub const BITS_PER_AXIS: u32 = 21;
@@ -133,16 +132,10 @@ pub fn interleave(x: u32, y: u32, z: u32) -> u64 {
 }
 
 /// Kernel: the key of primitive `id` and its index as the sort's value.
-pub fn morton_kernel<B: RecordLoad<Aabb> + ?Sized>(
-    id: u32,
-    params: &BuildParams,
-    boxes: &B,
-    keys: &mut [u64],
-    values: &mut [u32],
-) {
+pub fn morton_kernel(id: u32, params: &BuildParams, boxes: &[Aabb], keys: &mut [u64], values: &mut [u32]) {
     if id < params.n {
         let frame = MortonFrame::from_params(params);
-        keys[id as usize] = frame.code(boxes.load(id as usize).centroid()) >> params.key_shift;
+        keys[id as usize] = frame.code(boxes[id as usize].centroid()) >> params.key_shift;
         values[id as usize] = id;
     }
 }

@@ -104,15 +104,6 @@ fn parts(v: Vec4) -> ([f32; 3], u32) {
     ([v.x, v.y, v.z], v.w.to_bits())
 }
 
-impl RecordLoad<Aabb> for [Vec4] {
-    #[inline]
-    fn load(&self, i: usize) -> Aabb {
-        let (min, _pad0) = parts(at(self, 2 * i));
-        let (max, _pad1) = parts(at(self, 2 * i + 1));
-        Aabb { min, _pad0, max, _pad1 }
-    }
-}
-
 impl RecordLoad<Bvh2Node> for [Vec4] {
     #[inline]
     fn load(&self, i: usize) -> Bvh2Node {
@@ -203,9 +194,6 @@ mod tests {
         let leaf_prims: &[LeafPrim] = bytemuck::cast_slice(&words);
         let loaded: Bvh2Node = vectors[..].load(0);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&nodes[0]));
-        let boxes: &[Aabb] = bytemuck::cast_slice(&words[..16]);
-        let loaded: Aabb = vectors[..].load(1);
-        assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&boxes[1]));
         let loaded: LeafPrim = vectors[..].load(1);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&leaf_prims[1]));
         let wide: &[WideNode] = bytemuck::cast_slice(&words[..20]);

@@ -354,7 +354,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::ReduceBounds, [p, input, output]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (input, output) = (view::<treelet_core::Aabb>(input), view(output));
+            let (input, output) = (view(input), view(output));
             let mut shared = [Aabb::EMPTY; WG];
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
                 bounds::reduce_bounds_phase(phase, lid, g, &p, input, output, &mut shared)
@@ -362,7 +362,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::Morton, [p, boxes, keys, values]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (boxes, keys, values) = (view::<treelet_core::Aabb>(boxes), view(keys), view(values));
+            let (boxes, keys, values) = (view(boxes), view(keys), view(values));
             for id in ids(groups) {
                 morton::morton_kernel(id, &p, boxes, keys, values);
             }
