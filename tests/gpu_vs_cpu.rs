@@ -17,14 +17,15 @@ fn lbvh_matches_cpu_on_random_scenes() {
     }
 }
 
-/// The agglomerative build (Apetrei 2014) gives the radix tree plus fit's
-/// nodes and parents bit for bit, on the GPU and on the CPU runner, also
-/// where many Morton keys are equal.
+/// The agglomerative build (Apetrei 2014), plain and with its lowest levels
+/// merged within subgroups, gives the radix tree plus fit's nodes and
+/// parents bit for bit, on the GPU and on the CPU runner (at several
+/// subgroup sizes), also where many Morton keys are equal.
 #[test]
 fn agglomerative_build_equals_radix_tree_and_fit() {
     use treelet::bvh::lbvh::{build_with, Hierarchy};
     let seed = treelet_tests::fresh_seed();
-    let mut scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 5, 1000, 40_000]
+    let mut scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 5, 1000, 40_000, 100_000]
         .iter()
         .map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64)))
         .collect();
@@ -39,10 +40,16 @@ fn agglomerative_build_equals_radix_tree_and_fit() {
         let reference = build_with(&mut CpuBackend::new(), spheres, Hierarchy::RadixTreeThenFit).unwrap();
         let mut trees =
             vec![("cpu agglomerative", build_with(&mut CpuBackend::new(), spheres, Hierarchy::Agglomerative).unwrap())];
+        // Merged within subgroups first, at the sizes devices have.
+        for (how, size) in [("cpu by subgroups of 8", 8), ("cpu by subgroups of 32", 32), ("cpu by subgroups of 64", 64)] {
+            let mut b = CpuBackend::with_subgroup_size(size);
+            trees.push((how, build_with(&mut b, spheres, Hierarchy::AgglomerativeSubgroup).unwrap()));
+        }
         if let Some(ctx) = &gpu_ctx {
             let mut b = GpuBackend::new(ctx.clone());
             trees.push(("gpu radix tree + fit", build_with(&mut b, spheres, Hierarchy::RadixTreeThenFit).unwrap()));
             trees.push(("gpu agglomerative", build_with(&mut b, spheres, Hierarchy::Agglomerative).unwrap()));
+            trees.push(("gpu by subgroups", build_with(&mut b, spheres, Hierarchy::AgglomerativeSubgroup).unwrap()));
         }
         for (how, t) in &trees {
             assert_eq!(t.prim_indices, reference.prim_indices, "{what}, {how}: order");

@@ -42,7 +42,7 @@ pub fn parent_side(keys: &[u64], n: u32, l: u32, r: u32) -> bool {
 
 /// Node index of the node covering `[l, r]`, given which child it is.
 #[inline]
-fn node_index(n: u32, l: u32, r: u32, left_child: bool) -> u32 {
+pub(crate) fn node_index(n: u32, l: u32, r: u32, left_child: bool) -> u32 {
     if l == r {
         leaf_node(n, l)
     } else if l == 0 && r == n - 1 {
@@ -74,12 +74,34 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
     if i >= n {
         return;
     }
-    let mut own = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
+    let own = write_leaf(i, n, sorted_prims, prim_boxes, nodes, parents);
     if n == 1 {
         return;
     }
-    let (mut l, mut r, mut current) = (i, i, leaf_node(n, i));
-    let mut left_child = parent_side(keys, n, l, r);
+    let left_child = parent_side(keys, n, i, i);
+    climb_from::<ORDERED>(n, keys, nodes, parents, ends, i, i, leaf_node(n, i), own, left_child);
+}
+
+/// The climb of the invocation that holds the finished node `current`
+/// covering `[l, r]` (not the root) with box `own`; `left_child` is
+/// [`parent_side`] of it. Goes on while it arrives second at its parent's
+/// split. The leaf's climb in [`agglomerate_kernel`], and the climb of the
+/// nodes that `crate::construct::agglomerate_subgroup` could not finish
+/// within their subgroup.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn climb_from<const ORDERED: bool>(
+    n: u32,
+    keys: &[u64],
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    ends: &mut [u32],
+    mut l: u32,
+    mut r: u32,
+    mut current: u32,
+    mut own: Aabb,
+    mut left_child: bool,
+) {
     loop {
         let split = if left_child { r } else { l - 1 };
         let far = if left_child { l } else { r };
@@ -101,16 +123,25 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
         let root = lo == 0 && hi == n - 1;
         left_child = !root && parent_side(keys, n, lo, hi);
         let parent = node_index(n, lo, hi, left_child);
-        nodes[parent as usize].left = left;
-        nodes[parent as usize].right = right;
-        store_box(&mut nodes[parent as usize], &own);
-        parents[left as usize] = parent;
-        parents[right as usize] = parent;
+        write_parent(nodes, parents, parent, left, right, &own, root);
         if root {
-            parents[0] = INVALID;
             return;
         }
         (l, r, current) = (lo, hi, parent);
+    }
+}
+
+/// Writes internal node `parent` over children `left` and `right` with box
+/// `b`, and the children's parent links (and the root's: none).
+#[inline]
+pub(crate) fn write_parent(nodes: &mut [Node], parents: &mut [u32], parent: u32, left: u32, right: u32, b: &Aabb, root: bool) {
+    nodes[parent as usize].left = left;
+    nodes[parent as usize].right = right;
+    store_box(&mut nodes[parent as usize], b);
+    parents[left as usize] = parent;
+    parents[right as usize] = parent;
+    if root {
+        parents[0] = INVALID;
     }
 }
 

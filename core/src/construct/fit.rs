@@ -31,15 +31,22 @@ pub(crate) fn load_box(node: &Node) -> Aabb {
     b
 }
 
+/// Leaf `i` (sorted position): its node, and its box.
+#[inline]
+pub(crate) fn leaf_record(i: u32, sorted_prims: &[u32], prim_boxes: &[Aabb]) -> (Node, Aabb) {
+    let b = prim_boxes[sorted_prims[i as usize] as usize];
+    (Node { min: b.min, left: i, max: b.max, right: LEAF_BIT | 1 }, b)
+}
+
 /// Writes leaf `i` (sorted position) of `n` and its box, which it returns;
 /// for a one-leaf tree, also its parent link (none). The start of every
 /// bottom-up climb ([`fit_kernel`], [`crate::construct::agglomerate`]).
 #[inline]
 pub(crate) fn write_leaf(i: u32, n: u32, sorted_prims: &[u32], prim_boxes: &[Aabb], nodes: &mut [Node], parents: &mut [u32]) -> Aabb {
     let leaf = leaf_node(n, i);
-    let b = prim_boxes[sorted_prims[i as usize] as usize];
-    nodes[leaf as usize].left = i;
-    nodes[leaf as usize].right = LEAF_BIT | 1;
+    let (record, b) = leaf_record(i, sorted_prims, prim_boxes);
+    nodes[leaf as usize].left = record.left;
+    nodes[leaf as usize].right = record.right;
     store_box(&mut nodes[leaf as usize], &b);
     if n == 1 {
         parents[0] = INVALID;

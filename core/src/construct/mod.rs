@@ -11,7 +11,7 @@
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`] | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
-//! | hierarchy and boxes in one pass | [`agglomerate`] | Apetrei 2014 |
+//! | hierarchy and boxes in one pass | [`agglomerate`]; [`agglomerate_subgroup`] (its lowest levels merged within subgroups) | Apetrei 2014 |
 //! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
 //! | SAH leaf collapse, depth-first compaction | [`collapse`] | Karras & Aila 2013, section 4.4 |
 //! | SAH cost | [`sah`] | MacDonald & Booth 1990 |
@@ -22,6 +22,7 @@
 //! sits at index `i` (the root is 0), leaf `j` (the `j`-th primitive in
 //! Morton order) at index `n - 1 + j`.
 pub mod agglomerate;
+pub mod agglomerate_subgroup;
 pub mod bounds;
 pub mod climb;
 pub mod collapse;

@@ -296,6 +296,18 @@ pub fn highest_lane(mask: u64) -> u32 {
     }
 }
 
+/// The lowest lane of a non-empty mask (in 32-bit halves, as
+/// [`highest_lane`]).
+#[inline]
+pub fn lowest_lane(mask: u64) -> u32 {
+    let low = mask as u32;
+    if low != 0 {
+        low.trailing_zeros()
+    } else {
+        32 + ((mask >> 32) as u32).trailing_zeros()
+    }
+}
+
 /// Bits set in a 64-bit mask (two 32-bit counts: 64-bit `OpBitCount` is
 /// not required of Vulkan drivers).
 #[inline]
@@ -374,5 +386,9 @@ mod tests {
         assert_eq!(highest_lane(0b1011), 3);
         assert_eq!(highest_lane(1 << 40 | 3), 40);
         assert_eq!(highest_lane(u64::MAX), 63);
+        assert_eq!(lowest_lane(1), 0);
+        assert_eq!(lowest_lane(0b1010_0000), 5);
+        assert_eq!(lowest_lane(1 << 40 | 1 << 63), 40);
+        assert_eq!(lowest_lane(u64::MAX), 0);
     }
 }

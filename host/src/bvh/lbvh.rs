@@ -113,7 +113,8 @@ pub fn build_on_device<B: Backend>(b: &mut B, spheres: &[Sphere]) -> Result<(Dev
 
 /// Builds the LBVH of spheres or triangles on `b` and leaves it there.
 pub fn build_primitives_on_device<B: Backend>(b: &mut B, prims: Primitives) -> Result<(DeviceBvh<B>, StageTimes)> {
-    build_primitives_with(b, prims, Hierarchy::from_env())
+    let hierarchy = Hierarchy::for_device(b, prims.len());
+    build_primitives_with(b, prims, hierarchy)
 }
 
 /// Builds the LBVH of `spheres` on `b` with the given way of making the
@@ -129,10 +130,16 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let ordered = b.ordered_atomics_in_divergent_flow();
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBoxes, Kernel::ReduceBounds, Kernel::Morton];
     k.extend(crate::bvh::sort::kernels(b));
-    k.extend(match Hierarchy::from_env() {
-        Hierarchy::RadixTreeThenFit => vec![Kernel::RadixTree, if ordered { Kernel::Fit } else { Kernel::FitRelaxed }],
-        Hierarchy::Agglomerative => vec![if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed }],
-    });
+    match Hierarchy::from_env() {
+        Some(h) => k.extend(h.kernels(ordered)),
+        // Which one runs depends on the primitive count.
+        None => {
+            k.extend(Hierarchy::Agglomerative.kernels(ordered));
+            if !b.runs_on_cpu() {
+                k.extend(Hierarchy::AgglomerativeSubgroup.kernels(ordered));
+            }
+        }
+    }
     k
 }
 
@@ -222,6 +229,23 @@ pub fn build_primitives_with<B: Backend>(
             let k = if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed };
             b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends], groups_for(n, WORKGROUP_SIZE));
         }
+        Hierarchy::AgglomerativeSubgroup => {
+            b.stage("fit");
+            let ends = b.zeroed("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
+            // At most one cluster per leaf is left to climb (where no two
+            // leaves of a subgroup are siblings): each queue has room for
+            // its workgroups' leaves, the climb's dispatch covers every
+            // place, and invocations past a queue's count return.
+            let (queues, capacity) = treelet_core::construct::agglomerate_subgroup::queue_shape(n);
+            let places = queues * capacity;
+            let queue = b.scratch("agglomerate queues", places as u64 * 8)?;
+            let stride = treelet_core::construct::agglomerate_subgroup::QUEUE_COUNTER_STRIDE;
+            let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
+            let all = [&p, &keys, &values, &boxes, &nodes, &parents, &queue, &queued];
+            b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));
+            let climb = if ordered { Kernel::ClimbQueued } else { Kernel::ClimbQueuedRelaxed };
+            b.dispatch(climb, &[&p, &keys, &nodes, &parents, &ends, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
+        }
     }
 
     let times = b.take_times()?;
@@ -230,7 +254,13 @@ pub fn build_primitives_with<B: Backend>(
     Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds, prims }, times))
 }
 
-/// How the hierarchy and its boxes are made from the sorted keys; both give
+/// Fewest primitives for which the default hierarchy is
+/// [`Hierarchy::AgglomerativeSubgroup`]: below, its second dispatch costs
+/// more than it saves (H100: 65 536 primitives 0.077 ms against 0.070 plain;
+/// 1M 0.21 against 0.33).
+pub const SUBGROUP_HIERARCHY_MIN: usize = 131_072;
+
+/// How the hierarchy and its boxes are made from the sorted keys; all give
 /// the same nodes, bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Hierarchy {
@@ -239,17 +269,48 @@ pub enum Hierarchy {
     RadixTreeThenFit,
     /// Apetrei 2014: both in one bottom-up pass.
     Agglomerative,
+    /// [`Hierarchy::Agglomerative`] with the lowest levels merged within
+    /// each subgroup (`treelet_core::construct::agglomerate_subgroup`).
+    AgglomerativeSubgroup,
 }
 
 impl Hierarchy {
-    /// The default, agglomerative (faster at every size measured on the
-    /// H100: 0.070 ms against 0.020 + 0.076 at 65 536 primitives, 0.328
-    /// against 0.064 + 0.311 at 1M, 1.12 against 0.21 + 1.03 at 4M; see the
-    /// README), or `TREELET_HIERARCHY=radix|agglomerative` (to measure).
-    pub fn from_env() -> Hierarchy {
+    /// The hierarchy for `n` primitives on `b`: `TREELET_HIERARCHY=radix|agglomerative|subgroup`
+    /// (to measure), else agglomerative (faster than radix tree plus fit at
+    /// every size measured on the H100: 0.070 ms against 0.020 + 0.076 at
+    /// 65 536 primitives, 0.328 against 0.064 + 0.311 at 1M), merged within
+    /// subgroups first on GPUs from [`SUBGROUP_HIERARCHY_MIN`] primitives up
+    /// (not on CPU cores: lavapipe's subgroups are 8 lanes, and there the
+    /// climb costs no more for being spread; 1M primitives on two cores
+    /// took 130 to 167 ms either way).
+    pub fn for_device<B: Backend>(b: &B, n: usize) -> Hierarchy {
+        Hierarchy::from_env().unwrap_or(if n >= SUBGROUP_HIERARCHY_MIN && !b.runs_on_cpu() {
+            Hierarchy::AgglomerativeSubgroup
+        } else {
+            Hierarchy::Agglomerative
+        })
+    }
+
+    /// The hierarchy `TREELET_HIERARCHY` asks for, if it does.
+    pub fn from_env() -> Option<Hierarchy> {
         match std::env::var("TREELET_HIERARCHY").as_deref() {
-            Ok("radix") => Hierarchy::RadixTreeThenFit,
-            _ => Hierarchy::Agglomerative,
+            Ok("radix") => Some(Hierarchy::RadixTreeThenFit),
+            Ok("agglomerative") => Some(Hierarchy::Agglomerative),
+            Ok("subgroup") => Some(Hierarchy::AgglomerativeSubgroup),
+            _ => None,
+        }
+    }
+
+    /// The kernels of a hierarchy (`ordered` as the device allows: see
+    /// `Backend::ordered_atomics_in_divergent_flow`).
+    fn kernels(self, ordered: bool) -> Vec<Kernel> {
+        match (self, ordered) {
+            (Hierarchy::RadixTreeThenFit, true) => vec![Kernel::RadixTree, Kernel::Fit],
+            (Hierarchy::RadixTreeThenFit, false) => vec![Kernel::RadixTree, Kernel::FitRelaxed],
+            (Hierarchy::Agglomerative, true) => vec![Kernel::Agglomerate],
+            (Hierarchy::Agglomerative, false) => vec![Kernel::AgglomerateRelaxed],
+            (Hierarchy::AgglomerativeSubgroup, true) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueued],
+            (Hierarchy::AgglomerativeSubgroup, false) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueuedRelaxed],
         }
     }
 }

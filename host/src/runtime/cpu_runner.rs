@@ -484,6 +484,31 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, nodes, parents, ends);
             }
         }
+        (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, queue, queued]) => {
+            use treelet_core::construct::agglomerate_subgroup::*;
+            let p: treelet_core::BuildParams = params(p);
+            let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view::<treelet_core::Node>(nodes));
+            let (parents, queue, queued) = (view(parents), view(queue), view(queued));
+            let mut states = [AgglomerateLane::default(); WG];
+            let size = subgroup_size;
+            let op = |phase| agglomerate_subgroup_op(agglomerate_subgroup_step(phase));
+            subgroup_workgroups(groups, AGGLOMERATE_SUBGROUP_PHASES, size, op, |g, phase, lid, lanes| {
+                let (id, l) = (g * WORKGROUP_SIZE + lid, lid as usize);
+                let step = agglomerate_subgroup_step(phase);
+                let (me, io) = (&mut states[l], &mut lanes[l]);
+                agglomerate_subgroup_phase(step, id, lid % size, size, p.n, keys, prims, boxes, nodes, parents, queue, queued, me, io);
+            });
+        }
+        (Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed, [p, keys, nodes, parents, ends, queue, queued]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (keys, nodes, parents, ends) = (view(keys), view(nodes), view(parents), view(ends));
+            let (queue, queued) = (view(queue), view(queued));
+            for id in ids(groups) {
+                treelet_core::construct::agglomerate_subgroup::climb_queued_kernel::<true>(
+                    id, p.n, keys, nodes, parents, ends, queue, queued,
+                );
+            }
+        }
         (
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed,
             [p, nodes, parents, flags, counts, costs, heights, tree_leaves],

@@ -108,6 +108,13 @@ pub enum Kernel {
     Agglomerate,
     /// [`Kernel::Agglomerate`] with relaxed exchanges, for CPU adapters.
     AgglomerateRelaxed,
+    /// The agglomerative build's lowest levels merged within each subgroup,
+    /// the rest queued for [`Kernel::ClimbQueued`].
+    AgglomerateSubgroup,
+    /// The climbs of the queued clusters, as [`Kernel::Agglomerate`]'s.
+    ClimbQueued,
+    /// [`Kernel::ClimbQueued`] with relaxed exchanges, for CPU adapters.
+    ClimbQueuedRelaxed,
     /// Treelet optimization: per-node counts, costs, heights (bottom up).
     TreeletInit,
     /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
@@ -149,7 +156,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 44] = [
+    const FIXED: [Kernel; 47] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -173,6 +180,9 @@ impl Kernel {
         Kernel::FitRelaxed,
         Kernel::Agglomerate,
         Kernel::AgglomerateRelaxed,
+        Kernel::AgglomerateSubgroup,
+        Kernel::ClimbQueued,
+        Kernel::ClimbQueuedRelaxed,
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletHistogram,
@@ -237,6 +247,9 @@ impl Kernel {
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
             Kernel::Agglomerate => "fit::agglomerate_cs",
             Kernel::AgglomerateRelaxed => "fit::agglomerate_relaxed_cs",
+            Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
+            Kernel::ClimbQueued => "fit::climb_queued_cs",
+            Kernel::ClimbQueuedRelaxed => "fit::climb_queued_relaxed_cs",
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
@@ -290,6 +303,8 @@ impl Kernel {
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }
+            Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, Read, Read],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
