@@ -394,8 +394,14 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             if let Some((before, after)) = clocks {
                 println!("{}", clocks::describe(before, after));
             }
-            let names: Vec<&str> =
-                rows.first().map(|r| r.median_ms.iter().map(|(s, _)| *s).collect()).unwrap_or_default();
+            // Every stage (or kernel) any size ran, in the order first run:
+            // the kernels differ by size (the sort's tiles, the hierarchy).
+            let mut names: Vec<&str> = Vec::new();
+            for (s, _) in rows.iter().flat_map(|r| &r.median_ms) {
+                if !names.contains(s) {
+                    names.push(s);
+                }
+            }
             let short = |s: &str| s.rsplit("::").next().unwrap_or(s).trim_end_matches("_cs").to_string();
             let width = names.iter().map(|s| short(s).len() + 2).max().unwrap_or(9).max(9);
             print!("{:>10}", "N");
@@ -405,8 +411,11 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             println!("{:>10}{:>10}", "total", "Mprims/s");
             for r in &rows {
                 print!("{:>10}", r.primitives);
-                for (_, v) in &r.median_ms {
-                    print!("{v:>width$.3}");
+                for name in &names {
+                    match r.median_ms.iter().find(|(s, _)| s == name) {
+                        Some((_, v)) => print!("{v:>width$.3}"),
+                        None => print!("{:>width$}", "-"),
+                    }
                 }
                 println!("{:>10.3}{:>10.1}", r.total_median_ms, r.mprims_per_s);
             }
