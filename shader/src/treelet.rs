@@ -2,46 +2,62 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
+use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_climb_kernel, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
 use treelet_core::gpu::subgroup::subgroup_barrier;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
 
-/// Per-node counts, costs and heights, bottom up; acquire-release counters (GPUs).
-#[spirv(compute(threads(256)))]
-pub fn treelet_init_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_init_kernel::<true>(id, params, nodes, parents, flags, counts, costs, heights, tree_leaves);
+/// Per-node counts, costs and heights, bottom up, in two kernels (the
+/// lowest levels, then the queued climbs); `$ordered`: acquire-release
+/// counters (GPUs), else relaxed (CPU adapters: lavapipe).
+macro_rules! treelet_init_kernels {
+    ($name:ident, $climb:ident, $ordered:literal) => {
+        #[spirv(compute(threads(256)))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &mut [u32],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            let summaries = (counts, costs, heights, tree_leaves);
+            treelet_init_kernel::<$ordered>(id, params, nodes, parents, flags, summaries, queue, queued);
+        }
+
+        #[spirv(compute(threads(256)))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $climb(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &[u32],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            let summaries = (counts, costs, heights, tree_leaves);
+            treelet_init_climb_kernel::<$ordered>(id, params, nodes, parents, flags, summaries, queue, queued);
+        }
+    };
 }
 
-/// As `treelet_init_cs` with relaxed counters, for CPU adapters (lavapipe).
-#[spirv(compute(threads(256)))]
-pub fn treelet_init_relaxed_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_init_kernel::<false>(id, params, nodes, parents, flags, counts, costs, heights, tree_leaves);
-}
+treelet_init_kernels!(treelet_init_cs, treelet_init_climb_cs, true);
+treelet_init_kernels!(treelet_init_relaxed_cs, treelet_init_climb_relaxed_cs, false);
 
 /// Counts treelet roots per height (a local histogram per workgroup first).
 #[spirv(compute(threads(256)))]

@@ -25,7 +25,7 @@
 //!    these nodes during the dispatch, so they are written as whole 32-byte
 //!    records ([`RecordStore`]; field by field, as the climb must write, they
 //!    took 1.7 of this kernel's 3 ms at 16M leaves). Then the clusters still
-//!    held are queued ([`queue_shape`]).
+//!    held are queued ([`crate::construct::climb_queue`]).
 //! 2. **The climbs** ([`climb_queued_kernel`]): one invocation per queued
 //!    cluster goes on with [`super::agglomerate::climb_from`], which is
 //!    correct from any finished node: a split whose two children were both
@@ -46,8 +46,7 @@ use crate::construct::radix_tree::{delta, leaf_node};
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{INVALID, Node};
 use crate::geometry::records::RecordStore;
-use crate::gpu::atomics;
-use crate::gpu::workgroup::WORKGROUP_SIZE;
+use crate::construct::climb_queue;
 use crate::gpu::subgroup::{highest_lane, lanes_below, lowest_lane, popcount, Lane, OP_BALLOT, OP_NONE, OP_SHUFFLE};
 
 /// Rounds of merging within the subgroup before the climb (H100, 1M and 16M
@@ -64,25 +63,6 @@ pub const STEP_RESERVE: u32 = 11;
 pub const STEP_QUEUE: u32 = 12;
 /// Phases of the kernel: the start, the rounds, the queueing.
 pub const AGGLOMERATE_SUBGROUP_PHASES: u32 = 4 + STEP_MERGE * SUBGROUP_ROUNDS;
-
-/// Most queues of clusters (see [`queue_shape`]).
-pub const MAX_QUEUES: u32 = 256;
-/// Words from one queue's counter to the next: each on its own 128-byte
-/// line, so that the queues' atomics do not meet in one place.
-pub const QUEUE_COUNTER_STRIDE: u32 = 32;
-
-/// The queues of the clusters left to climb for `n` leaves: how many, and
-/// the places in each. Workgroup `g` (of 256 leaves) queues into queue
-/// `g % queues`, whose counter is word `QUEUE_COUNTER_STRIDE * (g % queues)`
-/// and whose places start at `(g % queues) * capacity`. One counter for all
-/// took the queueing of 16M leaves from tenths of a millisecond to 3 ms on
-/// the H100: one subgroup's atomic at a time on one word.
-#[inline]
-pub const fn queue_shape(n: u32) -> (u32, u32) {
-    let groups = n.div_ceil(WORKGROUP_SIZE);
-    let queues = if groups < MAX_QUEUES { if groups == 0 { 1 } else { groups } } else { MAX_QUEUES };
-    (queues, groups.div_ceil(queues) * WORKGROUP_SIZE)
-}
 
 /// The step that phase `phase` runs.
 #[inline]
@@ -259,20 +239,18 @@ pub fn agglomerate_subgroup_phase<Nodes: RecordStore<Node> + ?Sized>(
         me.held_mask = holders;
         let leader = if holders != 0 { lowest_lane(holders) } else { lane };
         if lane == leader && holders != 0 {
-            let queue = (id / WORKGROUP_SIZE) % queue_shape(n).0;
-            io.input = atomics::add_device(&mut queued[(queue * QUEUE_COUNTER_STRIDE) as usize], popcount(holders));
+            io.input = climb_queue::reserve(id, n, queued, popcount(holders));
         }
         io.arg = leader;
     } else if step == STEP_QUEUE && me.holds {
-        let (queues, capacity) = queue_shape(n);
-        let place = (id / WORKGROUP_SIZE) % queues * capacity + io.output as u32 + popcount(me.held_mask & lanes_below(lane));
+        let place = climb_queue::place(id, n, io.output as u32 + popcount(me.held_mask & lanes_below(lane)));
         queue[2 * place as usize] = me.l | (me.wants_right as u32) << 31;
         queue[2 * place as usize + 1] = me.r;
     }
 }
 
 /// Kernel: the climb of the cluster at place `id` of the queues (see
-/// [`queue_shape`]; places past a queue's count hold none), as
+/// [`climb_queue`]; places past a queue's count hold none), as
 /// [`agglomerate_subgroup_phase`] left it in `queue`; `ends` zeroed before.
 #[allow(clippy::too_many_arguments)]
 pub fn climb_queued_kernel<const ORDERED: bool>(
@@ -285,11 +263,9 @@ pub fn climb_queued_kernel<const ORDERED: bool>(
     queue: &[u32],
     queued: &[u32],
 ) {
-    let (queues, capacity) = queue_shape(n);
-    let (which, k) = (id / capacity, id % capacity);
-    if which >= queues || k >= queued[(which * QUEUE_COUNTER_STRIDE) as usize] {
+    let Some(id) = climb_queue::entry(id, n, queued) else {
         return;
-    }
+    };
     let (first, r) = (queue[2 * id as usize], queue[2 * id as usize + 1]);
     let (l, wants_right) = (first & !(1 << 31), first >> 31 != 0);
     let node = node_index(n, l, r, wants_right);
@@ -313,9 +289,9 @@ mod tests {
         let n = keys.len() as u32;
         let count = 2 * keys.len() - 1;
         let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![0u32; count]);
-        let (queues, capacity) = queue_shape(n);
+        let (queues, capacity) = climb_queue::queue_shape(n);
         let places = queues * capacity;
-        let (mut queue, mut queued) = (vec![0u32; 2 * places as usize], vec![0u32; (queues * QUEUE_COUNTER_STRIDE) as usize]);
+        let (mut queue, mut queued) = (vec![0u32; 2 * places as usize], vec![0u32; (queues * climb_queue::QUEUE_COUNTER_STRIDE) as usize]);
         let mut lanes = vec![Lane::default(); group as usize];
         let mut states = vec![AgglomerateLane::default(); group as usize];
         for &g in order {
@@ -356,7 +332,7 @@ mod tests {
             agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut nodes, &mut parents, &mut ends);
         }
         for size in [1u32, 4, 8, 32, 64] {
-            let group = WORKGROUP_SIZE;
+            let group = crate::gpu::workgroup::WORKGROUP_SIZE;
             let groups = n.div_ceil(group);
             // Workgroups last to first: climbs meet the other way round.
             let order: Vec<u32> = (0..groups).rev().collect();

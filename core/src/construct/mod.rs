@@ -9,7 +9,7 @@
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
 //! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
-//! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`] | Karras 2012, section 4; Apetrei 2014 |
+//! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`]; [`climb_queue`] (climbs handed from one kernel to the next) | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
 //! | hierarchy and boxes in one pass | [`agglomerate`]; [`agglomerate_subgroup`] (its lowest levels merged within subgroups) | Apetrei 2014 |
 //! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
@@ -25,6 +25,7 @@ pub mod agglomerate;
 pub mod agglomerate_subgroup;
 pub mod bounds;
 pub mod climb;
+pub mod climb_queue;
 pub mod collapse;
 pub mod fill;
 pub mod fit;

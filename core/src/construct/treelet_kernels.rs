@@ -27,17 +27,33 @@
 //! check's branch kept the GPU from issuing the next load before the last
 //! one returned, which made forming 12 µs.
 use crate::construct::climb::Climb;
+use crate::construct::climb_queue;
 use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, optimize, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{WG, WORKGROUP_SIZE};
 
+/// Levels [`treelet_init_kernel`] climbs before it queues the climbs that go
+/// on for [`treelet_init_climb_kernel`] (about one leaf in eight). H100,
+/// the `bvh2` layout's collapse stage of a 1M-triangle LBVH: 0.379 ms with
+/// 3 levels, 0.407 to 0.420 with 1, 0.407 in one kernel; at 4M 1.23 ms
+/// either way (1.26 in one kernel).
+pub const INIT_FIRST_LEVELS: u32 = 3;
+
 /// Kernel (one invocation per leaf, climbing with [`Climb`] as
-/// [`crate::construct::fit`] does): writes
+/// [`crate::construct::fit`] does), the first of two: writes
 /// every node's primitive count, subtree SAH cost and height (leaves 0), and
 /// its number of leaves after the final collapse (1 where it collapses), an
 /// internal node once both children are done. `flags` are zeroed counters.
+/// Climbs at most [`INIT_FIRST_LEVELS`] levels, then queues the last node it
+/// finished in `queue` (counts in the zeroed `queued`, see
+/// [`crate::construct::climb_queue`]) for [`treelet_init_climb_kernel`],
+/// whose subgroups are then full of long climbs (H100, 1M leaves: 0.093 +
+/// 0.119 ms, one kernel 0.235; `docs/results/h100-agglomerate-subgroup/`).
+/// A small gain next to the hierarchy's (`crate::construct::agglomerate_subgroup`):
+/// without merging within subgroups, the first kernel's subgroups still
+/// wait for their slowest lane over three levels.
 #[allow(clippy::too_many_arguments)]
 pub fn treelet_init_kernel<const ORDERED: bool>(
     i: u32,
@@ -45,15 +61,15 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     nodes: &[Node],
     parents: &[u32],
     flags: &mut [u32],
-    counts: &mut [u32],
-    node_costs: &mut [f32],
-    heights: &mut [u32],
-    tree_leaves: &mut [u32],
+    summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
+    queue: &mut [u32],
+    queued: &mut [u32],
 ) {
     let n = params.n;
     if i >= n {
         return;
     }
+    let (counts, node_costs, heights, tree_leaves) = summaries;
     let costs = params.costs();
     // Leaves are found through the tree, not by index: restructuring moves
     // internal nodes but never leaves, and leaf `i` stays at `n - 1 + i`.
@@ -64,23 +80,67 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     atomics::store_u32(&mut heights[leaf as usize], 0);
     atomics::store_u32(&mut tree_leaves[leaf as usize], 1);
     let mut climb = Climb::<ORDERED>::new(leaf);
+    let mut levels = 0;
     while let Some(parent) = climb.next(parents, flags) {
-        let p = nodes[parent as usize];
-        let (l, r) = (p.left as usize, p.right as usize);
-        let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
-        let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);
-        let area = costs.area(&p.aabb());
-        let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
-        let leaves = if costs.collapses(area, count, children) {
-            1
-        } else {
-            atomics::load_u32(&tree_leaves[l]) + atomics::load_u32(&tree_leaves[r])
-        };
-        atomics::store_u32(&mut counts[parent as usize], count);
-        atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
-        atomics::store_u32(&mut heights[parent as usize], height);
-        atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
+        summarize(parent, params, nodes, (&mut *counts, &mut *node_costs, &mut *heights, &mut *tree_leaves));
+        levels += 1;
+        if levels == INIT_FIRST_LEVELS && parent != 0 {
+            let k = climb_queue::reserve(i, n, queued, 1);
+            queue[climb_queue::place(i, n, k) as usize] = parent;
+            return;
+        }
     }
+}
+
+/// Kernel, the second of two: the climb from the node at place `id` of
+/// the queues [`treelet_init_kernel`] filled, as that kernel climbs.
+#[allow(clippy::too_many_arguments)]
+pub fn treelet_init_climb_kernel<const ORDERED: bool>(
+    id: u32,
+    params: &TreeletParams,
+    nodes: &[Node],
+    parents: &[u32],
+    flags: &mut [u32],
+    summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
+    queue: &[u32],
+    queued: &[u32],
+) {
+    let Some(place) = climb_queue::entry(id, params.n, queued) else {
+        return;
+    };
+    let (counts, node_costs, heights, tree_leaves) = summaries;
+    let mut climb = Climb::<ORDERED>::new(queue[place as usize]);
+    while let Some(parent) = climb.next(parents, flags) {
+        summarize(parent, params, nodes, (&mut *counts, &mut *node_costs, &mut *heights, &mut *tree_leaves));
+    }
+}
+
+/// Writes internal node `parent`'s count, cost, height and collapsed leaf
+/// count from its children's.
+#[inline]
+fn summarize(
+    parent: u32,
+    params: &TreeletParams,
+    nodes: &[Node],
+    summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
+) {
+    let (counts, node_costs, heights, tree_leaves) = summaries;
+    let costs = params.costs();
+    let p = nodes[parent as usize];
+    let (l, r) = (p.left as usize, p.right as usize);
+    let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
+    let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);
+    let area = costs.area(&p.aabb());
+    let height = 1 + atomics::load_u32(&heights[l]).max(atomics::load_u32(&heights[r]));
+    let leaves = if costs.collapses(area, count, children) {
+        1
+    } else {
+        atomics::load_u32(&tree_leaves[l]) + atomics::load_u32(&tree_leaves[r])
+    };
+    atomics::store_u32(&mut counts[parent as usize], count);
+    atomics::store_f32(&mut node_costs[parent as usize], costs.subtree(area, count, children));
+    atomics::store_u32(&mut heights[parent as usize], height);
+    atomics::store_u32(&mut tree_leaves[parent as usize], leaves);
 }
 
 /// Heights the level lists hold; the last slot counts deeper nodes (an

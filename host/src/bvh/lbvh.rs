@@ -236,10 +236,10 @@ pub fn build_primitives_with<B: Backend>(
             // leaves of a subgroup are siblings): each queue has room for
             // its workgroups' leaves, the climb's dispatch covers every
             // place, and invocations past a queue's count return.
-            let (queues, capacity) = treelet_core::construct::agglomerate_subgroup::queue_shape(n);
+            let (queues, capacity) = treelet_core::construct::climb_queue::queue_shape(n);
             let places = queues * capacity;
             let queue = b.scratch("agglomerate queues", places as u64 * 8)?;
-            let stride = treelet_core::construct::agglomerate_subgroup::QUEUE_COUNTER_STRIDE;
+            let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
             let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
             let all = [&p, &keys, &values, &boxes, &nodes, &parents, &queue, &queued];
             b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));

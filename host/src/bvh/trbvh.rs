@@ -261,15 +261,28 @@ fn scratch<B: Backend>(b: &mut B, n: u32) -> Result<Scratch<B>> {
 /// Every node's count, cost, height and output leaf count, bottom up.
 fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &TreeletParams) -> Result<()> {
     let n = bvh.n;
-    let init = if b.ordered_atomics_in_divergent_flow() { Kernel::TreeletInit } else { Kernel::TreeletInitRelaxed };
+    let [init, climb] = init_kernels(b);
     let flags = b.zeroed("treelet flags", (n as u64 - 1) * 4)?;
     let p = b.upload("treelet params", &[*base])?;
-    b.dispatch(
-        init,
-        &[&p, &bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves],
-        groups_for(n, WORKGROUP_SIZE),
-    );
+    // The lowest levels, then the climbs that go on, from queues.
+    let (queues, capacity) = treelet_core::construct::climb_queue::queue_shape(n);
+    let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
+    let queue = b.scratch("treelet init queues", (queues * capacity) as u64 * 4)?;
+    let queued = b.zeroed("treelet init queue counts", (queues * stride) as u64 * 4)?;
+    let all = [&p, &bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves, &queue, &queued];
+    b.dispatch(init, &all, groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(climb, &all, groups_for(queues * capacity, WORKGROUP_SIZE));
     Ok(())
+}
+
+/// The two kernels of [`init_pass`] on `b` (relaxed counters where the
+/// device needs them).
+fn init_kernels<B: Backend>(b: &B) -> [Kernel; 2] {
+    if b.ordered_atomics_in_divergent_flow() {
+        [Kernel::TreeletInit, Kernel::TreeletInitClimb]
+    } else {
+        [Kernel::TreeletInitRelaxed, Kernel::TreeletInitClimbRelaxed]
+    }
 }
 
 /// Checks the counts, costs and heights in `s` against a fresh climb.
@@ -340,8 +353,8 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
 /// The kernels [`collapse`] dispatches on `b` (its counts come from the
 /// treelet pass's init kernel).
 pub fn collapse_kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let init = if b.ordered_atomics_in_divergent_flow() { Kernel::TreeletInit } else { Kernel::TreeletInitRelaxed };
-    vec![Kernel::Fill, init, Kernel::Collapse]
+    let [init, climb] = init_kernels(b);
+    vec![Kernel::Fill, init, climb, Kernel::Collapse]
 }
 
 /// The root box of a device BVH (one node read back).

@@ -119,6 +119,10 @@ pub enum Kernel {
     TreeletInit,
     /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
     TreeletInitRelaxed,
+    /// The climbs [`Kernel::TreeletInit`] queued.
+    TreeletInitClimb,
+    /// [`Kernel::TreeletInitClimb`] with relaxed counters, for CPU adapters.
+    TreeletInitClimbRelaxed,
     /// Treelet optimization: count treelet roots per height.
     TreeletHistogram,
     /// Treelet optimization: list treelet roots by height.
@@ -156,7 +160,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 47] = [
+    const FIXED: [Kernel; 49] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -185,6 +189,8 @@ impl Kernel {
         Kernel::ClimbQueuedRelaxed,
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
+        Kernel::TreeletInitClimb,
+        Kernel::TreeletInitClimbRelaxed,
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
@@ -252,6 +258,8 @@ impl Kernel {
             Kernel::ClimbQueuedRelaxed => "fit::climb_queued_relaxed_cs",
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
+            Kernel::TreeletInitClimb => "treelet::treelet_init_climb_cs",
+            Kernel::TreeletInitClimbRelaxed => "treelet::treelet_init_climb_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
@@ -306,7 +314,10 @@ impl Kernel {
             Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, Read, Read],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
-                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
+            }
+            Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed => {
+                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, Read, Read]
             }
             Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
