@@ -146,7 +146,7 @@ pub(crate) fn write_parent(nodes: &mut [Node], parents: &mut [u32], parent: u32,
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     extern crate std;
     use super::*;
     use crate::construct::fit::fit_kernel;
@@ -158,14 +158,7 @@ mod tests {
     fn both(keys: &[u64]) -> [(Vec<Node>, Vec<u32>); 2] {
         let n = keys.len() as u32;
         let count = 2 * keys.len() - 1;
-        // Boxes in an order unrelated to the keys, some sharing faces.
-        let boxes: Vec<Aabb> = (0..n)
-            .map(|k| {
-                let x = ((k * 7919) % 97) as f32 * 0.5;
-                Aabb::new(glam::Vec3::new(x, -x, (k % 5) as f32), glam::Vec3::new(x + 1.0, 3.0, (k % 5) as f32 + 2.0))
-            })
-            .collect();
-        let prims: Vec<u32> = (0..n).rev().collect();
+        let (boxes, prims) = leaves(n);
         let (mut nodes_a, mut parents_a) = (vec![Node::default(); count], vec![0u32; count]);
         let mut flags = vec![0u32; count];
         for i in 0..n {
@@ -188,6 +181,33 @@ mod tests {
         [(nodes_a, parents_a), (nodes_b, parents_b)]
     }
 
+    /// Boxes for `n` leaves in an order unrelated to the keys, some sharing
+    /// faces, and the leaves' primitives (reversed).
+    pub(crate) fn leaves(n: u32) -> (Vec<Aabb>, Vec<u32>) {
+        let boxes = (0..n)
+            .map(|k| {
+                let x = ((k * 7919) % 97) as f32 * 0.5;
+                Aabb::new(glam::Vec3::new(x, -x, (k % 5) as f32), glam::Vec3::new(x + 1.0, 3.0, (k % 5) as f32 + 2.0))
+            })
+            .collect();
+        (boxes, (0..n).rev().collect())
+    }
+
+    /// Sorted random keys with many lengths of common prefix and some
+    /// duplicates.
+    pub(crate) fn random_keys(n: usize, x: &mut u64) -> Vec<u64> {
+        let mut keys: Vec<u64> = (0..n)
+            .map(|_| {
+                *x ^= *x << 13;
+                *x ^= *x >> 7;
+                *x ^= *x << 17;
+                *x >> (*x % 50)
+            })
+            .collect();
+        keys.sort_unstable();
+        keys
+    }
+
     fn check(keys: &[u64]) {
         let [(na, pa), (nb, pb)] = both(keys);
         for k in 0..na.len() {
@@ -206,16 +226,7 @@ mod tests {
         }
         let mut x = 0x1234_5678_9abc_def0u64;
         for n in [200usize, 1000, 4097] {
-            let keys: Vec<u64> = (0..n)
-                .map(|_| {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
-                    x >> (x % 50) // many lengths of common prefix, some duplicates
-                })
-                .collect::<Vec<_>>()
-                .tap_sort();
-            check(&keys);
+            check(&random_keys(n, &mut x));
         }
     }
 

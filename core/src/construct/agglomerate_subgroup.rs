@@ -278,6 +278,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::construct::agglomerate::agglomerate_kernel;
+    use crate::construct::agglomerate::tests::{leaves, random_keys};
     use crate::gpu::subgroup::emulate;
     use std::vec;
     use std::vec::Vec;
@@ -320,13 +321,7 @@ mod tests {
     fn check(keys: &[u64]) {
         let n = keys.len() as u32;
         let count = 2 * keys.len() - 1;
-        let boxes: Vec<Aabb> = (0..n)
-            .map(|k| {
-                let x = ((k * 7919) % 97) as f32 * 0.5;
-                Aabb::new(glam::Vec3::new(x, -x, (k % 5) as f32), glam::Vec3::new(x + 1.0, 3.0, (k % 5) as f32 + 2.0))
-            })
-            .collect();
-        let prims: Vec<u32> = (0..n).rev().collect();
+        let (boxes, prims) = leaves(n);
         let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![0u32; count]);
         for i in 0..n {
             agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut nodes, &mut parents, &mut ends);
@@ -353,16 +348,7 @@ mod tests {
         }
         let mut x = 0x9abc_def0_1234_5678u64;
         for n in [100usize, 1000, 5000, 70_000] {
-            let mut keys: Vec<u64> = (0..n)
-                .map(|_| {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
-                    x >> (x % 50) // many lengths of common prefix, some duplicates
-                })
-                .collect();
-            keys.sort_unstable();
-            check(&keys);
+            check(&random_keys(n, &mut x));
         }
     }
 }

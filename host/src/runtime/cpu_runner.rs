@@ -510,29 +510,22 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             }
         }
         (
-            Kernel::TreeletInit | Kernel::TreeletInitRelaxed,
+            Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed,
             [p, nodes, parents, flags, counts, costs, heights, tree_leaves, queue, queued],
         ) => {
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
             let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
             let (queue, queued) = (view(queue), view(queued));
+            // The first kernel climbs from the leaves, the second from its queues.
+            let first = matches!(kernel, Kernel::TreeletInit | Kernel::TreeletInitRelaxed);
             for id in ids(groups) {
                 let summaries = (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves);
-                treelet_kernels::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
-            }
-        }
-        (
-            Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed,
-            [p, nodes, parents, flags, counts, costs, heights, tree_leaves, queue, queued],
-        ) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
-            let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
-            let (queue, queued) = (view(queue), view(queued));
-            for id in ids(groups) {
-                let summaries = (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves);
-                treelet_kernels::treelet_init_climb_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
+                if first {
+                    treelet_kernels::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
+                } else {
+                    treelet_kernels::treelet_init_climb_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
+                }
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
