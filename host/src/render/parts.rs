@@ -87,16 +87,36 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Zeroed room for `width * height` pixels, or none where the machine
+/// cannot hold them (the caller then reports the header's size).
+fn pixels_or_none(width: usize, height: usize) -> Vec<[f32; 4]> {
+    let mut pixels = Vec::new();
+    match width.checked_mul(height) {
+        Some(n) if pixels.try_reserve_exact(n).is_ok() => pixels.resize(n, [0f32; 4]),
+        _ => {}
+    }
+    pixels
+}
+
 /// Reads a part: what it is of, and its sums.
 pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
     crate::input::check(path, "part")?;
+    // The header's size is allocated before any pixel is read: a damaged
+    // header can ask for petabytes, which must be an error, not an abort.
     let image = read_first_rgba_layer_from_file(
         path,
-        |size, _| (size.width(), vec![[0f32; 4]; size.width() * size.height()]),
-        |(w, pixels), p, (r, g, b, a): (f32, f32, f32, f32)| pixels[p.y() * *w + p.x()] = [r, g, b, a],
+        |size, _| (size.width(), pixels_or_none(size.width(), size.height())),
+        |(w, pixels), p, (r, g, b, a): (f32, f32, f32, f32)| {
+            if let Some(pixel) = pixels.get_mut(p.y() * *w + p.x()) {
+                *pixel = [r, g, b, a];
+            }
+        },
     )
     .with_context(|| format!("cannot read {} as an EXR image", path.display()))?;
     let size = image.layer_data.size;
+    if image.layer_data.channel_data.pixels.1.len() != size.width() * size.height() {
+        bail!("{}: its header says {}x{} pixels, more than this machine can hold", path.display(), size.width(), size.height());
+    }
     let other = &image.layer_data.attributes.other;
     let field = |key: &str| -> Result<String> {
         match other.get(&Text::from(format!("{PREFIX}{key}").as_str())) {
@@ -197,4 +217,49 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
     let image = super::sums::mean_image(reference.width, reference.height, &sums, samples.end - samples.start);
     let planned_end = parts.iter().map(|p| p.1.planned_end).max().unwrap_or(samples.end);
     Ok((PartInfo { samples, planned_end, ..reference }, image))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Room for a header's pixels is asked for, not assumed: a damaged
+    /// header found by `tests/fuzz.rs` asked for 49 PB, and `vec!` aborts.
+    #[test]
+    fn room_for_impossible_sizes_is_refused() {
+        assert_eq!(pixels_or_none(3, 2).len(), 6);
+        assert!(pixels_or_none(1 << 31, 1 << 31).is_empty());
+        assert!(pixels_or_none(usize::MAX, 2).is_empty());
+    }
+
+    /// A header whose data window asks for more pixels than the file holds:
+    /// an error that names the file.
+    #[test]
+    fn a_huge_data_window_is_an_error() {
+        let dir = std::env::temp_dir().join(format!("treelet-part-window-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("part.exr");
+        let info = PartInfo {
+            scene: "cornell".into(),
+            scene_hash: "0".into(),
+            width: 3,
+            height: 2,
+            seed: 1,
+            integrator: "nee".into(),
+            samples: 0..4,
+            planned_end: 4,
+        };
+        write_part(&path, &info, &[[1.0; 4]; 6]).unwrap();
+        assert!(read_part(&path).is_ok());
+        // dataWindow: name, type "box2i", size 16, then xMin yMin xMax yMax.
+        let mut bytes = std::fs::read(&path).unwrap();
+        let name = b"dataWindow\0box2i\0";
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+        bytes[at..at + 4].copy_from_slice(&(-0x3fff_ffffi32).to_le_bytes());
+        bytes[at + 8..at + 12].copy_from_slice(&0x3fff_ffffi32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read_part(&path).unwrap_err();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(format!("{err:#}").contains("part.exr"), "{err:#}");
+    }
 }
