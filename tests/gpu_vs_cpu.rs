@@ -121,7 +121,7 @@ fn sort_stress_on_large_inputs() {
         let values: Vec<u32> = (0..n).collect();
         b.begin_build();
         let kinds: &[SortTiles] = if treelet::bvh::sort::multisplit_runs_on(&b) {
-            &[SortTiles::Large, SortTiles::Small, SortTiles::Multisplit, SortTiles::MultisplitSmall]
+            &[SortTiles::Large, SortTiles::Small, SortTiles::Multisplit, SortTiles::MultisplitSmall, SortTiles::MultisplitMedium]
         } else {
             &[SortTiles::Large, SortTiles::Small]
         };
@@ -148,15 +148,17 @@ fn check_sort(ctx: &std::sync::Arc<treelet::runtime::gpu::GpuContext>, keys: &[u
     // Without look-back (lavapipe) the GPU sorts with large tiles only.
     let look_back_on_gpu = GpuBackend::new(ctx.clone()).look_back_works();
     for size in [32, 64] {
-        for tiles in [SortTiles::Multisplit, SortTiles::MultisplitSmall] {
+        for tiles in [SortTiles::Multisplit, SortTiles::MultisplitSmall, SortTiles::MultisplitMedium] {
             let c = run_sort(&mut CpuBackend::with_subgroup_size(size), keys, &values, key_bits, tiles);
             assert!(c.0 == ek, "cpu keys, {tiles:?} tiles, subgroups of {size}, {what}");
             assert!(c.1 == ev, "cpu values (stability), {tiles:?} tiles, subgroups of {size}, {what}");
         }
     }
     let multisplit_on_gpu = treelet::bvh::sort::multisplit_runs_on(&GpuBackend::new(ctx.clone()));
-    for tiles in [SortTiles::Small, SortTiles::Large, SortTiles::Multisplit, SortTiles::MultisplitSmall] {
-        let multisplit = matches!(tiles, SortTiles::Multisplit | SortTiles::MultisplitSmall);
+    for tiles in
+        [SortTiles::Small, SortTiles::Large, SortTiles::Multisplit, SortTiles::MultisplitSmall, SortTiles::MultisplitMedium]
+    {
+        let multisplit = matches!(tiles, SortTiles::Multisplit | SortTiles::MultisplitSmall | SortTiles::MultisplitMedium);
         if !multisplit {
             let c = run_sort(&mut CpuBackend::new(), keys, &values, key_bits, tiles);
             assert!(c.0 == ek, "cpu keys, {tiles:?} tiles, {what}");

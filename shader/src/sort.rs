@@ -2,7 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
 use treelet_core::construct::sort_multisplit::{
-    MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
+    MEDIUM_MULTISPLIT_SORT_ITEMS, MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
     multisplit_pass_phases, multisplit_pass_sync,
 };
 use treelet_core::gpu::subgroup::{Lane, apply_with};
@@ -182,10 +182,12 @@ macro_rules! multisplit_kernel {
 
 multisplit_kernel!(sort_multisplit_cs, MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
 multisplit_kernel!(sort_multisplit_small_cs, SMALL_MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
+multisplit_kernel!(sort_multisplit_medium_cs, MEDIUM_MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21]);
 // The same passes with the byte match by NVIDIA's partition instruction,
 // for devices on which the host enabled `VK_NV_shader_subgroup_partitioned`.
 multisplit_kernel!(sort_multisplit_partitioned_cs, MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
 multisplit_kernel!(sort_multisplit_small_partitioned_cs, SMALL_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
+multisplit_kernel!(sort_multisplit_medium_partitioned_cs, MEDIUM_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21]);
 
 #[spirv(compute(threads(256)))]
 pub fn sort_tile_counts_cs(

@@ -91,6 +91,13 @@ pub const MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * MULTISPLIT_SORT_ITEMS;
 pub const SMALL_MULTISPLIT_SORT_ITEMS: u32 = 4;
 /// Keys per workgroup of the small-tile form.
 pub const SMALL_MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * SMALL_MULTISPLIT_SORT_ITEMS;
+/// Keys per lane of the medium-tile form: between the two (H100: 8 passes
+/// of 1M keys 0.308 ms against 0.318 with 8 keys a lane and 0.334 with 4;
+/// 2M 0.519 against 0.536; at 8M and 16M 8 keys a lane are faster,
+/// `docs/results/h100-agglomerate-subgroup/log_sort_tiles.txt`).
+pub const MEDIUM_MULTISPLIT_SORT_ITEMS: u32 = 6;
+/// Keys per workgroup of the medium-tile form.
+pub const MEDIUM_MULTISPLIT_SORT_TILE: u32 = WORKGROUP_SIZE * MEDIUM_MULTISPLIT_SORT_ITEMS;
 const _: () = assert!(MULTISPLIT_SORT_TILE as usize <= 2 * SUBGROUP_COUNTS, "the counters hold the tile's order");
 /// Most keys per lane: a lane keeps its digits in one 64-bit word.
 pub const MAX_MULTISPLIT_ITEMS: u32 = 8;

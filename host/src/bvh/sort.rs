@@ -3,7 +3,9 @@
 use anyhow::Result;
 use treelet_core::construct::scan::SCAN_TILE;
 use treelet_core::construct::sort::{MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE, histogram_tile, passes_for, state};
-use treelet_core::construct::sort_multisplit::{MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE, SMALL_MULTISPLIT_SORT_TILE};
+use treelet_core::construct::sort_multisplit::{
+    MEDIUM_MULTISPLIT_SORT_TILE, MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE, SMALL_MULTISPLIT_SORT_TILE,
+};
 use treelet_core::geometry::buffers::{ScanParams, SortParams};
 use treelet_core::gpu::workgroup::groups_for;
 
@@ -18,9 +20,13 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
         k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
         if multisplit_by_default(b) {
             k.extend(if b.subgroup_partitioned() {
-                [Kernel::SortMultisplitSmallPartitioned, Kernel::SortMultisplitPartitioned]
+                [
+                    Kernel::SortMultisplitSmallPartitioned,
+                    Kernel::SortMultisplitMediumPartitioned,
+                    Kernel::SortMultisplitPartitioned,
+                ]
             } else {
-                [Kernel::SortMultisplitSmall, Kernel::SortMultisplit]
+                [Kernel::SortMultisplitSmall, Kernel::SortMultisplitMedium, Kernel::SortMultisplit]
             });
         } else {
             k.push(Kernel::SortOnesweep);
@@ -49,7 +55,7 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
 /// large tiles ranked in workgroup memory).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SortTiles {
-    /// By size and device: `TREELET_SORT_TILES=small|large|multisplit|multisplit-small`
+    /// By size and device: `TREELET_SORT_TILES=small|large|multisplit|multisplit-medium|multisplit-small`
     /// overrides it (to measure).
     Auto,
     /// `treelet_core::construct::sort::SMALL_SORT_TILE` keys per workgroup.
@@ -62,6 +68,8 @@ pub enum SortTiles {
     Multisplit,
     /// The same with half the keys per lane (`SMALL_MULTISPLIT_SORT_TILE`).
     MultisplitSmall,
+    /// The same with three quarters of the keys per lane (`MEDIUM_MULTISPLIT_SORT_TILE`).
+    MultisplitMedium,
 }
 
 impl SortTiles {
@@ -70,7 +78,7 @@ impl SortTiles {
     ///
     /// Small tiles up to [`SMALL_TILES_UP_TO`] keys, then tiles ranked by
     /// subgroups where the device runs them, small ones up to
-    /// [`SMALL_MULTISPLIT_UP_TO`]: on the H100 (one machine, `bench build
+    /// [`SMALL_MULTISPLIT_UP_TO`], medium ones up to [`MEDIUM_MULTISPLIT_UP_TO`]: on the H100 (one machine, `bench build
     /// --per-kernel`, medians of 11 and 21, 2026-11-26) the 8 passes ranked
     /// by subgroups take 0.202 / 0.351 / 0.990 / 3.25 ms at 65 536 / 1M /
     /// 4M / 16M keys, small tiles 0.135 / 0.582 / 2.15 / 8.29 and large
@@ -87,8 +95,10 @@ impl SortTiles {
             Ok("large") => SortTiles::Large,
             Ok("multisplit") => SortTiles::Multisplit,
             Ok("multisplit-small") => SortTiles::MultisplitSmall,
+            Ok("multisplit-medium") => SortTiles::MultisplitMedium,
             _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
             _ if multisplit && n <= SMALL_MULTISPLIT_UP_TO => SortTiles::MultisplitSmall,
+            _ if multisplit && n <= MEDIUM_MULTISPLIT_UP_TO => SortTiles::MultisplitMedium,
             _ if multisplit => SortTiles::Multisplit,
             _ => SortTiles::Large,
         }
@@ -114,6 +124,13 @@ fn multisplit_by_default<B: Backend>(b: &B) -> bool {
 /// were 14% faster at 262 144 keys, 5% at 524 288, 1.6% slower at 750 000
 /// (`docs/results/h100-sort-occupancy/log_small_multisplit.txt`).
 const SMALL_MULTISPLIT_UP_TO: u32 = 600_000;
+
+/// Largest sort that takes the medium tiles ranked by subgroups by default:
+/// on the H100 they were 3% faster than the large ones at 1M and 2M keys,
+/// 1% at 4M, 4% and 6% slower at 8M and 16M; the small ones were as fast
+/// at 524 288 and faster below
+/// (`docs/results/h100-agglomerate-subgroup/log_sort_tiles.txt`).
+const MEDIUM_MULTISPLIT_UP_TO: u32 = 4_000_000;
 
 /// Largest sort that takes small tiles by default: on the H100 small tiles
 /// sorted 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
@@ -154,7 +171,7 @@ pub fn radix_sort_tiled<B: Backend>(
     let passes = passes_for(key_bits);
     // Small tiles where large ones would leave the GPU idle (look-back only).
     let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_by_default(b)) } else { SortTiles::Large };
-    let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall);
+    let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall | SortTiles::MultisplitMedium);
     if multisplit && !multisplit_runs_on(b) {
         anyhow::bail!(
             "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",
@@ -171,6 +188,10 @@ pub fn radix_sort_tiled<B: Backend>(
             (Kernel::SortMultisplitSmallPartitioned, SMALL_MULTISPLIT_SORT_TILE)
         }
         SortTiles::MultisplitSmall => (Kernel::SortMultisplitSmall, SMALL_MULTISPLIT_SORT_TILE),
+        SortTiles::MultisplitMedium if b.subgroup_partitioned() => {
+            (Kernel::SortMultisplitMediumPartitioned, MEDIUM_MULTISPLIT_SORT_TILE)
+        }
+        SortTiles::MultisplitMedium => (Kernel::SortMultisplitMedium, MEDIUM_MULTISPLIT_SORT_TILE),
         _ => (Kernel::SortOnesweep, SORT_TILE),
     };
     let tiles = groups_for(n, tile);

@@ -413,6 +413,16 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let partitioned = kernel == Kernel::SortMultisplitSmallPartitioned;
             multisplit_sort_pass::<SMALL_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size, partitioned);
         }
+        (
+            Kernel::SortMultisplitMedium | Kernel::SortMultisplitMediumPartitioned,
+            [p, keys_in, values_in, keys_out, values_out, sort_state],
+        ) => {
+            use treelet_core::construct::sort_multisplit::MEDIUM_MULTISPLIT_SORT_ITEMS;
+            let p: treelet_core::SortParams = params(p);
+            let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
+            let partitioned = kernel == Kernel::SortMultisplitMediumPartitioned;
+            multisplit_sort_pass::<MEDIUM_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size, partitioned);
+        }
         (Kernel::SortTileCounts, [p, keys, tile_counts]) => {
             let p: treelet_core::SortParams = params(p);
             let (keys, tile_counts) = (view(keys), view(tile_counts));

@@ -83,6 +83,8 @@ pub enum Kernel {
     SortMultisplit,
     /// The same with half the keys per lane (small tiles).
     SortMultisplitSmall,
+    /// The same with three quarters of the keys per lane (medium tiles).
+    SortMultisplitMedium,
     /// [`Kernel::SortMultisplit`] matching digits by NVIDIA's partition
     /// instruction instead of ballots (devices with
     /// `VK_NV_shader_subgroup_partitioned`, see
@@ -90,6 +92,8 @@ pub enum Kernel {
     SortMultisplitPartitioned,
     /// [`Kernel::SortMultisplitSmall`] likewise.
     SortMultisplitSmallPartitioned,
+    /// [`Kernel::SortMultisplitMedium`] likewise.
+    SortMultisplitMediumPartitioned,
     /// Radix sort without look-back: this pass's digit counts per tile.
     SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
@@ -160,7 +164,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 49] = [
+    const FIXED: [Kernel; 51] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::ReduceBounds,
@@ -171,8 +175,10 @@ impl Kernel {
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
         Kernel::SortMultisplitSmall,
+        Kernel::SortMultisplitMedium,
         Kernel::SortMultisplitPartitioned,
         Kernel::SortMultisplitSmallPartitioned,
+        Kernel::SortMultisplitMediumPartitioned,
         Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
@@ -240,8 +246,10 @@ impl Kernel {
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
             Kernel::SortMultisplitSmall => "sort::sort_multisplit_small_cs",
+            Kernel::SortMultisplitMedium => "sort::sort_multisplit_medium_cs",
             Kernel::SortMultisplitPartitioned => "sort::sort_multisplit_partitioned_cs",
             Kernel::SortMultisplitSmallPartitioned => "sort::sort_multisplit_small_partitioned_cs",
+            Kernel::SortMultisplitMediumPartitioned => "sort::sort_multisplit_medium_partitioned_cs",
             Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit::multisplit_cs",
@@ -302,8 +310,10 @@ impl Kernel {
             | Kernel::SortOnesweepScanned
             | Kernel::SortMultisplit
             | Kernel::SortMultisplitSmall
+            | Kernel::SortMultisplitMedium
             | Kernel::SortMultisplitPartitioned
-            | Kernel::SortMultisplitSmallPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            | Kernel::SortMultisplitSmallPartitioned
+            | Kernel::SortMultisplitMediumPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
