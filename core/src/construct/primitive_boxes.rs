@@ -17,12 +17,14 @@ pub fn primitive_boxes_kernel<B: RecordStore<Aabb> + ?Sized>(
     triangles: &[Triangle],
     boxes: &mut B,
 ) {
-    let b = if id < spheres {
-        at(sphere_data, id as usize).aabb()
-    } else if id < n {
-        at(triangles, (id - spheres) as usize).aabb()
-    } else {
-        return;
-    };
-    boxes.store(id as usize, &b);
+    if id < n {
+        boxes.store(id as usize, &primitive_box(id, spheres, sphere_data, triangles));
+    }
+}
+
+/// The box of primitive `id` (of those there are): sphere `id` below
+/// `spheres`, else triangle `id - spheres`.
+#[inline]
+pub fn primitive_box(id: u32, spheres: u32, sphere_data: &[Sphere], triangles: &[Triangle]) -> Aabb {
+    if id < spheres { at(sphere_data, id as usize).aabb() } else { at(triangles, (id - spheres) as usize).aabb() }
 }

@@ -80,8 +80,9 @@ pub struct BuildParams {
     pub n: u32,
     /// Number of elements the bounds reduction reads in this pass.
     pub reduce_len: u32,
-    /// 1 when the reduction reads primitive boxes and reduces their centroids.
-    pub reduce_centroids: u32,
+    /// Unused (the centroids are reduced as the boxes are made, by
+    /// `construct::bounds::primitive_bounds_phase`).
+    pub _pad_reduce: u32,
     /// How many of the `n` primitives are spheres (the rest are triangles).
     pub spheres: u32,
     /// Centroid bounds of the scene (Morton quantization frame).

@@ -128,7 +128,7 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 /// questions of `b` as it asks), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let ordered = b.ordered_atomics_in_divergent_flow();
-    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBoxes, Kernel::ReduceBounds, Kernel::Morton];
+    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::ReduceBounds, Kernel::Morton];
     k.extend(crate::bvh::sort::kernels(b));
     match Hierarchy::from_env() {
         Some(h) => k.extend(h.kernels(ordered)),
@@ -185,19 +185,21 @@ pub fn build_primitives_with<B: Backend>(
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
-    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &spheres, &triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
-    // Reduce centroids, then partial boxes, until one box remains.
-    let (mut input, mut len, mut centroids) = (boxes.clone(), n, 1);
+    // The boxes and the first pass of their centroid bounds in one kernel,
+    // then partial boxes reduced until one remains.
+    let groups = groups_for(n, REDUCE_TILE);
+    let partials = b.scratch("bounds partials", groups as u64 * 32)?;
+    b.dispatch(Kernel::PrimitiveBounds, &[&p, &spheres, &triangles, &boxes, &partials], groups);
+    let (mut input, mut len) = (partials, groups);
     let centroid_bounds = loop {
+        if len == 1 {
+            break b.read::<Aabb>(&input, 1)?[0];
+        }
         let groups = groups_for(len, REDUCE_TILE);
         let output = b.scratch("bounds partials", groups as u64 * 32)?;
-        let rp =
-            b.upload("reduce params", &[BuildParams { reduce_len: len, reduce_centroids: centroids, ..params }])?;
+        let rp = b.upload("reduce params", &[BuildParams { reduce_len: len, ..params }])?;
         b.dispatch(Kernel::ReduceBounds, &[&rp, &input, &output], groups);
-        if groups == 1 {
-            break b.read::<Aabb>(&output, 1)?[0];
-        }
-        (input, len, centroids) = (output, groups, 0);
+        (input, len) = (output, groups);
     };
 
     b.stage("morton");

@@ -352,6 +352,15 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
             }
         }
+        (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, output]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (spheres, triangles) = (view(spheres), view(triangles));
+            let (boxes, output) = (view::<Aabb>(boxes), view(output));
+            let mut shared = [Aabb::EMPTY; WG];
+            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
+                bounds::primitive_bounds_phase(phase, lid, g, &p, spheres, triangles, boxes, output, &mut shared)
+            });
+        }
         (Kernel::ReduceBounds, [p, input, output]) => {
             let p: treelet_core::BuildParams = params(p);
             let (input, output) = (view(input), view(output));

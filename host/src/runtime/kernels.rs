@@ -68,6 +68,9 @@ fn render_entry_point(method: Method, variant: u8) -> &'static str {
 pub enum Kernel {
     Fill,
     PrimitiveBoxes,
+    /// [`Kernel::PrimitiveBoxes`] fused with the first pass of the centroid
+    /// bounds ([`Kernel::ReduceBounds`]).
+    PrimitiveBounds,
     ReduceBounds,
     Morton,
     /// Radix sort: digit counts of every pass.
@@ -164,9 +167,10 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 51] = [
+    const FIXED: [Kernel; 52] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
+        Kernel::PrimitiveBounds,
         Kernel::ReduceBounds,
         Kernel::Morton,
         Kernel::SortHistogram,
@@ -238,6 +242,7 @@ impl Kernel {
         match self {
             Kernel::Fill => "fill::fill_cs",
             Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
+            Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
@@ -298,6 +303,7 @@ impl Kernel {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
+            Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
