@@ -76,6 +76,7 @@ fn agglomerate_step<const STEP: u32>(
     inputs: (&[u64], &[u32], &[Aabb]),
     nodes: &mut [Vec4],
     parents: &mut [u32],
+    ends: &mut [u32],
     queue: &mut [u32],
     queued: &mut [u32],
     me: &mut treelet_core::construct::agglomerate_subgroup::AgglomerateLane,
@@ -83,7 +84,7 @@ fn agglomerate_step<const STEP: u32>(
 ) {
     use treelet_core::construct::agglomerate_subgroup::{agglomerate_subgroup_op, agglomerate_subgroup_phase};
     let (keys, sorted_prims, prim_boxes) = inputs;
-    agglomerate_subgroup_phase(STEP, id, lane, size, n, keys, sorted_prims, prim_boxes, nodes, parents, queue, queued, me, io);
+    agglomerate_subgroup_phase(STEP, id, lane, size, n, keys, sorted_prims, prim_boxes, nodes, parents, ends, queue, queued, me, io);
     treelet_core::gpu::subgroup::apply(agglomerate_subgroup_op(STEP), io);
 }
 
@@ -105,8 +106,9 @@ pub fn agglomerate_subgroup_cs(
     // Two 16-byte vectors per node: whole records (see `treelet_core::geometry::records`).
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &mut [Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] queue: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] queued: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] queue: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queued: &mut [u32],
 ) {
     use treelet_core::construct::agglomerate_subgroup::{AgglomerateLane, SUBGROUP_ROUNDS};
     let id = linear_id(gid.x, gid.y, groups.x);
@@ -114,23 +116,23 @@ pub fn agglomerate_subgroup_cs(
     let mut me = AgglomerateLane::default();
     let mut io = treelet_core::gpu::subgroup::Lane::default();
     let i = (keys, sorted_prims, prim_boxes);
-    agglomerate_step::<0>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
+    agglomerate_step::<0>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
     let mut round = 0;
     while round < SUBGROUP_ROUNDS {
-        agglomerate_step::<1>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<2>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<3>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<4>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<5>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<6>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<7>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<8>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-        agglomerate_step::<9>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
+        agglomerate_step::<1>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<2>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<3>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<4>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<5>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<6>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<7>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<8>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+        agglomerate_step::<9>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
         round += 1;
     }
-    agglomerate_step::<10>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-    agglomerate_step::<11>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
-    agglomerate_step::<12>(id, lane, size, n, i, nodes, parents, queue, queued, &mut me, &mut io);
+    agglomerate_step::<10>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+    agglomerate_step::<11>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
+    agglomerate_step::<12>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
 }
 
 /// The climbs of the clusters [`agglomerate_subgroup_cs`] queued; `$ordered`

@@ -155,6 +155,7 @@ pub fn agglomerate_subgroup_phase<Nodes: RecordStore<Node> + ?Sized>(
     prim_boxes: &[Aabb],
     nodes: &mut Nodes,
     parents: &mut [u32],
+    ends: &mut [u32],
     queue: &mut [u32],
     queued: &mut [u32],
     me: &mut AgglomerateLane,
@@ -162,6 +163,11 @@ pub fn agglomerate_subgroup_phase<Nodes: RecordStore<Node> + ?Sized>(
 ) {
     if step == STEP_START {
         me.holds = false;
+        // The climbs' exchange slots, zeroed here rather than by a fill
+        // before: only the second kernel uses them.
+        if id + 1 < n {
+            ends[id as usize] = 0;
+        }
         if id < n {
             let (leaf, b) = leaf_record(id, sorted_prims, prim_boxes);
             nodes.store(leaf_node(n, id) as usize, &leaf);
@@ -289,7 +295,8 @@ mod tests {
     fn run(keys: &[u64], size: u32, group: u32, order: &[u32], boxes: &[Aabb], prims: &[u32]) -> (Vec<Node>, Vec<u32>) {
         let n = keys.len() as u32;
         let count = 2 * keys.len() - 1;
-        let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![0u32; count]);
+        // Exchange slots not zeroed: the first kernel zeroes them.
+        let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![u32::MAX; count]);
         let (queues, capacity) = climb_queue::queue_shape(n);
         let places = queues * capacity;
         let (mut queue, mut queued) = (vec![0u32; 2 * places as usize], vec![0u32; (queues * climb_queue::QUEUE_COUNTER_STRIDE) as usize]);
@@ -303,7 +310,7 @@ mod tests {
                     let (me, io) = (&mut states[lid as usize], &mut lanes[lid as usize]);
                     let (q, c) = (&mut queue[..], &mut queued[..]);
                     agglomerate_subgroup_phase(
-                        step, id, lid % size, size, n, keys, prims, boxes, &mut nodes[..], &mut parents, q, c, me, io,
+                        step, id, lid % size, size, n, keys, prims, boxes, &mut nodes[..], &mut parents, &mut ends, q, c, me, io,
                     );
                 }
                 for chunk in lanes.chunks_mut(size as usize) {

@@ -233,7 +233,8 @@ pub fn build_primitives_with<B: Backend>(
         }
         Hierarchy::AgglomerativeSubgroup => {
             b.stage("fit");
-            let ends = b.zeroed("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
+            // Zeroed by the first kernel.
+            let ends = b.scratch("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
             // At most one cluster per leaf is left to climb (where no two
             // leaves of a subgroup are siblings): each queue has room for
             // its workgroups' leaves, the climb's dispatch covers every
@@ -243,7 +244,7 @@ pub fn build_primitives_with<B: Backend>(
             let queue = b.scratch("agglomerate queues", places as u64 * 8)?;
             let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
             let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
-            let all = [&p, &keys, &values, &boxes, &nodes, &parents, &queue, &queued];
+            let all = [&p, &keys, &values, &boxes, &nodes, &parents, &ends, &queue, &queued];
             b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));
             let climb = if ordered { Kernel::ClimbQueued } else { Kernel::ClimbQueuedRelaxed };
             b.dispatch(climb, &[&p, &keys, &nodes, &parents, &ends, &queue, &queued], groups_for(places, WORKGROUP_SIZE));

@@ -503,11 +503,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, nodes, parents, ends);
             }
         }
-        (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, queue, queued]) => {
+        (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, ends, queue, queued]) => {
             use treelet_core::construct::agglomerate_subgroup::*;
             let p: treelet_core::BuildParams = params(p);
             let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view::<treelet_core::Node>(nodes));
-            let (parents, queue, queued) = (view(parents), view(queue), view(queued));
+            let (parents, ends, queue, queued) = (view(parents), view(ends), view(queue), view(queued));
             let mut states = [AgglomerateLane::default(); WG];
             let size = subgroup_size;
             let op = |phase| agglomerate_subgroup_op(agglomerate_subgroup_step(phase));
@@ -515,7 +515,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 let (id, l) = (g * WORKGROUP_SIZE + lid, lid as usize);
                 let step = agglomerate_subgroup_step(phase);
                 let (me, io) = (&mut states[l], &mut lanes[l]);
-                agglomerate_subgroup_phase(step, id, lid % size, size, p.n, keys, prims, boxes, nodes, parents, queue, queued, me, io);
+                agglomerate_subgroup_phase(step, id, lid % size, size, p.n, keys, prims, boxes, nodes, parents, ends, queue, queued, me, io);
             });
         }
         (Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed, [p, keys, nodes, parents, ends, queue, queued]) => {

@@ -327,7 +327,7 @@ impl Kernel {
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }
-            Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, Read, Read],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
