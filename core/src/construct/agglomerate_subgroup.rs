@@ -41,12 +41,12 @@
 //! (`docs/results/h100-agglomerate-subgroup/`). Written in the phases of
 //! [`crate::gpu::subgroup`].
 use crate::construct::agglomerate::{climb_from, node_index};
+use crate::construct::climb_queue;
 use crate::construct::fit::{leaf_record, load_box};
 use crate::construct::radix_tree::{delta, leaf_node};
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{INVALID, Node};
+use crate::geometry::buffers::{Node, INVALID};
 use crate::geometry::records::RecordStore;
-use crate::construct::climb_queue;
 use crate::gpu::subgroup::{highest_lane, lanes_below, lowest_lane, popcount, Lane, OP_BALLOT, OP_NONE, OP_SHUFFLE};
 
 /// Rounds of merging within the subgroup before the climb (H100, 1M and 16M
@@ -296,10 +296,12 @@ mod tests {
         let n = keys.len() as u32;
         let count = 2 * keys.len() - 1;
         // Exchange slots not zeroed: the first kernel zeroes them.
-        let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![u32::MAX; count]);
+        let (mut nodes, mut parents, mut ends) =
+            (vec![Node::default(); count], vec![0u32; count], vec![u32::MAX; count]);
         let (queues, capacity) = climb_queue::queue_shape(n);
         let places = queues * capacity;
-        let (mut queue, mut queued) = (vec![0u32; 2 * places as usize], vec![0u32; (queues * climb_queue::QUEUE_COUNTER_STRIDE) as usize]);
+        let (mut queue, mut queued) =
+            (vec![0u32; 2 * places as usize], vec![0u32; (queues * climb_queue::QUEUE_COUNTER_STRIDE) as usize]);
         let mut lanes = vec![Lane::default(); group as usize];
         let mut states = vec![AgglomerateLane::default(); group as usize];
         for &g in order {
@@ -310,7 +312,21 @@ mod tests {
                     let (me, io) = (&mut states[lid as usize], &mut lanes[lid as usize]);
                     let (q, c) = (&mut queue[..], &mut queued[..]);
                     agglomerate_subgroup_phase(
-                        step, id, lid % size, size, n, keys, prims, boxes, &mut nodes[..], &mut parents, &mut ends, q, c, me, io,
+                        step,
+                        id,
+                        lid % size,
+                        size,
+                        n,
+                        keys,
+                        prims,
+                        boxes,
+                        &mut nodes[..],
+                        &mut parents,
+                        &mut ends,
+                        q,
+                        c,
+                        me,
+                        io,
                     );
                 }
                 for chunk in lanes.chunks_mut(size as usize) {

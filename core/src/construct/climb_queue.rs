@@ -32,7 +32,15 @@ pub const QUEUE_COUNTER_STRIDE: u32 = 32;
 #[inline]
 pub const fn queue_shape(n: u32) -> (u32, u32) {
     let groups = n.div_ceil(WORKGROUP_SIZE);
-    let queues = if groups < MAX_QUEUES { if groups == 0 { 1 } else { groups } } else { MAX_QUEUES };
+    let queues = if groups < MAX_QUEUES {
+        if groups == 0 {
+            1
+        } else {
+            groups
+        }
+    } else {
+        MAX_QUEUES
+    };
     (queues, groups.div_ceil(queues) * WORKGROUP_SIZE)
 }
 
@@ -62,7 +70,11 @@ pub fn place(id: u32, n: u32, k: u32) -> u32 {
 pub fn entry(id: u32, n: u32, queued: &[u32]) -> Option<u32> {
     let (queues, capacity) = queue_shape(n);
     let (which, k) = (id / capacity, id % capacity);
-    if which < queues && k < queued[(which * QUEUE_COUNTER_STRIDE) as usize] { Some(id) } else { None }
+    if which < queues && k < queued[(which * QUEUE_COUNTER_STRIDE) as usize] {
+        Some(id)
+    } else {
+        None
+    }
 }
 
 #[cfg(test)]
