@@ -66,6 +66,70 @@ fn agglomerative_build_equals_radix_tree_and_fit() {
     }
 }
 
+/// H-PLOC (`treelet_core::construct::hploc`): valid trees at every
+/// subgroup size the CPU runner takes, on random spheres, runs of equal
+/// keys, equal boxes and a terrain mesh; on the GPU, the CPU runner's nodes
+/// and parents bit for bit at the GPU's subgroup size; and trees of lower
+/// SAH than the LBVH's on the mesh (what the builder is for).
+#[test]
+fn hploc_matches_cpu_and_is_valid() {
+    use treelet::bvh::lbvh::{build_primitives_with, Bvh, Hierarchy};
+    use treelet::scene::primitives::Primitives;
+    use treelet_core::construct::sah::{sah_cost, SahCosts};
+    let seed = treelet_tests::fresh_seed();
+    let mut sphere_scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 3, 5, 33, 1000, 40_000, 100_000]
+        .iter()
+        .map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64)))
+        .collect();
+    let mut clustered = random_spheres(5000, seed);
+    for (k, s) in clustered.iter_mut().enumerate() {
+        s.center = [(k % 7) as f32; 3];
+    }
+    sphere_scenes.push((format!("clustered, seed {seed}"), clustered.clone()));
+    for s in clustered.iter_mut() {
+        s.radius = 1.0;
+    }
+    sphere_scenes.push(("equal spheres".into(), vec![clustered[0]; 3000]));
+    let terrain = treelet::scene::model::terrain(60_000);
+    let mut scenes: Vec<(String, Primitives)> =
+        sphere_scenes.iter().map(|(w, s)| (w.clone(), Primitives::spheres(s))).collect();
+    scenes.push(("terrain:60000".into(), Primitives::triangles(&terrain)));
+    let build = |b: &mut dyn FnMut(Primitives) -> Bvh, prims| b(prims);
+    let gpu_ctx = gpu();
+    for (what, prims) in &scenes {
+        let check = |t: &Bvh, how: &str| {
+            let v = treelet::bvh::validate::validate_primitives(*prims, &t.nodes, &t.parents, &t.prim_indices);
+            assert!(v.is_valid(), "{what}, {how}: invalid: {:?}", v.errors);
+        };
+        let cpu = |size: u32| {
+            let mut b = CpuBackend::with_subgroup_size(size);
+            build(&mut |p| build_primitives_with(&mut b, p, Hierarchy::Hploc).unwrap().0.read(&mut b).unwrap(), *prims)
+        };
+        for size in [4, 8, 16, 32, 64] {
+            check(&cpu(size), &format!("cpu, subgroups of {size}"));
+        }
+        if let Some(ctx) = &gpu_ctx {
+            let size = ctx.info.subgroup_min_size;
+            assert_eq!(size, ctx.info.subgroup_max_size, "the GPU's subgroup size varies: compare by SAH instead");
+            let mut b = GpuBackend::new(ctx.clone());
+            let g = build_primitives_with(&mut b, *prims, Hierarchy::Hploc).unwrap().0.read(&mut b).unwrap();
+            check(&g, "gpu");
+            let c = cpu(size);
+            assert_eq!(g.prim_indices, c.prim_indices, "{what}: order");
+            if let Some(i) = (0..c.nodes.len()).find(|&i| g.nodes[i] != c.nodes[i]) {
+                panic!("{what}: node {i}: gpu {:?}, cpu (subgroups of {size}) {:?}", g.nodes[i], c.nodes[i]);
+            }
+            assert_eq!(g.parents, c.parents, "{what}: parents");
+        }
+        if what.starts_with("terrain") {
+            let mut b = CpuBackend::new();
+            let lbvh = build_primitives_with(&mut b, *prims, Hierarchy::Agglomerative).unwrap().0.read(&mut b).unwrap();
+            let (h, l) = (sah_cost(&cpu(32).nodes, SahCosts::KARRAS_AILA), sah_cost(&lbvh.nodes, SahCosts::KARRAS_AILA));
+            assert!(h < 0.98 * l, "{what}: H-PLOC SAH {h} against the LBVH's {l}");
+        }
+    }
+}
+
 #[test]
 fn sort_matches_cpu_and_std_on_random_keys() {
     let Some(ctx) = gpu() else { return };

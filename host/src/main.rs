@@ -16,7 +16,7 @@ use treelet::render::parts::{self, PartInfo};
 use treelet::render::settings::MemoryEstimate;
 use treelet::render::{Control, Integrator, PassRow, RenderSettings, Stopped};
 use treelet::runtime::memory::{available_bytes, human};
-use treelet::bvh::report::{run_build, run_build_sweep, BuildReport};
+use treelet::bvh::report::{run_build_with, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
@@ -45,9 +45,10 @@ enum Command {
         builder: Builder,
         #[arg(long, value_enum, default_value = "auto")]
         device: DeviceChoice,
-        /// Treelet optimization rounds (trbvh).
-        #[arg(long, default_value_t = TreeletConfig::default().rounds)]
-        rounds: u32,
+        /// Treelet optimization rounds after the build: trbvh (default 3),
+        /// hploc (default 0: the tree as H-PLOC merged it).
+        #[arg(long)]
+        rounds: Option<u32>,
         /// Smallest subtree restructured in the first round, doubled each round (trbvh).
         #[arg(long, default_value_t = TreeletConfig::default().gamma)]
         gamma: u32,
@@ -541,13 +542,13 @@ fn run(cli: Cli) -> Result<bool> {
     treelet::input::set_max_input_bytes(cli.max_input_bytes);
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
+            let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
             let scene = Scene::from_spec(&scene)?;
-            let treelets = (builder == Builder::Trbvh).then_some(&config);
             let (_, report) = match (builder, device) {
                 (Builder::Sweep, DeviceChoice::Gpu) => anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu"),
                 (Builder::Sweep, _) => run_build_sweep(&scene, max_leaf)?,
-                (_, _) => treelet::with_backend!(device.open()?, |b| run_build(b, &scene, treelets)?),
+                (_, _) => treelet::with_backend!(device.open()?, |b| run_build_with(b, &scene, builder, config)?),
             };
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);

@@ -29,6 +29,7 @@ pub mod climb_queue;
 pub mod collapse;
 pub mod fill;
 pub mod fit;
+pub mod hploc;
 pub mod morton;
 pub mod multisplit;
 pub mod primitive_boxes;

@@ -75,6 +75,28 @@ pub const THEN_SUBGROUP_BARRIER: u32 = 1 << 8;
 /// ([`super::workgroup::barrier`]), for kernels that mix both kinds of phase.
 pub const THEN_WORKGROUP_BARRIER: u32 = 1 << 9;
 
+/// Flag of a synchronisation code: after the operation, a barrier across the
+/// subgroup that also orders storage-buffer accesses at device scope, so
+/// that what one lane acquired (or its lanes wrote) from other invocations
+/// is visible to (or released by) the others: for kernels whose lanes take
+/// turns at climbing and share the work at each level (`construct::hploc`).
+pub const THEN_STORAGE_BARRIER: u32 = 1 << 10;
+
+/// Synchronisation code `sync` for a device whose subgroups run their lanes
+/// in lockstep, one vector instruction for all lanes in program order
+/// (lavapipe: a subgroup is one SIMD vector of one CPU thread), where the
+/// lanes see each other's accesses without a barrier: the subgroup barriers
+/// are dropped. Needed there because lavapipe executes any barrier, even
+/// an `OpMemoryBarrier`, as a workgroup barrier, so a kernel whose subgroups
+/// loop a different number of times (`construct::hploc`) loses the
+/// invocations that wait at one after the rest of the workgroup has
+/// returned (seen: climbs stopped at their second level, merges after
+/// loading their clusters).
+#[inline]
+pub const fn lockstep(sync: u32) -> u32 {
+    sync & !(THEN_SUBGROUP_BARRIER | THEN_STORAGE_BARRIER)
+}
+
 /// Largest subgroup size supported (ballots are 64-bit).
 pub const MAX_SUBGROUP_SIZE: u32 = 64;
 
@@ -157,6 +179,9 @@ pub fn apply_with<const PARTITIONED: bool>(sync: u32, lane: &mut Lane) {
     if sync & THEN_WORKGROUP_BARRIER != 0 {
         super::workgroup::barrier();
     }
+    if sync & THEN_STORAGE_BARRIER != 0 {
+        subgroup_storage_barrier();
+    }
 }
 
 /// A barrier across the subgroup that makes the workgroup memory its lanes
@@ -173,6 +198,21 @@ pub fn subgroup_barrier() {
             { Scope::Subgroup as u32 },
             { Scope::Subgroup as u32 },
             { Semantics::WORKGROUP_MEMORY.bits() | Semantics::ACQUIRE_RELEASE.bits() },
+        >();
+    }
+}
+
+/// [`subgroup_barrier`] that also orders storage-buffer memory, at device
+/// scope ([`THEN_STORAGE_BARRIER`]). Nothing to do on the CPU runner.
+#[inline]
+pub fn subgroup_storage_barrier() {
+    #[cfg(target_arch = "spirv")]
+    {
+        use spirv_std::memory::{Scope, Semantics};
+        spirv_std::arch::control_barrier::<
+            { Scope::Subgroup as u32 },
+            { Scope::Device as u32 },
+            { Semantics::WORKGROUP_MEMORY.bits() | Semantics::UNIFORM_MEMORY.bits() | Semantics::ACQUIRE_RELEASE.bits() },
         >();
     }
 }

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::{Backend, StageTimes};
 use treelet::bvh::layout::Layout;
 use treelet::bvh::lbvh;
-use treelet::bvh::tree::Accel;
+use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::{render, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::{self, TreeletConfig};
@@ -16,11 +16,26 @@ use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
 
 /// One build on the device, the tree left there (as in a renderer).
-pub(crate) fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], builder: Option<&TreeletConfig>) -> Result<StageTimes> {
-    let (bvh, mut times) = lbvh::build_on_device(b, spheres)?;
-    if let Some(config) = builder {
+/// One device build of `builder` (`config`: the treelet rounds of trbvh,
+/// and of hploc where it has any; the leaf collapse of both).
+pub(crate) fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], (builder, config): (Builder, &TreeletConfig)) -> Result<StageTimes> {
+    let prims = treelet::scene::primitives::Primitives::spheres(spheres);
+    let (bvh, mut times) = match builder {
+        Builder::Hploc => lbvh::build_primitives_with(b, prims, lbvh::Hierarchy::Hploc)?,
+        _ => lbvh::build_on_device(b, spheres)?,
+    };
+    let optimized = if builder == Builder::Trbvh || (builder == Builder::Hploc && config.rounds > 0) {
         let root = trbvh::root_box(b, &bvh)?;
-        let (_, rounds) = trbvh::optimize(b, bvh, &root, config)?;
+        Some(trbvh::optimize(b, bvh, &root, config)?.1)
+    } else if builder == Builder::Hploc {
+        b.take_times()?;
+        b.stage("collapse");
+        trbvh::collapse(b, bvh, config.max_leaf)?;
+        Some(b.take_times()?)
+    } else {
+        None
+    };
+    if let Some(rounds) = optimized {
         for s in &rounds.order {
             times.add(s, rounds.get(s));
         }
@@ -234,7 +249,7 @@ pub(crate) fn bench_sizes<B: Backend>(
     b: &mut B,
     sizes: &[usize],
     repeats: usize,
-    builder: Option<&TreeletConfig>,
+    builder: (Builder, &TreeletConfig),
 ) -> Result<Vec<Row>> {
     let bar = ProgressBar::new((sizes.len() * (repeats + 1)) as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} builds {msg}").unwrap());

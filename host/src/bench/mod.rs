@@ -84,12 +84,15 @@ pub enum BenchCommand {
     },
     /// LBVH (and treelet-optimization) build times over random:N scenes.
     Build {
-        /// lbvh: the Karras 2012 build; trbvh: the build plus treelet restructuring (stage times of both).
+        /// lbvh: the Karras 2012 build; trbvh: the build plus treelet
+        /// restructuring (stage times of both); hploc: H-PLOC plus the SAH
+        /// leaf collapse (and treelet rounds with --rounds).
         #[arg(long, value_enum, default_value = "lbvh")]
         builder: Builder,
-        /// Treelet rounds, first gamma and largest collapsed leaf (trbvh).
-        #[arg(long, default_value_t = TreeletConfig::default().rounds)]
-        rounds: u32,
+        /// Treelet rounds (trbvh: default 3; hploc: default 0), first gamma
+        /// and largest collapsed leaf (trbvh, hploc).
+        #[arg(long)]
+        rounds: Option<u32>,
         #[arg(long, default_value_t = TreeletConfig::default().gamma)]
         gamma: u32,
         #[arg(long, default_value_t = TreeletConfig::default().max_leaf)]
@@ -372,11 +375,12 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             Ok(())
         }
         BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
+            let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
             if builder == Builder::Sweep {
-                anyhow::bail!("bench build times the device builders (lbvh, trbvh); time the sweep builder with `treelet build --builder sweep --device cpu`");
+                anyhow::bail!("bench build times the device builders (lbvh, trbvh, hploc); time the sweep builder with `treelet build --builder sweep --device cpu`");
             }
-            let treelets = (builder == Builder::Trbvh).then_some(&config);
+            let treelets = (builder, &config);
             let (adapter, timing, rows, clocks) = match device.open()? {
                 Device::Gpu(ctx) => {
                     let mut b = GpuBackend::new(ctx).with_per_kernel_times(per_kernel);

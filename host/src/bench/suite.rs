@@ -7,7 +7,7 @@ use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
-use treelet::bvh::tree::Accel;
+use treelet::bvh::tree::{Accel, Builder};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;
@@ -96,6 +96,7 @@ fn accel_name(a: Accel) -> &'static str {
         Accel::None => "linear scan",
         Accel::Lbvh => "LBVH",
         Accel::Trbvh => "TRBVH",
+        Accel::Hploc => "H-PLOC",
         Accel::Sweep => "full-sweep SAH",
     }
 }
@@ -191,7 +192,11 @@ fn measure(figure: Figure, s: &Suite, runner: &Device) -> Result<FigureDoc> {
                     ]
                 };
                 for (name, config) in configs {
-                    for row in bench_sizes(b, &device_sizes, r.max(3), config.as_ref())? {
+                    let builder = match &config {
+                        Some(c) => (Builder::Trbvh, c),
+                        None => (Builder::Lbvh, &TreeletConfig::default()),
+                    };
+                    for row in bench_sizes(b, &device_sizes, r.max(3), builder)? {
                         let total = if figure == Figure::Graph25 {
                             [row.total_min_ms, row.total_median_ms, row.total_max_ms]
                         } else {

@@ -143,6 +143,14 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     k
 }
 
+/// The kernels [`build_primitives_with`] dispatches on `b` for `hierarchy`.
+pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
+    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::ReduceBounds, Kernel::Morton];
+    k.extend(crate::bvh::sort::kernels(b));
+    k.extend(hierarchy.kernels(b.ordered_atomics_in_divergent_flow()));
+    k
+}
+
 /// [`build_primitives_on_device`] with the given way of making the hierarchy.
 pub fn build_primitives_with<B: Backend>(
     b: &mut B,
@@ -231,6 +239,21 @@ pub fn build_primitives_with<B: Backend>(
             let k = if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed };
             b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends], groups_for(n, WORKGROUP_SIZE));
         }
+        Hierarchy::Hploc => {
+            b.stage("fit");
+            let min = treelet_core::construct::hploc::MIN_SUBGROUP_SIZE;
+            if b.min_subgroup_size() < min {
+                anyhow::bail!(
+                    "the hploc builder needs subgroups of at least {min} lanes, and this device may run {}: use --builder lbvh or trbvh",
+                    b.min_subgroup_size()
+                );
+            }
+            let ends = b.zeroed("hploc ends", (n as u64 - 1).max(1) * 4)?;
+            let words = treelet_core::construct::hploc::lists_words(n) as u64;
+            let lists = b.scratch("hploc clusters", words * 4)?;
+            let k = if ordered { Kernel::Hploc } else { Kernel::HplocRelaxed };
+            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends, &lists], groups_for(n, WORKGROUP_SIZE));
+        }
         Hierarchy::AgglomerativeSubgroup => {
             b.stage("fit");
             // Zeroed by the first kernel.
@@ -263,8 +286,8 @@ pub fn build_primitives_with<B: Backend>(
 /// 1M 0.21 against 0.33).
 pub const SUBGROUP_HIERARCHY_MIN: usize = 131_072;
 
-/// How the hierarchy and its boxes are made from the sorted keys; all give
-/// the same nodes, bit for bit.
+/// How the hierarchy and its boxes are made from the sorted keys; all but
+/// [`Hierarchy::Hploc`] give the same nodes, bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Hierarchy {
     /// Karras 2012: the radix tree (one invocation per internal node), then
@@ -275,6 +298,10 @@ pub enum Hierarchy {
     /// [`Hierarchy::Agglomerative`] with the lowest levels merged within
     /// each subgroup (`treelet_core::construct::agglomerate_subgroup`).
     AgglomerativeSubgroup,
+    /// H-PLOC (Benthin et al. 2024, `treelet_core::construct::hploc`): not
+    /// the radix tree but a better one, whose nodes merge nearest
+    /// neighbours; the hierarchy of `Builder::Hploc`, never a default.
+    Hploc,
 }
 
 impl Hierarchy {
@@ -314,6 +341,8 @@ impl Hierarchy {
             (Hierarchy::Agglomerative, false) => vec![Kernel::AgglomerateRelaxed],
             (Hierarchy::AgglomerativeSubgroup, true) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueued],
             (Hierarchy::AgglomerativeSubgroup, false) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueuedRelaxed],
+            (Hierarchy::Hploc, true) => vec![Kernel::Hploc],
+            (Hierarchy::Hploc, false) => vec![Kernel::HplocRelaxed],
         }
     }
 }

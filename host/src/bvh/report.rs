@@ -10,6 +10,7 @@ use treelet_core::{Aabb, Node};
 
 use crate::bvh::lbvh::{self, Bvh, STAGES};
 use crate::bvh::trbvh::{self, TreeletConfig};
+use crate::bvh::tree::Builder;
 use crate::bvh::validate::validate_primitives;
 use crate::scene::Scene;
 
@@ -99,18 +100,44 @@ pub fn run_build<B: Backend>(
     scene: &Scene,
     treelets: Option<&TreeletConfig>,
 ) -> Result<(Bvh, BuildReport)> {
+    run_build_with(backend, scene, if treelets.is_some() { Builder::Trbvh } else { Builder::Lbvh }, treelets.cloned().unwrap_or_default())
+}
+
+/// [`run_build`] for a device builder (`lbvh`; `trbvh` with `config`'s
+/// rounds; `hploc`, with `config`'s rounds if any), whose leaves are
+/// collapsed by SAH as for tracing (`trbvh`, `hploc`, up to
+/// `config.max_leaf` primitives).
+pub fn run_build_with<B: Backend>(
+    backend: &mut B,
+    scene: &Scene,
+    builder: Builder,
+    config: TreeletConfig,
+) -> Result<(Bvh, BuildReport)> {
+    // Treelet rounds: the TRBVH's, or over the H-PLOC tree where asked.
+    let treelets = (builder == Builder::Trbvh || (builder == Builder::Hploc && config.rounds > 0)).then_some(&config);
+    let hierarchy = match builder {
+        Builder::Hploc => Some(lbvh::Hierarchy::Hploc),
+        Builder::Lbvh | Builder::Trbvh => None,
+        Builder::Sweep => anyhow::bail!("internal: the sweep builder is run by run_build_sweep"),
+    };
     let prims = scene.primitives();
     prims.check()?;
     crate::bvh::tree::check_build_memory(prims.len() as u64, backend.class())?;
     // Pipelines first, all at once: a fresh machine's driver compiles each for
     // long, and a build timed around that compile runs on a cooled-down GPU.
-    let mut kernels = lbvh::kernels(backend);
+    let mut kernels = match hierarchy {
+        Some(h) => [lbvh::kernels_with(backend, h), trbvh::collapse_kernels(backend)].concat(),
+        None => lbvh::kernels(backend),
+    };
     if treelets.is_some() {
         kernels.extend(crate::bvh::trbvh::kernels(backend));
     }
     backend.prepare_kernels(&kernels);
     let start = Instant::now();
-    let (mut device_bvh, times) = lbvh::build_primitives_on_device(backend, prims)?;
+    let (mut device_bvh, times) = match hierarchy {
+        Some(h) => lbvh::build_primitives_with(backend, prims, h)?,
+        None => lbvh::build_primitives_on_device(backend, prims)?,
+    };
     let mut bvh = device_bvh.read(backend)?;
     let mut ms: serde_json::Map<String, serde_json::Value> =
         STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
@@ -128,6 +155,14 @@ pub fn run_build<B: Backend>(
         ms.insert("collapse".into(), serde_json::json!(rounds.get("collapse")));
         round_ms = Some(per_round);
         bvh = device_bvh.read(backend)?;
+    } else if builder != Builder::Lbvh {
+        backend.take_times()?;
+        backend.stage("collapse");
+        device_bvh = trbvh::collapse(backend, device_bvh, config.max_leaf)?;
+        let collapse = backend.take_times()?.total();
+        total_ms += collapse;
+        ms.insert("collapse".into(), serde_json::json!(collapse));
+        bvh = device_bvh.read(backend)?;
     }
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
@@ -137,7 +172,7 @@ pub fn run_build<B: Backend>(
         primitives: prims.len(),
         spheres: prims.counts().0,
         triangles: prims.counts().1,
-        builder: if treelets.is_some() { "trbvh" } else { "lbvh" },
+        builder: builder.name(),
         device: backend.device_kind(),
         adapter: backend.adapter(),
         nodes: bvh.nodes.len(),
@@ -149,7 +184,7 @@ pub fn run_build<B: Backend>(
         ms,
         timing: if times.source.is_empty() { "wall-clock" } else { times.source },
         leaves: leaf_count(&bvh.nodes),
-        max_leaf: treelets.map(|c| c.max_leaf),
+        max_leaf: (builder != Builder::Lbvh).then_some(config.max_leaf),
         rounds: treelets.map(|c| c.rounds),
         gamma: treelets.map(|c| c.gamma),
         sah_before,

@@ -22,8 +22,24 @@ pub enum Builder {
     Lbvh,
     /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the chosen device.
     Trbvh,
+    /// H-PLOC (Benthin et al. 2024): the LBVH's Morton order, nearest
+    /// neighbours merged within subgroups as the climbs go up, on the
+    /// chosen device (subgroups of 4 lanes or more).
+    Hploc,
     /// Full-sweep SAH, top-down on the CPU: the quality reference.
     Sweep,
+}
+
+impl Builder {
+    /// The word the command line takes (`--builder`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Builder::Lbvh => "lbvh",
+            Builder::Trbvh => "trbvh",
+            Builder::Hploc => "hploc",
+            Builder::Sweep => "sweep",
+        }
+    }
 }
 
 /// How closest hits are found.
@@ -40,6 +56,8 @@ pub enum Accel {
     Lbvh,
     /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
     Trbvh,
+    /// Traverse the H-PLOC tree (Benthin et al. 2024).
+    Hploc,
     /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
     Sweep,
 }
@@ -52,6 +70,7 @@ impl Accel {
             Accel::None => "none",
             Accel::Lbvh => "lbvh",
             Accel::Trbvh => "trbvh",
+            Accel::Hploc => "hploc",
             Accel::Sweep => "sweep",
         }
     }
@@ -64,6 +83,7 @@ impl Accel {
             Accel::None => None,
             Accel::Lbvh => Some(Builder::Lbvh),
             Accel::Trbvh => Some(Builder::Trbvh),
+            Accel::Hploc => Some(Builder::Hploc),
             Accel::Sweep => Some(Builder::Sweep),
         })
     }
@@ -109,6 +129,7 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
     let mut k = match builder {
         Builder::Lbvh => lbvh::kernels(b),
         Builder::Trbvh => [lbvh::kernels(b), trbvh::kernels(b)].concat(),
+        Builder::Hploc => lbvh::kernels_with(b, lbvh::Hierarchy::Hploc),
         Builder::Sweep => Vec::new(),
     };
     k.extend(crate::bvh::layout::kernels(b, layout));
@@ -159,7 +180,7 @@ impl<B: Backend> BuiltTree<B> {
 }
 
 /// The binary tree `builder` makes, to be laid out for tracing: the LBVH
-/// as built, the TRBVH's restructured tree before its leaf collapse, or the
+/// as built, the TRBVH's restructured tree (or the H-PLOC tree) before its leaf collapse, or the
 /// full-sweep tree built on the CPU and uploaded. Starts a new build on `b`.
 pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> Result<BuiltTree<B>> {
     let config = TreeletConfig::default();
@@ -176,6 +197,11 @@ pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> 
             // The LBVH is traced as built (one primitive per leaf).
             let max_leaf = if builder == Builder::Trbvh { config.max_leaf } else { 1 };
             BuiltTree { bvh, max_leaf, build_ms }
+        }
+        Builder::Hploc => {
+            let (bvh, times) = lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?;
+            // Leaves collapsed by SAH when laid out, as the TRBVH's.
+            BuiltTree { bvh, max_leaf: config.max_leaf, build_ms: times.total() }
         }
         Builder::Sweep => {
             let build = std::time::Instant::now();

@@ -518,6 +518,38 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 agglomerate_subgroup_phase(step, id, lid % size, size, p.n, keys, prims, boxes, nodes, parents, ends, queue, queued, me, io);
             });
         }
+        (Kernel::Hploc | Kernel::HplocRelaxed, [p, keys, prims, boxes, nodes, parents, ends, lists]) => {
+            use treelet_core::construct::hploc::{hploc_op, hploc_step, HplocLane};
+            let p: treelet_core::BuildParams = params(p);
+            let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view::<treelet_core::Node>(nodes));
+            let (parents, ends, lists) = (view(parents), view(ends), view(lists));
+            let mut shared = ([treelet_core::Aabb::EMPTY; WG], [0u32; WG], [0u32; WG]);
+            let size = subgroup_size;
+            // Subgroup after subgroup, each to its end: the climbs meet
+            // whatever the order, and no step waits on another subgroup.
+            for g in 0..groups {
+                for base in (0..WORKGROUP_SIZE).step_by(size as usize) {
+                    let mut me = [HplocLane::default(); WG];
+                    let mut io = [Lane::default(); WG];
+                    let (me, io) = (&mut me[..size as usize], &mut io[..size as usize]);
+                    macro_rules! step {
+                        ($step:expr, $arg:expr) => {
+                            for lane in 0..size {
+                                let id = g * WORKGROUP_SIZE + base + lane;
+                                let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
+                                let (l, inputs) = (lane as usize, (&*keys, &*prims, &*boxes));
+                                hploc_step::<true>(
+                                    $step, $arg, id, lane, size, base, p.n, inputs, nodes, parents, ends, lists, sh,
+                                    &mut me[l], &mut io[l],
+                                );
+                            }
+                            subgroup::emulate(hploc_op($step), io);
+                        };
+                    }
+                    treelet_core::hploc_schedule!(step, io[0].output, me[0].more());
+                }
+            }
+        }
         (Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed, [p, keys, nodes, parents, ends, queue, queued]) => {
             let p: treelet_core::BuildParams = params(p);
             let (keys, nodes, parents, ends) = (view(keys), view(nodes), view(parents), view(ends));

@@ -122,6 +122,11 @@ pub enum Kernel {
     ClimbQueued,
     /// [`Kernel::ClimbQueued`] with relaxed exchanges, for CPU adapters.
     ClimbQueuedRelaxed,
+    /// H-PLOC (Benthin et al. 2024): nearest-neighbour clusters merged
+    /// within subgroups as the climbs go up.
+    Hploc,
+    /// [`Kernel::Hploc`] with relaxed exchanges, for CPU adapters.
+    HplocRelaxed,
     /// Treelet optimization: per-node counts, costs, heights (bottom up).
     TreeletInit,
     /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
@@ -167,7 +172,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 52] = [
+    const FIXED: [Kernel; 54] = [
         Kernel::Fill,
         Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
@@ -197,6 +202,8 @@ impl Kernel {
         Kernel::AgglomerateSubgroup,
         Kernel::ClimbQueued,
         Kernel::ClimbQueuedRelaxed,
+        Kernel::Hploc,
+        Kernel::HplocRelaxed,
         Kernel::TreeletInit,
         Kernel::TreeletInitRelaxed,
         Kernel::TreeletInitClimb,
@@ -269,6 +276,8 @@ impl Kernel {
             Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
             Kernel::ClimbQueued => "fit::climb_queued_cs",
             Kernel::ClimbQueuedRelaxed => "fit::climb_queued_relaxed_cs",
+            Kernel::Hploc => "fit::hploc_cs",
+            Kernel::HplocRelaxed => "fit::hploc_relaxed_cs",
             Kernel::TreeletInit => "treelet::treelet_init_cs",
             Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
             Kernel::TreeletInitClimb => "treelet::treelet_init_climb_cs",
@@ -329,6 +338,7 @@ impl Kernel {
             }
             Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, Read, Read],
+            Kernel::Hploc | Kernel::HplocRelaxed => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
