@@ -134,7 +134,7 @@ fn every_layout_traces_like_the_scan(what: &str, spheres: &[Sphere], triangles: 
     let hits = probes.iter().filter(|p| p.3.is_hit()).count();
     assert!(hits * 8 > probes.len(), "{what}: only {hits} of {} rays hit: a weak test", probes.len());
     let b = &mut CpuBackend::new();
-    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc, Accel::Sweep] {
         for layout in Layout::ALL {
             let tree = build(b, prims, accel, layout);
             tree.validate(prims);
@@ -295,7 +295,7 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
     use treelet::bvh::tree::Accel;
     use treelet::bvh::layout::Layout;
     for scene in [treelet::scene::cornell(), treelet::scene::random_scene("random:3000", 3000, 7), treelet::scene::mesh_scene("terrain", &treelet::scene::terrain(5000))] {
-        for accel in [Accel::None, Accel::Lbvh, Accel::Trbvh] {
+        for accel in [Accel::None, Accel::Lbvh, Accel::Trbvh, Accel::Hploc] {
             for layout in [Layout::Classic, Layout::Bvh2, Layout::Cwbvh] {
                 let settings = RenderSettings {
                     width: 16,
@@ -343,7 +343,7 @@ fn tree_depth_on_the_device_is_the_trees_depth() {
         deepest
     }
     fn check<B: Backend>(b: &mut B, spheres: &[Sphere], what: &str) {
-        for builder in [Builder::Lbvh, Builder::Trbvh] {
+        for builder in [Builder::Lbvh, Builder::Trbvh, Builder::Hploc] {
             let built = binary_tree(b, Primitives { spheres, triangles: &[] }, builder).unwrap();
             let nodes: Vec<Node> = b.read(&built.bvh.nodes, built.bvh.node_count as usize).unwrap();
             let expected = walk(&nodes).min(treelet_core::layouts::depth::DEPTH_LIMIT);

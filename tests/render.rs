@@ -97,7 +97,7 @@ fn every_tree_and_layout_renders_what_the_scan_renders() {
         let s = |accel| settings(40, 30, 8, seed as u32, accel);
         let none = pixels(&mut CpuBackend::new(), &scene, &s(Accel::None));
         assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{}: NaN or negative pixels", scene.name);
-        for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+        for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc, Accel::Sweep] {
             for layout in Layout::ALL {
                 let tree = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { layout, ..s(accel) });
                 assert_eq!(

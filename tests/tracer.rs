@@ -131,7 +131,7 @@ fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> (Vec<RayHit
 fn tracer_finds_the_scans_hits_before_and_after_a_refit() {
     let seed = fresh_seed();
     // ForRays: every device class picks the LBVH for one ray and the treelets for 2^40.
-    for quality in [Quality::Fast, Quality::High, Quality::ForRays(1), Quality::ForRays(1 << 40)] {
+    for quality in [Quality::Fast, Quality::High, Quality::Balanced, Quality::ForRays(1), Quality::ForRays(1 << 40)] {
         let cpu = round_trip(&mut CpuBackend::new(), seed, quality);
         if let Some(ctx) = gpu() {
             let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);

@@ -173,7 +173,7 @@ fn hploc<const ORDERED: bool>(
     groups: UVec3,
     lane: u32,
     size: u32,
-    n: u32,
+    settings: (u32, u32, u32),
     inputs: (&[u64], &[u32], &[Aabb]),
     nodes: &mut [Node],
     parents: &mut [u32],
@@ -197,7 +197,7 @@ fn hploc<const ORDERED: bool>(
                 lane,
                 size,
                 base,
-                n,
+                settings,
                 inputs,
                 nodes,
                 parents,
@@ -240,7 +240,8 @@ macro_rules! hploc_kernel {
         ) {
             let inputs = (keys, sorted_prims, prim_boxes);
             let shared = (boxes, clusters, nearest);
-            hploc::<$ordered>(gid, groups, lane, size, params.n, inputs, nodes, parents, ends, lists, shared);
+            let settings = (params.n, params.cluster_keep, params.cluster_radius);
+            hploc::<$ordered>(gid, groups, lane, size, settings, inputs, nodes, parents, ends, lists, shared);
         }
     };
 }

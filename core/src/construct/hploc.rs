@@ -200,7 +200,9 @@ fn merged_area(a: &Aabb, b: &Aabb) -> f32 {
 /// Step `step` of lane `lane` (of `size`; `base` is the workgroup-local
 /// index of the subgroup's lane 0) of invocation `id`, over `n` sorted
 /// keys. `arg`: the lane whose range is being merged (pick and store
-/// steps). `lists`: [`lists_words`] words; `ends`: a zeroed word per split.
+/// steps). `keep`: most clusters a finished range keeps (0: the most, half
+/// the subgroup); `radius`: how far apart in cluster order two clusters may
+/// merge (0: any). `lists`: [`lists_words`] words; `ends`: a zeroed word per split.
 /// Workgroup memory (`boxes`, `clusters`, `nearest`): each subgroup uses its
 /// own lanes' entries. `ORDERED` as for [`super::agglomerate::agglomerate_kernel`].
 #[allow(clippy::too_many_arguments)]
@@ -212,7 +214,7 @@ pub fn hploc_step<const ORDERED: bool>(
     lane: u32,
     size: u32,
     base: u32,
-    n: u32,
+    (n, keep, radius): (u32, u32, u32),
     inputs: (&[u64], &[u32], &[Aabb]),
     nodes: &mut [Node],
     parents: &mut [u32],
@@ -225,6 +227,8 @@ pub fn hploc_step<const ORDERED: bool>(
     let (keys, sorted_prims, prim_boxes) = inputs;
     let (boxes, clusters, nearest) = shared;
     let limit = cluster_limit(size);
+    // At least 2 (see the numbering above), at most the limit.
+    let keep = if keep == 0 { limit } else { keep.clamp(2, limit) };
     let at = (base + lane) as usize;
     if step == STEP_START {
         me.active = false;
@@ -275,7 +279,7 @@ pub fn hploc_step<const ORDERED: bool>(
         let right =
             if right_leaves <= limit { right_leaves } else { atomics::load_u32(&lists[(2 * n + mid + 1) as usize]) };
         me.count = left + right;
-        me.keep = if first == 0 && last == n - 1 { 1 } else { limit };
+        me.keep = if first == 0 && last == n - 1 { 1 } else { keep };
         let j = lane;
         if j < me.count {
             let (start, k, unmerged) =
@@ -317,10 +321,16 @@ pub fn hploc_step<const ORDERED: bool>(
             let s = base as usize;
             me.own = boxes[at];
             me.cluster = clusters[at];
-            let mut best = if j == 0 { 1 } else { 0 };
+            // Candidates `k` with |k - j| <= radius (0: all).
+            let (low, high) = if radius == 0 {
+                (0, me.count)
+            } else {
+                (if j > radius { j - radius } else { 0 }, (j + radius + 1).min(me.count))
+            };
+            let mut best = if j == low { low + 1 } else { low };
             let mut best_area = merged_area(&me.own, &boxes[s + best as usize]);
             let mut k = best + 1;
-            while k < me.count {
+            while k < high {
                 if k != j {
                     let area = merged_area(&me.own, &boxes[s + k as usize]);
                     if area < best_area {
@@ -404,6 +414,11 @@ pub(crate) mod tests {
     /// Runs the kernel over `n` leaves, subgroup after subgroup, as the CPU
     /// runner does; returns nodes and parents.
     pub(crate) fn build(keys: &[u64], boxes: &[Aabb], size: u32) -> (Vec<Node>, Vec<u32>) {
+        build_with(keys, boxes, size, 0, 0)
+    }
+
+    /// [`build`] with `keep` and `radius` as for [`hploc_step`].
+    pub(crate) fn build_with(keys: &[u64], boxes: &[Aabb], size: u32, keep: u32, radius: u32) -> (Vec<Node>, Vec<u32>) {
         let n = keys.len() as u32;
         let prims: Vec<u32> = (0..n).collect();
         let count = (2 * n - 1) as usize;
@@ -429,7 +444,7 @@ pub(crate) mod tests {
                                 lane,
                                 size,
                                 base,
-                                n,
+                                (n, keep, radius),
                                 (keys, &prims, boxes),
                                 &mut nodes,
                                 &mut parents,
@@ -539,20 +554,33 @@ pub(crate) mod tests {
     /// An independent H-PLOC, recursive over Karras's radix tree of the
     /// same keys (the climbs meet at its nodes): returns the range's
     /// clusters' boxes and adds the areas of the nodes it makes to `areas`.
-    fn reference(node: u32, keys: &[u64], boxes: &[Aabb], limit: u32, areas: &mut f64) -> (Vec<Aabb>, u32) {
+    fn reference(
+        node: u32,
+        keys: &[u64],
+        boxes: &[Aabb],
+        (limit, keep, radius): (u32, u32, u32),
+        areas: &mut f64,
+    ) -> (Vec<Aabb>, u32) {
         let n = keys.len() as u32;
         if node >= n - 1 {
             return (vec![boxes[(node - (n - 1)) as usize]], 1);
         }
         let (l, r) = crate::construct::radix_tree::children(keys, n, node);
-        let (mut clusters, left_leaves) = reference(l, keys, boxes, limit, areas);
-        let (right, right_leaves) = reference(r, keys, boxes, limit, areas);
+        let (mut clusters, left_leaves) = reference(l, keys, boxes, (limit, keep, radius), areas);
+        let (right, right_leaves) = reference(r, keys, boxes, (limit, keep, radius), areas);
         clusters.extend(right);
         let leaves = left_leaves + right_leaves;
         if leaves <= limit && node != 0 {
             return (clusters, leaves);
         }
-        let keep = if node == 0 { 1 } else { limit } as usize;
+        let keep = if node == 0 {
+            1
+        } else if keep == 0 {
+            limit
+        } else {
+            keep.clamp(2, limit)
+        } as usize;
+        let radius = if radius == 0 { usize::MAX } else { radius as usize };
         while clusters.len() > keep {
             let c = clusters.len();
             let area = |a: &Aabb, b: &Aabb| {
@@ -567,7 +595,7 @@ pub(crate) mod tests {
             let nearest: Vec<usize> = (0..c)
                 .map(|j| {
                     let mut best = (f32::INFINITY, usize::MAX, usize::MAX, usize::MAX);
-                    for k in (0..c).filter(|&k| k != j) {
+                    for k in (0..c).filter(|&k| k != j && k.abs_diff(j) <= radius) {
                         let cand = (area(&clusters[j], &clusters[k]), j.min(k), j.max(k), k);
                         if best.1 == usize::MAX
                             || cand.0 < best.0
@@ -597,13 +625,15 @@ pub(crate) mod tests {
 
     #[test]
     fn same_tree_as_an_independent_recursive_hploc() {
-        for &size in &[4u32, 8, 32, 64] {
+        let settings =
+            [(4u32, 0u32, 0u32), (8, 0, 0), (32, 0, 0), (64, 0, 0), (32, 8, 0), (32, 2, 3), (64, 5, 1), (8, 3, 2)];
+        for &(size, keep, radius) in &settings {
             for &(n, dup) in &[(2u32, false), (40, false), (3000, false), (2000, true)] {
                 let (keys, boxes) = random_scene(n, 77 + n + size, dup);
-                let (nodes, parents) = build(&keys, &boxes, size);
+                let (nodes, parents) = build_with(&keys, &boxes, size, keep, radius);
                 check_tree(&nodes, &parents, n);
                 let mut expected = 0.0;
-                let (root, _) = reference(0, &keys, &boxes, cluster_limit(size), &mut expected);
+                let (root, _) = reference(0, &keys, &boxes, (cluster_limit(size), keep, radius), &mut expected);
                 assert_eq!(root.len(), 1);
                 let got: f64 = nodes[..(n - 1) as usize].iter().map(|x| x.aabb().surface_area() as f64).sum();
                 assert!(

@@ -80,16 +80,19 @@ pub struct BuildParams {
     pub n: u32,
     /// Number of elements the bounds reduction reads in this pass.
     pub reduce_len: u32,
-    /// Unused (the centroids are reduced as the boxes are made, by
-    /// `construct::bounds::primitive_bounds_phase`).
-    pub _pad_reduce: u32,
+    /// H-PLOC (`construct::hploc`): most clusters a finished range keeps
+    /// (0: half the subgroup, the most there is room for).
+    pub cluster_keep: u32,
     /// How many of the `n` primitives are spheres (the rest are triangles).
     pub spheres: u32,
     /// Centroid bounds of the scene (Morton quantization frame).
     pub frame: Aabb,
     /// Low bits dropped from each Morton key (0: all of [`crate::construct::morton::KEY_BITS`]).
     pub key_shift: u32,
-    pub _pad0: [u32; 3],
+    /// H-PLOC: how far apart (in cluster order) two clusters may be to be
+    /// merged (0: any two of the range).
+    pub cluster_radius: u32,
+    pub _pad0: [u32; 2],
 }
 const _: () = assert!(core::mem::size_of::<BuildParams>() == 64);
 

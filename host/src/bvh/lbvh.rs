@@ -189,6 +189,9 @@ pub fn build_primitives_with<B: Backend>(
         .clamp(1, KEY_BITS);
     let mut params = BuildParams { n, key_shift: KEY_BITS - key_bits, ..Default::default() };
     params.spheres = prims.spheres.len() as u32;
+    if hierarchy == Hierarchy::Hploc {
+        (params.cluster_keep, params.cluster_radius) = hploc_settings();
+    }
     let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
@@ -279,6 +282,28 @@ pub fn build_primitives_with<B: Backend>(
     let prims = Some((spheres, triangles));
     Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds, prims }, times))
 }
+
+/// H-PLOC's most clusters a merged range keeps (the paper: half the
+/// subgroup, 16 on NVIDIA) and how far apart two merged clusters may be
+/// (0: any two of the range): [`HPLOC_KEEP`] and [`HPLOC_RADIUS`], or
+/// `TREELET_HPLOC_KEEP` and `TREELET_HPLOC_RADIUS` (0: the most) to measure.
+pub fn hploc_settings() -> (u32, u32) {
+    let get = |name: &str, default| std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default);
+    (get("TREELET_HPLOC_KEEP", HPLOC_KEEP), get("TREELET_HPLOC_RADIUS", HPLOC_RADIUS))
+}
+
+/// Clusters a merged range keeps: 2, not the paper's 16. Measured on the
+/// H100 (bunny4, 940 544 triangles, `bvh2`, 1920x1080; all four keeps
+/// against all radii, `docs/results/h100-hploc/`): with 16 kept the
+/// clusters left over at each level are merged late, into nodes that
+/// overlap, and primary rays ran at 1.41 G/s against the LBVH's 2.11 and
+/// the TRBVH's 2.13, although the SAH was lower than the LBVH's; with 2
+/// kept, 2.09 G primary and 1.02 G diffuse rays/s (TRBVH: 2.13, 1.02) for
+/// a build of 1.85 ms against the TRBVH's 9.05.
+pub const HPLOC_KEEP: u32 = 2;
+/// Any two clusters of a range may merge (radius 2 builds in 1.41 ms, with
+/// diffuse rays 5% slower).
+pub const HPLOC_RADIUS: u32 = 0;
 
 /// Fewest primitives for which the default hierarchy is
 /// [`Hierarchy::AgglomerativeSubgroup`]: below, its second dispatch costs

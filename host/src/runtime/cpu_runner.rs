@@ -539,7 +539,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                                 let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
                                 let (l, inputs) = (lane as usize, (&*keys, &*prims, &*boxes));
                                 hploc_step::<true>(
-                                    $step, $arg, id, lane, size, base, p.n, inputs, nodes, parents, ends, lists, sh,
+                                    $step, $arg, id, lane, size, base, (p.n, p.cluster_keep, p.cluster_radius), inputs, nodes, parents, ends, lists, sh,
                                     &mut me[l], &mut io[l],
                                 );
                             }
