@@ -17,6 +17,20 @@ fn lbvh_matches_cpu_on_random_scenes() {
     }
 }
 
+/// Random spheres, `n` of them for each `n` of `sizes`, named by size and seed.
+fn random_sphere_scenes(sizes: &[usize], seed: u64) -> Vec<(String, Vec<treelet_core::Sphere>)> {
+    sizes.iter().map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64))).collect()
+}
+
+/// Many spheres on few distinct centres: long runs of equal keys.
+fn clustered_spheres(seed: u64) -> Vec<treelet_core::Sphere> {
+    let mut clustered = random_spheres(5000, seed);
+    for (k, s) in clustered.iter_mut().enumerate() {
+        s.center = [(k % 7) as f32; 3];
+    }
+    clustered
+}
+
 /// The agglomerative build (Apetrei 2014), plain and with its lowest levels
 /// merged within subgroups, gives the radix tree plus fit's nodes and
 /// parents bit for bit, on the GPU and on the CPU runner (at several
@@ -25,16 +39,8 @@ fn lbvh_matches_cpu_on_random_scenes() {
 fn agglomerative_build_equals_radix_tree_and_fit() {
     use treelet::bvh::lbvh::{build_with, Hierarchy};
     let seed = treelet_tests::fresh_seed();
-    let mut scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 5, 1000, 40_000, 100_000]
-        .iter()
-        .map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64)))
-        .collect();
-    // Many spheres on few distinct centres: long runs of equal keys.
-    let mut clustered = random_spheres(5000, seed);
-    for (k, s) in clustered.iter_mut().enumerate() {
-        s.center = [(k % 7) as f32; 3];
-    }
-    scenes.push((format!("clustered, seed {seed}"), clustered));
+    let mut scenes = random_sphere_scenes(&[1, 2, 5, 1000, 40_000, 100_000], seed);
+    scenes.push((format!("clustered, seed {seed}"), clustered_spheres(seed)));
     let gpu_ctx = gpu();
     for (what, spheres) in &scenes {
         let reference = build_with(&mut CpuBackend::new(), spheres, Hierarchy::RadixTreeThenFit).unwrap();
@@ -77,14 +83,8 @@ fn hploc_matches_cpu_and_is_valid() {
     use treelet::scene::primitives::Primitives;
     use treelet_core::construct::sah::{sah_cost, SahCosts};
     let seed = treelet_tests::fresh_seed();
-    let mut sphere_scenes: Vec<(String, Vec<treelet_core::Sphere>)> = [1usize, 2, 3, 5, 33, 1000, 40_000, 100_000]
-        .iter()
-        .map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64)))
-        .collect();
-    let mut clustered = random_spheres(5000, seed);
-    for (k, s) in clustered.iter_mut().enumerate() {
-        s.center = [(k % 7) as f32; 3];
-    }
+    let mut sphere_scenes = random_sphere_scenes(&[1, 2, 3, 5, 33, 1000, 40_000, 100_000], seed);
+    let mut clustered = clustered_spheres(seed);
     sphere_scenes.push((format!("clustered, seed {seed}"), clustered.clone()));
     for s in clustered.iter_mut() {
         s.radius = 1.0;
