@@ -179,7 +179,7 @@ fn hploc<const ORDERED: bool>(
     parents: &mut [u32],
     ends: &mut [u32],
     lists: &mut [u32],
-    shared: (&mut [Aabb; WG], &mut [u32; WG], &mut [u32; WG]),
+    shared: (&mut treelet_core::construct::hploc::SharedBoxes, &mut [u32; WG], &mut [u32; WG]),
 ) {
     use treelet_core::construct::hploc::{hploc_op, hploc_step, HplocLane};
     use treelet_core::gpu::subgroup::{apply, Lane};
@@ -234,7 +234,7 @@ macro_rules! hploc_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lists: &mut [u32],
-            #[spirv(workgroup)] boxes: &mut [Aabb; WG],
+            #[spirv(workgroup)] boxes: &mut treelet_core::construct::hploc::SharedBoxes,
             #[spirv(workgroup)] clusters: &mut [u32; WG],
             #[spirv(workgroup)] nearest: &mut [u32; WG],
         ) {

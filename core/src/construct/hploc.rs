@@ -39,7 +39,7 @@
 //! The kernel is written in steps ([`crate::gpu::subgroup`]); their order
 //! depends on the data (how many lanes reach a range to merge, how many
 //! rounds of merging a range takes), so it is given once, by the macro
-//! [`hploc_schedule!`], which the shader's entry point and the CPU runner
+//! [`hploc_schedule!`](crate::hploc_schedule), which the shader's entry point and the CPU runner
 //! both expand, with the step and the subgroup-uniform values their own way.
 //! The trees depend on the subgroup size (through `T`); the GPU and the CPU
 //! runner at the same size build the same nodes, bit for bit.
@@ -184,6 +184,28 @@ impl HplocLane {
     }
 }
 
+/// Words of workgroup memory for the boxes of a workgroup's lanes' clusters:
+/// six floats a lane, no padding (8 KB of workgroup memory a workgroup in
+/// all, not 10: one more workgroup fits an SM).
+pub const SHARED_BOX_WORDS: usize = 6 * WG;
+/// The workgroup's cluster boxes, six floats a lane.
+pub type SharedBoxes = [f32; SHARED_BOX_WORDS];
+
+#[inline]
+fn load_shared(boxes: &SharedBoxes, i: usize) -> Aabb {
+    let w = 6 * i;
+    Aabb::from_arrays([boxes[w], boxes[w + 1], boxes[w + 2]], [boxes[w + 3], boxes[w + 4], boxes[w + 5]])
+}
+
+#[inline]
+fn store_shared(boxes: &mut SharedBoxes, i: usize, b: &Aabb) {
+    let w = 6 * i;
+    for k in 0..3 {
+        boxes[w + k] = b.min[k];
+        boxes[w + 3 + k] = b.max[k];
+    }
+}
+
 /// The surface area that orders merges; NaN (an infinite extent times a
 /// zero one) as infinity, so that the order of pairs stays total and every
 /// round merges at least its least pair.
@@ -220,7 +242,7 @@ pub fn hploc_step<const ORDERED: bool>(
     parents: &mut [u32],
     ends: &mut [u32],
     lists: &mut [u32],
-    shared: (&mut [Aabb; WG], &mut [u32; WG], &mut [u32; WG]),
+    shared: (&mut SharedBoxes, &mut [u32; WG], &mut [u32; WG]),
     me: &mut HplocLane,
     io: &mut Lane,
 ) {
@@ -292,7 +314,7 @@ pub fn hploc_step<const ORDERED: bool>(
                 (c, load_box(&nodes[c as usize]))
             };
             clusters[at] = cluster;
-            boxes[at] = b;
+            store_shared(boxes, at, &b);
         }
         if j + 1 < me.count {
             me.free = if j + 1 < left {
@@ -319,7 +341,7 @@ pub fn hploc_step<const ORDERED: bool>(
         let j = lane;
         if j < me.count {
             let s = base as usize;
-            me.own = boxes[at];
+            me.own = load_shared(boxes, at);
             me.cluster = clusters[at];
             // Candidates `k` with |k - j| <= radius (0: all).
             let (low, high) = if radius == 0 {
@@ -328,11 +350,11 @@ pub fn hploc_step<const ORDERED: bool>(
                 (if j > radius { j - radius } else { 0 }, (j + radius + 1).min(me.count))
             };
             let mut best = if j == low { low + 1 } else { low };
-            let mut best_area = merged_area(&me.own, &boxes[s + best as usize]);
+            let mut best_area = merged_area(&me.own, &load_shared(boxes, s + best as usize));
             let mut k = best + 1;
             while k < high {
                 if k != j {
-                    let area = merged_area(&me.own, &boxes[s + k as usize]);
+                    let area = merged_area(&me.own, &load_shared(boxes, s + k as usize));
                     if area < best_area {
                         best_area = area;
                         best = k;
@@ -364,7 +386,7 @@ pub fn hploc_step<const ORDERED: bool>(
         if me.creates {
             let slot = io.output as u32;
             let other = (base + me.partner) as usize;
-            let merged = me.own.union(&boxes[other]);
+            let merged = me.own.union(&load_shared(boxes, other));
             // The root's last merge: two clusters left, one kept.
             let root = me.keep == 1 && me.count == 2;
             write_parent(nodes, parents, slot, me.cluster, clusters[other], &merged, root);
@@ -376,7 +398,7 @@ pub fn hploc_step<const ORDERED: bool>(
         let survivors = io.output;
         if me.survives {
             let to = (base + popcount(survivors & lanes_below(lane))) as usize;
-            boxes[to] = me.own;
+            store_shared(boxes, to, &me.own);
             clusters[to] = me.cluster;
         }
         // The free slots left are the lowest: lanes keep theirs.
@@ -425,7 +447,7 @@ pub(crate) mod tests {
         let (mut nodes, mut parents) = (vec![Node::default(); count], vec![0u32; count]);
         let mut ends = vec![0u32; n as usize];
         let mut lists = vec![0u32; lists_words(n) as usize];
-        let mut shared = ([Aabb::EMPTY; WG], [0u32; WG], [0u32; WG]);
+        let mut shared = ([0f32; SHARED_BOX_WORDS], [0u32; WG], [0u32; WG]);
         let groups = n.div_ceil(WORKGROUP_SIZE);
         // Later workgroups first: the result must not depend on the order.
         for g in (0..groups).rev() {

@@ -523,7 +523,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let p: treelet_core::BuildParams = params(p);
             let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view::<treelet_core::Node>(nodes));
             let (parents, ends, lists) = (view(parents), view(ends), view(lists));
-            let mut shared = ([treelet_core::Aabb::EMPTY; WG], [0u32; WG], [0u32; WG]);
+            let mut shared = ([0f32; treelet_core::construct::hploc::SHARED_BOX_WORDS], [0u32; WG], [0u32; WG]);
             let size = subgroup_size;
             // Subgroup after subgroup, each to its end: the climbs meet
             // whatever the order, and no step waits on another subgroup.
