@@ -129,6 +129,7 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
                 let cpu = treelet::runtime::backend::DeviceClass::CpuRunner;
                 let expected = match cheaper_builder(cpu, n, Work::Paths(1 << 20)).0 {
                     Builder::Trbvh => Accel::Trbvh,
+                    Builder::Hploc => Accel::Hploc,
                     _ => Accel::Lbvh,
                 };
                 assert_eq!(p.accel, expected, "{}: {}", scene.name, p.accel_reason);

@@ -161,8 +161,9 @@ pub struct Plan {
 /// Chooses the acceleration structure, its layout and the kernel variant
 /// for rendering `paths` camera paths (pixels times samples) of `scene` on
 /// a device of `class`. `Accel::Auto` picks the linear scan up to the
-/// measured crossover, else the LBVH or the treelet-optimized BVH, whichever
-/// gives the least build plus render time ([`cheaper_builder`]);
+/// measured crossover, else the LBVH, the H-PLOC tree (on GPUs) or the
+/// treelet-optimized BVH, whichever gives the least build plus render time
+/// ([`cheaper_builder`]);
 /// `Layout::Auto` the fastest measured layout.
 pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
     let features = SceneFeatures::of(scene);
@@ -178,7 +179,11 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
         ),
         Accel::Auto => {
             let (builder, why) = cheaper_builder(class, n, Work::Paths(paths));
-            let accel = if builder == Builder::Trbvh { Accel::Trbvh } else { Accel::Lbvh };
+            let accel = match builder {
+                Builder::Trbvh => Accel::Trbvh,
+                Builder::Hploc => Accel::Hploc,
+                Builder::Lbvh | Builder::Sweep => Accel::Lbvh,
+            };
             (
                 accel,
                 format!(
