@@ -422,13 +422,53 @@ pub fn hploc_step<const ORDERED: bool>(
     }
 }
 
+/// The kernel on the CPU: the subgroup of `size` lanes whose lane 0 is
+/// workgroup-local invocation `base` of workgroup `group`, run to its end
+/// (no step waits on another subgroup, and the climbs meet in any order),
+/// each step on every lane, then its operation emulated
+/// ([`crate::gpu::subgroup::emulate`]). The CPU runner calls it for every
+/// subgroup of a dispatch. Arguments as for [`hploc_step`].
+#[cfg(not(target_arch = "spirv"))]
+#[allow(clippy::too_many_arguments)]
+pub fn hploc_subgroup_on_cpu(
+    group: u32,
+    base: u32,
+    size: u32,
+    settings: (u32, u32, u32),
+    inputs: (&[u64], &[u32], &[Aabb]),
+    nodes: &mut [Node],
+    parents: &mut [u32],
+    ends: &mut [u32],
+    lists: &mut [u32],
+    shared: (&mut SharedBoxes, &mut [u32; WG], &mut [u32; WG]),
+) {
+    use crate::gpu::subgroup::{emulate, MAX_SUBGROUP_SIZE};
+    let (boxes, clusters, nearest) = shared;
+    let mut lanes = [HplocLane::default(); MAX_SUBGROUP_SIZE as usize];
+    let mut io = [Lane::default(); MAX_SUBGROUP_SIZE as usize];
+    let (lanes, io) = (&mut lanes[..size as usize], &mut io[..size as usize]);
+    macro_rules! step {
+        ($step:expr, $arg:expr) => {
+            for lane in 0..size {
+                let id = group * crate::gpu::workgroup::WORKGROUP_SIZE + base + lane;
+                let sh = (&mut *boxes, &mut *clusters, &mut *nearest);
+                let (me, lane_io) = (&mut lanes[lane as usize], &mut io[lane as usize]);
+                hploc_step::<true>(
+                    $step, $arg, id, lane, size, base, settings, inputs, nodes, parents, ends, lists, sh, me, lane_io,
+                );
+            }
+            emulate(hploc_op($step), io);
+        };
+    }
+    hploc_schedule!(step, io[0].output, lanes[0].more());
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     extern crate std;
     use super::*;
     use crate::geometry::buffers::{INVALID, LEAF_BIT};
     use crate::gpu::rng::hash;
-    use crate::gpu::subgroup::emulate;
     use crate::gpu::workgroup::WORKGROUP_SIZE;
     use std::vec;
     use std::vec::Vec;
@@ -452,35 +492,20 @@ pub(crate) mod tests {
         // Later workgroups first: the result must not depend on the order.
         for g in (0..groups).rev() {
             for base in (0..WORKGROUP_SIZE).step_by(size as usize) {
-                let mut lanes = vec![HplocLane::default(); size as usize];
-                let mut io = vec![Lane::default(); size as usize];
-                macro_rules! step {
-                    ($step:expr, $arg:expr) => {
-                        for lane in 0..size {
-                            let id = g * WORKGROUP_SIZE + base + lane;
-                            let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
-                            hploc_step::<true>(
-                                $step,
-                                $arg,
-                                id,
-                                lane,
-                                size,
-                                base,
-                                (n, keep, radius),
-                                (keys, &prims, boxes),
-                                &mut nodes,
-                                &mut parents,
-                                &mut ends,
-                                &mut lists,
-                                sh,
-                                &mut lanes[lane as usize],
-                                &mut io[lane as usize],
-                            );
-                        }
-                        emulate(hploc_op($step), &mut io);
-                    };
-                }
-                hploc_schedule!(step, io[0].output, lanes[0].more());
+                let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
+                let inputs = (keys, &prims[..], boxes);
+                hploc_subgroup_on_cpu(
+                    g,
+                    base,
+                    size,
+                    (n, keep, radius),
+                    inputs,
+                    &mut nodes,
+                    &mut parents,
+                    &mut ends,
+                    &mut lists,
+                    sh,
+                );
             }
         }
         (nodes, parents)

@@ -519,34 +519,17 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             });
         }
         (Kernel::Hploc | Kernel::HplocRelaxed, [p, keys, prims, boxes, nodes, parents, ends, lists]) => {
-            use treelet_core::construct::hploc::{hploc_op, hploc_step, HplocLane};
+            use treelet_core::construct::hploc::{hploc_subgroup_on_cpu, SHARED_BOX_WORDS};
             let p: treelet_core::BuildParams = params(p);
             let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view::<treelet_core::Node>(nodes));
             let (parents, ends, lists) = (view(parents), view(ends), view(lists));
-            let mut shared = ([0f32; treelet_core::construct::hploc::SHARED_BOX_WORDS], [0u32; WG], [0u32; WG]);
-            let size = subgroup_size;
-            // Subgroup after subgroup, each to its end: the climbs meet
-            // whatever the order, and no step waits on another subgroup.
+            let mut shared = ([0f32; SHARED_BOX_WORDS], [0u32; WG], [0u32; WG]);
+            let settings = (p.n, p.cluster_keep, p.cluster_radius);
             for g in 0..groups {
-                for base in (0..WORKGROUP_SIZE).step_by(size as usize) {
-                    let mut me = [HplocLane::default(); WG];
-                    let mut io = [Lane::default(); WG];
-                    let (me, io) = (&mut me[..size as usize], &mut io[..size as usize]);
-                    macro_rules! step {
-                        ($step:expr, $arg:expr) => {
-                            for lane in 0..size {
-                                let id = g * WORKGROUP_SIZE + base + lane;
-                                let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
-                                let (l, inputs) = (lane as usize, (&*keys, &*prims, &*boxes));
-                                hploc_step::<true>(
-                                    $step, $arg, id, lane, size, base, (p.n, p.cluster_keep, p.cluster_radius), inputs, nodes, parents, ends, lists, sh,
-                                    &mut me[l], &mut io[l],
-                                );
-                            }
-                            subgroup::emulate(hploc_op($step), io);
-                        };
-                    }
-                    treelet_core::hploc_schedule!(step, io[0].output, me[0].more());
+                for base in (0..WORKGROUP_SIZE).step_by(subgroup_size as usize) {
+                    let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
+                    let inputs = (&*keys, &*prims, &*boxes);
+                    hploc_subgroup_on_cpu(g, base, subgroup_size, settings, inputs, nodes, parents, ends, lists, sh);
                 }
             }
         }
