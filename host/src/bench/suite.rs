@@ -257,13 +257,19 @@ fn measure(figure: Figure, s: &Suite, runner: &Device) -> Result<FigureDoc> {
                 let tag = spec.split(':').next().unwrap_or(spec);
                 let mut found: Vec<(String, f64, f64)> = Vec::new();
                 treelet::with_backend!(runner, |b| {
-                    for (name, config) in [
-                        ("LBVH", None),
-                        ("TRBVH g1", Some(TreeletConfig { gamma: 1, ..Default::default() })),
-                        ("TRBVH g3", Some(TreeletConfig::default())),
-                        ("TRBVH g7", Some(TreeletConfig { gamma: 7, ..Default::default() })),
+                    for (name, builder, config) in [
+                        ("LBVH", Builder::Lbvh, None),
+                        ("TRBVH g1", Builder::Trbvh, Some(TreeletConfig { gamma: 1, ..Default::default() })),
+                        ("TRBVH g3", Builder::Trbvh, Some(TreeletConfig::default())),
+                        ("TRBVH g7", Builder::Trbvh, Some(TreeletConfig { gamma: 7, ..Default::default() })),
+                        // H-PLOC with its leaves collapsed, as traced; then with three treelet rounds.
+                        ("H-PLOC", Builder::Hploc, None),
+                        ("H-PLOC + 3 rounds", Builder::Hploc, Some(TreeletConfig::default())),
                     ] {
-                        let (sah, ms) = device_build(b, &scene, config.as_ref())?;
+                        if builder == Builder::Hploc && b.min_subgroup_size() < treelet_core::construct::hploc::MIN_SUBGROUP_SIZE {
+                            continue;
+                        }
+                        let (sah, ms) = device_build(b, &scene, builder, config.as_ref())?;
                         found.push((name.to_string(), ms, sah));
                         if name == "LBVH" || name == "TRBVH g3" {
                             // The same tree laid out as a compressed wide BVH:
@@ -291,14 +297,18 @@ fn measure(figure: Figure, s: &Suite, runner: &Device) -> Result<FigureDoc> {
             let sizes: Vec<usize> = if q { vec![1000, 10000] } else { vec![10000, 100000, 1000000] };
             let mut d = doc(figure, "rays per second through each tree (terrain:N, mesh alone)", "triangles", "M rays/s", (true, false));
             d.parameters = serde_json::json!({ "width": w, "height": h, "sizes": sizes });
-            let pb = bar(sizes.len() * 3, "trees");
+            let pb = bar(sizes.len() * 4, "trees");
             treelet::with_backend!(runner, |b| {
                 for &n in &sizes {
                     let scene = Scene::from_spec(&format!("terrain:{n}"))?.mesh_only()?;
-                    for a in [Accel::Lbvh, Accel::Trbvh, Accel::Sweep] {
+                    for a in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc, Accel::Sweep] {
                         // The seed's layout and the compressed wide one for every
-                        // tree; the two-box binary layout for the TRBVH.
-                        let layouts = if a == Accel::Trbvh { Layout::ALL.to_vec() } else { vec![Layout::Classic, Layout::Cwbvh] };
+                        // tree; the two-box binary layout for the TRBVH and H-PLOC.
+                        let layouts = match a {
+                            Accel::Trbvh => Layout::ALL.to_vec(),
+                            Accel::Hploc => vec![Layout::Bvh2, Layout::Cwbvh],
+                            _ => vec![Layout::Classic, Layout::Cwbvh],
+                        };
                         let plan = RaysPlan { layouts, workgroup_stack: false };
                         for row in bench_rays(b, &scene, a, &plan, (w, h), r.max(3))? {
                             let (x, name) = (row.primitives as f64, tree_name(a, row.layout));
@@ -324,19 +334,30 @@ fn random_boxes(n: usize) -> Vec<treelet_core::Aabb> {
 
 /// SAH and build time (ms, GPU timestamps: median of 3 after half a second
 /// of warm-up builds, as `bench build`) of a device build.
-fn device_build<B: Backend>(b: &mut B, scene: &Scene, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
+fn device_build<B: Backend>(b: &mut B, scene: &Scene, builder: Builder, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
     use treelet::bvh::{lbvh, trbvh};
     use treelet_core::construct::sah::{SahCosts, sah_cost};
     let all = scene.primitives();
     let once = |b: &mut B| -> Result<(lbvh::DeviceBvh<B>, f64)> {
         b.begin_build();
-        let (bvh, t) = lbvh::build_primitives_on_device(b, all)?;
+        let (bvh, t) = match builder {
+            Builder::Hploc => lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?,
+            _ => lbvh::build_primitives_on_device(b, all)?,
+        };
         let mut ms = t.total();
         let bvh = match config {
             Some(c) => {
                 let root = trbvh::root_box(b, &bvh)?;
                 let (o, t) = trbvh::optimize(b, bvh, &root, c)?;
                 ms += t.total();
+                o
+            }
+            // H-PLOC's leaves collapsed, as it is traced.
+            None if builder == Builder::Hploc => {
+                b.take_times()?;
+                b.stage("collapse");
+                let o = trbvh::collapse(b, bvh, TreeletConfig::default().max_leaf)?;
+                ms += b.take_times()?.total();
                 o
             }
             None => bvh,
