@@ -5,42 +5,21 @@ use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::{Backend, StageTimes};
 use treelet::bvh::layout::Layout;
-use treelet::bvh::lbvh;
 use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::{render, Integrator, RenderSettings};
 use treelet::scene::{random_spheres, Scene};
-use treelet::bvh::trbvh::{self, TreeletConfig};
+use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;
 use treelet::runtime::kernels::{render_entry_point_name, Method};
 use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
 
-/// One build on the device, the tree left there (as in a renderer).
 /// One device build of `builder` (`config`: the treelet rounds of trbvh,
-/// and of hploc where it has any; the leaf collapse of both).
+/// and of hploc where it has any; the leaf collapse of both), the tree left
+/// there (as in a renderer).
 pub(crate) fn build_once<B: Backend>(b: &mut B, spheres: &[Sphere], (builder, config): (Builder, &TreeletConfig)) -> Result<StageTimes> {
     let prims = treelet::scene::primitives::Primitives::spheres(spheres);
-    let (bvh, mut times) = match builder {
-        Builder::Hploc => lbvh::build_primitives_with(b, prims, lbvh::Hierarchy::Hploc)?,
-        _ => lbvh::build_on_device(b, spheres)?,
-    };
-    let optimized = if builder == Builder::Trbvh || (builder == Builder::Hploc && config.rounds > 0) {
-        let root = trbvh::root_box(b, &bvh)?;
-        Some(trbvh::optimize(b, bvh, &root, config)?.1)
-    } else if builder == Builder::Hploc {
-        b.take_times()?;
-        b.stage("collapse");
-        trbvh::collapse(b, bvh, config.max_leaf)?;
-        Some(b.take_times()?)
-    } else {
-        None
-    };
-    if let Some(rounds) = optimized {
-        for s in &rounds.order {
-            times.add(s, rounds.get(s));
-        }
-    }
-    Ok(times)
+    Ok(treelet::bvh::tree::collapsed_tree(b, prims, builder, config)?.1)
 }
 
 /// Paths per second of a render, by wall clock and by render-kernel time.

@@ -335,34 +335,15 @@ fn random_boxes(n: usize) -> Vec<treelet_core::Aabb> {
 /// SAH and build time (ms, GPU timestamps: median of 3 after half a second
 /// of warm-up builds, as `bench build`) of a device build.
 fn device_build<B: Backend>(b: &mut B, scene: &Scene, builder: Builder, config: Option<&TreeletConfig>) -> Result<(f64, f64)> {
-    use treelet::bvh::{lbvh, trbvh};
+    use treelet::bvh::lbvh;
     use treelet_core::construct::sah::{SahCosts, sah_cost};
     let all = scene.primitives();
+    // No config: no treelet rounds (H-PLOC's leaves still collapsed, as traced).
+    let config = config.copied().unwrap_or(TreeletConfig { rounds: 0, ..Default::default() });
     let once = |b: &mut B| -> Result<(lbvh::DeviceBvh<B>, f64)> {
         b.begin_build();
-        let (bvh, t) = match builder {
-            Builder::Hploc => lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?,
-            _ => lbvh::build_primitives_on_device(b, all)?,
-        };
-        let mut ms = t.total();
-        let bvh = match config {
-            Some(c) => {
-                let root = trbvh::root_box(b, &bvh)?;
-                let (o, t) = trbvh::optimize(b, bvh, &root, c)?;
-                ms += t.total();
-                o
-            }
-            // H-PLOC's leaves collapsed, as it is traced.
-            None if builder == Builder::Hploc => {
-                b.take_times()?;
-                b.stage("collapse");
-                let o = trbvh::collapse(b, bvh, TreeletConfig::default().max_leaf)?;
-                ms += b.take_times()?.total();
-                o
-            }
-            None => bvh,
-        };
-        Ok((bvh, ms))
+        let (bvh, t) = treelet::bvh::tree::collapsed_tree(b, all, builder, &config)?;
+        Ok((bvh, t.total()))
     };
     let warm = std::time::Instant::now();
     while warm.elapsed().as_secs_f64() < 0.5 {

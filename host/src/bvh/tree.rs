@@ -213,6 +213,41 @@ pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> 
     })
 }
 
+/// The tree `builder` makes on the device with its leaves collapsed by SAH
+/// as it is traced, and the stage times of the whole build (what `bench
+/// build` and the pareto figure time): the LBVH as built; the LBVH, then
+/// `config`'s treelet rounds and the collapse; H-PLOC's tree, then the
+/// rounds (where `config` has any) and the collapse. Starts a new build.
+pub fn collapsed_tree<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    builder: Builder,
+    config: &TreeletConfig,
+) -> Result<(lbvh::DeviceBvh<B>, StageTimes)> {
+    let (bvh, mut times) = match builder {
+        Builder::Lbvh | Builder::Trbvh => lbvh::build_primitives_on_device(b, all)?,
+        Builder::Hploc => lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?,
+        Builder::Sweep => bail!("internal: the sweep builder runs on the CPU"),
+    };
+    let (bvh, more) = match builder {
+        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 => {
+            let root = trbvh::root_box(b, &bvh)?;
+            trbvh::optimize(b, bvh, &root, config)?
+        }
+        Builder::Hploc => {
+            b.take_times()?;
+            b.stage("collapse");
+            let collapsed = trbvh::collapse(b, bvh, config.max_leaf)?;
+            (collapsed, b.take_times()?)
+        }
+        _ => (bvh, StageTimes::default()),
+    };
+    for s in &more.order {
+        times.add(s, more.get(s));
+    }
+    Ok((bvh, times))
+}
+
 /// Host bytes a tree build takes per primitive where the device's memory is
 /// the host's (the CPU runner, lavapipe): scene, Morton codes, the sort,
 /// nodes, treelets (measured: 310 to 330 bytes with TRBVH at 1M primitives
