@@ -3,6 +3,7 @@ use spirv_std::spirv;
 use treelet_core::Aabb;
 use treelet_core::construct::bounds;
 use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::Sphere;
 use treelet_core::gpu::workgroup::{WG, linear_group};
@@ -36,10 +37,12 @@ pub fn primitive_bounds_cs(
     // Two 16-byte vectors per box (see `treelet_core::geometry::records`).
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] boxes: &mut [Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] output: &mut [Aabb],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles_hi: &[Triangle],
     #[spirv(workgroup)] shared: &mut [Aabb; WG],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
+    let triangles = Split::new(triangles, triangles_hi);
     unrolled_phases!(bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9], |phase| {
-        bounds::primitive_bounds_phase(phase, lid, group, params, spheres, triangles, boxes, output, shared)
+        bounds::primitive_bounds_phase(phase, lid, group, params, spheres, &triangles, boxes, output, shared)
     });
 }

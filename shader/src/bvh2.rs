@@ -1,6 +1,7 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{LayoutParams, Node, Sphere};
+use treelet_core::geometry::split::{Split, SplitMut};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 
@@ -13,9 +14,13 @@ pub fn bvh2_nodes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes_hi: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] out_hi: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, nodes, parents, out);
+    let nodes = Split::new(nodes, nodes_hi);
+    let out = &mut SplitMut::new(out, out_hi);
+    treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, &nodes, parents, out);
 }
 
 /// One primitive, in leaf order, as its leaf stores it.
@@ -28,7 +33,9 @@ pub fn leaf_prims_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] out_hi: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
+    let out = &mut SplitMut::new(out, out_hi);
     treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
 }

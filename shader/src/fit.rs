@@ -2,6 +2,7 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::BuildParams;
 use treelet_core::gpu::workgroup::{linear_id, WG};
+use treelet_core::geometry::split::SplitMut;
 use treelet_core::{Aabb, Node};
 
 /// A bottom-up fit entry point; `$ordered` as in
@@ -19,9 +20,10 @@ macro_rules! fit_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] nodes_hi: &mut [Node],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
-            treelet_core::construct::fit::fit_kernel::<$ordered>(id, params.n, sorted_prims, prim_boxes, nodes, parents, flags);
+            treelet_core::construct::fit::fit_kernel::<$ordered>(id, params.n, sorted_prims, prim_boxes, &mut SplitMut::new(nodes, nodes_hi), parents, flags);
         }
     };
 }
@@ -41,6 +43,7 @@ macro_rules! agglomerate_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &mut [Node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] nodes_hi: &mut [Node],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let n = params.n;
@@ -50,7 +53,7 @@ macro_rules! agglomerate_kernel {
                 keys,
                 sorted_prims,
                 prim_boxes,
-                nodes,
+                &mut SplitMut::new(nodes, nodes_hi),
                 parents,
                 ends,
             );
@@ -74,7 +77,7 @@ fn agglomerate_step<const STEP: u32>(
     size: u32,
     n: u32,
     inputs: (&[u64], &[u32], &[Aabb]),
-    nodes: &mut [Vec4],
+    nodes: &mut SplitMut<Vec4>,
     parents: &mut [u32],
     ends: &mut [u32],
     queue: &mut [u32],
@@ -109,12 +112,14 @@ pub fn agglomerate_subgroup_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] queue: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queued: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &mut [Vec4],
 ) {
     use treelet_core::construct::agglomerate_subgroup::{AgglomerateLane, SUBGROUP_ROUNDS};
     let id = linear_id(gid.x, gid.y, groups.x);
     let n = params.n;
     let mut me = AgglomerateLane::default();
     let mut io = treelet_core::gpu::subgroup::Lane::default();
+    let nodes = &mut SplitMut::new(nodes, nodes_hi);
     let i = (keys, sorted_prims, prim_boxes);
     agglomerate_step::<0>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
     let mut round = 0;
@@ -151,10 +156,11 @@ macro_rules! climb_queued_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] ends: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] queue: &[u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] queued: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] nodes_hi: &mut [Node],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             treelet_core::construct::agglomerate_subgroup::climb_queued_kernel::<$ordered>(
-                id, params.n, keys, nodes, parents, ends, queue, queued,
+                id, params.n, keys, &mut SplitMut::new(nodes, nodes_hi), parents, ends, queue, queued,
             );
         }
     };
@@ -175,7 +181,7 @@ fn hploc<const ORDERED: bool>(
     size: u32,
     settings: (u32, u32, u32),
     inputs: (&[u64], &[u32], &[Aabb]),
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
     lists: &mut [u32],
@@ -234,6 +240,7 @@ macro_rules! hploc_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lists: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &mut [Node],
             #[spirv(workgroup)] boxes: &mut treelet_core::construct::hploc::SharedBoxes,
             #[spirv(workgroup)] clusters: &mut [u32; WG],
             #[spirv(workgroup)] nearest: &mut [u32; WG],
@@ -241,6 +248,7 @@ macro_rules! hploc_kernel {
             let inputs = (keys, sorted_prims, prim_boxes);
             let shared = (boxes, clusters, nearest);
             let settings = (params.n, params.cluster_keep, params.cluster_radius);
+            let nodes = &mut SplitMut::new(nodes, nodes_hi);
             hploc::<$ordered>(gid, groups, lane, size, settings, inputs, nodes, parents, ends, lists, shared);
         }
     };

@@ -4,6 +4,7 @@ use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
 use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_climb_kernel, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
+use treelet_core::geometry::split::{Split, SplitMut};
 use treelet_core::gpu::subgroup::subgroup_barrier;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
 
@@ -27,10 +28,11 @@ macro_rules! treelet_init_kernels {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] nodes_hi: &[Node],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let summaries = (counts, costs, heights, tree_leaves);
-            treelet_init_kernel::<$ordered>(id, params, nodes, parents, flags, summaries, queue, queued);
+            treelet_init_kernel::<$ordered, _>(id, params, &Split::new(nodes, nodes_hi), parents, flags, summaries, queue, queued);
         }
 
         #[spirv(compute(threads(256)))]
@@ -48,10 +50,11 @@ macro_rules! treelet_init_kernels {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &[u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] nodes_hi: &[Node],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let summaries = (counts, costs, heights, tree_leaves);
-            treelet_init_climb_kernel::<$ordered>(id, params, nodes, parents, flags, summaries, queue, queued);
+            treelet_init_climb_kernel::<$ordered, _>(id, params, &Split::new(nodes, nodes_hi), parents, flags, summaries, queue, queued);
         }
     };
 }
@@ -163,9 +166,13 @@ pub fn collapse_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_nodes: &mut [Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out_parents: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] out_prims: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_nodes_hi: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    collapse_kernel(id, params.n, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims);
+    let nodes = Split::new(nodes, nodes_hi);
+    let out_nodes = &mut SplitMut::new(out_nodes, out_nodes_hi);
+    collapse_kernel(id, params.n, &nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims);
 }
 
 /// Restructures the treelets of one height, one invocation each (heights

@@ -26,6 +26,7 @@ use crate::construct::fit::{load_box, store_box, write_leaf};
 use crate::construct::radix_tree::{delta, leaf_node};
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{INVALID, Node};
+use crate::geometry::split::SplitMut;
 
 /// Whether the node covering `[l, r]` of `n` sorted keys is its parent's
 /// left child (the parent's split is then `r`; else `l - 1`).
@@ -67,7 +68,7 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
     keys: &[u64],
     sorted_prims: &[u32],
     prim_boxes: &[Aabb],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
 ) {
@@ -93,7 +94,7 @@ pub fn agglomerate_kernel<const ORDERED: bool>(
 pub fn climb_from<const ORDERED: bool>(
     n: u32,
     keys: &[u64],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
     mut l: u32,
@@ -117,7 +118,7 @@ pub fn climb_from<const ORDERED: bool>(
         } else {
             (other, r, node_index(n, other, split, true))
         };
-        let sibling_box = load_box(&nodes[sibling as usize]);
+        let sibling_box = nodes.with(sibling as usize, load_box);
         let (left, right) = if left_child { (current, sibling) } else { (sibling, current) };
         own = if left_child { own.union(&sibling_box) } else { sibling_box.union(&own) };
         let root = lo == 0 && hi == n - 1;
@@ -134,10 +135,20 @@ pub fn climb_from<const ORDERED: bool>(
 /// Writes internal node `parent` over children `left` and `right` with box
 /// `b`, and the children's parent links (and the root's: none).
 #[inline]
-pub(crate) fn write_parent(nodes: &mut [Node], parents: &mut [u32], parent: u32, left: u32, right: u32, b: &Aabb, root: bool) {
-    nodes[parent as usize].left = left;
-    nodes[parent as usize].right = right;
-    store_box(&mut nodes[parent as usize], b);
+pub(crate) fn write_parent(
+    nodes: &mut SplitMut<Node>,
+    parents: &mut [u32],
+    parent: u32,
+    left: u32,
+    right: u32,
+    b: &Aabb,
+    root: bool,
+) {
+    nodes.with_mut(parent as usize, |node| {
+        node.left = left;
+        node.right = right;
+        store_box(node, b);
+    });
     parents[left as usize] = parent;
     parents[right as usize] = parent;
     if root {
@@ -162,10 +173,10 @@ pub(crate) mod tests {
         let (mut nodes_a, mut parents_a) = (vec![Node::default(); count], vec![0u32; count]);
         let mut flags = vec![0u32; count];
         for i in 0..n {
-            radix_tree_kernel(i, n, keys, &mut nodes_a, &mut parents_a);
+            radix_tree_kernel(i, n, keys, &mut crate::geometry::split::thirds(&mut nodes_a), &mut parents_a);
         }
         for i in 0..n {
-            fit_kernel::<true>(i, n, &prims, &boxes, &mut nodes_a, &mut parents_a, &mut flags);
+            fit_kernel::<true>(i, n, &prims, &boxes, &mut crate::geometry::split::thirds(&mut nodes_a), &mut parents_a, &mut flags);
         }
         let (mut nodes_b, mut parents_b) = (vec![Node::default(); count], vec![0u32; count]);
         let mut ends = vec![0u32; count];
@@ -176,7 +187,7 @@ pub(crate) mod tests {
             o
         };
         for &i in &order {
-            agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut nodes_b, &mut parents_b, &mut ends);
+            agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut crate::geometry::split::thirds(&mut nodes_b), &mut parents_b, &mut ends);
         }
         [(nodes_a, parents_a), (nodes_b, parents_b)]
     }

@@ -47,6 +47,7 @@ use crate::construct::radix_tree::{delta, leaf_node};
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{Node, INVALID};
 use crate::geometry::records::RecordStore;
+use crate::geometry::split::SplitMut;
 use crate::gpu::subgroup::{highest_lane, lanes_below, lowest_lane, popcount, Lane, OP_BALLOT, OP_NONE, OP_SHUFFLE};
 
 /// Rounds of merging within the subgroup before the climb (H100, 1M and 16M
@@ -263,7 +264,7 @@ pub fn climb_queued_kernel<const ORDERED: bool>(
     id: u32,
     n: u32,
     keys: &[u64],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
     queue: &[u32],
@@ -275,7 +276,7 @@ pub fn climb_queued_kernel<const ORDERED: bool>(
     let (first, r) = (queue[2 * id as usize], queue[2 * id as usize + 1]);
     let (l, wants_right) = (first & !(1 << 31), first >> 31 != 0);
     let node = node_index(n, l, r, wants_right);
-    let own = load_box(&nodes[node as usize]);
+    let own = nodes.with(node as usize, load_box);
     climb_from::<ORDERED>(n, keys, nodes, parents, ends, l, r, node, own, wants_right);
 }
 
@@ -336,7 +337,7 @@ mod tests {
         }
         // The queue's climbs last to first: they meet the other way round.
         for id in (0..places).rev() {
-            climb_queued_kernel::<true>(id, n, keys, &mut nodes, &mut parents, &mut ends, &queue, &queued);
+            climb_queued_kernel::<true>(id, n, keys, &mut crate::geometry::split::thirds(&mut nodes), &mut parents, &mut ends, &queue, &queued);
         }
         (nodes, parents)
     }
@@ -347,7 +348,7 @@ mod tests {
         let (boxes, prims) = leaves(n);
         let (mut nodes, mut parents, mut ends) = (vec![Node::default(); count], vec![0u32; count], vec![0u32; count]);
         for i in 0..n {
-            agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut nodes, &mut parents, &mut ends);
+            agglomerate_kernel::<true>(i, n, keys, &prims, &boxes, &mut crate::geometry::split::thirds(&mut nodes), &mut parents, &mut ends);
         }
         for size in [1u32, 4, 8, 32, 64] {
             let group = crate::gpu::workgroup::WORKGROUP_SIZE;

@@ -8,6 +8,7 @@ use crate::construct::primitive_boxes::primitive_box;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{BuildParams, Sphere};
 use crate::geometry::records::RecordStore;
+use crate::geometry::split::Split;
 use crate::geometry::triangle::Triangle;
 use crate::gpu::workgroup::{WG, WG_LOG2, WORKGROUP_SIZE, reduction_stride};
 
@@ -58,7 +59,7 @@ pub fn primitive_bounds_phase<B: RecordStore<Aabb> + ?Sized>(
     group: u32,
     params: &BuildParams,
     spheres: &[Sphere],
-    triangles: &[Triangle],
+    triangles: &Split<Triangle>,
     boxes: &mut B,
     output: &mut [Aabb],
     shared: &mut [Aabb; WG],

@@ -20,17 +20,17 @@
 //! So one invocation per primitive climbs to the root twice: once to sum its
 //! offsets, once to write every output node whose leftmost primitive it is.
 //! No atomics and no ordering between invocations are needed.
-use crate::geometry::records::RecordStore;
+use crate::geometry::records::{RecordLoad, RecordStore};
 use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
 
 /// Kernel, one invocation per primitive slot `i < n`: writes its primitive
 /// index into `out_prims`, and the output nodes (and parent links) of which
 /// it is the leftmost primitive. The output has `2 * tree_leaves[0] - 1` nodes.
 #[allow(clippy::too_many_arguments)]
-pub fn collapse_kernel<O: RecordStore<Node> + ?Sized>(
+pub fn collapse_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Node> + ?Sized>(
     i: u32,
     n: u32,
-    nodes: &[Node],
+    nodes: &N,
     parents: &[u32],
     counts: &[u32],
     tree_leaves: &[u32],
@@ -50,7 +50,7 @@ pub fn collapse_kernel<O: RecordStore<Node> + ?Sized>(
     let mut current = leaf;
     while current != 0 {
         let parent = parents[current as usize];
-        let (prim_step, node_step) = step(&nodes[parent as usize], current, counts, tree_leaves);
+        let (prim_step, node_step) = step(&nodes.load(parent as usize), current, counts, tree_leaves);
         prim_pos += prim_step;
         node_pos += node_step;
         depth += 1;
@@ -73,12 +73,12 @@ pub fn collapse_kernel<O: RecordStore<Node> + ?Sized>(
             (INVALID, 0, 0)
         } else {
             let parent = parents[current as usize];
-            let (p, s) = step(&nodes[parent as usize], current, counts, tree_leaves);
+            let (p, s) = step(&nodes.load(parent as usize), current, counts, tree_leaves);
             (parent, p, s)
         };
         if d >= top_depth {
             let index = node_pos - node_below;
-            let src = nodes[current as usize];
+            let src = nodes.load(current as usize);
             let mut out = src;
             if d == top_depth {
                 out.left = prim_pos - prim_below;

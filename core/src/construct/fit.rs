@@ -11,6 +11,7 @@ use crate::construct::climb::Climb;
 use crate::construct::radix_tree::leaf_node;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{INVALID, LEAF_BIT, Node};
+use crate::geometry::split::SplitMut;
 use crate::gpu::atomics;
 
 #[inline]
@@ -42,12 +43,21 @@ pub(crate) fn leaf_record(i: u32, sorted_prims: &[u32], prim_boxes: &[Aabb]) -> 
 /// for a one-leaf tree, also its parent link (none). The start of every
 /// bottom-up climb ([`fit_kernel`], [`crate::construct::agglomerate`]).
 #[inline]
-pub(crate) fn write_leaf(i: u32, n: u32, sorted_prims: &[u32], prim_boxes: &[Aabb], nodes: &mut [Node], parents: &mut [u32]) -> Aabb {
+pub(crate) fn write_leaf(
+    i: u32,
+    n: u32,
+    sorted_prims: &[u32],
+    prim_boxes: &[Aabb],
+    nodes: &mut SplitMut<Node>,
+    parents: &mut [u32],
+) -> Aabb {
     let leaf = leaf_node(n, i);
     let (record, b) = leaf_record(i, sorted_prims, prim_boxes);
-    nodes[leaf as usize].left = record.left;
-    nodes[leaf as usize].right = record.right;
-    store_box(&mut nodes[leaf as usize], &b);
+    nodes.with_mut(leaf as usize, |node| {
+        node.left = record.left;
+        node.right = record.right;
+        store_box(node, &b);
+    });
     if n == 1 {
         parents[0] = INVALID;
     }
@@ -63,7 +73,7 @@ pub fn fit_kernel<const ORDERED: bool>(
     n: u32,
     sorted_prims: &[u32],
     prim_boxes: &[Aabb],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     flags: &mut [u32],
 ) {
@@ -78,12 +88,12 @@ pub fn fit_kernel<const ORDERED: bool>(
     let mut own = b;
     let mut climb = Climb::<ORDERED>::new(leaf_node(n, i));
     while let Some(parent) = climb.next(parents, flags) {
-        let (left, right) = (nodes[parent as usize].left, nodes[parent as usize].right);
+        let (left, right) = nodes.with(parent as usize, |node| (node.left, node.right));
         own = if left == climb.child() {
-            own.union(&load_box(&nodes[right as usize]))
+            own.union(&nodes.with(right as usize, load_box))
         } else {
-            load_box(&nodes[left as usize]).union(&own)
+            nodes.with(left as usize, load_box).union(&own)
         };
-        store_box(&mut nodes[parent as usize], &own);
+        nodes.with_mut(parent as usize, |node| store_box(node, &own));
     }
 }

@@ -49,6 +49,7 @@ use crate::construct::fit::{load_box, write_leaf};
 use crate::construct::radix_tree::leaf_node;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::Node;
+use crate::geometry::split::SplitMut;
 use crate::gpu::atomics;
 use crate::gpu::subgroup::{
     lanes_below, popcount, Lane, OP_BALLOT, OP_NONE, OP_SHUFFLE, THEN_STORAGE_BARRIER, THEN_SUBGROUP_BARRIER,
@@ -238,7 +239,7 @@ pub fn hploc_step<const ORDERED: bool>(
     base: u32,
     (n, keep, radius): (u32, u32, u32),
     inputs: (&[u64], &[u32], &[Aabb]),
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
     lists: &mut [u32],
@@ -311,7 +312,7 @@ pub fn hploc_step<const ORDERED: bool>(
                 (leaf_node(n, i), prim_boxes[sorted_prims[i as usize] as usize])
             } else {
                 let c = atomics::load_u32(&lists[(start + k) as usize]);
-                (c, load_box(&nodes[c as usize]))
+                (c, nodes.with(c as usize, load_box))
             };
             clusters[at] = cluster;
             store_shared(boxes, at, &b);
@@ -436,7 +437,7 @@ pub fn hploc_subgroup_on_cpu(
     size: u32,
     settings: (u32, u32, u32),
     inputs: (&[u64], &[u32], &[Aabb]),
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     ends: &mut [u32],
     lists: &mut [u32],
@@ -500,7 +501,7 @@ pub(crate) mod tests {
                     size,
                     (n, keep, radius),
                     inputs,
-                    &mut nodes,
+                    &mut crate::geometry::split::thirds(&mut nodes),
                     &mut parents,
                     &mut ends,
                     &mut lists,

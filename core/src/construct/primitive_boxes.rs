@@ -5,6 +5,7 @@ use crate::geometry::buffers::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::gpu::unchecked::at;
 use crate::geometry::records::RecordStore;
+use crate::geometry::split::Split;
 
 /// Kernel: the box of primitive `id`: sphere `id` below `spheres`, else
 /// triangle `id - spheres`. `boxes` as records or as vectors (see
@@ -14,7 +15,7 @@ pub fn primitive_boxes_kernel<B: RecordStore<Aabb> + ?Sized>(
     n: u32,
     spheres: u32,
     sphere_data: &[Sphere],
-    triangles: &[Triangle],
+    triangles: &Split<Triangle>,
     boxes: &mut B,
 ) {
     if id < n {
@@ -25,6 +26,6 @@ pub fn primitive_boxes_kernel<B: RecordStore<Aabb> + ?Sized>(
 /// The box of primitive `id` (of those there are): sphere `id` below
 /// `spheres`, else triangle `id - spheres`.
 #[inline]
-pub fn primitive_box(id: u32, spheres: u32, sphere_data: &[Sphere], triangles: &[Triangle]) -> Aabb {
-    if id < spheres { at(sphere_data, id as usize).aabb() } else { at(triangles, (id - spheres) as usize).aabb() }
+pub fn primitive_box(id: u32, spheres: u32, sphere_data: &[Sphere], triangles: &Split<Triangle>) -> Aabb {
+    if id < spheres { at(sphere_data, id as usize).aabb() } else { triangles.get((id - spheres) as usize).aabb() }
 }

@@ -18,6 +18,7 @@
 //! outside `0..n`. Duplicate keys (as the paper says) compare their indices
 //! instead: `δ = 64 + clz(i ^ j)`, so identical keys still give a valid tree.
 use crate::geometry::buffers::{INVALID, Node};
+use crate::geometry::split::SplitMut;
 
 /// Leading zeros of a u64 from two 32-bit counts: rust-gpu's 64-bit
 /// `leading_zeros` gave wrong results on lavapipe when the high word is set.
@@ -96,13 +97,15 @@ pub fn children(keys: &[u64], n: u32, i: u32) -> (u32, u32) {
 
 /// Kernel: writes internal node `i`'s children and their parent links.
 /// Boxes are left for [`crate::construct::fit`].
-pub fn radix_tree_kernel(i: u32, n: u32, keys: &[u64], nodes: &mut [Node], parents: &mut [u32]) {
+pub fn radix_tree_kernel(i: u32, n: u32, keys: &[u64], nodes: &mut SplitMut<Node>, parents: &mut [u32]) {
     if n < 2 || i >= n - 1 {
         return;
     }
     let (left, right) = children(keys, n, i);
-    nodes[i as usize].left = left;
-    nodes[i as usize].right = right;
+    nodes.with_mut(i as usize, |node| {
+        node.left = left;
+        node.right = right;
+    });
     parents[left as usize] = i;
     parents[right as usize] = i;
     if i == 0 {

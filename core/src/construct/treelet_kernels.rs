@@ -30,6 +30,7 @@ use crate::construct::climb::Climb;
 use crate::construct::climb_queue;
 use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, optimize, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
 use crate::geometry::buffers::{Node, TreeletParams};
+use crate::geometry::records::RecordLoad;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{WG, WORKGROUP_SIZE};
@@ -55,10 +56,10 @@ pub const INIT_FIRST_LEVELS: u32 = 3;
 /// without merging within subgroups, the first kernel's subgroups still
 /// wait for their slowest lane over three levels.
 #[allow(clippy::too_many_arguments)]
-pub fn treelet_init_kernel<const ORDERED: bool>(
+pub fn treelet_init_kernel<const ORDERED: bool, N: RecordLoad<Node> + ?Sized>(
     i: u32,
     params: &TreeletParams,
-    nodes: &[Node],
+    nodes: &N,
     parents: &[u32],
     flags: &mut [u32],
     summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
@@ -74,7 +75,7 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
     // Leaves are found through the tree, not by index: restructuring moves
     // internal nodes but never leaves, and leaf `i` stays at `n - 1 + i`.
     let leaf = n - 1 + i;
-    let node = nodes[leaf as usize];
+    let node = nodes.load(leaf as usize);
     atomics::store_u32(&mut counts[leaf as usize], node.prim_count());
     atomics::store_f32(&mut node_costs[leaf as usize], node_cost(&node, node.prim_count(), (0.0, 0.0), &costs));
     atomics::store_u32(&mut heights[leaf as usize], 0);
@@ -95,10 +96,10 @@ pub fn treelet_init_kernel<const ORDERED: bool>(
 /// Kernel, the second of two: the climb from the node at place `id` of
 /// the queues [`treelet_init_kernel`] filled, as that kernel climbs.
 #[allow(clippy::too_many_arguments)]
-pub fn treelet_init_climb_kernel<const ORDERED: bool>(
+pub fn treelet_init_climb_kernel<const ORDERED: bool, N: RecordLoad<Node> + ?Sized>(
     id: u32,
     params: &TreeletParams,
-    nodes: &[Node],
+    nodes: &N,
     parents: &[u32],
     flags: &mut [u32],
     summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
@@ -118,15 +119,15 @@ pub fn treelet_init_climb_kernel<const ORDERED: bool>(
 /// Writes internal node `parent`'s count, cost, height and collapsed leaf
 /// count from its children's.
 #[inline]
-fn summarize(
+fn summarize<N: RecordLoad<Node> + ?Sized>(
     parent: u32,
     params: &TreeletParams,
-    nodes: &[Node],
+    nodes: &N,
     summaries: (&mut [u32], &mut [f32], &mut [u32], &mut [u32]),
 ) {
     let (counts, node_costs, heights, tree_leaves) = summaries;
     let costs = params.costs();
-    let p = nodes[parent as usize];
+    let p = nodes.load(parent as usize);
     let (l, r) = (p.left as usize, p.right as usize);
     let count = atomics::load_u32(&counts[l]) + atomics::load_u32(&counts[r]);
     let children = atomics::load_f32(&node_costs[l]) + atomics::load_f32(&node_costs[r]);

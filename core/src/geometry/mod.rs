@@ -13,4 +13,5 @@ pub mod features;
 pub mod intersect;
 pub mod prims;
 pub mod records;
+pub mod split;
 pub mod triangle;

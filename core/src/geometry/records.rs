@@ -104,6 +104,15 @@ fn parts(v: Vec4) -> ([f32; 3], u32) {
     ([v.x, v.y, v.z], v.w.to_bits())
 }
 
+impl RecordLoad<Node> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> Node {
+        let (min, left) = parts(at(self, 2 * i));
+        let (max, right) = parts(at(self, 2 * i + 1));
+        Node { min, left, max, right }
+    }
+}
+
 impl RecordLoad<Bvh2Node> for [Vec4] {
     #[inline]
     fn load(&self, i: usize) -> Bvh2Node {

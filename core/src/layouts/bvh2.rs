@@ -12,7 +12,7 @@
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
 //! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
-use crate::geometry::records::RecordStore;
+use crate::geometry::records::{RecordLoad, RecordStore};
 use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
 use crate::geometry::triangle::Triangle;
@@ -22,17 +22,17 @@ use crate::geometry::triangle::Triangle;
 /// right child `right = i + 2 L` where `L` is its left sibling's leaf
 /// count): each internal node writes its [`Bvh2Node`]. A tree of one leaf
 /// gets a root whose second child is an empty box.
-pub fn bvh2_node_kernel<O: RecordStore<Bvh2Node> + ?Sized>(
+pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> + ?Sized>(
     i: u32,
     node_count: u32,
-    nodes: &[Node],
+    nodes: &N,
     parents: &[u32],
     out: &mut O,
 ) {
     if i >= node_count {
         return;
     }
-    let node = nodes[i as usize];
+    let node = nodes.load(i as usize);
     if node.is_leaf() {
         if node_count == 1 {
             let mut root = Bvh2Node { left: node.left, left_count: node.prim_count(), ..Default::default() };
@@ -53,7 +53,7 @@ pub fn bvh2_node_kernel<O: RecordStore<Bvh2Node> + ?Sized>(
         index += if x == p + 1 { 1 } else { (x - p) / 2 };
         x = p;
     }
-    let (l, r) = (nodes[node.left as usize], nodes[node.right as usize]);
+    let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
     let (left, left_count) = child_ref(&l, index + 1);
     let (right, right_count) = child_ref(&r, index + (node.right - i) / 2);
     let record = Bvh2Node {

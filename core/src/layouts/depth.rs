@@ -4,6 +4,7 @@
 //! triangles about 40 ms of wall time on the H100, where this kernel
 //! returns one word.
 use crate::geometry::buffers::Node;
+use crate::geometry::records::RecordLoad;
 use crate::gpu::atomics;
 
 /// Longest climb [`leaf_depth_kernel`] makes: one more level than the
@@ -18,8 +19,14 @@ pub const DEPTH_LIMIT: u32 = 65;
 /// (root 0, `parents` its parent links): a leaf climbs to the root and
 /// raises `deepest[0]` (zeroed) to its depth (the root's is 0), or to
 /// [`DEPTH_LIMIT`] if it is deeper.
-pub fn leaf_depth_kernel(i: u32, node_count: u32, nodes: &[Node], parents: &[u32], deepest: &mut [u32]) {
-    if i >= node_count || !nodes[i as usize].is_leaf() {
+pub fn leaf_depth_kernel<N: RecordLoad<Node> + ?Sized>(
+    i: u32,
+    node_count: u32,
+    nodes: &N,
+    parents: &[u32],
+    deepest: &mut [u32],
+) {
+    if i >= node_count || !nodes.load(i as usize).is_leaf() {
         return;
     }
     let (mut x, mut depth) = (i, 0u32);

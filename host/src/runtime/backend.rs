@@ -91,7 +91,9 @@ pub trait Backend: Send {
     fn subgroup_partitioned(&self) -> bool {
         false
     }
-    /// Largest buffer this device accepts in one binding, in bytes.
+    /// Largest buffer this device accepts, in bytes (on a GPU, two
+    /// bindings' worth: kernels bind large buffers in two parts, see
+    /// `treelet_core::geometry::split`).
     fn max_buffer_bytes(&self) -> u64;
     /// The device's own memory, in bytes, where it has one apart from the
     /// host's and says how large (Vulkan's largest device-local heap).
@@ -149,7 +151,7 @@ pub fn check_fits<B: Backend>(backend: &B, label: &str, bytes: u64) -> Result<()
     if bytes > max {
         anyhow::bail!(
             "scene too large for this device: buffer `{label}` needs {bytes} bytes, \
-             the adapter `{}` allows {max} bytes per binding",
+             the adapter `{}` allows {max} bytes per buffer",
             backend.adapter()
         );
     }

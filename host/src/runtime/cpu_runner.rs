@@ -11,6 +11,7 @@ use std::time::Instant;
 use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
+use treelet_core::geometry::split::{Split, SplitMut};
 use treelet_core::geometry::aabb::Aabb;
 use treelet_core::construct::multisplit::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
 use treelet_core::gpu::subgroup::{self, Lane};
@@ -349,7 +350,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let p: treelet_core::BuildParams = params(p);
             let (spheres, triangles, boxes) = (view(spheres), view(triangles), view::<treelet_core::Aabb>(boxes));
             for id in ids(groups) {
-                primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, triangles, boxes);
+                primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, &Split::whole(triangles), boxes);
             }
         }
         (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, output]) => {
@@ -358,7 +359,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (boxes, output) = (view::<Aabb>(boxes), view(output));
             let mut shared = [Aabb::EMPTY; WG];
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, &p, spheres, triangles, boxes, output, &mut shared)
+                bounds::primitive_bounds_phase(phase, lid, g, &p, spheres, &Split::whole(triangles), boxes, output, &mut shared)
             });
         }
         (Kernel::ReduceBounds, [p, input, output]) => {
@@ -484,7 +485,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let p: treelet_core::BuildParams = params(p);
             let (keys, nodes, parents) = (view(keys), view(nodes), view(parents));
             for id in ids(groups) {
-                radix_tree::radix_tree_kernel(id, p.n, keys, nodes, parents);
+                radix_tree::radix_tree_kernel(id, p.n, keys, &mut SplitMut::whole(nodes), parents);
             }
         }
         (Kernel::Fit | Kernel::FitRelaxed, [p, prims, boxes, nodes, parents, flags]) => {
@@ -492,7 +493,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
             let (parents, flags) = (view(parents), view(flags));
             for id in ids(groups) {
-                fit::fit_kernel::<true>(id, p.n, prims, boxes, nodes, parents, flags);
+                fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
@@ -500,7 +501,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view(nodes));
             let (parents, ends) = (view(parents), view(ends));
             for id in ids(groups) {
-                agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, nodes, parents, ends);
+                agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, &mut SplitMut::whole(nodes), parents, ends);
             }
         }
         (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, ends, queue, queued]) => {
@@ -529,7 +530,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 for base in (0..WORKGROUP_SIZE).step_by(subgroup_size as usize) {
                     let sh = (&mut shared.0, &mut shared.1, &mut shared.2);
                     let inputs = (&*keys, &*prims, &*boxes);
-                    hploc_subgroup_on_cpu(g, base, subgroup_size, settings, inputs, nodes, parents, ends, lists, sh);
+                    hploc_subgroup_on_cpu(g, base, subgroup_size, settings, inputs, &mut SplitMut::whole(nodes), parents, ends, lists, sh);
                 }
             }
         }
@@ -539,7 +540,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (queue, queued) = (view(queue), view(queued));
             for id in ids(groups) {
                 treelet_core::construct::agglomerate_subgroup::climb_queued_kernel::<true>(
-                    id, p.n, keys, nodes, parents, ends, queue, queued,
+                    id, p.n, keys, &mut SplitMut::whole(nodes), parents, ends, queue, queued,
                 );
             }
         }
@@ -556,15 +557,15 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             for id in ids(groups) {
                 let summaries = (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves);
                 if first {
-                    treelet_kernels::treelet_init_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
+                    treelet_kernels::treelet_init_kernel::<true, [treelet_core::Node]>(id, &p, nodes, parents, flags, summaries, queue, queued);
                 } else {
-                    treelet_kernels::treelet_init_climb_kernel::<true>(id, &p, nodes, parents, flags, summaries, queue, queued);
+                    treelet_kernels::treelet_init_climb_kernel::<true, [treelet_core::Node]>(id, &p, nodes, parents, flags, summaries, queue, queued);
                 }
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (nodes, parents, counts, tree_leaves) = (view(nodes), view(parents), view(counts), view(tree_leaves));
+            let (nodes, parents, counts, tree_leaves) = (view::<treelet_core::Node>(nodes), view(parents), view(counts), view(tree_leaves));
             let (prims, out_nodes, out_parents, out_prims) =
                 (view(prims), view::<treelet_core::Node>(out_nodes), view(out_parents), view(out_prims));
             for id in ids(groups) {
@@ -635,14 +636,14 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, out) = (view(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
+            let (nodes, parents, out) = (view::<treelet_core::Node>(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
             for id in ids(groups) {
                 bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
         }
         (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, deepest) = (view(nodes), view(parents), view(deepest));
+            let (nodes, parents, deepest) = (view::<treelet_core::Node>(nodes), view(parents), view(deepest));
             for id in ids(groups) {
                 treelet_core::layouts::depth::leaf_depth_kernel(id, p.nodes, nodes, parents, deepest);
             }

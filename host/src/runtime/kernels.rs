@@ -307,6 +307,23 @@ impl Kernel {
         }
     }
 
+    /// The bindings (of [`Kernel::bindings`]) that may pass one binding's
+    /// limit, in the order of their second parts: the shader declares the
+    /// part from the split on (`treelet_core::geometry::split`) as binding
+    /// `bindings().len() + k` for the `k`-th of them, with the same access.
+    pub fn split_bindings(self) -> &'static [usize] {
+        match self {
+            Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
+            Kernel::Fit | Kernel::FitRelaxed => &[3],
+            Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
+            Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
+            Kernel::Collapse => &[1, 6],
+            Kernel::Bvh2Nodes => &[1, 3],
+            Kernel::LeafPrims => &[4],
+            _ => &[],
+        }
+    }
+
     /// Bindings in order; binding 0 is always the parameter struct.
     pub fn bindings(self) -> &'static [Access] {
         match self {

@@ -44,11 +44,31 @@ pub struct GpuBackend {
     stage: &'static str,
     pending: Vec<Segment>,
     times: StageTimes,
+    /// Where buffers bound in two parts are split (bytes; tests set it
+    /// small, see [`GpuBackend::with_split_bytes`]).
+    split_bytes: u64,
+    /// The second part of a binding whose buffer fits the first (never
+    /// read): one for read-only bindings, one for writable ones (wgpu
+    /// forbids one buffer in both uses within a dispatch).
+    unused_parts: [wgpu::Buffer; 2],
+    /// A dispatch that could not be bound, reported by the next wait.
+    error: Option<anyhow::Error>,
 }
 
 impl GpuBackend {
     pub fn new(ctx: Arc<GpuContext>) -> Self {
+        let unused_part = |label| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: crate::runtime::gpu::context::SPLIT_UNIT,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
         Self {
+            split_bytes: ctx.split_bytes(),
+            unused_parts: [unused_part("unused second part (read)"), unused_part("unused second part (write)")],
+            error: None,
             ctx,
             free: Default::default(),
             used: Vec::new(),
@@ -63,6 +83,16 @@ impl GpuBackend {
     /// instead of one pass per stage. Adds a little overhead per dispatch.
     pub fn with_per_kernel_times(mut self, on: bool) -> Self {
         self.per_kernel = on;
+        self
+    }
+
+    /// Splits buffers bound in two parts after `bytes` (a multiple of
+    /// [`crate::runtime::gpu::context::SPLIT_UNIT`], at most the device's
+    /// own split) instead of only those past one binding's limit: how the
+    /// tests run both parts of every split kernel on small scenes.
+    pub fn with_split_bytes(mut self, bytes: u64) -> Self {
+        let unit = crate::runtime::gpu::context::SPLIT_UNIT;
+        self.split_bytes = (bytes / unit * unit).clamp(unit, self.ctx.split_bytes());
         self
     }
 
@@ -114,6 +144,10 @@ impl GpuBackend {
 
     /// Submits every recorded dispatch and waits; adds their stage times.
     fn flush(&mut self) -> Result<()> {
+        if let Some(e) = self.error.take() {
+            self.pending.clear();
+            return Err(e);
+        }
         let segments = std::mem::take(&mut self.pending);
         if segments.is_empty() {
             return Ok(());
@@ -211,7 +245,7 @@ impl Backend for GpuBackend {
         self.ctx.subgroup_partitioned && std::env::var("TREELET_SORT_MATCH").map_or(true, |v| v != "ballots")
     }
     fn max_buffer_bytes(&self) -> u64 {
-        self.ctx.max_binding_bytes()
+        self.ctx.max_buffer_bytes()
     }
     fn device_memory_bytes(&self) -> Option<u64> {
         self.ctx.device_memory
@@ -265,11 +299,48 @@ impl Backend for GpuBackend {
         if groups == 0 {
             return;
         }
-        let entries: Vec<_> = bindings
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-            .collect();
+        // Buffers past `split_bytes` are bound in two parts where the kernel
+        // reads them so (`Kernel::split_bindings`), else whole.
+        let split = kernel.split_bindings();
+        let mut entries: Vec<_> = Vec::with_capacity(bindings.len() + split.len());
+        for (i, b) in bindings.iter().enumerate() {
+            let resource = if split.contains(&i) && b.size() > self.split_bytes {
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: b,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(self.split_bytes),
+                })
+            } else if b.size() > self.ctx.max_binding_bytes() {
+                self.error.get_or_insert_with(|| {
+                    anyhow::anyhow!(
+                        "scene too large for this device: `{}` binds a buffer of {} bytes whole, the adapter `{}` \
+                         allows {} bytes per binding (builds and layouts that split large buffers: lbvh, hploc, bvh2)",
+                        kernel.entry_point(),
+                        b.size(),
+                        self.ctx.info.name,
+                        self.ctx.max_binding_bytes()
+                    )
+                });
+                return;
+            } else {
+                b.as_entire_binding()
+            };
+            entries.push(wgpu::BindGroupEntry { binding: i as u32, resource });
+        }
+        for (k, &i) in split.iter().enumerate() {
+            let b = bindings[i];
+            let resource = if b.size() > self.split_bytes {
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: b,
+                    offset: self.split_bytes,
+                    size: std::num::NonZeroU64::new(b.size() - self.split_bytes),
+                })
+            } else {
+                let writes = kernel.bindings()[i] == crate::runtime::kernels::Access::ReadWrite;
+                self.unused_parts[writes as usize].as_entire_binding()
+            };
+            entries.push(wgpu::BindGroupEntry { binding: (bindings.len() + k) as u32, resource });
+        }
         let bind_group = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(kernel.entry_point()),
             layout: &self.ctx.pipeline(kernel).layout,

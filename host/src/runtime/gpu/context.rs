@@ -358,7 +358,27 @@ impl GpuContext {
     pub fn max_binding_bytes(&self) -> u64 {
         self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size)
     }
+
+    /// Where a buffer bound in two parts is split, in bytes: the most one
+    /// binding holds, on a boundary of every record kept in such buffers
+    /// (16-byte vectors, 32-byte nodes, 48-byte triangles and leaf
+    /// primitives, 64-byte `bvh2` nodes) and of the offset alignment.
+    pub fn split_bytes(&self) -> u64 {
+        let unit = SPLIT_UNIT.max(self.limits.min_storage_buffer_offset_alignment as u64);
+        (self.max_binding_bytes() / unit * unit).max(unit)
+    }
+
+    /// Largest buffer: two bindings' worth where kernels bind it in two
+    /// parts (`Kernel::split_bindings`).
+    pub fn max_buffer_bytes(&self) -> u64 {
+        (2 * self.split_bytes()).min(self.limits.max_buffer_size)
+    }
 }
+
+/// Split points are multiples of this (the least common multiple of the
+/// record sizes in split buffers, 16, 32, 48 and 64 bytes, and of 256, the
+/// largest offset alignment Vulkan allows).
+pub const SPLIT_UNIT: u64 = 768;
 
 /// A Vulkan instance (the backend Treelet's SPIR-V passthrough needs).
 fn instance() -> wgpu::Instance {
@@ -408,9 +428,10 @@ fn shader_module(device: &wgpu::Device, kernel: Kernel) -> wgpu::ShaderModule {
 
 fn build_pipeline(device: &wgpu::Device, kernel: Kernel, cache: Option<&wgpu::PipelineCache>) -> Pipeline {
             let module = &shader_module(device, kernel);
-            let entries: Vec<_> = kernel
-                .bindings()
+            let accesses = kernel.bindings();
+            let entries: Vec<_> = accesses
                 .iter()
+                .chain(kernel.split_bindings().iter().map(|&i| &accesses[i]))
                 .enumerate()
                 .map(|(i, access)| wgpu::BindGroupLayoutEntry {
                     binding: i as u32,
