@@ -365,7 +365,7 @@ fn tree_depth_on_the_device_is_the_trees_depth() {
 /// is split after a few hundred records here, so each kernel reads and
 /// writes both parts. (Traversal still binds its buffers whole.)
 #[test]
-fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
+fn gpu_buffers_in_two_parts_build_as_whole() {
     let Some(ctx) = treelet_tests::gpu() else { return };
     let seed = treelet_tests::fresh_seed() as u32;
     let spheres = random_spheres(700, seed as u64);
