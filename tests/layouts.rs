@@ -71,7 +71,7 @@ fn primitive_centre(prims: &Prims, p: u32) -> Vec3 {
     if p < prims.sphere_count {
         Vec3::from_array(prims.spheres[p as usize].center)
     } else {
-        let t = prims.triangles[(p - prims.sphere_count) as usize];
+        let t = prims.triangle(p - prims.sphere_count);
         (Vec3::from_array(t.v0) + Vec3::from_array(t.v1) + Vec3::from_array(t.v2)) / 3.0
     }
 }
@@ -128,7 +128,7 @@ fn rays(prims: &Prims, lo: Vec3, hi: Vec3, seed: u32, count: u32) -> Vec<(Vec3, 
 fn every_layout_traces_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[Triangle], seed: u32) {
     let prims = Primitives { spheres, triangles };
     prims.check().unwrap();
-    let scene = Prims { spheres, sphere_count: spheres.len() as u32, triangles, triangle_count: triangles.len() as u32 };
+    let scene = Prims::new(spheres, triangles);
     let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
     let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 600);
     let hits = probes.iter().filter(|p| p.3.is_hit()).count();
@@ -359,13 +359,14 @@ fn tree_depth_on_the_device_is_the_trees_depth() {
 }
 
 /// Buffers bound in two parts (`treelet_core::geometry::split`: how scenes
-/// past one binding's 2 GiB build) give exactly the trees of the same
-/// buffers bound whole, on the same device: every buffer the split kernels
-/// bind (triangles, nodes, collapsed nodes, `bvh2` nodes, leaf primitives)
-/// is split after a few hundred records here, so each kernel reads and
-/// writes both parts. (Traversal still binds its buffers whole.)
+/// past one binding's 2 GiB build and trace) give exactly the trees and
+/// hits of the same buffers bound whole, on the same device: every buffer
+/// the split kernels bind (triangles, nodes, collapsed nodes, `bvh2` and
+/// leaf primitives) is split after a few hundred records here, so each
+/// kernel reads and writes both parts; the hits are also the scan's.
 #[test]
-fn gpu_buffers_in_two_parts_build_as_whole() {
+fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
+    use treelet::{Quality, Ray, Tracer};
     let Some(ctx) = treelet_tests::gpu() else { return };
     let seed = treelet_tests::fresh_seed() as u32;
     let spheres = random_spheres(700, seed as u64);
@@ -384,5 +385,26 @@ fn gpu_buffers_in_two_parts_build_as_whole() {
                 }
             }
         }
+        // Casts through split `bvh2` buffers (and triangles) on the device.
+        let scene = prims.as_core();
+        let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
+        let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 400);
+        let rays: Vec<Ray> = probes.iter().map(|(o, d, _, _)| Ray::new(o.to_array(), d.to_array())).collect();
+        let mut hits = Vec::new();
+        for mut b in [GpuBackend::new(ctx.clone()), GpuBackend::new(ctx.clone()).with_split_bytes(split)] {
+            let t = Tracer::build(&mut b, prims.spheres, prims.triangles, Quality::Fast).unwrap();
+            hits.push((t.closest_hits(&mut b, &rays).unwrap(), t.occluded(&mut b, &rays).unwrap()));
+        }
+        // The probes aim at primitives: most hit, and the scan agrees (to
+        // rounding: the tracer takes unnormalized directions and `t_min`).
+        let found = hits[1].0.iter().filter(|h| h.is_hit()).count();
+        assert!(found > rays.len() / 2, "{what}: {found} of {} probes hit", rays.len());
+        let agree = |h: &treelet::RayHit, scan: &treelet_core::trace::hit::Hit| {
+            h.is_hit() == scan.is_hit() && (!h.is_hit() || (h.t - scan.t).abs() <= 1e-4 * scan.t.abs().max(1.0))
+        };
+        let disagree = hits[1].0.iter().zip(&probes).filter(|(h, p)| !agree(h, &p.3)).count();
+        assert!(disagree * 100 <= rays.len(), "{what}: {disagree} of {} probes disagree with the scan", rays.len());
+        assert_eq!(hits[0].0, hits[1].0, "{what}: closest hits through split buffers differ");
+        assert_eq!(hits[0].1, hits[1].1, "{what}: occlusion through split buffers differs");
     }
 }

@@ -155,7 +155,7 @@ mod stiff {
         let lbvh = build(b, tris, None);
         let trbvh = build(b, tris, Some(&TreeletConfig::default()));
         let sweep = treelet::bvh::sweep::build_collapsed_boxes(&prims.boxes(), 8).unwrap();
-        let scene = Prims { spheres: &[], sphere_count: 0, triangles: tris, triangle_count: tris.len() as u32 };
+        let scene = Prims::new(&[], tris);
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let (center, size) = (bounds.centroid(), bounds.extent().max_element());
         let mut hits = 0;

@@ -54,7 +54,7 @@ fn rays(rng: &mut impl Rng, n: usize) -> Vec<Ray> {
 /// The closest hit from `t_min` on (the scan from the point at `t_min`),
 /// up to `t_max`: distance and primitive (the record is checked apart).
 fn scan(g: &Geometry, r: &Ray) -> RayHit {
-    let prims = Prims { spheres: &g.0, sphere_count: g.0.len() as u32, triangles: &g.1, triangle_count: g.1.len() as u32 };
+    let prims = Prims::new(&g.0, &g.1);
     let d = Vec3::from(r.dir);
     if d.length() == 0.0 {
         return RayHit::MISS;

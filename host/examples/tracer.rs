@@ -50,12 +50,7 @@ fn rays() -> Vec<Ray> {
 fn trace_and_check<B: Backend>(b: &mut B, tracer: &Tracer<B>, scene: &(Vec<Sphere>, Vec<Triangle>), rays: &[Ray]) -> Result<Vec<RayHit>> {
     let hits = tracer.closest_hits(b, rays)?;
     let (spheres, triangles) = scene;
-    let prims = Prims {
-        spheres,
-        sphere_count: spheres.len() as u32,
-        triangles,
-        triangle_count: triangles.len() as u32,
-    };
+    let prims = Prims::new(spheres, triangles);
     for (r, h) in rays.iter().zip(&hits) {
         let d = Vec3::from(r.dir).normalize();
         let scan = closest_hit_linear(Vec3::from(r.origin), d, Origin::NONE, &prims);

@@ -33,9 +33,11 @@ pub fn leaf_prims_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] out: &mut [Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] out_hi: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles_hi: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_hi: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
+    let triangles = Split::new(triangles, triangles_hi);
     let out = &mut SplitMut::new(out, out_hi);
     treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
 }

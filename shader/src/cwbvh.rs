@@ -1,6 +1,7 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{LayoutParams, Node, Sphere};
+use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::layouts::cwbvh_build::{wide_count_kernel, wide_dp_kernel, wide_emit_kernel, wide_place_kernel};
@@ -91,8 +92,10 @@ pub fn wide_emit_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_nodes: &mut [Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] out_prims: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] triangles_hi: &[Triangle],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
+    let triangles = Split::new(triangles, triangles_hi);
     wide_emit_kernel(
         id, params, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles,
         out_nodes, out_prims,

@@ -2,6 +2,7 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{Material, Node, RenderParams, Sphere};
 use treelet_core::geometry::features::{ALL, TRIANGLES};
+use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
@@ -16,6 +17,8 @@ use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 /// The `bvh2` and `cwbvh` layouts' records are bound as 16-byte vectors, read one
 /// vector per load (`treelet_core::geometry::records`).
 macro_rules! render_kernel {
+    // Trees in the `bvh2` and `cwbvh` layouts: nodes, leaf primitives and
+    // triangles may each pass one binding (`treelet_core::geometry::split`).
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
@@ -29,10 +32,39 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] prims_hi: &[$prim],
         ) {
             let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
             if pixel != u32::MAX {
-                let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
+                let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
+                let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
+                let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, lights, &mut [0u32; 1], 0);
+                accumulate(&mut accum[pixel as usize], sums);
+            }
+        }
+    };
+    // The scan and the seed's layout (small scenes, comparisons): their
+    // buffers in one binding each, triangles still in one or two parts.
+    (whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
+        ) {
+            let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
+            if pixel != u32::MAX {
+                let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
                 let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, lights, &mut [0u32; 1], 0);
                 accumulate(&mut accum[pixel as usize], sums);
             }
@@ -48,7 +80,7 @@ macro_rules! render_entry_points {
         $(
             pub mod $name {
                 use super::*;
-                render_kernel!(linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                render_kernel!(whole linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
                 render_kernel!(bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
                 render_kernel!(cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
             }
@@ -59,12 +91,13 @@ treelet_core::for_each_render_variant!(render_entry_points);
 
 // The seed's layout, kept for comparison: the general kernel only
 // (`render::classic_cs`).
-render_kernel!(classic_cs, Node, u32, ClassicTree::new, ALL);
+render_kernel!(whole classic_cs, Node, u32, ClassicTree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
 /// through one layout (`$tree` from bindings 3 and 4), its stack private,
 /// testing the primitive kinds of `$features`.
 macro_rules! cast_kernel {
+    // As `render_kernel!`: the `bvh2` and `cwbvh` layouts' buffers in one or two parts.
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
@@ -77,19 +110,42 @@ macro_rules! cast_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] prims_hi: &[$prim],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
-            let scene = SceneRefs::new(params, spheres, triangles, materials, $tree(nodes, prims));
+            let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
+            let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
+            treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
+        }
+    };
+    (whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
             treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
 }
 
 // Every kind of primitive, and triangles alone (meshes).
-cast_kernel!(cast_classic_cs, Node, u32, ClassicTree::new, ALL);
+cast_kernel!(whole cast_classic_cs, Node, u32, ClassicTree::new, ALL);
 cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
 cast_kernel!(cast_cwbvh_cs, Vec4, Vec4, WideTree::new, ALL);
-cast_kernel!(cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
+cast_kernel!(whole cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
 cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
 cast_kernel!(cast_cwbvh_triangles_cs, Vec4, Vec4, WideTree::new, TRIANGLES);
 
@@ -106,9 +162,13 @@ pub fn cast_cwbvh_workgroup_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] prims_hi: &[Vec4],
     #[spirv(workgroup)] stack: &mut [u32; WORKGROUP_STACK_WORDS],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    let scene = SceneRefs::new(params, spheres, triangles, materials, WideTree::new(nodes, prims));
+    let tree = WideTree::new(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
+    let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
     treelet_core::render::rays::cast_kernel::<_, ALL, WORKGROUP_STACK_WORDS>(id, params, &scene, rays, stack, lane);
 }

@@ -5,22 +5,38 @@ use glam::Vec3;
 use crate::geometry::buffers::{LeafPrim, Sphere};
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{ray_sphere_mode, MISS};
+use crate::geometry::split::Split;
 use crate::geometry::triangle::{ray_triangle, Triangle, WatertightRay};
 
 /// The primitives rays are traced against (counts given apart from the
-/// slices, which on a GPU may be longer than their content).
+/// slices, which on a GPU may be longer than their content). Triangles may
+/// be bound in two parts ([`Split`]): a mesh's can pass 2 GiB.
 pub struct Prims<'a> {
     pub spheres: &'a [Sphere],
     pub sphere_count: u32,
-    pub triangles: &'a [Triangle],
+    pub triangles: Split<'a, Triangle>,
     pub triangle_count: u32,
 }
 
 impl<'a> Prims<'a> {
+    /// Spheres, then triangles: all of both slices (host code; kernels
+    /// take counts and triangles in parts from their bindings).
+    #[cfg(not(target_arch = "spirv"))]
+    pub fn new(spheres: &'a [Sphere], triangles: &'a [Triangle]) -> Self {
+        let (sphere_count, triangle_count) = (spheres.len() as u32, triangles.len() as u32);
+        Prims { spheres, sphere_count, triangles: Split::whole(triangles), triangle_count }
+    }
+
     /// Spheres only.
     #[cfg(not(target_arch = "spirv"))]
     pub fn spheres(spheres: &'a [Sphere]) -> Self {
-        Prims { spheres, sphere_count: spheres.len() as u32, triangles: &[], triangle_count: 0 }
+        Prims { spheres, sphere_count: spheres.len() as u32, triangles: Split::whole(&[]), triangle_count: 0 }
+    }
+
+    /// Triangle `k` (primitive `sphere_count + k`).
+    #[inline]
+    pub fn triangle(&self, k: u32) -> Triangle {
+        self.triangles.get(k as usize)
     }
 
     #[inline]
@@ -59,7 +75,7 @@ impl<'a> Prims<'a> {
         } else if prim == from.prim {
             MISS // a flat triangle cannot be hit again by a ray leaving it
         } else {
-            ray_triangle(ray, &self.triangles[(prim - self.sphere_count) as usize], t_max)
+            ray_triangle(ray, &self.triangle(prim - self.sphere_count), t_max)
         }
     }
 }
@@ -95,7 +111,7 @@ impl Prims<'_> {
             let s = self.spheres[prim as usize];
             LeafPrim { p0: s.center, prim, p1: [s.radius, 0.0, 0.0], ..Default::default() }
         } else {
-            let t = self.triangles[(prim - self.sphere_count) as usize];
+            let t = self.triangle(prim - self.sphere_count);
             LeafPrim { p0: t.v0, prim, p1: t.v1, p2: t.v2, ..Default::default() }
         }
     }

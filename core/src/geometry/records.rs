@@ -98,6 +98,15 @@ impl<T: Copy> RecordLoad<T> for [T] {
     }
 }
 
+/// A reference reads as what it refers to (trees hold their buffers by
+/// value: slices on the CPU, views of bindings on the GPU).
+impl<T, R: RecordLoad<T> + ?Sized> RecordLoad<T> for &R {
+    #[inline]
+    fn load(&self, i: usize) -> T {
+        (**self).load(i)
+    }
+}
+
 /// The three floats and the word of other bits of `v`.
 #[inline]
 fn parts(v: Vec4) -> ([f32; 3], u32) {

@@ -15,6 +15,7 @@
 use crate::geometry::records::{RecordLoad, RecordStore};
 use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
+use crate::geometry::split::Split;
 use crate::geometry::triangle::Triangle;
 
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
@@ -88,7 +89,7 @@ pub fn leaf_prims_kernel<O: RecordStore<LeafPrim> + ?Sized>(
     sphere_count: u32,
     prim_indices: &[u32],
     spheres: &[Sphere],
-    triangles: &[Triangle],
+    triangles: Split<'_, Triangle>,
     out: &mut O,
 ) {
     if j >= n {

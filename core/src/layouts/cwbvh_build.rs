@@ -38,6 +38,7 @@ use crate::construct::treelet::TreeletCosts;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{LayoutParams, LeafPrim, Node, Sphere, WideNode};
 use crate::geometry::prims::Prims;
+use crate::geometry::split::Split;
 use crate::geometry::triangle::Triangle;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{get, set};
@@ -438,7 +439,7 @@ pub fn wide_emit_kernel<W: RecordStore<WideNode> + ?Sized, L: RecordStore<LeafPr
     positions: &[u32],
     prim_indices: &[u32],
     spheres: &[Sphere],
-    triangles: &[Triangle],
+    triangles: Split<'_, Triangle>,
     out_nodes: &mut W,
     out_prims: &mut L,
 ) {

@@ -31,6 +31,7 @@ use glam::Vec3;
 use crate::geometry::buffers::{Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{MISS, surface_offset};
+use crate::geometry::split::Split;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{Triangle, WatertightRay};
 use crate::gpu::rng::BounceRng;
@@ -97,7 +98,13 @@ impl<'a, T: ClosestHit> SceneRefs<'a, T> {
     /// The scene the render and cast kernels see: their bindings, with the
     /// primitive counts from `params` (buffers may be longer than their content).
     #[inline]
-    pub fn new(params: &RenderParams, spheres: &'a [Sphere], triangles: &'a [Triangle], materials: &'a [Material], tree: T) -> Self {
+    pub fn new(
+        params: &RenderParams,
+        spheres: &'a [Sphere],
+        triangles: Split<'a, Triangle>,
+        materials: &'a [Material],
+        tree: T,
+    ) -> Self {
         let prims = Prims { spheres, sphere_count: params.prims, triangles, triangle_count: params.triangles };
         SceneRefs { prims, materials, tree }
     }
@@ -458,7 +465,7 @@ pub fn hit_normal_for<const F: u32>(prims: &Prims, prim: u32, x: Vec3, d: Vec3) 
     if prims.is_sphere::<F>(prim) {
         (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize()
     } else {
-        let t = prims.triangles[(prim - prims.sphere_count) as usize];
+        let t = prims.triangle(prim - prims.sphere_count);
         let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
         (b - a).cross(c - a).normalize_or(-d)
     }
@@ -604,7 +611,7 @@ mod tests {
                 light_count: 1,
                 ..Default::default()
             };
-            let scene = SceneRefs::new(&params, &spheres, &[], &materials, Scan::new(&[], &[]));
+            let scene = SceneRefs::new(&params, &spheres, Split::whole(&[]), &materials, Scan::new(&[], &[]));
             for pixel in 0..w * h {
                 let got = render_pixel::<_, { features::ALL }, 1>(pixel, &params, &scene, &lights, &mut [0; 1], 0);
                 let (x, y) = (pixel % w, h - 1 - pixel / w);

@@ -44,7 +44,7 @@ pub fn light_power(prims: &Prims, materials: &[Material], prim: u32) -> f32 {
         let r = prims.spheres[prim as usize].radius;
         4.0 * core::f32::consts::PI * r * r
     } else {
-        triangle_area(&prims.triangles[(prim - prims.sphere_count) as usize])
+        triangle_area(&prims.triangle(prim - prims.sphere_count))
     };
     e * area
 }
@@ -134,7 +134,7 @@ pub fn sample_light(prims: &Prims, prim: u32, x: Vec3, u1: f32, u2: f32) -> Ligh
         let dir = (u * (cp * sin) + v * (sp * sin) + w * cos).normalize();
         LightSample { dir, pdf: 1.0 / (2.0 * core::f32::consts::PI * width) }
     } else {
-        let t = &prims.triangles[(prim - prims.sphere_count) as usize];
+        let t = &prims.triangle(prim - prims.sphere_count);
         let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
         // Uniform on the triangle (Turk's square-root parametrization).
         let su = libm::sqrtf(u1);
@@ -175,7 +175,7 @@ pub fn light_pdf(prims: &Prims, prim: u32, x: Vec3, dir: Vec3, t: f32) -> f32 {
             0.0
         }
     } else {
-        triangle_pdf(&prims.triangles[(prim - prims.sphere_count) as usize], dir, t * t)
+        triangle_pdf(&prims.triangle(prim - prims.sphere_count), dir, t * t)
     }
 }
 
@@ -203,7 +203,7 @@ mod tests {
         let spheres = [Sphere::new([0.0, 0.0, 10.0], 2.0)];
         // Behind the shading point, so that neither hides the other.
         let triangles = [Triangle::new([-1.0, -1.0, -5.0], [3.0, -1.0, -5.0], [-1.0, 2.0, -6.0])];
-        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: &triangles, triangle_count: 1 };
+        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: crate::geometry::split::Split::whole(&triangles), triangle_count: 1 };
         let x = Vec3::new(0.3, -0.2, 0.0);
         // Sphere: 2π(1 - cos θmax).
         let d = Vec3::from_array(spheres[0].center) - x;

@@ -133,7 +133,7 @@ fn geometric_normal<const F: u32>(prims: &Prims, prim: u32, x: Vec3) -> Vec3 {
     if prims.is_sphere::<F>(prim) {
         (x - Vec3::from_array(prims.spheres[prim as usize].center)).normalize_or_zero()
     } else {
-        let t = &prims.triangles[(prim - prims.sphere_count) as usize];
+        let t = &prims.triangle(prim - prims.sphere_count);
         let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
         (b - a).cross(c - a).normalize_or_zero()
     }
@@ -146,7 +146,7 @@ fn barycentrics<const F: u32>(prims: &Prims, prim: u32, o: Vec3, d: Vec3) -> (f3
     if prims.is_sphere::<F>(prim) {
         return (0.0, 0.0);
     }
-    let tri = &prims.triangles[(prim - prims.sphere_count) as usize];
+    let tri = &prims.triangle(prim - prims.sphere_count);
     let (_, b1, b2) = ray_triangle_barycentrics(&WatertightRay::new(o, d), tri, MISS);
     (b1, b2)
 }

@@ -26,23 +26,25 @@ use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 /// A tree in the layout of this module: its nodes and leaf primitives as
 /// records (`[Bvh2Node]`, `[LeafPrim]`) or as the 16-byte vectors of their
 /// bytes (`[Vec4]`, how the GPU kernels bind them: see
-/// [`crate::geometry::records`]).
-pub struct Bvh2Tree<'a, N: ?Sized = [Bvh2Node], P: ?Sized = [LeafPrim]> {
-    pub nodes: &'a N,
-    pub leaf_prims: &'a P,
+/// [`crate::geometry::records`]), held by value: slices, or views of
+/// buffers bound in two parts ([`crate::geometry::split::Split`]; a
+/// reference to such a view made in the shader lost its contents).
+pub struct Bvh2Tree<N, P> {
+    pub nodes: N,
+    pub leaf_prims: P,
 }
 
-impl<'a, N: RecordLoad<Bvh2Node> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> Bvh2Tree<'a, N, P> {
+impl<N: RecordLoad<Bvh2Node>, P: RecordLoad<LeafPrim>> Bvh2Tree<N, P> {
     #[inline]
-    pub fn new(nodes: &'a N, leaf_prims: &'a P) -> Self {
+    pub fn new(nodes: N, leaf_prims: P) -> Self {
         Bvh2Tree { nodes, leaf_prims }
     }
 }
 
-impl<N: RecordLoad<Bvh2Node> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> ClosestHit for Bvh2Tree<'_, N, P> {
+impl<N: RecordLoad<Bvh2Node>, P: RecordLoad<LeafPrim>> ClosestHit for Bvh2Tree<N, P> {
     #[inline]
     fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
-        trace_bvh2::<F>(o, d, from, query, prims, self.nodes, self.leaf_prims)
+        trace_bvh2::<F>(o, d, from, query, prims, &self.nodes, &self.leaf_prims)
     }
 }
 

@@ -210,7 +210,7 @@ mod tests {
             Triangle::new([3.0, 1.0, 0.0], [3.0, -1.0, 0.0], [3.0, 0.0, -1.0]),
         ];
         let d = Vec3::new(1.0, 0.1, 0.0).normalize(); // crosses the shared edge (z = 0)
-        let prims = Prims { spheres: &[], sphere_count: 0, triangles: &tris, triangle_count: 2 };
+        let prims = Prims { spheres: &[], sphere_count: 0, triangles: crate::geometry::split::Split::whole(&tris), triangle_count: 2 };
         let nodes = two_leaf_tree(tris[1].aabb(), tris[0].aabb());
         let linear = closest_hit_linear(o, d, Origin::NONE, &prims);
         let bvh = closest_hit_bvh(o, d, Origin::NONE, &prims, &nodes, &[1, 0]);

@@ -142,19 +142,20 @@ fn hit_bits(x: &Axis, y: &Axis, z: &Axis, meta: u32, word: usize, oct_inv4: u32,
 /// Its nodes and leaf primitives as records or as the 16-byte vectors of
 /// their bytes (how the GPU kernels bind them: see
 /// [`crate::geometry::records`]).
-pub struct WideTree<'a, N: ?Sized = [WideNode], P: ?Sized = [LeafPrim]> {
-    pub nodes: &'a N,
-    pub leaf_prims: &'a P,
+/// Held by value, as [`crate::trace::bvh2::Bvh2Tree`].
+pub struct WideTree<N, P> {
+    pub nodes: N,
+    pub leaf_prims: P,
 }
 
-impl<'a, N: RecordLoad<WideNode> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> WideTree<'a, N, P> {
+impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> WideTree<N, P> {
     #[inline]
-    pub fn new(nodes: &'a N, leaf_prims: &'a P) -> Self {
+    pub fn new(nodes: N, leaf_prims: P) -> Self {
         WideTree { nodes, leaf_prims }
     }
 }
 
-impl<N: RecordLoad<WideNode> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> ClosestHit for WideTree<'_, N, P> {
+impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> ClosestHit for WideTree<N, P> {
     #[inline]
     fn trace<const F: u32, const S: usize>(
         &self,
@@ -167,7 +168,7 @@ impl<N: RecordLoad<WideNode> + ?Sized, P: RecordLoad<LeafPrim> + ?Sized> Closest
         lane: u32,
     ) -> Hit {
         let mut private = [0u32; 2 * WIDE_STACK];
-        trace_cwbvh_with::<F, S>(o, d, from, query, prims, self.nodes, self.leaf_prims, &mut private, stack, lane as usize)
+        trace_cwbvh_with::<F, S>(o, d, from, query, prims, &self.nodes, &self.leaf_prims, &mut private, stack, lane as usize)
     }
 }
 

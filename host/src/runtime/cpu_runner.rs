@@ -653,7 +653,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (prim_indices, spheres, triangles, out) =
                 (view(prim_indices), view(spheres), view(triangles), view::<treelet_core::LeafPrim>(out));
             for id in ids(groups) {
-                bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, triangles, out);
+                bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, Split::whole(triangles), out);
             }
         }
         (Kernel::WideDp | Kernel::WideDpRelaxed, [p, nodes, parents, flags, counts, costs, decisions]) => {
@@ -711,7 +711,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     positions,
                     prim_indices,
                     spheres,
-                    triangles,
+                    Split::whole(triangles),
                     out_nodes,
                     out_prims,
                 );
@@ -719,7 +719,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::Cast(..) | Kernel::CastWideWorkgroupStack, [p, spheres, materials, nodes, prims, rays, triangles]) => {
             let p: treelet_core::RenderParams = params(p);
-            let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
+            let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
             let rays: &mut [[f32; 4]] = view(rays);
             match kernel {
                 Kernel::Cast(Method::Classic, tri) => {
@@ -729,17 +729,17 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
                 Kernel::Cast(Method::Bvh2, tri) => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::<[treelet_core::Bvh2Node], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::Cast(Method::Cwbvh, tri) => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
                 Kernel::CastWideWorkgroupStack => {
                     let scene =
-                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims)));
+                        SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
                     cast_all::<_, { treelet_core::geometry::features::ALL }, WORKGROUP_STACK_WORDS>(&p, &scene, rays, groups);
                 }
                 _ => panic!("{kernel:?}: no such cast kernel"),
@@ -748,7 +748,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         (Kernel::Render(method, v), [p, spheres, materials, nodes, prims, accum, triangles, lights]) => {
             let p: treelet_core::RenderParams = params(p);
             let lights: &[Light] = view(lights);
-            let (spheres, triangles, materials) = (view(spheres), view(triangles), view(materials));
+            let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
             let accum: &mut [[f32; 4]] = view(accum);
             match method {
                 Method::Scan => {
@@ -760,11 +760,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Bvh2 => {
-                    let tree = Bvh2Tree::<[treelet_core::Bvh2Node], [treelet_core::LeafPrim]>::new(view(nodes), view(prims));
+                    let tree = Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Cwbvh => {
-                    let tree = WideTree::<[treelet_core::WideNode], [treelet_core::LeafPrim]>::new(view(nodes), view(prims));
+                    let tree = WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
             }

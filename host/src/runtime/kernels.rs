@@ -319,7 +319,10 @@ impl Kernel {
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
             Kernel::Bvh2Nodes => &[1, 3],
-            Kernel::LeafPrims => &[4],
+            Kernel::LeafPrims => &[3, 4],
+            Kernel::WideEmit => &[9],
+            Kernel::Render(Method::Scan | Method::Classic, _) | Kernel::Cast(Method::Scan | Method::Classic, _) => &[6],
+            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6, 3, 4],
             _ => &[],
         }
     }

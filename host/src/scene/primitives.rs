@@ -29,7 +29,7 @@ impl<'a> Primitives<'a> {
         treelet_core::geometry::prims::Prims {
             spheres: self.spheres,
             sphere_count: self.spheres.len() as u32,
-            triangles: self.triangles,
+            triangles: treelet_core::geometry::split::Split::whole(self.triangles),
             triangle_count: self.triangles.len() as u32,
         }
     }
