@@ -321,8 +321,9 @@ impl Kernel {
             Kernel::Bvh2Nodes => &[1, 3],
             Kernel::LeafPrims => &[3, 4],
             Kernel::WideEmit => &[9],
-            Kernel::Render(Method::Scan | Method::Classic, _) | Kernel::Cast(Method::Scan | Method::Classic, _) => &[6],
-            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6, 3, 4],
+            // Traversal: the `bvh2` layout's nodes and leaf primitives too.
+            Kernel::Render(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) => &[6, 3, 4],
+            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
     }
