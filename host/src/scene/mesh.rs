@@ -125,13 +125,171 @@ fn obj_error_line<'t>(text: &'t str, error: &tobj::LoadError) -> Option<(usize, 
     None
 }
 
+/// A PLY vertex as the loader keeps it: its position, or which coordinate
+/// it lacks (12 bytes a vertex, not the parser's map of named properties:
+/// those took 41 GB for a 60M-triangle mesh).
+#[derive(Clone, Copy, Default)]
+struct PlyVertex {
+    xyz: [f32; 3],
+    set: u8,
+}
+
+impl PlyVertex {
+    fn axis(name: &str) -> Option<usize> {
+        ["x", "y", "z"].iter().position(|&a| a == name)
+    }
+
+    fn number(&mut self, name: &str, v: f32) -> ply_rs_bw::ply::PropertyAccessResult {
+        match Self::axis(name) {
+            Some(a) => {
+                self.xyz[a] = v;
+                self.set |= 1 << a;
+                ply_rs_bw::ply::PropertyAccessResult::Set
+            }
+            None => ply_rs_bw::ply::PropertyAccessResult::Ignored,
+        }
+    }
+}
+
+impl ply_rs_bw::ply::PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn set_char(&mut self, name: &str, v: i8) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_uchar(&mut self, name: &str, v: u8) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_short(&mut self, name: &str, v: i16) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_ushort(&mut self, name: &str, v: u16) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_int(&mut self, name: &str, v: i32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_uint(&mut self, name: &str, v: u32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+    fn set_float(&mut self, name: &str, v: f32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v)
+    }
+    fn set_double(&mut self, name: &str, v: f64) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.number(name, v as f32)
+    }
+}
+
+/// A PLY face as the loader keeps it: its vertex indices, the first three
+/// in place (a triangle allocates nothing), or why it has none.
+#[derive(Default)]
+struct PlyFace {
+    first: [i64; 3],
+    rest: Vec<i64>,
+    len: u32,
+    /// 0: no index list yet; 1: a list of integers; 2: `vertex_indices` of another type.
+    kind: u8,
+}
+
+impl PlyFace {
+    fn is_indices(name: &str) -> bool {
+        name == "vertex_indices" || name == "vertex_index"
+    }
+
+    fn list(&mut self, name: &str, values: impl ExactSizeIterator<Item = i64>) -> ply_rs_bw::ply::PropertyAccessResult {
+        if !Self::is_indices(name) {
+            return ply_rs_bw::ply::PropertyAccessResult::Ignored;
+        }
+        self.len = values.len() as u32;
+        self.kind = 1;
+        for (k, v) in values.enumerate() {
+            if k < 3 {
+                self.first[k] = v;
+            } else {
+                self.rest.push(v);
+            }
+        }
+        ply_rs_bw::ply::PropertyAccessResult::Set
+    }
+
+    fn other(&mut self, name: &str) -> ply_rs_bw::ply::PropertyAccessResult {
+        if Self::is_indices(name) {
+            self.kind = 2;
+            return ply_rs_bw::ply::PropertyAccessResult::Set;
+        }
+        ply_rs_bw::ply::PropertyAccessResult::Ignored
+    }
+
+    fn index(&self, k: usize) -> i64 {
+        if k < 3 { self.first[k] } else { self.rest[k - 3] }
+    }
+}
+
+impl ply_rs_bw::ply::PropertyAccess for PlyFace {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn set_list_char(&mut self, name: &str, v: Vec<i8>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_uchar(&mut self, name: &str, v: Vec<u8>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_short(&mut self, name: &str, v: Vec<i16>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_ushort(&mut self, name: &str, v: Vec<u16>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_int(&mut self, name: &str, v: Vec<i32>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_uint(&mut self, name: &str, v: Vec<u32>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_float(&mut self, name: &str, _: Vec<f32>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_list_double(&mut self, name: &str, _: Vec<f64>) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_char(&mut self, name: &str, _: i8) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_uchar(&mut self, name: &str, _: u8) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_short(&mut self, name: &str, _: i16) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_ushort(&mut self, name: &str, _: u16) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_int(&mut self, name: &str, _: i32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_uint(&mut self, name: &str, _: u32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_float(&mut self, name: &str, _: f32) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+    fn set_double(&mut self, name: &str, _: f64) -> ply_rs_bw::ply::PropertyAccessResult {
+        self.other(name)
+    }
+}
+
 /// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
-/// `face` elements with a `vertex_indices` (or `vertex_index`) list.
+/// `face` elements with a `vertex_indices` (or `vertex_index`) list. Read
+/// into compact records (other elements are read and dropped), so a mesh
+/// takes little more memory than its triangles.
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
-    use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
+    use ply_rs_bw::parser::{Parser, Reader};
+    use ply_rs_bw::ply::DefaultElement;
     let bytes = crate::input::read(path, "mesh")?;
-    let ply = Parser::<DefaultElement>::new().read_ply(&mut bytes.as_slice()).map_err(|e| {
+    let name = path.display();
+    let parse_error = |e: ply_rs_bw::parser::ParseError| {
         // The parser's message spans lines and names a line of the file, not
         // the element: one line, with the element that line holds.
         let full = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
@@ -142,49 +300,49 @@ pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
             None => full,
         };
         match ply_error_element(&bytes, &message) {
-            Some((element, index)) => anyhow!("{}: {element} {index}: {message}", path.display()),
-            None => anyhow!("{}: not a valid PLY file: {message}", path.display()),
+            Some((element, index)) => anyhow!("{name}: {element} {index}: {message}"),
+            None => anyhow!("{name}: not a valid PLY file: {message}"),
         }
-    })?;
-    let name = path.display();
-    let vertices = ply.payload.get("vertex").ok_or_else(|| anyhow!("{name}: no `vertex` element"))?;
-    let faces = ply.payload.get("face").ok_or_else(|| anyhow!("{name}: no `face` element"))?;
-    let mut positions = Vec::with_capacity(vertices.len());
-    for (i, v) in vertices.iter().enumerate() {
-        let coord = |axis: &str| {
-            v.get(axis)
-                .and_then(Property::to_f32_lossy)
-                .ok_or_else(|| anyhow!("{name}: vertex {i}: no numeric `{axis}` property"))
-        };
-        positions.push([coord("x")?, coord("y")?, coord("z")?]);
+    };
+    let mut reader = Reader::new(bytes.as_slice());
+    let header = Parser::<DefaultElement>::new().read_header(&mut reader).map_err(parse_error)?;
+    let (mut vertices, mut faces) = (None, None);
+    for (element, def) in &header.elements {
+        match element.as_str() {
+            "vertex" => vertices = Some(Parser::<PlyVertex>::new().read_payload_for_element(&mut reader, def, &header).map_err(parse_error)?),
+            "face" => faces = Some(Parser::<PlyFace>::new().read_payload_for_element(&mut reader, def, &header).map_err(parse_error)?),
+            _ => {
+                Parser::<DefaultElement>::new().read_payload_for_element(&mut reader, def, &header).map_err(parse_error)?;
+            }
+        }
     }
+    let vertices = vertices.ok_or_else(|| anyhow!("{name}: no `vertex` element"))?;
+    let faces = faces.ok_or_else(|| anyhow!("{name}: no `face` element"))?;
+    if let Some((i, v)) = vertices.iter().enumerate().find(|(_, v)| v.set != 0b111) {
+        let axis = ["x", "y", "z"][(!v.set).trailing_zeros() as usize];
+        bail!("{name}: vertex {i}: no numeric `{axis}` property");
+    }
+    let positions: Vec<[f32; 3]> = vertices.into_iter().map(|v| v.xyz).collect();
     let mut triangles = Vec::with_capacity(faces.len());
     for (f, face) in faces.iter().enumerate() {
-        let list = face
-            .get("vertex_indices")
-            .or_else(|| face.get("vertex_index"))
-            .ok_or_else(|| anyhow!("{name}: face {f}: no `vertex_indices` list"))?;
-        let indices: Vec<i64> = match list {
-            Property::ListChar(l) => l.iter().map(|&x| x as i64).collect(),
-            Property::ListUChar(l) => l.iter().map(|&x| x as i64).collect(),
-            Property::ListShort(l) => l.iter().map(|&x| x as i64).collect(),
-            Property::ListUShort(l) => l.iter().map(|&x| x as i64).collect(),
-            Property::ListInt(l) => l.iter().map(|&x| x as i64).collect(),
-            Property::ListUInt(l) => l.iter().map(|&x| x as i64).collect(),
-            _ => bail!("{name}: face {f}: `vertex_indices` is not a list of integers"),
-        };
-        if indices.len() < 3 {
-            bail!("{name}: face {f} has {} vertices (at least 3 needed)", indices.len());
+        match face.kind {
+            0 => bail!("{name}: face {f}: no `vertex_indices` list"),
+            2 => bail!("{name}: face {f}: `vertex_indices` is not a list of integers"),
+            _ => {}
+        }
+        let count = face.len as usize;
+        if count < 3 {
+            bail!("{name}: face {f} has {count} vertices (at least 3 needed)");
         }
         let vertex = |k: usize| -> Result<[f32; 3]> {
-            let i = indices[k];
+            let i = face.index(k);
             usize::try_from(i)
                 .ok()
                 .and_then(|i| positions.get(i).copied())
                 .ok_or_else(|| anyhow!("{name}: face {f}: vertex index {i} out of range 0..{}", positions.len()))
         };
         // A polygon becomes a fan of triangles around its first vertex.
-        for k in 1..indices.len() - 1 {
+        for k in 1..count - 1 {
             triangles.push(Triangle::new(vertex(0)?, vertex(k)?, vertex(k + 1)?));
         }
     }
