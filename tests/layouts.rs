@@ -361,8 +361,8 @@ fn tree_depth_on_the_device_is_the_trees_depth() {
 /// Buffers bound in two parts (`treelet_core::geometry::split`: how scenes
 /// past one binding's 2 GiB build and trace) give exactly the trees and
 /// hits of the same buffers bound whole, on the same device: every buffer
-/// the split kernels bind (triangles, nodes, collapsed nodes, `bvh2` and
-/// leaf primitives) is split after a few hundred records here, so each
+/// the split kernels bind (triangles, nodes, through the treelet rounds
+/// too, collapsed nodes, `bvh2` and leaf primitives) is split after a few hundred records here, so each
 /// kernel reads and writes both parts; the hits are also the scan's.
 #[test]
 fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
@@ -373,7 +373,7 @@ fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
     let tris = terrain(5_000);
     let split = 768 * 13; // 208 triangles, 312 nodes, 156 bvh2 nodes
     for (what, prims) in [("terrain", Primitives::triangles(&tris)), ("spheres and terrain", Primitives { spheres: &spheres, triangles: &tris })] {
-        for accel in [Accel::Lbvh, Accel::Hploc] {
+        for accel in [Accel::Lbvh, Accel::Hploc, Accel::Trbvh] {
             for layout in [Layout::Bvh2, Layout::Cwbvh] {
                 let whole = build(&mut GpuBackend::new(ctx.clone()), prims, accel, layout);
                 let parts = build(&mut GpuBackend::new(ctx.clone()).with_split_bytes(split), prims, accel, layout);

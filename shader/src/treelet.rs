@@ -116,6 +116,7 @@ pub fn treelet_restructure_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] costs: &mut [f32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] heights: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] marks: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &mut [Node],
     #[spirv(workgroup)] stage: &mut [u32; TEAM_STAGE],
     #[spirv(workgroup)] cost: &mut [f32; TEAM_COSTS],
     #[spirv(workgroup)] parts: &mut [u32; TEAM_PARTS],
@@ -123,6 +124,7 @@ pub fn treelet_restructure_cs(
     #[spirv(workgroup)] votes: &mut [u32; TEAM_VOTES],
 ) {
     let group = linear_group(group.x, group.y, groups.x);
+    let nodes = &mut SplitMut::new(nodes, nodes_hi);
     // Read once: each phase would load it again after its barrier.
     let params = *params;
     // After the first phase (which fills the shared subset order), a team
@@ -189,7 +191,9 @@ pub fn treelet_restructure_single_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] marks: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &mut [Node],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
+    let nodes = &mut SplitMut::new(nodes, nodes_hi);
     treelet_restructure_single(id, params, roots, nodes, parents, counts, costs, heights, marks);
 }

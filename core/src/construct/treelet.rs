@@ -30,6 +30,7 @@
 //! treelet spread over a team of lanes.
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{Node, TreeletParams};
+use crate::geometry::records::{RecordLoad, RecordStore};
 use crate::gpu::unchecked::{at, get, put, set};
 
 /// Leaves of a treelet (the paper's 7).
@@ -207,9 +208,9 @@ pub struct Formed {
 /// the chain of dependent loads is one per expansion and no longer.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn form_treelet<const N: usize>(
+pub fn form_treelet<const N: usize, NS: RecordLoad<Node> + ?Sized>(
     root: u32,
-    nodes: &[Node],
+    nodes: &NS,
     counts: &[u32],
     node_costs: &[f32],
     heights: &[u32],
@@ -218,7 +219,7 @@ pub fn form_treelet<const N: usize>(
     b: usize,
 ) -> Formed {
     stage[b + T_INTERNALS] = root;
-    let r = at(nodes, root as usize);
+    let r = nodes.load(root as usize);
     let root_count = at(counts, root as usize);
     let mut internal_count = 1usize;
     let mut leaf_count = 2usize;
@@ -228,7 +229,7 @@ pub fn form_treelet<const N: usize>(
     loop {
         // Both new leaves' data first, then the stage writes: the loads
         // wait on no one, one round trip to memory per expansion.
-        let (ln, rn) = (at(nodes, left as usize), at(nodes, right as usize));
+        let (ln, rn) = (nodes.load(left as usize), nodes.load(right as usize));
         let (lc, rc) = (at(counts, left as usize), at(counts, right as usize));
         let (lk, rk) = (at(node_costs, left as usize), at(node_costs, right as usize));
         let (lh, rh) = (at(heights, left as usize), at(heights, right as usize));
@@ -484,13 +485,13 @@ pub fn plan_rewire<const N: usize, const M: usize>(stage: &mut [u32; N], b: usiz
 /// `cb`). Internal nodes are independent here: lanes may take one each.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn rewire_internal<const N: usize, const C: usize>(
+pub fn rewire_internal<const N: usize, const C: usize, NS: RecordStore<Node> + ?Sized>(
     k: usize,
     stage: &[u32; N],
     b: usize,
     cost: &[f32; C],
     cb: usize,
-    nodes: &mut [Node],
+    nodes: &mut NS,
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
@@ -510,7 +511,7 @@ pub fn rewire_internal<const N: usize, const C: usize>(
     let (left, right) = (child(0), child(1));
     // The whole node in one store: it is not read here, only written.
     let x = subset_box(s, n, stage, b);
-    put(nodes, node, Node { min: x.min, left, max: x.max, right });
+    nodes.store(node, &Node { min: x.min, left, max: x.max, right });
     put(parents, left as usize, node as u32);
     put(parents, right as usize, node as u32);
     put(counts, node, subset_count(s, n, stage, b));

@@ -31,6 +31,7 @@ use crate::construct::climb_queue;
 use crate::construct::treelet::{PACKED_WORDS, SUBSETS, TREELET_LEAVES, TREELET_WORDS, T_CHANGED, T_COSTS, T_COUNT, T_CURRENT, T_HEIGHT, T_INTERNALS, T_REWIRE, best_whole_partition, first_cheapest, form_treelet, improves, node_cost, optimize, packed_bits, plan_rewire, rewire_internal, solve_subset, subset_box, subset_count, whole_partition};
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::geometry::records::RecordLoad;
+use crate::geometry::split::SplitMut;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, set};
 use crate::gpu::workgroup::{WG, WORKGROUP_SIZE};
@@ -334,9 +335,9 @@ fn mark(changed_round: u32, kept: bool) -> u32 {
 /// since (with `params.skip_kept`), else the round its subtree last
 /// changed in: this one if anything under it did.
 #[inline]
-fn changed_round(root: u32, params: &TreeletParams, nodes: &[Node], marks: &[u32]) -> Option<u32> {
+fn changed_round<NS: RecordLoad<Node> + ?Sized>(root: u32, params: &TreeletParams, nodes: &NS, marks: &[u32]) -> Option<u32> {
     let round = params.round;
-    let r = at(nodes, root as usize);
+    let r = nodes.load(root as usize);
     let below = at(marks, r.left as usize) >> 1 == round || at(marks, r.right as usize) >> 1 == round;
     let old = at(marks, root as usize);
     if params.skip_kept == 1 && old & 1 == 1 && !below {
@@ -395,7 +396,7 @@ pub fn treelet_restructure_phase(
     params: &TreeletParams,
     roots: &[u32],
     subsets: &[u32],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],
@@ -533,7 +534,7 @@ pub fn treelet_restructure_single(
     id: u32,
     params: &TreeletParams,
     roots: &[u32],
-    nodes: &mut [Node],
+    nodes: &mut SplitMut<Node>,
     parents: &mut [u32],
     counts: &mut [u32],
     node_costs: &mut [f32],

@@ -612,7 +612,8 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights, marks]) => {
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (roots, subsets, nodes, parents) = (view(roots), view(subsets), view(nodes), view(parents));
+            let (roots, subsets, parents) = (view(roots), view(subsets), view(parents));
+            let nodes = &mut SplitMut::whole(view(nodes));
             let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
             let mut stage = [0u32; treelet_kernels::TEAM_STAGE];
             let mut cost = [0f32; treelet_kernels::TEAM_COSTS];
@@ -628,7 +629,8 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
         }
         (Kernel::TreeletRestructureSingle, [p, roots, nodes, parents, counts, costs, heights, marks]) => {
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (roots, nodes, parents) = (view(roots), view(nodes), view(parents));
+            let (roots, parents) = (view(roots), view(parents));
+            let nodes = &mut SplitMut::whole(view(nodes));
             let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
             for id in ids(groups) {
                 treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);

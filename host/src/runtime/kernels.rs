@@ -318,6 +318,8 @@ impl Kernel {
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
+            Kernel::TreeletRestructure => &[3],
+            Kernel::TreeletRestructureSingle => &[2],
             Kernel::Bvh2Nodes => &[1, 3],
             Kernel::LeafPrims => &[3, 4],
             Kernel::WideEmit => &[9],
