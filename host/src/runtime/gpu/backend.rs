@@ -314,7 +314,7 @@ impl Backend for GpuBackend {
                 self.error.get_or_insert_with(|| {
                     anyhow::anyhow!(
                         "scene too large for this device: `{}` binds a buffer of {} bytes whole, the adapter `{}` \
-                         allows {} bytes per binding (the lbvh and hploc builds and the bvh2 layout and traversal split large buffers)",
+                         allows {} bytes per binding (the builds, the bvh2 layout and its traversal split large buffers; cwbvh does not yet)",
                         kernel.entry_point(),
                         b.size(),
                         self.ctx.info.name,
