@@ -157,6 +157,9 @@ where
     }
 }
 
+// `SplitMut` repeats `Split`'s reads rather than lending a `Split` of
+// itself: a view made on the fly and referenced is the pattern that lost
+// its contents in the shader (see `crate::trace::bvh2::Bvh2Tree`).
 impl<T, V> RecordLoad<T> for SplitMut<'_, V>
 where
     [V]: RecordLoad<T>,

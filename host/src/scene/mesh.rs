@@ -139,10 +139,10 @@ impl PlyVertex {
         ["x", "y", "z"].iter().position(|&a| a == name)
     }
 
-    fn number(&mut self, name: &str, v: f32) -> ply_rs_bw::ply::PropertyAccessResult {
+    fn number(&mut self, name: &str, v: f64) -> ply_rs_bw::ply::PropertyAccessResult {
         match Self::axis(name) {
             Some(a) => {
-                self.xyz[a] = v;
+                self.xyz[a] = v as f32;
                 self.set |= 1 << a;
                 ply_rs_bw::ply::PropertyAccessResult::Set
             }
@@ -151,34 +151,23 @@ impl PlyVertex {
     }
 }
 
+/// The parser's typed setters (one per PLY scalar type), each to `$to`.
+macro_rules! scalar_setters {
+    ($to:ident) => {
+        scalar_setters!($to, set_char i8, set_uchar u8, set_short i16, set_ushort u16, set_int i32, set_uint u32, set_float f32, set_double f64);
+    };
+    ($to:ident, $($set:ident $t:ty),*) => {
+        $(fn $set(&mut self, name: &str, v: $t) -> ply_rs_bw::ply::PropertyAccessResult {
+            self.$to(name, v as f64)
+        })*
+    };
+}
+
 impl ply_rs_bw::ply::PropertyAccess for PlyVertex {
     fn new() -> Self {
         Self::default()
     }
-    fn set_char(&mut self, name: &str, v: i8) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_uchar(&mut self, name: &str, v: u8) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_short(&mut self, name: &str, v: i16) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_ushort(&mut self, name: &str, v: u16) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_int(&mut self, name: &str, v: i32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_uint(&mut self, name: &str, v: u32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
-    fn set_float(&mut self, name: &str, v: f32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v)
-    }
-    fn set_double(&mut self, name: &str, v: f64) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.number(name, v as f32)
-    }
+    scalar_setters!(number);
 }
 
 /// A PLY face as the loader keeps it: its vertex indices, the first three
@@ -213,7 +202,8 @@ impl PlyFace {
         ply_rs_bw::ply::PropertyAccessResult::Set
     }
 
-    fn other(&mut self, name: &str) -> ply_rs_bw::ply::PropertyAccessResult {
+    /// A scalar, or a list of floats: not vertex indices.
+    fn other(&mut self, name: &str, _: f64) -> ply_rs_bw::ply::PropertyAccessResult {
         if Self::is_indices(name) {
             self.kind = 2;
             return ply_rs_bw::ply::PropertyAccessResult::Set;
@@ -249,35 +239,12 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
         self.list(name, v.into_iter().map(i64::from))
     }
     fn set_list_float(&mut self, name: &str, _: Vec<f32>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
+        self.other(name, 0.0)
     }
     fn set_list_double(&mut self, name: &str, _: Vec<f64>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
+        self.other(name, 0.0)
     }
-    fn set_char(&mut self, name: &str, _: i8) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_uchar(&mut self, name: &str, _: u8) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_short(&mut self, name: &str, _: i16) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_ushort(&mut self, name: &str, _: u16) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_int(&mut self, name: &str, _: i32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_uint(&mut self, name: &str, _: u32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_float(&mut self, name: &str, _: f32) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
-    fn set_double(&mut self, name: &str, _: f64) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.other(name)
-    }
+    scalar_setters!(other);
 }
 
 /// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
