@@ -163,6 +163,15 @@ macro_rules! scalar_setters {
     };
 }
 
+/// The parser's integer list setters, each to [`PlyFace::list`].
+macro_rules! list_setters {
+    ($($set:ident $t:ty),*) => {
+        $(fn $set(&mut self, name: &str, v: Vec<$t>) -> ply_rs_bw::ply::PropertyAccessResult {
+            self.list(name, v.into_iter().map(i64::from))
+        })*
+    };
+}
+
 impl ply_rs_bw::ply::PropertyAccess for PlyVertex {
     fn new() -> Self {
         Self::default()
@@ -220,24 +229,7 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
     fn new() -> Self {
         Self::default()
     }
-    fn set_list_char(&mut self, name: &str, v: Vec<i8>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
-    fn set_list_uchar(&mut self, name: &str, v: Vec<u8>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
-    fn set_list_short(&mut self, name: &str, v: Vec<i16>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
-    fn set_list_ushort(&mut self, name: &str, v: Vec<u16>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
-    fn set_list_int(&mut self, name: &str, v: Vec<i32>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
-    fn set_list_uint(&mut self, name: &str, v: Vec<u32>) -> ply_rs_bw::ply::PropertyAccessResult {
-        self.list(name, v.into_iter().map(i64::from))
-    }
+    list_setters!(set_list_char i8, set_list_uchar u8, set_list_short i16, set_list_ushort u16, set_list_int i32, set_list_uint u32);
     fn set_list_float(&mut self, name: &str, _: Vec<f32>) -> ply_rs_bw::ply::PropertyAccessResult {
         self.other(name, 0.0)
     }
