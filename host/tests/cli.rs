@@ -184,6 +184,50 @@ fn bench_rays_mesh_only() {
     assert!(e.contains("has no triangles"), "{e}");
 }
 
+/// `bench rays --figure` draws build time against rays/s for each tree,
+/// with OptiX's point from peer.py's output; a peer file for another mesh
+/// or size, or without a mesh line, is refused by name.
+#[test]
+fn bench_rays_tradeoff_figure_with_the_peer_point() {
+    let dir = std::env::temp_dir().join(format!("treelet-tradeoff-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let peer = dir.join("peer.jsonl");
+    let line = |tris: u32, w: u32| {
+        format!(
+            "{{\"peer\": \"OptiX via Mitsuba 3.9.1 cuda_ad_rgb\", \"triangles\": {tris}, \"build_wall_ms_median\": 1.5, \"width\": {w}, \"height\": 24, \"primary_mrays_s\": 40.0, \"diffuse_mrays_s\": 20.0}}\n{{\"peer\": \"Mitsuba path\", \"scene\": \"smallpt cornell\"}}\n"
+        )
+    };
+    std::fs::write(&peer, line(512, 32)).unwrap();
+    let args = ["bench", "rays", "--device", "cpu", "--width", "32", "--height", "24", "--repeats", "1", "--mesh-only", "--scene", "terrain:500"]; // 512 triangles
+    let extra = ["--accels", "lbvh,hploc", "--layouts", "bvh2,cwbvh", "--figure", dir.to_str().unwrap(), "--optix", peer.to_str().unwrap()];
+    let out = treelet(&[&args[..], &extra[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for kind in ["primary", "diffuse"] {
+        assert!(dir.join(format!("tradeoff-{kind}.png")).is_file(), "{kind}");
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join(format!("tradeoff-{kind}.json"))).unwrap()).unwrap();
+        let points = doc["points"].as_array().unwrap();
+        let names: Vec<&str> = points.iter().map(|p| p["series"].as_str().unwrap()).collect();
+        // Two trees in two layouts (H-PLOC where the CPU runner's subgroups allow), and the peer.
+        assert!(names.contains(&"LBVH, bvh2") && names.contains(&"LBVH, cwbvh"), "{names:?}");
+        let optix = points.iter().find(|p| p["series"] == "OptiX via Mitsuba 3.9.1").expect("the peer's point");
+        assert_eq!((optix["x"].as_f64(), optix["median"].as_f64()), (Some(1.5), Some(if kind == "primary" { 40.0 } else { 20.0 })));
+        for p in points {
+            assert!(p["x"].as_f64().unwrap() > 0.0 && p["median"].as_f64().unwrap() > 0.0, "{p}");
+        }
+    }
+    for (text, needle) in [
+        (line(500, 32), "for 500 triangles, this mesh has 512"),
+        (line(512, 64), "for 64x24, these rays for 32x24"),
+        ("{\"peer\": \"Mitsuba path\"}\n".to_string(), "no mesh measurement"),
+        ("not json\n".to_string(), "line 1: not a JSON line"),
+    ] {
+        std::fs::write(&peer, text).unwrap();
+        let e = stderr_of(&[&args[..], &extra[..]].concat());
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `bench dynamic` animates a mesh frame by frame (refit, rebuilds, rays)
 /// and writes what it measured; a scene without triangles is refused.
 #[test]

@@ -23,6 +23,7 @@ mod figure;
 mod measure;
 pub mod results;
 mod suite;
+mod tradeoff;
 
 /// Options of every figure command.
 #[derive(clap::Args, Clone)]
@@ -140,6 +141,14 @@ pub enum BenchCommand {
         mesh_only: bool,
         #[arg(long)]
         json: Option<std::path::PathBuf>,
+        /// Also draw build time against rays per second (`tradeoff-primary`
+        /// and `tradeoff-diffuse`, JSON and PNG) into this folder.
+        #[arg(long)]
+        figure: Option<std::path::PathBuf>,
+        /// OptiX's point for that figure: the output of
+        /// `../shared/tools/optix-peer/peer.py` for the same mesh and size.
+        #[arg(long, requires = "figure")]
+        optix: Option<std::path::PathBuf>,
     },
     /// An animated mesh through the engine API: per frame, refit against
     /// rebuild (LBVH, TRBVH), and one frame's rays (closest hits and
@@ -240,13 +249,20 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, json } => {
+        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, json, figure, optix } => {
+            // The peer's file first: a bad one fails before minutes of timing.
+            let peer = optix.as_deref().map(tradeoff::read_peer).transpose()?;
             let scene = Scene::from_spec(&scene)?;
             let scene = if mesh_only { scene.mesh_only()? } else { scene };
+            if let Some(p) = &peer {
+                tradeoff::check_peer(p, scene.triangles.len(), (width, height))?;
+            }
             let plan = RaysPlan { layouts, workgroup_stack };
             let mut rows = Vec::new();
             let mut clocks = None;
-            let adapter = match device.open()? {
+            let opened = device.open()?;
+            let kind = if matches!(opened, Device::Gpu(_)) { "gpu" } else { "cpu" };
+            let adapter = match opened {
                 Device::Gpu(ctx) => {
                     let mut b = GpuBackend::new(ctx);
                     let before = clocks::read();
@@ -295,6 +311,10 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
                 let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows, "clocks": clocks });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            if let Some(dir) = figure {
+                tradeoff::write(&dir, &rows, (width, height), (kind, &adapter), peer.as_ref())?;
+                eprintln!("wrote {}/tradeoff-primary.png and tradeoff-diffuse.png", dir.display());
             }
             Ok(())
         }

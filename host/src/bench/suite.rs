@@ -83,7 +83,7 @@ fn render_times<B: Backend>(
 }
 
 /// A tree and its layout, as the figures name them ("TRBVH, cwbvh").
-fn tree_name(a: Accel, layout: Layout) -> String {
+pub(crate) fn tree_name(a: Accel, layout: Layout) -> String {
     match layout {
         Layout::Auto => accel_name(a).to_string(),
         _ => format!("{}, {}", accel_name(a), layout.name()),
