@@ -60,5 +60,5 @@ pub mod tracer;
 pub use runtime::backend::Backend;
 pub use runtime::cpu_runner::CpuBackend;
 pub use runtime::gpu::{GpuBackend, GpuContext};
-pub use tracer::{Quality, Ray, RayHit, Tracer};
+pub use tracer::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer};
 pub use treelet_core::{Sphere, Triangle};

@@ -1,6 +1,7 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{Material, Node, RenderParams, Sphere};
+use treelet_core::geometry::buffers::{InstanceRecord, Material, Node, RenderParams, Sphere};
+use treelet_core::geometry::prims::Prims;
 use treelet_core::geometry::features::{ALL, TRIANGLES};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
@@ -171,4 +172,29 @@ pub fn cast_cwbvh_workgroup_cs(
     let tree = WideTree::new(nodes, prims);
     let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
     treelet_core::render::rays::cast_kernel::<_, ALL, WORKGROUP_STACK_WORDS>(id, params, &scene, rays, stack, lane);
+}
+
+/// An engine's rays through an instanced scene: the top-level tree over
+/// the instances, then each instance's mesh tree (bindings: see
+/// `treelet_core::render::rays::cast_instances_kernel`).
+#[spirv(compute(threads(256)))]
+pub fn cast_instances_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] top_nodes: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] top_leaves: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] instances: &[InstanceRecord],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] leaves: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] rays: &mut [[f32; 4]],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    // Bound whole: the part past the split (the same slice) is never read.
+    let prims = Prims { spheres, sphere_count: 0, triangles: Split::new(triangles, triangles), triangle_count: params.triangles };
+    treelet_core::render::rays::cast_instances_kernel(
+        id, params, top_nodes, top_leaves, instances, nodes, leaves, &prims, rays,
+    );
 }

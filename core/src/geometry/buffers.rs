@@ -137,6 +137,18 @@ pub struct FillParams {
 }
 const _: () = assert!(core::mem::size_of::<FillParams>() == 16);
 
+/// Parameters of [`crate::construct::fill::copy_words_kernel`] (in words).
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct CopyParams {
+    pub len: u32,
+    pub src_offset: u32,
+    pub dst_offset: u32,
+    pub _pad0: u32,
+}
+const _: () = assert!(core::mem::size_of::<CopyParams>() == 16);
+
 /// Surface kinds of smallpt.
 pub const DIFFUSE: u32 = 0;
 pub const MIRROR: u32 = 1;
@@ -202,7 +214,10 @@ pub struct RenderParams {
     pub integrator: u32,
     /// Entries of the light table ([`crate::render::lights::Light`]).
     pub light_count: u32,
-    pub _pad: [u32; 2],
+    /// Instances of an instanced scene's cast
+    /// ([`crate::render::rays::cast_instances_kernel`]).
+    pub instances: u32,
+    pub _pad: u32,
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
 
@@ -260,6 +275,51 @@ pub struct LeafPrim {
     pub _pad2: u32,
 }
 const _: () = assert!(core::mem::size_of::<LeafPrim>() == 48);
+
+/// One placed copy of a mesh, as the instanced traversal reads it
+/// ([`crate::trace::instances`]): the rows of the 3x4 matrix that takes
+/// world points into the mesh's own space (`x' = row · (x, 1)`), and where
+/// the mesh's tree and triangles start in the buffers that hold every
+/// mesh's one after another. repr(C), Pod, 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct InstanceRecord {
+    pub object_from_world: [[f32; 4]; 3],
+    /// The mesh's root node in the bottom-level node buffer.
+    pub node_base: u32,
+    /// Its first leaf primitive (`LeafPrim`) and first triangle.
+    pub leaf_base: u32,
+    pub triangle_base: u32,
+    /// The mesh's index, as the engine numbered its meshes.
+    pub mesh: u32,
+}
+const _: () = assert!(core::mem::size_of::<InstanceRecord>() == 64);
+
+impl InstanceRecord {
+    /// The ray `o + t d` in the mesh's space: the same `t` reaches the same
+    /// point (an affine map keeps the parameter; `d` is not renormalized).
+    #[inline]
+    pub fn to_object(&self, o: Vec3, d: Vec3) -> (Vec3, Vec3) {
+        let row = |k: usize| Vec3::new(self.object_from_world[k][0], self.object_from_world[k][1], self.object_from_world[k][2]);
+        let (x, y, z) = (row(0), row(1), row(2));
+        let shift = Vec3::new(self.object_from_world[0][3], self.object_from_world[1][3], self.object_from_world[2][3]);
+        (Vec3::new(x.dot(o), y.dot(o), z.dot(o)) + shift, Vec3::new(x.dot(d), y.dot(d), z.dot(d)))
+    }
+
+    /// The cross product `(v1 - v0) x (v2 - v0)` of a triangle once placed
+    /// in the world, from `n`, the same of the triangle in the mesh's space
+    /// (unnormalized): the transpose of the world-to-object map's linear
+    /// part applied to `n`, turned over where the map mirrors (the placed
+    /// corners then go round the other way).
+    #[inline]
+    pub fn normal_to_world(&self, n: Vec3) -> Vec3 {
+        let m = &self.object_from_world;
+        let row = |k: usize| Vec3::new(m[k][0], m[k][1], m[k][2]);
+        let w = row(0) * n.x + row(1) * n.y + row(2) * n.z;
+        if row(0).dot(row(1).cross(row(2))) < 0.0 { -w } else { w }
+    }
+}
 
 /// A binary node holding both children's boxes (Aila & Laine 2009), so a
 /// ray tests both children with the one load that reached their parent.

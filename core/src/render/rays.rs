@@ -7,7 +7,10 @@
 //! OptiX peer times its intersection launches alone.
 use glam::Vec3;
 
-use crate::geometry::buffers::RenderParams;
+use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, RenderParams};
+use crate::geometry::records::RecordLoad;
+use crate::gpu::unchecked::at;
+use crate::trace::instances::{trace_instances, InstanceHit};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{WatertightRay, ray_triangle_barycentrics};
@@ -72,29 +75,18 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);
     if params.cast_mode == CAST_RAYS || params.cast_mode == CAST_OCCLUDED {
-        if rays[j][3] != 0.0 {
-            let (o, d) = (Vec3::new(rays[i][0], rays[i][1], rays[i][2]), Vec3::new(rays[j][0], rays[j][1], rays[j][2]));
-            let len = d.length();
-            let t_max = rays[i][3];
-            // An infinite `t_max` is no bound; a NaN one finds nothing.
-            let query = if params.cast_mode == CAST_OCCLUDED { Query::occlusion(t_max, u32::MAX) } else { Query::closest_within(t_max) };
-            let hit = if len > 0.0 && len.is_finite() && t_max >= 0.0 {
-                trace::<T, F, S>(o, d / len, Origin::NONE, query, scene, stack, lane)
+        let EngineRay { o, d, query, marked } = engine_ray(params, rays, id);
+        if marked {
+            let hit = if query.t_max >= 0.0 { trace::<T, F, S>(o, d, Origin::NONE, query, scene, stack, lane) } else { Hit::NONE };
+            let found = hit.is_hit() && hit.t <= query.t_max;
+            let record = if found {
+                let (b1, b2) = barycentrics::<F>(&scene.prims, hit.prim, o, d);
+                let n = geometric_normal::<F>(&scene.prims, hit.prim, o + d * hit.t);
+                Some(([hit.t, f32::from_bits(hit.prim), b1, b2], [n.x, n.y, n.z, 0.0]))
             } else {
-                Hit::NONE
+                None
             };
-            let found = hit.is_hit() && hit.t <= t_max;
-            rays[i] = if params.cast_mode == CAST_OCCLUDED {
-                [found as u32 as f32, 0.0, 0.0, 0.0]
-            } else if found {
-                let (b1, b2) = barycentrics::<F>(&scene.prims, hit.prim, o, d / len);
-                let n = geometric_normal::<F>(&scene.prims, hit.prim, o + d / len * hit.t);
-                rays[j] = [n.x, n.y, n.z, 0.0];
-                [hit.t, f32::from_bits(hit.prim), b1, b2]
-            } else {
-                rays[j] = [0.0; 4];
-                [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0]
-            };
+            write_engine_hit(params, rays, id, found, record);
         }
     } else if params.cast_mode == CAST_PRIMARY {
         let (o, d) = camera_ray(params, id);
@@ -123,6 +115,100 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
         let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
+    }
+}
+
+/// Kernel (one invocation per ray, in tiles as [`cast_kernel`]): an
+/// engine's rays ([`CAST_RAYS`], [`CAST_OCCLUDED`]) through an instanced
+/// scene ([`crate::trace::instances`]: the top-level tree `top_nodes`,
+/// `top_leaves` over `instances`; the meshes' trees `nodes`, `leaves`; their
+/// triangles in `prims`, one mesh after another). A closest hit writes
+/// `(t, primitive within its mesh, b1, b2)` and `(unit world normal, bits
+/// of the instance)`, as [`cast_kernel`] does for one mesh.
+#[allow(clippy::too_many_arguments)]
+pub fn cast_instances_kernel(
+    invocation: u32,
+    params: &RenderParams,
+    top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
+    top_leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
+    instances: &[InstanceRecord],
+    nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
+    leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
+    prims: &Prims,
+    rays: &mut [[f32; 4]],
+) {
+    let id = tiled_pixel(invocation, params.width, params.height);
+    if id == u32::MAX || (params.cast_mode != CAST_RAYS && params.cast_mode != CAST_OCCLUDED) {
+        return;
+    }
+    let EngineRay { o, d, query, marked } = engine_ray(params, rays, id);
+    if !marked {
+        return;
+    }
+    let hit = if query.t_max >= 0.0 && params.instances > 0 {
+        trace_instances(o, d, query, top_nodes, top_leaves, instances, nodes, leaves, prims)
+    } else {
+        InstanceHit { t: MISS, prim: u32::MAX, instance: u32::MAX }
+    };
+    let found = hit.is_hit() && hit.t <= query.t_max;
+    let record = if found && params.cast_mode == CAST_RAYS {
+        // The barycentrics by the traversal's own test, in the mesh's space.
+        let instance = at(instances, hit.instance as usize);
+        let tri = prims.triangle(instance.triangle_base + hit.prim);
+        let (o2, d2) = instance.to_object(o, d);
+        let (_, b1, b2) = ray_triangle_barycentrics(&WatertightRay::new(o2, d2), &tri, MISS);
+        let (a, b, c) = (Vec3::from_array(tri.v0), Vec3::from_array(tri.v1), Vec3::from_array(tri.v2));
+        let n = instance.normal_to_world((b - a).cross(c - a)).normalize_or_zero();
+        Some(([hit.t, f32::from_bits(hit.prim), b1, b2], [n.x, n.y, n.z, f32::from_bits(hit.instance)]))
+    } else {
+        None
+    };
+    write_engine_hit(params, rays, id, found, record);
+}
+
+/// An engine's ray ([`CAST_RAYS`], [`CAST_OCCLUDED`]), read by [`engine_ray`].
+#[derive(Clone, Copy)]
+pub struct EngineRay {
+    pub o: Vec3,
+    /// Unit direction.
+    pub d: Vec3,
+    pub query: Query,
+    /// The ray is marked to be traced (else its slots stay as they are).
+    pub marked: bool,
+}
+
+/// An engine's ray `id`: origin, unit direction and the query to trace. A
+/// ray with no direction or an invalid `t_max` gets a query with a
+/// negative `t_max`: not to be traced, it finds nothing. (A struct, not an
+/// `Option`: rust-gpu cannot make an `Option` of vectors.)
+#[inline]
+pub fn engine_ray(params: &RenderParams, rays: &[[f32; 4]], id: u32) -> EngineRay {
+    let (i, j) = (2 * id as usize, 2 * id as usize + 1);
+    let (o, d) = (Vec3::new(rays[i][0], rays[i][1], rays[i][2]), Vec3::new(rays[j][0], rays[j][1], rays[j][2]));
+    let len = d.length();
+    // An infinite `t_max` is no bound; a NaN one finds nothing.
+    let mut t_max = rays[i][3];
+    if !(len > 0.0 && len.is_finite() && t_max >= 0.0) {
+        t_max = -1.0;
+    }
+    let query = if params.cast_mode == CAST_OCCLUDED { Query::occlusion(t_max, u32::MAX) } else { Query::closest_within(t_max) };
+    EngineRay { o, d: d / len.max(f32::MIN_POSITIVE), query, marked: rays[j][3] != 0.0 }
+}
+
+/// Writes what ray `id` found: for an occlusion query whether it `found`
+/// anything; for a closest hit its `record` (hit, and normal with the
+/// instance), or a miss.
+#[inline]
+pub fn write_engine_hit(params: &RenderParams, rays: &mut [[f32; 4]], id: u32, found: bool, record: Option<([f32; 4], [f32; 4])>) {
+    let (i, j) = (2 * id as usize, 2 * id as usize + 1);
+    if params.cast_mode == CAST_OCCLUDED {
+        rays[i] = [found as u32 as f32, 0.0, 0.0, 0.0];
+    } else if let Some((hit, normal)) = record {
+        rays[i] = hit;
+        rays[j] = normal;
+    } else {
+        rays[i] = [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0];
+        rays[j] = [0.0, 0.0, 0.0, f32::from_bits(u32::MAX)];
     }
 }
 

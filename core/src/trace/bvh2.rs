@@ -53,7 +53,7 @@ impl<N: RecordLoad<Bvh2Node>, P: RecordLoad<LeafPrim>> ClosestHit for Bvh2Tree<N
 /// inside this loop lost hits on lavapipe, about one occluded ray in twenty).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn leaf<const F: u32>(
+pub(crate) fn leaf<const F: u32>(
     hit: &mut Hit,
     first: u32,
     count: u32,
@@ -100,29 +100,45 @@ pub fn trace_bvh2<const F: u32>(
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaf_prims: &(impl RecordLoad<LeafPrim> + ?Sized),
 ) -> Hit {
-    let mut hit = query.start();
     if prims.count() == 0 {
-        return hit;
+        return query.start();
     }
-    let slabs = SlabRay::new(o, d);
     let ray = WatertightRay::new(o, d);
-    let at_ray = (o, d, from);
+    walk_bvh2(&SlabRay::new(o, d), &query, nodes, |hit, first, count| {
+        leaf::<F>(hit, first, count, (o, d, from), &query, &ray, prims, leaf_prims)
+    })
+}
+
+/// The walk through a [`Bvh2Node`] tree (root 0) that every traversal of
+/// this layout shares, from `query.start()`: nearer child first; a leaf's
+/// `count` items from `first` on go to `leaf(hit, first, count)`, which
+/// narrows `hit` (primitives, or an instanced scene's instances:
+/// [`crate::trace::instances`]). Returns when `query` is done or no node
+/// nearer than the hit is left.
+#[inline]
+pub fn walk_bvh2(
+    slabs: &SlabRay,
+    query: &Query,
+    nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
+    mut leaf: impl FnMut(&mut Hit, u32, u32),
+) -> Hit {
+    let mut hit = query.start();
     // Entries: node index and the entry distance it was pushed with.
     let mut stack = [0u32; 2 * STACK_DEPTH];
     let mut top = 0usize;
     let mut node = 0u32;
     loop {
         let n = nodes.load(node as usize);
-        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
-        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, slabs, hit.t);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
         // Leaves are tested at once; only internal children are walked.
         if go_left && n.left_count > 0 {
-            leaf::<F>(&mut hit, n.left, n.left_count, at_ray, &query, &ray, prims, leaf_prims);
+            leaf(&mut hit, n.left, n.left_count);
             go_left = false;
         }
         if go_right && n.right_count > 0 {
-            leaf::<F>(&mut hit, n.right, n.right_count, at_ray, &query, &ray, prims, leaf_prims);
+            leaf(&mut hit, n.right, n.right_count);
             go_right = false;
         }
         if query.done(&hit) {

@@ -15,3 +15,4 @@ pub mod bvh2;
 pub mod classic;
 pub mod cwbvh;
 pub mod hit;
+pub mod instances;

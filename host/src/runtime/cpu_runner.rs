@@ -346,6 +346,29 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fill::fill_kernel(id, &p, data);
             }
         }
+        (Kernel::CopyWords, [p, src, dst]) => {
+            let p: treelet_core::CopyParams = params(p);
+            let (src, dst) = (view::<u32>(src), view::<u32>(dst));
+            for id in ids(groups) {
+                fill::copy_words_kernel(id, &p, src, dst);
+            }
+        }
+        (Kernel::CastInstances, [p, top_nodes, top_leaves, instances, nodes, leaves, spheres, triangles, rays]) => {
+            use treelet_core::{Bvh2Node, LeafPrim};
+            let p: treelet_core::RenderParams = params(p);
+            let prims = treelet_core::geometry::prims::Prims {
+                spheres: view(spheres),
+                sphere_count: 0,
+                triangles: Split::whole(view(triangles)),
+                triangle_count: p.triangles,
+            };
+            let (top_nodes, top_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(top_nodes), view(top_leaves));
+            let (nodes, leaves): (&[Bvh2Node], &[LeafPrim]) = (view(nodes), view(leaves));
+            let (instances, rays) = (view(instances), view(rays));
+            for id in ids(groups) {
+                treelet_core::render::rays::cast_instances_kernel(id, &p, top_nodes, top_leaves, instances, nodes, leaves, &prims, rays);
+            }
+        }
         (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {
             let p: treelet_core::BuildParams = params(p);
             let (spheres, triangles, boxes) = (view(spheres), view(triangles), view::<treelet_core::Aabb>(boxes));

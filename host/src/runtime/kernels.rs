@@ -169,11 +169,18 @@ pub enum Kernel {
     Cast(Method, bool),
     /// [`Kernel::Cast`] through the wide BVH with the top of the stack in workgroup memory.
     CastWideWorkgroupStack,
+    /// Words copied from one buffer into another.
+    CopyWords,
+    /// An engine's rays through an instanced scene (a top-level tree over
+    /// instances of meshes, `bvh2` layout at both levels).
+    CastInstances,
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 54] = [
+    const FIXED: [Kernel; 56] = [
         Kernel::Fill,
+        Kernel::CopyWords,
+        Kernel::CastInstances,
         Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
         Kernel::ReduceBounds,
@@ -248,6 +255,8 @@ impl Kernel {
     pub fn entry_point(self) -> &'static str {
         match self {
             Kernel::Fill => "fill::fill_cs",
+            Kernel::CopyWords => "fill::copy_words_cs",
+            Kernel::CastInstances => "render::cast_instances_cs",
             Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
@@ -334,6 +343,8 @@ impl Kernel {
     pub fn bindings(self) -> &'static [Access] {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
+            Kernel::CopyWords => &[Read, Read, ReadWrite],
+            Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],

@@ -31,6 +31,9 @@ use crate::runtime::backend::{Backend, DeviceClass};
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
 
+mod instances;
+pub use instances::{Instance, InstancedTracer};
+
 /// A ray of a batch: from `origin` along `dir` (any length but zero), hits
 /// from distance `t_min` (finite, at least 0) up to `t_max` (both along the
 /// normalized direction). A ray that leaves a surface should start a little
@@ -51,23 +54,28 @@ impl Ray {
 }
 
 /// The closest hit of a ray: the primitive (spheres first, then triangles,
-/// in the order given to [`Tracer::build`]), the distance along the
-/// normalized direction, a triangle's barycentric coordinates of the hit
-/// (of `v1` and `v2`: the point is `(1 - b1 - b2) v0 + b1 v1 + b2 v2`; 0 for
-/// a sphere), to interpolate vertex normals and texture coordinates, and the
-/// geometric normal (unit; a triangle's `(v1 - v0) x (v2 - v0)`, a sphere's
-/// outward). For no hit: `prim == u32::MAX`, `t` infinite, the rest 0.
+/// in the order given to [`Tracer::build`]; in an instanced scene the
+/// triangle's index within its mesh), the instance hit (0 for a
+/// [`Tracer`], which is one), the distance along the normalized direction,
+/// a triangle's barycentric coordinates of the hit (of `v1` and `v2`: the
+/// point is `(1 - b1 - b2) v0 + b1 v1 + b2 v2`; 0 for a sphere), to
+/// interpolate vertex normals and texture coordinates, and the geometric
+/// normal in world space (unit; a triangle's `(v1 - v0) x (v2 - v0)`, a
+/// sphere's outward). For no hit: `prim` and `instance` `u32::MAX`, `t`
+/// infinite, the rest 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayHit {
     pub t: f32,
     pub prim: u32,
+    pub instance: u32,
     pub barycentrics: [f32; 2],
     pub normal: [f32; 3],
 }
 
 impl RayHit {
     /// No hit.
-    pub const MISS: RayHit = RayHit { t: f32::INFINITY, prim: u32::MAX, barycentrics: [0.0; 2], normal: [0.0; 3] };
+    pub const MISS: RayHit =
+        RayHit { t: f32::INFINITY, prim: u32::MAX, instance: u32::MAX, barycentrics: [0.0; 2], normal: [0.0; 3] };
 
     pub fn is_hit(&self) -> bool {
         self.prim != u32::MAX
@@ -109,14 +117,33 @@ impl Quality {
     }
 }
 
-/// The record of a device hit `(t, prim, b1, b2)` with its normal `(n, 0)`
-/// of ray `r` (traced from `t_min` on: see [`device_rays`]).
-fn hit_record(r: &Ray, [t, prim, b1, b2]: [f32; 4], [nx, ny, nz, _]: [f32; 4]) -> RayHit {
+/// The record of a device hit `(t, prim, b1, b2)` with its normal and
+/// instance `(n, bits of the instance)` of ray `r` (traced from `t_min` on:
+/// see [`device_rays`]).
+fn hit_record(r: &Ray, [t, prim, b1, b2]: [f32; 4], [nx, ny, nz, instance]: [f32; 4]) -> RayHit {
     let prim = prim.to_bits();
     if prim == u32::MAX {
         return RayHit::MISS;
     }
-    RayHit { t: t + r.t_min, prim, barycentrics: [b1, b2], normal: [nx, ny, nz] }
+    RayHit { t: t + r.t_min, prim, instance: instance.to_bits(), barycentrics: [b1, b2], normal: [nx, ny, nz] }
+}
+
+/// Uploads `rays`, has `cast` trace them on the device in place, and reads
+/// the two vectors of each back.
+fn read_batch<B: Backend>(
+    b: &mut B,
+    rays: &[Ray],
+    cast: impl FnOnce(&mut B, &B::Buffer) -> Result<()>,
+) -> Result<Vec<[f32; 4]>> {
+    let buffer = b.upload("rays", &device_rays(rays)?)?;
+    cast(b, &buffer)?;
+    b.read(&buffer, 2 * rays.len())
+}
+
+/// The image a batch of `count` rays is cast as (the cast kernels walk one).
+fn batch_dims(count: usize) -> Result<(u32, u32)> {
+    let slots = batch_slots(count)? as u32;
+    Ok((BATCH_WIDTH.min(slots.max(1)), slots.div_ceil(BATCH_WIDTH).max(1)))
 }
 
 /// Rays a device batch holds per row (the cast kernels walk an image).
@@ -230,9 +257,7 @@ impl<B: Backend> Tracer<B> {
             check_rays(rays)?;
             return Ok(vec![RayHit::MISS; rays.len()]);
         }
-        let buffer = b.upload("rays", &device_rays(rays)?)?;
-        self.closest_hits_on_device(b, &buffer, rays.len())?;
-        let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
+        let out = read_batch(b, rays, |b, buffer| self.closest_hits_on_device(b, buffer, rays.len()))?;
         Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
     }
 
@@ -245,9 +270,7 @@ impl<B: Backend> Tracer<B> {
             check_rays(rays)?;
             return Ok(vec![false; rays.len()]);
         }
-        let buffer = b.upload("rays", &device_rays(rays)?)?;
-        self.occluded_on_device(b, &buffer, rays.len())?;
-        let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
+        let out = read_batch(b, rays, |b, buffer| self.occluded_on_device(b, buffer, rays.len()))?;
         Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
     }
 
@@ -257,8 +280,9 @@ impl<B: Backend> Tracer<B> {
     /// `rays[2k]` = (origin, t_max) and `rays[2k + 1]` = (direction, 1), as
     /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, b1,
     /// b2): a triangle's barycentric coordinates of the hit as in [`RayHit`]
-    /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0),
-    /// zeros for a miss. The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0:
+    /// the bits of instance 0); for a miss (inf, bits of `u32::MAX`, 0, 0)
+    /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
     /// `count` must be zero. Submitted, not waited for.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_RAYS)
@@ -272,8 +296,7 @@ impl<B: Backend> Tracer<B> {
     }
 
     fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
-        let slots = batch_slots(count)? as u32;
-        let (width, height) = (BATCH_WIDTH.min(slots.max(1)), slots.div_ceil(BATCH_WIDTH).max(1));
+        let (width, height) = batch_dims(count)?;
         let params = RenderParams {
             width,
             height,

@@ -1,0 +1,387 @@
+//! Instanced scenes for engines: each mesh gets its own (bottom-level)
+//! tree, built once and refit or rebuilt only when the mesh changes; the
+//! scene places meshes many times with 3x4 transforms, and a top-level tree
+//! over the placed copies, cheap to rebuild every frame, finds which copies
+//! a ray meets. Both levels are traced in one kernel
+//! (`treelet_core::trace::instances`), on the GPU or the CPU runner.
+//!
+//! ```
+//! use treelet::{CpuBackend, Instance, InstancedTracer, Quality, Ray, Triangle};
+//! let quad = [Triangle::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]), Triangle::new([1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0])];
+//! let b = &mut CpuBackend::new();
+//! // The quad twice: at z = 5, and at z = 9.
+//! let placed = [Instance::translated(0, [0.0, 0.0, 5.0]), Instance::translated(0, [0.0, 0.0, 9.0])];
+//! let mut scene = InstancedTracer::build(b, &[&quad], &placed, Quality::Fast)?;
+//! let ray = Ray::new([0.7, 0.6, 0.0], [0.0, 0.0, 1.0]);
+//! let hit = scene.closest_hits(b, &[ray])?[0];
+//! assert_eq!((hit.t, hit.instance, hit.prim), (5.0, 0, 1));
+//! // Next frame: the first copy moves away; only the top level is rebuilt.
+//! scene.set_instances(b, &[Instance::translated(0, [4.0, 0.0, 5.0]), placed[1]])?;
+//! assert_eq!(scene.closest_hits(b, &[ray])?[0].instance, 1);
+//! # anyhow::Ok(())
+//! ```
+use anyhow::{bail, Context, Result};
+use treelet_core::geometry::buffers::{CopyParams, InstanceRecord, RenderParams};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
+use treelet_core::render::integrator::tiled_invocations;
+use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
+
+use super::{batch_dims, hit_record, read_batch, Quality, Ray, RayHit, Tracer};
+use crate::bvh::layout::{Layout, TracedTree};
+use crate::bvh::tree::{binary_tree, Builder};
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::Kernel;
+use crate::scene::primitives::Primitives;
+
+/// A placed copy of mesh `mesh` (its index in the list given to
+/// [`InstancedTracer::build`]): `transform` takes the mesh's points into
+/// the world, as the rows of a 3x4 matrix (`world = M · (x, y, z, 1)`). Any
+/// invertible transform: rotations, scales (also negative or unequal),
+/// shears, translations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    pub mesh: u32,
+    pub transform: [[f32; 4]; 3],
+}
+
+impl Instance {
+    /// The transform that leaves a mesh where it is.
+    pub const IDENTITY: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]];
+
+    /// Mesh `mesh` moved by `offset`.
+    pub fn translated(mesh: u32, offset: [f32; 3]) -> Instance {
+        let mut transform = Self::IDENTITY;
+        for (row, o) in transform.iter_mut().zip(offset) {
+            row[3] = o;
+        }
+        Instance { mesh, transform }
+    }
+}
+
+/// Every mesh's tree and triangles, one mesh after another in one buffer
+/// each (what the instanced kernel binds), and where each mesh's start.
+struct Gathered<B: Backend> {
+    nodes: B::Buffer,
+    leaves: B::Buffer,
+    triangles: B::Buffer,
+    /// Per mesh: first node, first leaf primitive, first triangle.
+    bases: Vec<[u32; 3]>,
+    /// Per mesh: its layout's node count (a refit may change it: the SAH
+    /// leaf collapse decides anew on the new boxes).
+    node_counts: Vec<u32>,
+    triangle_count: u32,
+}
+
+/// The top-level tree over the instances' world boxes (leaf primitive `k`
+/// is instance `k`) and the instances as the kernel reads them.
+struct TopLevel<B: Backend> {
+    tree: TracedTree<B>,
+    records: B::Buffer,
+    count: u32,
+}
+
+/// Meshes placed many times, on one device, for closest hits and occlusion
+/// queries: see the module doc.
+pub struct InstancedTracer<B: Backend> {
+    meshes: Vec<Tracer<B>>,
+    /// Each mesh's box in its own space.
+    bounds: Vec<[[f64; 3]; 2]>,
+    gathered: Gathered<B>,
+    top: Option<TopLevel<B>>,
+    instances: Vec<Instance>,
+    /// Placeholders: the kernel's sphere binding (instanced meshes are
+    /// triangles), and its top-level bindings while there are no instances.
+    no_spheres: B::Buffer,
+    no_top: [B::Buffer; 3],
+    update_ms: f64,
+}
+
+impl<B: Backend> InstancedTracer<B> {
+    /// Builds a tree per mesh (with `quality`'s builder) and the top-level
+    /// tree over `instances`. Every mesh needs a triangle; bad input (a
+    /// non-finite vertex, an instance of a mesh that is not there, a
+    /// non-finite or singular transform) is refused by name.
+    pub fn build(b: &mut B, meshes: &[&[Triangle]], instances: &[Instance], quality: Quality) -> Result<Self> {
+        if meshes.len() > u32::MAX as usize {
+            bail!("{} meshes: at most {} are supported", meshes.len(), u32::MAX);
+        }
+        let mut trees = Vec::with_capacity(meshes.len());
+        let mut bounds = Vec::with_capacity(meshes.len());
+        let mut update_ms = 0.0;
+        for (m, triangles) in meshes.iter().enumerate() {
+            if triangles.is_empty() {
+                bail!("mesh {m} has no triangles: every instanced mesh needs one");
+            }
+            let tracer = Tracer::build(b, &[], triangles, quality).with_context(|| format!("mesh {m}"))?;
+            update_ms += tracer.last_update_ms();
+            trees.push(tracer);
+            bounds.push(mesh_bounds(triangles));
+        }
+        let gathered = gather(b, &trees)?;
+        let no_spheres = b.upload("no spheres", &[treelet_core::Sphere::default()])?;
+        let no_top = [b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?];
+        b.keep(&[&no_spheres, &no_top[0], &no_top[1], &no_top[2]]);
+        let mut scene = InstancedTracer {
+            meshes: trees,
+            bounds,
+            gathered,
+            top: None,
+            instances: Vec::new(),
+            no_spheres,
+            no_top,
+            update_ms: 0.0,
+        };
+        scene.set_instances(b, instances)?;
+        scene.update_ms += update_ms;
+        Ok(scene)
+    }
+
+    /// Places the meshes anew (any number of instances, any transforms):
+    /// rebuilds the top-level tree only.
+    pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> Result<()> {
+        let records = self.records(instances)?;
+        self.instances = instances.to_vec();
+        self.top = None;
+        self.update_ms = 0.0;
+        if instances.is_empty() {
+            return Ok(());
+        }
+        // The top level is an LBVH over the instances' world boxes, each
+        // given as a triangle whose box it is (corners `min`, `max`, `min`):
+        // the builders need nothing but the boxes. One instance a leaf: each
+        // costs a walk of its mesh's tree.
+        let boxes: Vec<Triangle> = instances.iter().map(|i| world_box(&self.bounds[i.mesh as usize], &i.transform)).collect();
+        let all = Primitives { spheres: &[], triangles: &boxes };
+        let built = binary_tree(b, all, Builder::Lbvh)?;
+        let prims = built.prim_buffers(b, all)?;
+        let (tree, layout_ms) = built.lay_out(b, Layout::Bvh2, &prims)?;
+        let records = b.upload("instances", &records)?;
+        b.keep(&[&tree.nodes, &tree.prims, &records]);
+        self.top = Some(TopLevel { tree, records, count: instances.len() as u32 });
+        self.update_ms = built.build_ms + layout_ms;
+        Ok(())
+    }
+
+    /// Moves the triangles of mesh `mesh` (the same count, in the same
+    /// order): its tree is refit (see [`Tracer::refit`]), its part of the
+    /// gathered buffers copied again, and the top level rebuilt over the
+    /// instances' new boxes.
+    pub fn refit_mesh(&mut self, b: &mut B, mesh: usize, triangles: &[Triangle]) -> Result<()> {
+        let Some(tracer) = self.meshes.get_mut(mesh) else {
+            bail!("refit of mesh {mesh}: there are {} meshes", self.meshes.len());
+        };
+        tracer.refit(b, &[], triangles).with_context(|| format!("mesh {mesh}"))?;
+        let refit_ms = tracer.last_update_ms();
+        self.bounds[mesh] = mesh_bounds(triangles);
+        let nodes = self.meshes[mesh].tree.as_ref().map_or(0, |t| t.node_count);
+        if nodes == self.gathered.node_counts[mesh] {
+            copy_mesh(b, &self.meshes[mesh], &self.gathered, mesh)?;
+        } else {
+            // The mesh's layout changed size: every mesh moves.
+            self.gathered = gather(b, &self.meshes)?;
+        }
+        let instances = std::mem::take(&mut self.instances);
+        self.set_instances(b, &instances)?;
+        self.update_ms += refit_ms;
+        Ok(())
+    }
+
+    /// Device time of the last update ([`Self::build`], [`Self::set_instances`],
+    /// [`Self::refit_mesh`]), in ms, as [`Tracer::last_update_ms`].
+    pub fn last_update_ms(&self) -> f64 {
+        self.update_ms
+    }
+
+    /// The instances as placed now.
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
+    }
+
+    /// The closest hit of each ray: as [`Tracer::closest_hits`], with the
+    /// instance hit, the primitive within its mesh, and the geometric normal
+    /// in world space.
+    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
+        let out = read_batch(b, rays, |b, buffer| self.closest_hits_on_device(b, buffer, rays.len()))?;
+        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+    }
+
+    /// Whether each ray hits anything up to its `t_max`, as [`Tracer::occluded`].
+    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
+        let out = read_batch(b, rays, |b, buffer| self.occluded_on_device(b, buffer, rays.len()))?;
+        Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+    }
+
+    /// [`Tracer::closest_hits_on_device`] through the instances: the same
+    /// layout, and the second vector of a hit holds the bits of the
+    /// instance in its last word.
+    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_RAYS)
+    }
+
+    /// [`Tracer::occluded_on_device`] through the instances.
+    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+    }
+
+    fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
+        let (width, height) = batch_dims(count)?;
+        let Some(top) = &self.top else {
+            // No instances: every ray misses. The kernel still writes the misses.
+            let p = RenderParams { width, height, cast_mode, instances: 0, ..Default::default() };
+            return self.dispatch(b, &p, rays, None);
+        };
+        let p = RenderParams { width, height, triangles: self.gathered.triangle_count, cast_mode, instances: top.count, ..Default::default() };
+        self.dispatch(b, &p, rays, Some(top))
+    }
+
+    fn dispatch(&self, b: &mut B, p: &RenderParams, rays: &B::Buffer, top: Option<&TopLevel<B>>) -> Result<()> {
+        let params = b.upload("trace params", &[*p])?;
+        let g = &self.gathered;
+        // With no instances, the top level's bindings are never read.
+        let (top_nodes, top_leaves, records) = match top {
+            Some(t) => (&t.tree.nodes, &t.tree.prims, &t.records),
+            None => (&self.no_top[0], &self.no_top[1], &self.no_top[2]),
+        };
+        b.stage("trace");
+        b.dispatch(
+            Kernel::CastInstances,
+            &[&params, top_nodes, top_leaves, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
+            groups_for(tiled_invocations(p.width, p.height), WORKGROUP_SIZE),
+        );
+        Ok(())
+    }
+
+    /// The kernel's records of `instances`, after checking them.
+    fn records(&self, instances: &[Instance]) -> Result<Vec<InstanceRecord>> {
+        if instances.len() > (u32::MAX / 2) as usize {
+            bail!("{} instances: at most {} are supported", instances.len(), u32::MAX / 2);
+        }
+        instances
+            .iter()
+            .enumerate()
+            .map(|(k, i)| {
+                let Some(&[node_base, leaf_base, triangle_base]) = self.gathered.bases.get(i.mesh as usize) else {
+                    bail!("instance {k} places mesh {}, but there are {} meshes", i.mesh, self.meshes.len());
+                };
+                let inverse = inverse(&i.transform).with_context(|| format!("instance {k}"))?;
+                Ok(InstanceRecord { object_from_world: inverse, node_base, leaf_base, triangle_base, mesh: i.mesh })
+            })
+            .collect()
+    }
+}
+
+/// The rows of the inverse of the affine map `m` (in f64, rounded once),
+/// or an error for a non-finite or singular one.
+fn inverse(m: &[[f32; 4]; 3]) -> Result<[[f32; 4]; 3]> {
+    if m.iter().flatten().any(|x| !x.is_finite()) {
+        bail!("the transform has a non-finite entry: {m:?}");
+    }
+    let a = |r: usize, c: usize| m[r][c] as f64;
+    // The adjugate's rows (cofactors, transposed), then the determinant.
+    let cof = |r: usize, c: usize| {
+        let (r1, r2, c1, c2) = ((r + 1) % 3, (r + 2) % 3, (c + 1) % 3, (c + 2) % 3);
+        a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)
+    };
+    let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
+    // Singular relative to the matrix's own scale: a flattened copy has no
+    // inside, and its inverse no meaning.
+    let scale = (0..9).map(|k| a(k / 3, k % 3).abs()).fold(0.0f64, f64::max);
+    if !(det.abs() > 1e-12 * scale * scale * scale) {
+        bail!("the transform is singular (determinant {det:e}): it flattens the mesh");
+    }
+    let inv = |r: usize, c: usize| cof(c, r) / det;
+    let mut out = [[0f32; 4]; 3];
+    for (r, row) in out.iter_mut().enumerate() {
+        let shift = -(0..3).map(|c| inv(r, c) * a(c, 3)).sum::<f64>();
+        *row = [inv(r, 0) as f32, inv(r, 1) as f32, inv(r, 2) as f32, shift as f32];
+    }
+    if out.iter().flatten().any(|x| !x.is_finite()) {
+        bail!("the transform's inverse overflows f32: {m:?}");
+    }
+    Ok(out)
+}
+
+/// The box of a mesh's triangles, in f64.
+fn mesh_bounds(triangles: &[Triangle]) -> [[f64; 3]; 2] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for t in triangles {
+        for v in [t.v0, t.v1, t.v2] {
+            for k in 0..3 {
+                lo[k] = lo[k].min(v[k] as f64);
+                hi[k] = hi[k].max(v[k] as f64);
+            }
+        }
+    }
+    [lo, hi]
+}
+
+/// The world box of a mesh box under `m`, as the triangle the top level is
+/// built over (`min`, `max`, `min`). Widened past f32 rounding: the ray is
+/// taken into the mesh's space in f32, so a box only just touching the mesh
+/// in exact arithmetic could cull a hit the mesh's tree would find.
+fn world_box([lo, hi]: &[[f64; 3]; 2], m: &[[f32; 4]; 3]) -> Triangle {
+    let mut min = [f64::INFINITY; 3];
+    let mut max = [f64::NEG_INFINITY; 3];
+    for corner in 0..8 {
+        let p = [0, 1, 2].map(|k| if corner >> k & 1 == 0 { lo[k] } else { hi[k] });
+        for r in 0..3 {
+            let w = m[r][0] as f64 * p[0] + m[r][1] as f64 * p[1] + m[r][2] as f64 * p[2] + m[r][3] as f64;
+            min[r] = min[r].min(w);
+            max[r] = max[r].max(w);
+        }
+    }
+    let size = (0..3).map(|k| (max[k] - min[k]).max(min[k].abs()).max(max[k].abs())).fold(0.0f64, f64::max);
+    let pad = size * 1e-5;
+    Triangle::new(min.map(|x| (x - pad) as f32), max.map(|x| (x + pad) as f32), min.map(|x| (x - pad) as f32))
+}
+
+/// Gathers every mesh's layout and triangles into one buffer each.
+fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>]) -> Result<Gathered<B>> {
+    let mut bases = Vec::with_capacity(meshes.len());
+    let mut node_counts = Vec::with_capacity(meshes.len());
+    let (mut nodes, mut leaves, mut triangles) = (0u64, 0u64, 0u64);
+    for t in meshes {
+        let tree = t.tree.as_ref().context("internal: an instanced mesh without a tree")?;
+        bases.push([nodes, leaves, triangles].map(|x| x as u32));
+        node_counts.push(tree.node_count);
+        nodes += tree.node_count as u64;
+        leaves += t.counts.1 as u64;
+        triangles += t.counts.1 as u64;
+        if nodes > u32::MAX as u64 / 16 || leaves > u32::MAX as u64 / 12 {
+            bail!("the meshes hold {triangles} triangles together: too many for one instanced scene");
+        }
+    }
+    let gathered = Gathered {
+        nodes: b.scratch("instanced nodes", nodes * 64)?,
+        leaves: b.scratch("instanced leaf primitives", leaves * 48)?,
+        triangles: b.scratch("instanced triangles", triangles * 48)?,
+        bases,
+        node_counts,
+        triangle_count: triangles as u32,
+    };
+    b.keep(&[&gathered.nodes, &gathered.leaves, &gathered.triangles]);
+    for (m, t) in meshes.iter().enumerate() {
+        copy_mesh(b, t, &gathered, m)?;
+    }
+    Ok(gathered)
+}
+
+/// Copies mesh `m`'s layout and triangles into their places in `g`.
+fn copy_mesh<B: Backend>(b: &mut B, t: &Tracer<B>, g: &Gathered<B>, m: usize) -> Result<()> {
+    let tree = t.tree.as_ref().context("internal: an instanced mesh without a tree")?;
+    let [node_base, leaf_base, triangle_base] = g.bases[m];
+    let triangles = t.counts.1 as u32;
+    b.stage("gather meshes");
+    for (src, dst, base, words_each, count) in [
+        (&tree.nodes, &g.nodes, node_base, 16, tree.node_count),
+        (&tree.prims, &g.leaves, leaf_base, 12, triangles),
+        (&t.prims.triangles, &g.triangles, triangle_base, 12, triangles),
+    ] {
+        let len = count * words_each;
+        let p = b.upload("copy params", &[CopyParams { len, src_offset: 0, dst_offset: base * words_each, _pad0: 0 }])?;
+        b.dispatch(Kernel::CopyWords, &[&p, src, dst], groups_for(len, WORKGROUP_SIZE));
+    }
+    Ok(())
+}

@@ -1,0 +1,223 @@
+//! Instanced scenes (`treelet::tracer::InstancedTracer`): random meshes
+//! placed many times with random rotations, scales (mirrors too), shears
+//! and translations, traced on the GPU and the CPU runner, against the same
+//! scene flattened into one mesh (every copy's triangles transformed on the
+//! host, in f64) and traced by a plain `Tracer`; occlusion against closest
+//! hits; top-level rebuilds and mesh refits; errors by name.
+use glam::{Mat3, Quat, Vec3};
+use rand::{Rng, SeedableRng};
+use treelet::runtime::backend::Backend;
+use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::GpuBackend;
+use treelet::tracer::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_tests::{fresh_seed, gpu};
+
+/// Meshes of random small triangles in the cube [-1, 1]^3.
+fn meshes(rng: &mut impl Rng, sizes: &[usize]) -> Vec<Vec<Triangle>> {
+    sizes
+        .iter()
+        .map(|&n| {
+            (0..n)
+                .map(|_| {
+                    let mut p = || Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let a = p();
+                    let (b, c) = (a + p() * 0.3, a + p() * 0.3);
+                    Triangle::new(a.into(), b.into(), c.into())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A random rotation, scale (unequal per axis, one in four mirrored), a
+/// little shear, and a translation within [0, 40]^3.
+fn transform(rng: &mut impl Rng) -> [[f32; 4]; 3] {
+    let q = Quat::from_xyzw(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize();
+    let mut scale = Vec3::new(rng.random_range(0.5..3.0), rng.random_range(0.5..3.0), rng.random_range(0.5..3.0));
+    if rng.random_range(0..4) == 0 {
+        scale.x = -scale.x;
+    }
+    let shear = Mat3::from_cols(Vec3::X, Vec3::new(rng.random_range(-0.3..0.3), 1.0, 0.0), Vec3::Z);
+    let m = Mat3::from_quat(q) * shear * Mat3::from_diagonal(scale);
+    let t = Vec3::new(rng.random_range(0.0..40.0), rng.random_range(0.0..40.0), rng.random_range(0.0..40.0));
+    [0, 1, 2].map(|r| [m.col(0)[r], m.col(1)[r], m.col(2)[r], t[r]])
+}
+
+fn instances(rng: &mut impl Rng, n: usize, meshes: usize) -> Vec<Instance> {
+    (0..n).map(|_| Instance { mesh: rng.random_range(0..meshes as u32), transform: transform(rng) }).collect()
+}
+
+/// Point `v` of a mesh placed by `m`, in f64 then rounded.
+fn place(m: &[[f32; 4]; 3], v: [f32; 3]) -> [f32; 3] {
+    [0, 1, 2].map(|r| (m[r][0] as f64 * v[0] as f64 + m[r][1] as f64 * v[1] as f64 + m[r][2] as f64 * v[2] as f64 + m[r][3] as f64) as f32)
+}
+
+/// The scene as one mesh, and for each of its triangles (instance, triangle in the mesh).
+fn flatten(meshes: &[Vec<Triangle>], instances: &[Instance]) -> (Vec<Triangle>, Vec<(u32, u32)>) {
+    let mut out = Vec::new();
+    let mut from = Vec::new();
+    for (k, i) in instances.iter().enumerate() {
+        for (p, t) in meshes[i.mesh as usize].iter().enumerate() {
+            out.push(Triangle::new(place(&i.transform, t.v0), place(&i.transform, t.v1), place(&i.transform, t.v2)));
+            from.push((k as u32, p as u32));
+        }
+    }
+    (out, from)
+}
+
+fn rays(rng: &mut impl Rng, n: usize) -> Vec<Ray> {
+    (0..n)
+        .map(|k| {
+            let o = [rng.random_range(-5.0..45.0), rng.random_range(-5.0..45.0), rng.random_range(-5.0..45.0)];
+            let d = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+            let t_min = if k % 3 == 0 { 2.0 } else { 0.0 };
+            Ray { origin: o, dir: d, t_min, t_max: if k % 4 == 0 { 15.0 } else { f32::INFINITY } }
+        })
+        .collect()
+}
+
+/// The instanced hits against the flattened scene's: the same instance and
+/// triangle and the same distance within rounding, but for at most 0.3% of
+/// the rays (the flattened triangles are rounded after the transform, the
+/// instanced ray before its mesh's test: a ray within rounding of an edge
+/// may pass on either side). Each hit's barycentrics give its point on the
+/// placed triangle, and its normal is the placed triangle's.
+fn check(what: &str, hits: &[RayHit], flat: &[RayHit], scene: &(Vec<Triangle>, Vec<(u32, u32)>), rays: &[Ray]) {
+    assert_eq!(hits.len(), rays.len());
+    let (mut differ, mut hit) = (0, 0);
+    for ((r, h), f) in rays.iter().zip(hits).zip(flat) {
+        let expected = f.is_hit().then(|| scene.1[f.prim as usize]);
+        let got = h.is_hit().then_some((h.instance, h.prim));
+        if got != expected {
+            differ += 1;
+            continue;
+        }
+        if !h.is_hit() {
+            continue;
+        }
+        hit += 1;
+        assert!((h.t - f.t).abs() <= 1e-4 * f.t.max(1.0), "{what}: ray {r:?}: instanced {h:?}, flattened {f:?}");
+        let t = &scene.0[f.prim as usize];
+        let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
+        let [b1, b2] = h.barycentrics;
+        let p = a * (1.0 - b1 - b2) + b * b1 + c * b2;
+        let x = Vec3::from(r.origin) + Vec3::from(r.dir).normalize() * h.t;
+        assert!((p - x).length() < 1e-3 * (1.0 + x.length()), "{what}: ray {r:?}: {h:?} at {x}, barycentrics give {p}");
+        let n = Vec3::from(h.normal);
+        assert!((n - (b - a).cross(c - a).normalize()).length() < 1e-3, "{what}: ray {r:?}: normal of {h:?}");
+    }
+    assert!(differ * 1000 <= 3 * rays.len(), "{what}: {differ} of {} rays differ from the flattened scene", rays.len());
+    assert!(hit > rays.len() / 20, "{what}: only {hit} of {} rays hit: the test would prove little", rays.len());
+}
+
+/// Builds, traces, moves the instances (top level only) and refits a mesh,
+/// each checked against its flattened scene; returns every hit.
+fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> Vec<RayHit> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let mut m = meshes(&mut rng, &[400, 60, 1]);
+    let placed = instances(&mut rng, 150, m.len());
+    let rays = rays(&mut rng, 4000);
+    let what = format!("{} {quality:?} seed {seed}", b.adapter());
+    let refs: Vec<&[Triangle]> = m.iter().map(|m| m.as_slice()).collect();
+    let mut scene = InstancedTracer::build(b, &refs, &placed, quality).unwrap();
+    let mut all = Vec::new();
+    let mut check_now = |b: &mut B, scene: &InstancedTracer<B>, m: &[Vec<Triangle>], placed: &[Instance], stage: &str| {
+        let flat = flatten(m, placed);
+        let flat_hits = Tracer::build(b, &[], &flat.0, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+        let hits = scene.closest_hits(b, &rays).unwrap();
+        check(&format!("{what}, {stage}"), &hits, &flat_hits, &flat, &rays);
+        // Occlusion: exactly the rays whose closest hit is within t_max.
+        let occluded = scene.occluded(b, &rays).unwrap();
+        for ((r, h), o) in rays.iter().zip(&hits).zip(&occluded) {
+            assert_eq!(*o, h.is_hit(), "{what}, {stage}: ray {r:?}: occluded {o}, closest hit {h:?}");
+        }
+        all.extend(hits);
+    };
+    check_now(b, &scene, &m, &placed, "built");
+    // Next frame: other instances, fewer of them; the meshes' trees stay.
+    let moved = instances(&mut rng, 90, m.len());
+    scene.set_instances(b, &moved).unwrap();
+    check_now(b, &scene, &m, &moved, "instances moved");
+    // Mesh 0 deforms: its tree is refit, the top level rebuilt.
+    for t in &mut m[0] {
+        for v in [&mut t.v0, &mut t.v1, &mut t.v2] {
+            v[1] += 0.5 * v[0].sin();
+        }
+    }
+    scene.refit_mesh(b, 0, &m[0]).unwrap();
+    check_now(b, &scene, &m, &moved, "mesh refit");
+    all
+}
+
+#[test]
+fn instanced_scenes_hit_what_the_flattened_scene_hits() {
+    let seed = fresh_seed();
+    for quality in [Quality::Fast, Quality::High] {
+        let cpu = round_trip(&mut CpuBackend::new(), seed, quality);
+        if let Some(ctx) = gpu() {
+            let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);
+            // Same kernels, same trees: the same hits but for rounding.
+            let same = cpu.iter().zip(&gpu).filter(|(c, g)| (c.instance, c.prim) == (g.instance, g.prim)).count();
+            assert!(same as f64 >= 0.999 * cpu.len() as f64, "{quality:?} seed {seed}: GPU and CPU agree on {same} hits of {}", cpu.len());
+        }
+    }
+}
+
+/// One copy in place (the identity) traces exactly as the mesh's own tracer:
+/// the ray is taken into the mesh's space without rounding.
+fn in_place<B: Backend>(b: &mut B, seed: u64) {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let m = meshes(&mut rng, &[500]);
+    let rays: Vec<Ray> = rays(&mut rng, 2000).into_iter().map(|r| Ray { origin: r.origin.map(|x| x / 20.0 - 1.0), ..r }).collect();
+    let plain = Tracer::build(b, &[], &m[0], Quality::High).unwrap().closest_hits(b, &rays).unwrap();
+    let placed = InstancedTracer::build(b, &[&m[0]], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High).unwrap();
+    let hits = placed.closest_hits(b, &rays).unwrap();
+    let mut n = 0;
+    for ((r, p), h) in rays.iter().zip(&plain).zip(&hits) {
+        assert_eq!(h, p, "{} seed {seed}: ray {r:?}", b.adapter());
+        n += p.is_hit() as usize;
+    }
+    assert!(n > rays.len() / 10, "seed {seed}: only {n} hits");
+}
+
+#[test]
+fn one_instance_in_place_is_the_mesh_itself() {
+    let seed = fresh_seed();
+    in_place(&mut CpuBackend::new(), seed);
+    if let Some(ctx) = gpu() {
+        in_place(&mut GpuBackend::new(ctx), seed);
+    }
+}
+
+#[test]
+fn instanced_tracer_rejects_bad_input_by_name() {
+    let b = &mut CpuBackend::new();
+    let tri = [Triangle::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
+    let err = |r: anyhow::Result<InstancedTracer<CpuBackend>>| format!("{:#}", r.err().expect("an error"));
+    let at = |k: u32| Instance::translated(k, [0.0, 0.0, 1.0]);
+    let e = err(InstancedTracer::build(b, &[&tri], &[at(0), at(3)], Quality::Fast));
+    assert!(e.contains("instance 1 places mesh 3, but there are 1 meshes"), "{e}");
+    let flat = Instance { mesh: 0, transform: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]] };
+    let e = err(InstancedTracer::build(b, &[&tri], &[at(0), flat], Quality::Fast));
+    assert!(e.contains("instance 1") && e.contains("singular"), "{e}");
+    let nan = Instance { mesh: 0, transform: [[f32::NAN, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+    let e = err(InstancedTracer::build(b, &[&tri], &[nan], Quality::Fast));
+    assert!(e.contains("instance 0") && e.contains("non-finite"), "{e}");
+    let e = err(InstancedTracer::build(b, &[&tri, &[]], &[at(0)], Quality::Fast));
+    assert!(e.contains("mesh 1 has no triangles"), "{e}");
+    let bad = [Triangle::new([0.0, f32::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
+    let e = err(InstancedTracer::build(b, &[&tri, &bad], &[at(0)], Quality::Fast));
+    assert!(e.contains("mesh 1") && e.contains("triangle 0"), "{e}");
+    // No instances: every ray misses, nothing is occluded.
+    let mut scene = InstancedTracer::build(b, &[&tri], &[], Quality::Fast).unwrap();
+    let ray = Ray::new([0.2, 0.2, -1.0], [0.0, 0.0, 1.0]);
+    assert_eq!(scene.closest_hits(b, &[ray]).unwrap(), vec![RayHit::MISS]);
+    assert_eq!(scene.occluded(b, &[ray]).unwrap(), vec![false]);
+    scene.set_instances(b, &[at(0)]).unwrap();
+    assert_eq!(scene.closest_hits(b, &[ray]).unwrap()[0].t, 2.0);
+    let e = format!("{:#}", scene.refit_mesh(b, 2, &tri).unwrap_err());
+    assert!(e.contains("refit of mesh 2: there are 1 meshes"), "{e}");
+    let e = format!("{:#}", scene.refit_mesh(b, 0, &[tri[0], tri[0]]).unwrap_err());
+    assert!(e.contains("mesh 0") && e.contains("refit with 0 spheres and 2 triangles"), "{e}");
+}
