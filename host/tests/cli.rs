@@ -228,6 +228,26 @@ fn bench_rays_tradeoff_figure_with_the_peer_point() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// `bench instances` times top-level rebuilds and rays through a grid of
+/// copies against the mesh alone, and writes them; a scene without
+/// triangles is refused.
+#[test]
+fn bench_instances_times_top_levels_and_rays() {
+    let json = std::env::temp_dir().join(format!("treelet-instances-{}.json", std::process::id()));
+    let args = ["bench", "instances", "--device", "cpu", "--repeats", "1", "--width", "24", "--height", "16", "--grid", "3"];
+    let out = treelet(&[&args[..], &["--scene", "terrain:300", "--top-sizes", "5,40", "--json", json.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = &doc["row"];
+    assert_eq!((row["grid_instances"].as_u64(), row["top_level"][1][0].as_u64()), (Some(9), Some(40)), "{doc}");
+    for key in ["single_primary_mrays", "single_diffuse_mrays", "instanced_primary_mrays", "instanced_diffuse_mrays"] {
+        assert!(row[key].as_f64().is_some_and(|v| v > 0.0 && v.is_finite()), "{key}: {doc}");
+    }
+    std::fs::remove_file(&json).ok();
+    let e = stderr_of(&[&args[..], &["--scene", "random:10"]].concat());
+    assert!(e.contains("has no triangles"), "{e}");
+}
+
 /// `bench dynamic` animates a mesh frame by frame (refit, rebuilds, rays)
 /// and writes what it measured; a scene without triangles is refused.
 #[test]

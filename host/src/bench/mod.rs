@@ -20,6 +20,7 @@ mod clocks;
 mod dynamic;
 mod error_curves;
 mod figure;
+mod instances;
 mod measure;
 pub mod results;
 mod suite;
@@ -170,6 +171,31 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+    /// Instancing through the engine API: top-level rebuilds of many
+    /// instances, and rays through a grid of copies of a mesh against rays
+    /// through the mesh alone.
+    Instances {
+        /// The mesh: terrain:N, an .obj/.ply mesh or a .gltf/.glb scene (its triangles).
+        #[arg(long, default_value = "terrain:100000")]
+        scene: String,
+        /// Copies on a side of the square grid traced (grid x grid instances).
+        #[arg(long, default_value_t = 32)]
+        grid: usize,
+        /// Instance counts of the timed top-level rebuilds.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 100000])]
+        top_sizes: Vec<usize>,
+        #[arg(long, default_value_t = 1920)]
+        width: u32,
+        #[arg(long, default_value_t = 1080)]
+        height: u32,
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: DeviceChoice,
+        /// Timed repeats (median reported), after one warm-up.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
     /// Specialized render kernels against the general one (--kernel full):
     /// render-kernel time per scene, and each kernel's SPIR-V size.
     Variants {
@@ -227,6 +253,39 @@ const VARIANT_SCENES: [&str; 5] =
 
 pub fn run(cmd: BenchCommand) -> Result<()> {
     match cmd {
+        BenchCommand::Instances { scene, grid, top_sizes, width, height, device, repeats, json } => {
+            let scene = Scene::from_spec(&scene)?;
+            let device = device.open()?;
+            let before = clocks::read();
+            let (adapter, row) = treelet::with_backend!(&device, |b| (
+                b.adapter(),
+                instances::bench_instances(b, &scene, grid, &top_sizes, (width, height), repeats)?
+            ));
+            let clocks = matches!(device, Device::Gpu(_)).then(|| (before, clocks::read()));
+            println!("instances of {} ({} triangles), {width}x{height}, {adapter}, median of {repeats}", scene.name, row.triangles);
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
+            for (count, device_ms, wall_ms) in &row.top_level {
+                println!("  top level, {count:>8} instances {device_ms:>9.3} ms  (wall {wall_ms:.3})");
+            }
+            let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+            println!("  mesh alone         {:>9.1} M primary rays/s, {:.1} M diffuse", row.single_primary_mrays, row.single_diffuse_mrays);
+            println!(
+                "  {} copies       {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's)",
+                row.grid_instances,
+                row.instanced_primary_mrays,
+                row.instanced_diffuse_mrays,
+                ratio(row.instanced_primary_mrays, row.single_primary_mrays),
+                ratio(row.instanced_diffuse_mrays, row.single_diffuse_mrays)
+            );
+            if let Some(path) = json {
+                let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
+                let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "row": row, "clocks": clocks });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
         BenchCommand::Dynamic { scene, frames, width, height, device, json } => {
             let scene = Scene::from_spec(&scene)?;
             let device = device.open()?;

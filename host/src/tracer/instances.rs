@@ -27,7 +27,8 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
-use super::{batch_dims, hit_record, read_batch, Quality, Ray, RayHit, Tracer};
+use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
+use super::primitives::{Quality, Tracer};
 use crate::bvh::layout::{Layout, TracedTree};
 use crate::bvh::tree::{binary_tree, Builder};
 use crate::runtime::backend::Backend;

@@ -1,0 +1,192 @@
+//! `bench instances`: what instancing costs an engine. The top-level tree's
+//! rebuild for many instances (what a frame of moving instances pays), and
+//! rays through a grid of copies of a mesh against rays through the mesh
+//! alone, each framed the same way (`bench rays --mesh-only`'s eye: the
+//! centre plus (0, 0.6, 0.8) times the extent, looking at the centre), one
+//! camera ray a pixel and one cosine bounce from each hit.
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use glam::{Mat3, Vec3};
+use rand::{Rng, SeedableRng};
+use treelet::runtime::backend::{Backend, DeviceClass};
+use treelet::scene::Scene;
+use treelet::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer, Triangle};
+
+use super::measure::median;
+
+/// Medians (ms: device time, `last_update_ms` and the trace stage's
+/// timestamps on a GPU; wall clock on the CPU runner).
+#[derive(Debug, serde::Serialize)]
+pub(crate) struct InstancesRow {
+    pub(crate) triangles: usize,
+    /// Top-level rebuilds: (instances, device ms, wall ms with the host's work and uploads).
+    pub(crate) top_level: Vec<(usize, f64, f64)>,
+    pub(crate) grid_instances: usize,
+    pub(crate) single_primary_mrays: f64,
+    pub(crate) single_diffuse_mrays: f64,
+    pub(crate) instanced_primary_mrays: f64,
+    pub(crate) instanced_diffuse_mrays: f64,
+    /// Rays cast in each measurement (primary; diffuse from their hits).
+    pub(crate) single_rays: (usize, usize),
+    pub(crate) instanced_rays: (usize, usize),
+}
+
+/// Copies of a mesh placed as `count` random rotations about the vertical
+/// and translations within a cube, as a frame of moving instances.
+fn scattered(count: usize, extent: f32, rng: &mut impl Rng) -> Vec<Instance> {
+    let side = extent * (count as f32).cbrt() * 1.5;
+    (0..count).map(|_| placed(rng.random_range(0.0..std::f32::consts::TAU), Vec3::new(rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..side)))).collect()
+}
+
+/// Mesh 0 turned by `angle` about the vertical, then moved by `at`.
+fn placed(angle: f32, at: Vec3) -> Instance {
+    let m = Mat3::from_rotation_y(angle);
+    Instance { mesh: 0, transform: [0, 1, 2].map(|r| [m.col(0)[r], m.col(1)[r], m.col(2)[r], at[r]]) }
+}
+
+/// The box of `points`.
+fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+    points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+/// One camera ray a pixel, looking at the centre of `lo..hi` from the
+/// centre plus (0, 0.6, 0.8) times its largest extent (smallpt's lens).
+fn camera_rays((lo, hi): (Vec3, Vec3), (w, h): (u32, u32)) -> Vec<Ray> {
+    let centre = (lo + hi) * 0.5;
+    let eye = centre + Vec3::new(0.0, 0.6, 0.8) * (hi - lo).max_element();
+    let forward = (centre - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let half = 0.5135 / 2.0;
+    (0..w * h)
+        .map(|k| {
+            let (x, y) = ((k % w) as f32 + 0.5, (k / w) as f32 + 0.5);
+            let dx = (2.0 * x / w as f32 - 1.0) * half * w as f32 / h as f32;
+            let dy = (1.0 - 2.0 * y / h as f32) * half;
+            Ray::new(eye.into(), (forward + right * dx + up * dy).normalize().into())
+        })
+        .collect()
+}
+
+/// A cosine-distributed bounce from each hit, on the side the ray came from,
+/// starting a little off the surface.
+fn bounces(rays: &[Ray], hits: &[RayHit], extent: f32, rng: &mut impl Rng) -> Vec<Ray> {
+    rays.iter()
+        .zip(hits)
+        .filter(|(_, h)| h.is_hit())
+        .map(|(r, h)| {
+            let d = Vec3::from(r.dir).normalize();
+            let mut n = Vec3::from(h.normal);
+            if n.dot(d) > 0.0 {
+                n = -n;
+            }
+            let (u1, u2): (f32, f32) = (rng.random(), rng.random());
+            let (a, b) = n.any_orthonormal_pair();
+            let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+            let dir = a * s * phi.cos() + b * s * phi.sin() + n * (1.0 - u1).sqrt();
+            let x = Vec3::from(r.origin) + d * h.t;
+            Ray { t_min: 1e-4 * extent, ..Ray::new(x.into(), dir.into()) }
+        })
+        .collect()
+}
+
+/// Device ms of `trace` (the trace stage; wall clock on the CPU runner).
+fn timed<B: Backend, T>(b: &mut B, trace: impl FnOnce(&mut B) -> Result<T>) -> Result<(f64, T)> {
+    let cpu = b.class() == DeviceClass::CpuRunner;
+    b.take_times()?;
+    let start = Instant::now();
+    let out = trace(b)?;
+    let stages = b.take_times()?;
+    Ok((if cpu { start.elapsed().as_secs_f64() * 1e3 } else { stages.get("trace") }, out))
+}
+
+/// Primary and diffuse M rays/s (medians of `repeats`) through `closest`.
+fn rays_per_second<B: Backend>(
+    b: &mut B,
+    framing: (Vec3, Vec3),
+    size: (u32, u32),
+    extent: f32,
+    repeats: usize,
+    closest: &dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
+) -> Result<(f64, f64, usize, usize)> {
+    let primary = camera_rays(framing, size);
+    let (_, hits) = timed(b, |b| closest(b, &primary))?; // warm-up
+    let diffuse = bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
+    let (mut p, mut d) = (Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        p.push(timed(b, |b| closest(b, &primary))?.0);
+        d.push(timed(b, |b| closest(b, &diffuse))?.0);
+    }
+    let mrays = |n: usize, ms: f64| n as f64 / ms / 1e3;
+    Ok((mrays(primary.len(), median(p)), mrays(diffuse.len(), median(d)), primary.len(), diffuse.len()))
+}
+
+/// `bench instances` on `b`: see the module doc.
+pub(crate) fn bench_instances<B: Backend>(
+    b: &mut B,
+    scene: &Scene,
+    grid: usize,
+    top_sizes: &[usize],
+    size: (u32, u32),
+    repeats: usize,
+) -> Result<InstancesRow> {
+    let mesh: &[Triangle] = &scene.triangles;
+    if mesh.is_empty() {
+        bail!("bench instances places a mesh: scene `{}` has no triangles (give terrain:N, an .obj/.ply mesh or a .gltf/.glb scene)", scene.name);
+    }
+    if grid == 0 || repeats == 0 || size.0 == 0 || size.1 == 0 {
+        bail!("bench instances needs a grid of at least one copy, one repeat and one ray");
+    }
+    let repeats = repeats.max(1);
+    let (lo, hi) = bounds(mesh.iter().flat_map(|t| [t.v0, t.v1, t.v2]).map(Vec3::from));
+    let extent = (hi - lo).max_element().max(1e-6);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+
+    // The mesh alone.
+    let single = Tracer::build(b, &[], mesh, Quality::High)?;
+    let (sp, sd, sn, sdn) = rays_per_second(b, (lo, hi), size, extent, repeats, &|b, r| single.closest_hits(b, r))?;
+    drop(single);
+
+    // A grid of copies, each turned about the vertical.
+    let step = 1.25 * extent;
+    let copies: Vec<Instance> = (0..grid * grid)
+        .map(|k| placed(rng.random_range(0.0..std::f32::consts::TAU), Vec3::new((k % grid) as f32 * step, 0.0, (k / grid) as f32 * step)))
+        .collect();
+    let mut scene_tracer = InstancedTracer::build(b, &[mesh], &copies, Quality::High)?;
+    let centre = (lo + hi) * 0.5;
+    let framing = bounds(copies.iter().flat_map(|i| {
+        let at = Vec3::new(i.transform[0][3], i.transform[1][3], i.transform[2][3]);
+        [at + centre - Vec3::splat(extent * 0.5), at + centre + Vec3::splat(extent * 0.5)]
+    }));
+    let (ip, id, ins, idn) = rays_per_second(b, framing, size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
+
+    // Top-level rebuilds of scattered copies (one warm-up each).
+    let mut top_level = Vec::new();
+    for &count in top_sizes {
+        let (mut device, mut wall) = (Vec::new(), Vec::new());
+        for k in 0..=repeats {
+            let frame = scattered(count, extent, &mut rng);
+            b.take_times()?;
+            let start = Instant::now();
+            scene_tracer.set_instances(b, &frame)?;
+            b.take_times()?;
+            if k > 0 {
+                device.push(scene_tracer.last_update_ms());
+                wall.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        top_level.push((count, median(device), median(wall)));
+    }
+    Ok(InstancesRow {
+        triangles: mesh.len(),
+        top_level,
+        grid_instances: copies.len(),
+        single_primary_mrays: sp,
+        single_diffuse_mrays: sd,
+        instanced_primary_mrays: ip,
+        instanced_diffuse_mrays: id,
+        single_rays: (sn, sdn),
+        instanced_rays: (ins, idn),
+    })
+}

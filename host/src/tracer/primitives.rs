@@ -1,0 +1,225 @@
+//! A tree over one set of an engine's primitives: build, refit, trace.
+use anyhow::{bail, Result};
+use treelet_core::geometry::buffers::{RenderParams, Sphere};
+use treelet_core::geometry::triangle::Triangle;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::render::integrator::tiled_invocations;
+use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
+
+use super::rays::{batch_dims, check_rays, hit_record, read_batch, Ray, RayHit};
+use crate::bvh::choice::{cheaper_builder, Work};
+use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
+use crate::bvh::refit::refit_uploaded;
+use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
+use crate::runtime::backend::{Backend, DeviceClass};
+use crate::runtime::kernels::{Kernel, Method};
+use crate::scene::primitives::Primitives;
+
+/// How much build time to spend for faster rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quality {
+    /// The LBVH (Karras 2012): the fastest build.
+    Fast,
+    /// The LBVH after treelet restructuring (Karras & Aila 2013): about ten
+    /// times the build time, faster rays.
+    High,
+    /// H-PLOC (Benthin et al. 2024, `treelet_core::construct::hploc`):
+    /// about three times the LBVH's build, rays close to `High`'s (H100,
+    /// 940k-triangle bunny: 1.85 ms against 0.58 and 9.05 ms; 1.02 G
+    /// diffuse rays/s as `High`). Needs subgroups of 4 lanes or more.
+    Balanced,
+    /// Whichever of the two gives the least build plus trace time when each
+    /// build serves this many rays, by the trade-off measured on the
+    /// device's class ([`crate::bvh::choice`]). An engine that builds every
+    /// frame passes one frame's rays; one that builds once, all the rays it
+    /// will trace. On the H100 the LBVH wins below about 8M rays a build
+    /// for any mesh, and below about 50M for a mesh of 1M triangles.
+    ForRays(u64),
+}
+
+impl Quality {
+    /// The builder this quality stands for on a device of `class`, for
+    /// `prims` primitives.
+    pub fn builder(self, class: DeviceClass, prims: usize) -> Builder {
+        match self {
+            Quality::Fast => Builder::Lbvh,
+            Quality::High => Builder::Trbvh,
+            Quality::Balanced => Builder::Hploc,
+            Quality::ForRays(rays) => cheaper_builder(class, prims, Work::Rays(rays)).0,
+        }
+    }
+}
+
+/// A tree over an engine's primitives on one device, laid out for tracing.
+pub struct Tracer<B: Backend> {
+    built: Option<BuiltTree<B>>,
+    /// The primitives, the tree in the `bvh2` layout and the counts (spheres,
+    /// triangles): what an instanced scene gathers of each mesh.
+    pub(super) prims: PrimBuffers<B>,
+    pub(super) tree: Option<TracedTree<B>>,
+    pub(super) counts: (usize, usize),
+    /// Device time of the last build or refit, layout included (ms).
+    update_ms: f64,
+}
+
+impl<B: Backend> Tracer<B> {
+    /// Builds the tree over `spheres` and `triangles` on `b` and lays it out
+    /// for tracing. Rejects non-finite or degenerate input, naming it.
+    pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> Result<Self> {
+        let all = Primitives { spheres, triangles };
+        all.check()?;
+        let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
+        let prims = match &built {
+            Some(t) => t.prim_buffers(b, all)?,
+            None => PrimBuffers::upload(b, all)?,
+        };
+        let mut tracer = Tracer {
+            built,
+            prims,
+            tree: None,
+            counts: (spheres.len(), triangles.len()),
+            update_ms: 0.0,
+        };
+        let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
+        tracer.update_ms = build_ms + tracer.lay_out(b)?;
+        tracer.keep_buffers(b);
+        Ok(tracer)
+    }
+
+    /// Moves the primitives: the same counts, in the same order, at new
+    /// places. The tree keeps its shape and gets new boxes (bottom-up, the
+    /// build's own fit kernel), then a new layout. A refit tree stays
+    /// correct however far things move, but its rays slow down as it drifts
+    /// from what a new build would make: rebuild after large changes.
+    pub fn refit(&mut self, b: &mut B, spheres: &[Sphere], triangles: &[Triangle]) -> Result<()> {
+        if (spheres.len(), triangles.len()) != self.counts {
+            bail!(
+                "refit with {} spheres and {} triangles: the tree was built over {} and {} (build a new one)",
+                spheres.len(),
+                triangles.len(),
+                self.counts.0,
+                self.counts.1
+            );
+        }
+        let all = Primitives { spheres, triangles };
+        all.check()?;
+        // The last update's temporaries go back to the pool (what this and
+        // other tracers hold was kept out of it), so that a tracer refit
+        // every frame does not make the pool grow.
+        b.begin_build();
+        // Uploaded once, for the refit and for tracing.
+        self.prims = PrimBuffers::upload(b, all)?;
+        let refit_ms = match &self.built {
+            Some(built) => refit_uploaded(b, &built.bvh, &self.prims)?.total(),
+            None => 0.0,
+        };
+        self.update_ms = refit_ms + self.lay_out(b)?;
+        self.keep_buffers(b);
+        Ok(())
+    }
+
+    /// Takes this tracer's buffers out of `b`'s pool, so that no later build
+    /// or refit on `b`, of this tracer or another, hands them out again.
+    fn keep_buffers(&self, b: &mut B) {
+        let mut kept = vec![&self.prims.spheres, &self.prims.triangles];
+        if let Some(built) = &self.built {
+            let bvh = &built.bvh;
+            kept.extend([&bvh.nodes, &bvh.parents, &bvh.prim_indices, &bvh.sorted_keys]);
+        }
+        if let Some(tree) = &self.tree {
+            kept.extend([&tree.nodes, &tree.prims]);
+        }
+        b.keep(&kept);
+    }
+
+    /// Device time of the last [`Tracer::build`] or [`Tracer::refit`], in
+    /// ms: the tree's build or refit and its layout for tracing (GPU
+    /// timestamps where the device has them; wall clock on the CPU runner).
+    /// Uploads and the host's work are not in it.
+    pub fn last_update_ms(&self) -> f64 {
+        self.update_ms
+    }
+
+    /// The two-box binary layout: the fastest to trace in our measurements.
+    /// Returns its device time (ms).
+    fn lay_out(&mut self, b: &mut B) -> Result<f64> {
+        let (tree, ms) = match &self.built {
+            Some(built) => {
+                let (tree, ms) = built.lay_out(b, Layout::Bvh2, &self.prims)?;
+                (Some(tree), ms)
+            }
+            None => (None, 0.0),
+        };
+        self.tree = tree;
+        Ok(ms)
+    }
+
+    /// The closest hit of each ray, with its hit record (see [`RayHit`]).
+    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
+        if self.tree.is_none() {
+            check_rays(rays)?;
+            return Ok(vec![RayHit::MISS; rays.len()]);
+        }
+        let out = read_batch(b, rays, |b, buffer| self.closest_hits_on_device(b, buffer, rays.len()))?;
+        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+    }
+
+    /// Whether each ray hits anything up to its `t_max` (inclusive): an
+    /// occlusion query, which stops at the first hit it finds (shadow and
+    /// ambient-occlusion rays). Agrees with [`Tracer::closest_hits`]: a ray
+    /// is occluded exactly when its closest hit is within `t_max`.
+    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
+        if self.tree.is_none() {
+            check_rays(rays)?;
+            return Ok(vec![false; rays.len()]);
+        }
+        let out = read_batch(b, rays, |b, buffer| self.occluded_on_device(b, buffer, rays.len()))?;
+        Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+    }
+
+    /// Traces `count` rays that are already on the device (for callers that
+    /// hold their rays in a GPU buffer, e.g. a `wgpu::Buffer` through
+    /// [`GpuBackend`](crate::runtime::gpu::GpuBackend)), in place: ray `k` is
+    /// `rays[2k]` = (origin, t_max) and `rays[2k + 1]` = (direction, 1), as
+    /// four f32 each, and `rays[2k]` becomes (t, bits of the primitive, b1,
+    /// b2): a triangle's barycentric coordinates of the hit as in [`RayHit`]
+    /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0:
+    /// the bits of instance 0); for a miss (inf, bits of `u32::MAX`, 0, 0)
+    /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// `count` must be zero. Submitted, not waited for.
+    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_RAYS)
+    }
+
+    /// [`Tracer::occluded`] on rays already on the device, laid out as for
+    /// [`Tracer::closest_hits_on_device`]: `rays[2k]` becomes (1 if
+    /// occluded else 0, 0, 0, 0). Submitted, not waited for.
+    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+        self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+    }
+
+    fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
+        let (width, height) = batch_dims(count)?;
+        let params = RenderParams {
+            width,
+            height,
+            prims: self.prims.sphere_count,
+            triangles: self.prims.triangle_count,
+            cast_mode,
+            ..Default::default()
+        };
+        let p = b.upload("trace params", &[params])?;
+        let materials = b.upload("no materials", &[treelet_core::geometry::buffers::Material::default()])?;
+        let Some(tree) = &self.tree else {
+            bail!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)");
+        };
+        let kernel = Kernel::Cast(Method::Bvh2, self.counts.0 == 0);
+        b.stage("trace");
+        b.dispatch(
+            kernel,
+            &[&p, &self.prims.spheres, &materials, &tree.nodes, &tree.prims, rays, &self.prims.triangles],
+            groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
+        );
+        Ok(())
+    }
+}
