@@ -1,6 +1,6 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{InstanceRecord, Material, Node, RenderParams, Sphere};
+use treelet_core::geometry::buffers::{Material, Node, RenderParams, Sphere};
 use treelet_core::geometry::prims::Prims;
 use treelet_core::geometry::features::{ALL, TRIANGLES};
 use treelet_core::geometry::split::Split;
@@ -184,7 +184,7 @@ pub fn cast_instances_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] top_nodes: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] top_leaves: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] instances: &[InstanceRecord],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] instances: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] leaves: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] spheres: &[Sphere],

@@ -12,7 +12,7 @@
 //! the CPU runner as records; the tests below check both give the same
 //! bytes.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, WideNode};
+use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, Node, WideNode};
 use crate::gpu::unchecked::{at, put};
 use glam::Vec4;
 
@@ -156,6 +156,16 @@ impl RecordLoad<LeafPrim> for [Vec4] {
         let (p1, _pad1) = parts(at(self, 3 * i + 1));
         let (p2, _pad2) = parts(at(self, 3 * i + 2));
         LeafPrim { p0, prim, p1, _pad1, p2, _pad2 }
+    }
+}
+
+impl RecordLoad<InstanceRecord> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> InstanceRecord {
+        let row = |k: usize| at(self, 4 * i + k).to_array();
+        let v = at(self, 4 * i + 3);
+        let [node_base, leaf_base, triangle_base, mesh] = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits(), v.w.to_bits()];
+        InstanceRecord { object_from_world: [row(0), row(1), row(2)], node_base, leaf_base, triangle_base, mesh }
     }
 }
 

@@ -9,7 +9,6 @@ use glam::Vec3;
 
 use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, RenderParams};
 use crate::geometry::records::RecordLoad;
-use crate::gpu::unchecked::at;
 use crate::trace::instances::{trace_instances, InstanceHit};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::{Origin, Prims};
@@ -131,7 +130,7 @@ pub fn cast_instances_kernel(
     params: &RenderParams,
     top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     top_leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
-    instances: &[InstanceRecord],
+    instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     prims: &Prims,
@@ -153,7 +152,7 @@ pub fn cast_instances_kernel(
     let found = hit.is_hit() && hit.t <= query.t_max;
     let record = if found && params.cast_mode == CAST_RAYS {
         // The barycentrics by the traversal's own test, in the mesh's space.
-        let instance = at(instances, hit.instance as usize);
+        let instance = instances.load(hit.instance as usize);
         let tri = prims.triangle(instance.triangle_base + hit.prim);
         let (o2, d2) = instance.to_object(o, d);
         let (_, b1, b2) = ray_triangle_barycentrics(&WatertightRay::new(o2, d2), &tri, MISS);

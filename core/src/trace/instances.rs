@@ -17,7 +17,6 @@ use crate::geometry::intersect::SlabRay;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::records::{Based, RecordLoad};
 use crate::geometry::triangle::WatertightRay;
-use crate::gpu::unchecked::at;
 use crate::trace::bvh2::{leaf, walk_bvh2};
 use crate::trace::hit::{Hit, Query};
 
@@ -50,7 +49,7 @@ pub fn trace_instances(
     query: Query,
     top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     top_leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
-    instances: &[InstanceRecord],
+    instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     prims: &Prims,
@@ -63,7 +62,7 @@ pub fn trace_instances(
         let mut k = 0;
         while k < count && !query.done(hit) {
             let instance = top_leaves.load((first + k) as usize).prim;
-            let record = at(instances, instance as usize);
+            let record = instances.load(instance as usize);
             let (o2, d2) = record.to_object(o, d);
             // Only hits nearer than the best so far (or as near, for the tie-break).
             let inner = Query { t_max: hit.t, skip: u32::MAX, any: query.any };

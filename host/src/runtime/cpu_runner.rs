@@ -364,7 +364,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             };
             let (top_nodes, top_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(top_nodes), view(top_leaves));
             let (nodes, leaves): (&[Bvh2Node], &[LeafPrim]) = (view(nodes), view(leaves));
-            let (instances, rays) = (view(instances), view(rays));
+            let (instances, rays): (&[treelet_core::InstanceRecord], _) = (view(instances), view(rays));
             for id in ids(groups) {
                 treelet_core::render::rays::cast_instances_kernel(id, &p, top_nodes, top_leaves, instances, nodes, leaves, &prims, rays);
             }
