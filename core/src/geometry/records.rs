@@ -107,22 +107,6 @@ impl<T, R: RecordLoad<T> + ?Sized> RecordLoad<T> for &R {
     }
 }
 
-/// The records of `records` from `base` on, read from 0: one tree among
-/// several laid out one after another in a buffer (an instanced scene's
-/// bottom-level trees, [`crate::trace::instances`]).
-#[derive(Clone, Copy)]
-pub struct Based<R> {
-    pub records: R,
-    pub base: u32,
-}
-
-impl<T, R: RecordLoad<T>> RecordLoad<T> for Based<R> {
-    #[inline]
-    fn load(&self, i: usize) -> T {
-        self.records.load(self.base as usize + i)
-    }
-}
-
 /// The three floats and the word of other bits of `v`.
 #[inline]
 fn parts(v: Vec4) -> ([f32; 3], u32) {

@@ -14,7 +14,7 @@
 //! climbing) and [`leaf_prims_kernel`](crate::layouts::bvh2::leaf_prims_kernel) (the primitives in leaf order).
 use glam::Vec3;
 
-use crate::geometry::buffers::{Bvh2Node, LeafPrim};
+use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim};
 use crate::geometry::features;
 use crate::geometry::intersect::{SlabRay, slab_interval};
 use crate::geometry::prims::{Origin, Prims};
@@ -103,70 +103,141 @@ pub fn trace_bvh2<const F: u32>(
     if prims.count() == 0 {
         return query.start();
     }
-    let ray = WatertightRay::new(o, d);
-    walk_bvh2(&SlabRay::new(o, d), &query, nodes, |hit, first, count| {
-        leaf::<F>(hit, first, count, (o, d, from), &query, &ray, prims, leaf_prims)
-    })
+    // One level: the top-level arguments are never read.
+    let one = Level { nodes, leaves: leaf_prims, instances: &NoInstances };
+    walk::<F, false, { 2 * STACK_DEPTH }>(o, d, from, &query, prims, &one, &one).0
 }
 
-/// The walk through a [`Bvh2Node`] tree (root 0) that every traversal of
-/// this layout shares, from `query.start()`: nearer child first; a leaf's
-/// `count` items from `first` on go to `leaf(hit, first, count)`, which
-/// narrows `hit` (primitives, or an instanced scene's instances:
-/// [`crate::trace::instances`]). Returns when `query` is done or no node
-/// nearer than the hit is left.
+/// The buffers of one level of a walk: a tree's nodes and leaf
+/// primitives, and for an instanced scene's top level its instances.
+pub struct Level<'a, N: ?Sized, L: ?Sized, I: ?Sized> {
+    pub nodes: &'a N,
+    pub leaves: &'a L,
+    pub instances: &'a I,
+}
+
+/// The instances of a walk without any ([`trace_bvh2`]).
+pub struct NoInstances;
+
+impl RecordLoad<InstanceRecord> for NoInstances {
+    #[inline]
+    fn load(&self, _: usize) -> InstanceRecord {
+        InstanceRecord::default()
+    }
+}
+
+/// A top-level leaf's index with this bit: the instance there, walked to
+/// as a node is (entered rather than tested).
+const ENTER: u32 = 1 << 31;
+
+/// The walk every traversal of this layout shares, nearer child first (see
+/// the module doc), from `query.start()`. With `INSTANCED`, the walk
+/// starts in `top`, a tree over instances ([`crate::trace::instances`]):
+/// a top-level leaf is an instance, entered when the walk gets to it by
+/// taking the ray into its mesh's space and going on in the mesh's tree
+/// (in `mesh`, at the instance's bases), on the same stack, until the
+/// stack is back at its height on entering. Without, `mesh` is the one
+/// tree (bases 0) and `top` is never read: the same code as a plain walk.
+/// `STACK`: words of the stack (two an entry; [`STACK_DEPTH`] entries a
+/// level). Returns the hit and its instance (`u32::MAX` without).
+#[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn walk_bvh2(
-    slabs: &SlabRay,
+pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
+    o: Vec3,
+    d: Vec3,
+    from: Origin,
     query: &Query,
-    nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
-    mut leaf: impl FnMut(&mut Hit, u32, u32),
-) -> Hit {
+    prims: &Prims,
+    top: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized, impl RecordLoad<InstanceRecord> + ?Sized>,
+    mesh: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized, impl RecordLoad<InstanceRecord> + ?Sized>,
+) -> (Hit, u32) {
     let mut hit = query.start();
-    // Entries: node index and the entry distance it was pushed with.
-    let mut stack = [0u32; 2 * STACK_DEPTH];
-    let mut top = 0usize;
+    let (mut found_in, mut current) = (u32::MAX, u32::MAX);
+    let world = SlabRay::new(o, d);
+    // Where the walk is: in a mesh (`inside`; its record's bases, the ray
+    // in its space), or in the top level.
+    let mut inside = !INSTANCED;
+    let mut record = InstanceRecord::default();
+    let (mut slabs, mut ray, mut at_ray) = (world, WatertightRay::new(o, d), (o, d, from));
+    // Entries: node index and the entry distance it was pushed with; below
+    // `floor`, the top level's. `STACK` words: two a level of depth, for
+    // both levels when instanced.
+    let mut stack = [0u32; STACK];
+    let (mut top_len, mut floor) = (0usize, 0usize);
     let mut node = 0u32;
     loop {
-        let n = nodes.load(node as usize);
-        let (ln, lf) = slab_interval(n.left_min, n.left_max, slabs, hit.t);
-        let (rn, rf) = slab_interval(n.right_min, n.right_max, slabs, hit.t);
+        if INSTANCED && !inside && node & ENTER != 0 {
+            current = top.leaves.load((node & !ENTER) as usize).prim;
+            record = top.instances.load(current as usize);
+            let (o2, d2) = record.to_object(o, d);
+            (slabs, ray, at_ray) = (SlabRay::new(o2, d2), WatertightRay::new(o2, d2), (o2, d2, Origin::NONE));
+            inside = true;
+            floor = top_len;
+            node = 0;
+        }
+        let n = if inside { mesh.nodes.load((record.node_base + node) as usize) } else { top.nodes.load(node as usize) };
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
-        // Leaves are tested at once; only internal children are walked.
-        if go_left && n.left_count > 0 {
-            leaf(&mut hit, n.left, n.left_count);
-            go_left = false;
-        }
-        if go_right && n.right_count > 0 {
-            leaf(&mut hit, n.right, n.right_count);
-            go_right = false;
-        }
-        if query.done(&hit) {
-            return hit;
+        let (mut left, mut right) = (n.left, n.right);
+        if inside {
+            // Leaves are tested at once; only internal children are walked.
+            let before = hit;
+            let leaves = (record.leaf_base, query, &ray, prims, mesh.leaves);
+            if go_left && n.left_count > 0 {
+                leaf::<F>(&mut hit, leaves.0 + n.left, n.left_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
+                go_left = false;
+            }
+            if go_right && n.right_count > 0 {
+                leaf::<F>(&mut hit, leaves.0 + n.right, n.right_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
+                go_right = false;
+            }
+            if INSTANCED && (hit.t != before.t || hit.prim != before.prim) {
+                found_in = current;
+            }
+            if query.done(&hit) {
+                return (hit, found_in);
+            }
+        } else {
+            // A top-level leaf (one instance) is walked to like a node.
+            if n.left_count > 0 {
+                left = ENTER | n.left;
+            }
+            if n.right_count > 0 {
+                right = ENTER | n.right;
+            }
         }
         if go_left && go_right {
-            let (near, far, far_t) = if ln <= rn { (n.left, n.right, rn) } else { (n.right, n.left, ln) };
-            if top < STACK_DEPTH {
-                set(&mut stack, 2 * top, far);
-                set(&mut stack, 2 * top + 1, far_t.to_bits());
-                top += 1;
+            let (near, far, far_t) = if ln <= rn { (left, right, rn) } else { (right, left, ln) };
+            if top_len < stack.len() / 2 {
+                set(&mut stack, 2 * top_len, far);
+                set(&mut stack, 2 * top_len + 1, far_t.to_bits());
+                top_len += 1;
             }
             node = near;
         } else if go_left {
-            node = n.left;
+            node = left;
         } else if go_right {
-            node = n.right;
+            node = right;
         } else {
-            // Back to the nearest pushed child still worth entering.
+            // Back to the nearest pushed child still worth entering; out of
+            // the mesh when its entries are all taken.
             let mut next = u32::MAX;
-            while top > 0 && next == u32::MAX {
-                top -= 1;
-                if f32::from_bits(get(&stack, 2 * top + 1)) <= hit.t {
-                    next = get(&stack, 2 * top);
+            while next == u32::MAX {
+                if INSTANCED && inside && top_len == floor {
+                    inside = false;
+                    slabs = world;
+                }
+                if top_len == 0 {
+                    break;
+                }
+                top_len -= 1;
+                if f32::from_bits(get(&stack, 2 * top_len + 1)) <= hit.t {
+                    next = get(&stack, 2 * top_len);
                 }
             }
             if next == u32::MAX {
-                return hit;
+                return (hit, found_in);
             }
             node = next;
         }
