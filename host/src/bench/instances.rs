@@ -2,8 +2,10 @@
 //! rebuild for many instances (what a frame of moving instances pays), and
 //! rays through a grid of copies of a mesh against rays through the mesh
 //! alone, each framed the same way (`bench rays --mesh-only`'s eye: the
-//! centre plus (0, 0.6, 0.8) times the extent, looking at the centre), one
-//! camera ray a pixel and one cosine bounce from each hit.
+//! centre plus (0, 0.6, 0.8) times the extent, looking at the centre; the
+//! grid also from nearly straight above), one camera ray a pixel and one
+//! cosine bounce from each hit; and the mesh as one instance in place,
+//! traced with the mesh alone's rays (the instanced walk's own cost).
 use std::time::Instant;
 
 use anyhow::{bail, Result};
@@ -22,11 +24,20 @@ pub(crate) struct InstancesRow {
     pub(crate) triangles: usize,
     /// Top-level rebuilds: (instances, device ms, wall ms with the host's work and uploads).
     pub(crate) top_level: Vec<(usize, f64, f64)>,
+    /// Stages of the largest top-level rebuild (device ms, medians).
+    pub(crate) top_level_stages: Vec<(String, f64)>,
+    /// The mesh as one instance in place, traced with the mesh alone's
+    /// rays: what the instanced walk itself costs.
+    pub(crate) in_place_primary_mrays: f64,
+    pub(crate) in_place_diffuse_mrays: f64,
     pub(crate) grid_instances: usize,
     pub(crate) single_primary_mrays: f64,
     pub(crate) single_diffuse_mrays: f64,
     pub(crate) instanced_primary_mrays: f64,
     pub(crate) instanced_diffuse_mrays: f64,
+    /// The grid seen from nearly straight above.
+    pub(crate) above_primary_mrays: f64,
+    pub(crate) above_diffuse_mrays: f64,
     /// Rays cast in each measurement (primary; diffuse from their hits).
     pub(crate) single_rays: (usize, usize),
     pub(crate) instanced_rays: (usize, usize),
@@ -50,11 +61,17 @@ fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
+/// The eye of `bench rays --mesh-only`: from the side and above.
+const OBLIQUE: Vec3 = Vec3::new(0.0, 0.6, 0.8);
+/// An eye nearly straight above (a grid of copies seen from above: about
+/// one copy behind each pixel, as for the mesh alone).
+const ABOVE: Vec3 = Vec3::new(0.0, 1.0, 0.2);
+
 /// One camera ray a pixel, looking at the centre of `lo..hi` from the
-/// centre plus (0, 0.6, 0.8) times its largest extent (smallpt's lens).
-fn camera_rays((lo, hi): (Vec3, Vec3), (w, h): (u32, u32)) -> Vec<Ray> {
+/// centre plus `view` times its largest extent (smallpt's lens).
+fn camera_rays((lo, hi): (Vec3, Vec3), view: Vec3, (w, h): (u32, u32)) -> Vec<Ray> {
     let centre = (lo + hi) * 0.5;
-    let eye = centre + Vec3::new(0.0, 0.6, 0.8) * (hi - lo).max_element();
+    let eye = centre + view * (hi - lo).max_element();
     let forward = (centre - eye).normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
@@ -104,13 +121,13 @@ fn timed<B: Backend, T>(b: &mut B, trace: impl FnOnce(&mut B) -> Result<T>) -> R
 /// Primary and diffuse M rays/s (medians of `repeats`) through `closest`.
 fn rays_per_second<B: Backend>(
     b: &mut B,
-    framing: (Vec3, Vec3),
+    (framing, view): ((Vec3, Vec3), Vec3),
     size: (u32, u32),
     extent: f32,
     repeats: usize,
     closest: &dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
 ) -> Result<(f64, f64, usize, usize)> {
-    let primary = camera_rays(framing, size);
+    let primary = camera_rays(framing, view, size);
     let (_, hits) = timed(b, |b| closest(b, &primary))?; // warm-up
     let diffuse = bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
     let (mut p, mut d) = (Vec::new(), Vec::new());
@@ -145,8 +162,11 @@ pub(crate) fn bench_instances<B: Backend>(
 
     // The mesh alone.
     let single = Tracer::build(b, &[], mesh, Quality::High)?;
-    let (sp, sd, sn, sdn) = rays_per_second(b, (lo, hi), size, extent, repeats, &|b, r| single.closest_hits(b, r))?;
+    let (sp, sd, sn, sdn) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| single.closest_hits(b, r))?;
     drop(single);
+    let one = InstancedTracer::build(b, &[mesh], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High)?;
+    let (op, od, _, _) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| one.closest_hits(b, r))?;
+    drop(one);
 
     // A grid of copies, each turned about the vertical.
     let step = 1.25 * extent;
@@ -159,12 +179,15 @@ pub(crate) fn bench_instances<B: Backend>(
         let at = Vec3::new(i.transform[0][3], i.transform[1][3], i.transform[2][3]);
         [at + centre - Vec3::splat(extent * 0.5), at + centre + Vec3::splat(extent * 0.5)]
     }));
-    let (ip, id, ins, idn) = rays_per_second(b, framing, size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
+    let (ip, id, ins, idn) = rays_per_second(b, (framing, OBLIQUE), size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
+    let (ap, ad, _, _) = rays_per_second(b, (framing, ABOVE), size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
 
     // Top-level rebuilds of scattered copies (one warm-up each).
     let mut top_level = Vec::new();
+    let mut top_level_stages = Vec::new();
     for &count in top_sizes {
         let (mut device, mut wall) = (Vec::new(), Vec::new());
+        let mut stages: Vec<(String, Vec<f64>)> = Vec::new();
         for k in 0..=repeats {
             let frame = scattered(count, extent, &mut rng);
             b.take_times()?;
@@ -174,18 +197,31 @@ pub(crate) fn bench_instances<B: Backend>(
             if k > 0 {
                 device.push(scene_tracer.last_update_ms());
                 wall.push(start.elapsed().as_secs_f64() * 1e3);
+                let times = scene_tracer.top_level_stages();
+                for s in &times.order {
+                    match stages.iter_mut().find(|(n, _)| n == s) {
+                        Some((_, v)) => v.push(times.get(s)),
+                        None => stages.push((s.to_string(), vec![times.get(s)])),
+                    }
+                }
             }
         }
         top_level.push((count, median(device), median(wall)));
+        top_level_stages = stages.into_iter().map(|(n, v)| (n, median(v))).collect();
     }
     Ok(InstancesRow {
         triangles: mesh.len(),
         top_level,
+        top_level_stages,
+        in_place_primary_mrays: op,
+        in_place_diffuse_mrays: od,
         grid_instances: copies.len(),
         single_primary_mrays: sp,
         single_diffuse_mrays: sd,
         instanced_primary_mrays: ip,
         instanced_diffuse_mrays: id,
+        above_primary_mrays: ap,
+        above_diffuse_mrays: ad,
         single_rays: (sn, sdn),
         instanced_rays: (ins, idn),
     })

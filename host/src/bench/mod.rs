@@ -269,8 +269,17 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             for (count, device_ms, wall_ms) in &row.top_level {
                 println!("  top level, {count:>8} instances {device_ms:>9.3} ms  (wall {wall_ms:.3})");
             }
+            let stages: Vec<String> = row.top_level_stages.iter().map(|(s, ms)| format!("{s} {ms:.3}")).collect();
+            println!("  largest top level, ms: {}", stages.join(", "));
             let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
             println!("  mesh alone         {:>9.1} M primary rays/s, {:.1} M diffuse", row.single_primary_mrays, row.single_diffuse_mrays);
+            println!(
+                "  one copy in place  {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's: the instanced walk's own cost)",
+                row.in_place_primary_mrays,
+                row.in_place_diffuse_mrays,
+                ratio(row.in_place_primary_mrays, row.single_primary_mrays),
+                ratio(row.in_place_diffuse_mrays, row.single_diffuse_mrays)
+            );
             println!(
                 "  {} copies       {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's)",
                 row.grid_instances,
@@ -278,6 +287,13 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 row.instanced_diffuse_mrays,
                 ratio(row.instanced_primary_mrays, row.single_primary_mrays),
                 ratio(row.instanced_diffuse_mrays, row.single_diffuse_mrays)
+            );
+            println!(
+                "  the same, above    {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x)",
+                row.above_primary_mrays,
+                row.above_diffuse_mrays,
+                ratio(row.above_primary_mrays, row.single_primary_mrays),
+                ratio(row.above_diffuse_mrays, row.single_diffuse_mrays)
             );
             if let Some(path) = json {
                 let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));

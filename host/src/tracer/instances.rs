@@ -30,8 +30,9 @@ use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
 use super::primitives::{Quality, Tracer};
 use crate::bvh::layout::{Layout, TracedTree};
-use crate::bvh::tree::{binary_tree, Builder};
-use crate::runtime::backend::Backend;
+use crate::bvh::lbvh;
+use crate::bvh::tree::BuiltTree;
+use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
 use crate::scene::primitives::Primitives;
 
@@ -96,6 +97,7 @@ pub struct InstancedTracer<B: Backend> {
     no_spheres: B::Buffer,
     no_top: [B::Buffer; 3],
     update_ms: f64,
+    top_stages: StageTimes,
 }
 
 impl<B: Backend> InstancedTracer<B> {
@@ -132,6 +134,7 @@ impl<B: Backend> InstancedTracer<B> {
             no_spheres,
             no_top,
             update_ms: 0.0,
+            top_stages: StageTimes::default(),
         };
         scene.set_instances(b, instances)?;
         scene.update_ms += update_ms;
@@ -154,13 +157,18 @@ impl<B: Backend> InstancedTracer<B> {
         // costs a walk of its mesh's tree.
         let boxes: Vec<Triangle> = instances.iter().map(|i| world_box(&self.bounds[i.mesh as usize], &i.transform)).collect();
         let all = Primitives { spheres: &[], triangles: &boxes };
-        let built = binary_tree(b, all, Builder::Lbvh)?;
+        let (bvh, mut stages) = lbvh::build_primitives_on_device(b, all)?;
+        let built = BuiltTree { bvh, max_leaf: 1, build_ms: stages.total() };
         let prims = built.prim_buffers(b, all)?;
-        let (tree, layout_ms) = built.lay_out(b, Layout::Bvh2, &prims)?;
+        let (tree, layout) = built.lay_out_timed(b, Layout::Bvh2, &prims)?;
+        for s in &layout.order {
+            stages.add(s, layout.get(s));
+        }
         let records = b.upload("instances", &records)?;
         b.keep(&[&tree.nodes, &tree.prims, &records]);
         self.top = Some(TopLevel { tree, records, count: instances.len() as u32 });
-        self.update_ms = built.build_ms + layout_ms;
+        self.update_ms = stages.total();
+        self.top_stages = stages;
         Ok(())
     }
 
@@ -192,6 +200,11 @@ impl<B: Backend> InstancedTracer<B> {
     /// [`Self::refit_mesh`]), in ms, as [`Tracer::last_update_ms`].
     pub fn last_update_ms(&self) -> f64 {
         self.update_ms
+    }
+
+    /// The stages of the last top-level build, device ms each (LBVH, collapse, layout).
+    pub fn top_level_stages(&self) -> &StageTimes {
+        &self.top_stages
     }
 
     /// The instances as placed now.
