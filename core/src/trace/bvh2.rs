@@ -153,12 +153,11 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
 ) -> (Hit, u32) {
     let mut hit = query.start();
     let (mut found_in, mut current) = (u32::MAX, u32::MAX);
-    let world = SlabRay::new(o, d);
-    // Where the walk is: in a mesh (`inside`; its record's bases, the ray
-    // in its space), or in the top level.
+    // Where the walk is: in a mesh (`inside`; the bases of its nodes and
+    // leaf primitives, the ray in its space), or in the top level.
     let mut inside = !INSTANCED;
-    let mut record = InstanceRecord::default();
-    let (mut slabs, mut ray, mut at_ray) = (world, WatertightRay::new(o, d), (o, d, from));
+    let (mut node_base, mut leaf_base) = (0u32, 0u32);
+    let (mut slabs, mut ray, mut at_ray) = (SlabRay::new(o, d), WatertightRay::new(o, d), (o, d, from));
     // Entries: node index and the entry distance it was pushed with; below
     // `floor`, the top level's. `STACK` words: two a level of depth, for
     // both levels when instanced.
@@ -168,14 +167,15 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     loop {
         if INSTANCED && !inside && node & ENTER != 0 {
             current = top.leaves.load((node & !ENTER) as usize).prim;
-            record = top.instances.load(current as usize);
+            let record = top.instances.load(current as usize);
+            (node_base, leaf_base) = (record.node_base, record.leaf_base);
             let (o2, d2) = record.to_object(o, d);
             (slabs, ray, at_ray) = (SlabRay::new(o2, d2), WatertightRay::new(o2, d2), (o2, d2, Origin::NONE));
             inside = true;
             floor = top_len;
             node = 0;
         }
-        let n = if inside { mesh.nodes.load((record.node_base + node) as usize) } else { top.nodes.load(node as usize) };
+        let n = if inside { mesh.nodes.load((node_base + node) as usize) } else { top.nodes.load(node as usize) };
         let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
         let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
@@ -183,7 +183,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
         if inside {
             // Leaves are tested at once; only internal children are walked.
             let before = hit;
-            let leaves = (record.leaf_base, query, &ray, prims, mesh.leaves);
+            let leaves = (leaf_base, query, &ray, prims, mesh.leaves);
             if go_left && n.left_count > 0 {
                 leaf::<F>(&mut hit, leaves.0 + n.left, n.left_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
                 go_left = false;
@@ -226,7 +226,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             while next == u32::MAX {
                 if INSTANCED && inside && top_len == floor {
                     inside = false;
-                    slabs = world;
+                    slabs = SlabRay::new(o, d);
                 }
                 if top_len == 0 {
                     break;
