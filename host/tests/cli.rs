@@ -240,6 +240,7 @@ fn bench_instances_times_top_levels_and_rays() {
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let row = &doc["row"];
     assert_eq!((row["grid_instances"].as_u64(), row["top_level"][1][0].as_u64()), (Some(9), Some(40)), "{doc}");
+    assert_eq!(row["in_place_differ"].as_u64(), Some(0), "one copy in place hits as the mesh alone: {doc}");
     for key in ["single_primary_mrays", "single_diffuse_mrays", "instanced_primary_mrays", "instanced_diffuse_mrays"] {
         assert!(row[key].as_f64().is_some_and(|v| v > 0.0 && v.is_finite()), "{key}: {doc}");
     }

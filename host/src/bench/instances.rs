@@ -30,6 +30,8 @@ pub(crate) struct InstancesRow {
     /// rays: what the instanced walk itself costs.
     pub(crate) in_place_primary_mrays: f64,
     pub(crate) in_place_diffuse_mrays: f64,
+    /// Camera rays whose hit in place differs from the mesh alone's (0 expected).
+    pub(crate) in_place_differ: usize,
     pub(crate) grid_instances: usize,
     pub(crate) single_primary_mrays: f64,
     pub(crate) single_diffuse_mrays: f64,
@@ -163,8 +165,13 @@ pub(crate) fn bench_instances<B: Backend>(
     // The mesh alone.
     let single = Tracer::build(b, &[], mesh, Quality::High)?;
     let (sp, sd, sn, sdn) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| single.closest_hits(b, r))?;
+    let check_rays = camera_rays((lo, hi), OBLIQUE, size);
+    let expected = single.closest_hits(b, &check_rays)?;
     drop(single);
     let one = InstancedTracer::build(b, &[mesh], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High)?;
+    let got = one.closest_hits(b, &check_rays)?;
+    // The same walk through the same tree: every hit the same.
+    let in_place_differ = expected.iter().zip(&got).filter(|(e, g)| (e.t, e.prim) != (g.t, g.prim)).count();
     let (op, od, _, _) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| one.closest_hits(b, r))?;
     drop(one);
 
@@ -215,6 +222,7 @@ pub(crate) fn bench_instances<B: Backend>(
         top_level_stages,
         in_place_primary_mrays: op,
         in_place_diffuse_mrays: od,
+        in_place_differ,
         grid_instances: copies.len(),
         single_primary_mrays: sp,
         single_diffuse_mrays: sd,

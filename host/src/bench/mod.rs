@@ -274,11 +274,12 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
             println!("  mesh alone         {:>9.1} M primary rays/s, {:.1} M diffuse", row.single_primary_mrays, row.single_diffuse_mrays);
             println!(
-                "  one copy in place  {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's: the instanced walk's own cost)",
+                "  one copy in place  {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's: the instanced walk's own cost; {} hits differ)",
                 row.in_place_primary_mrays,
                 row.in_place_diffuse_mrays,
                 ratio(row.in_place_primary_mrays, row.single_primary_mrays),
-                ratio(row.in_place_diffuse_mrays, row.single_diffuse_mrays)
+                ratio(row.in_place_diffuse_mrays, row.single_diffuse_mrays),
+                row.in_place_differ
             );
             println!(
                 "  {} copies       {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the mesh alone's)",
