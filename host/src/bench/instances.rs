@@ -13,7 +13,11 @@ use glam::{Mat3, Vec3};
 use rand::{Rng, SeedableRng};
 use treelet::runtime::backend::{Backend, DeviceClass};
 use treelet::scene::Scene;
+use treelet::runtime::kernels::Kernel;
+use treelet::tracer::{batch_slots, device_rays};
 use treelet::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer, Triangle};
+use treelet_core::geometry::buffers::CopyParams;
+use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use super::measure::median;
 
@@ -110,35 +114,59 @@ fn bounces(rays: &[Ray], hits: &[RayHit], extent: f32, rng: &mut impl Rng) -> Ve
         .collect()
 }
 
-/// Device ms of `trace` (the trace stage; wall clock on the CPU runner).
-fn timed<B: Backend, T>(b: &mut B, trace: impl FnOnce(&mut B) -> Result<T>) -> Result<(f64, T)> {
-    let cpu = b.class() == DeviceClass::CpuRunner;
-    b.take_times()?;
-    let start = Instant::now();
-    let out = trace(b)?;
-    let stages = b.take_times()?;
-    Ok((if cpu { start.elapsed().as_secs_f64() * 1e3 } else { stages.get("trace") }, out))
+/// A tracer as the benchmark drives it: closest hits from host rays (to
+/// make the bounce rays), and in place on the device (what is timed).
+struct Traced<'a, B: Backend> {
+    closest: &'a dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
+    on_device: &'a dyn Fn(&mut B, &B::Buffer, usize) -> Result<()>,
 }
 
-/// Primary and diffuse M rays/s (medians of `repeats`) through `closest`.
+/// Device ms of tracing `rays` (median of `repeats`), each repeat a fresh
+/// copy of them made on the device right before, with no host work in
+/// between: at 1080p an upload and read-back of the rays leaves the GPU
+/// idle long enough for its clock to fall (H100: a traversal timed that
+/// way ran 5.5x slower, 1980 against 345 MHz). Half a second of untimed
+/// repeats first brings the clock up.
+fn traced_ms<B: Backend>(b: &mut B, rays: &[Ray], repeats: usize, t: &Traced<B>) -> Result<f64> {
+    let pristine = b.upload("bench rays", &device_rays(rays)?)?;
+    let work = b.scratch("bench rays in place", 2 * batch_slots(rays.len())? as u64 * 16)?;
+    let words = 2 * batch_slots(rays.len())? as u32 * 4;
+    let copy = b.upload("bench copy", &[CopyParams { len: words, ..Default::default() }])?;
+    let cpu = b.class() == DeviceClass::CpuRunner;
+    let once = |b: &mut B| -> Result<f64> {
+        b.take_times()?;
+        b.stage("copy");
+        b.dispatch(Kernel::CopyWords, &[&copy, &pristine, &work], groups_for(words, WORKGROUP_SIZE));
+        let start = Instant::now();
+        (t.on_device)(b, &work, rays.len())?;
+        let stages = b.take_times()?;
+        Ok(if cpu { start.elapsed().as_secs_f64() * 1e3 } else { stages.get("trace") })
+    };
+    let warm = Instant::now();
+    while warm.elapsed().as_secs_f64() < if cpu { 0.0 } else { 0.5 } {
+        once(b)?;
+    }
+    let times = (0..repeats).map(|_| once(b)).collect::<Result<Vec<f64>>>()?;
+    Ok(median(times))
+}
+
+/// Primary and diffuse M rays/s (medians of `repeats`) through `t`, and the
+/// numbers of rays.
 fn rays_per_second<B: Backend>(
     b: &mut B,
     (framing, view): ((Vec3, Vec3), Vec3),
     size: (u32, u32),
     extent: f32,
     repeats: usize,
-    closest: &dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
+    t: &Traced<B>,
 ) -> Result<(f64, f64, usize, usize)> {
     let primary = camera_rays(framing, view, size);
-    let (_, hits) = timed(b, |b| closest(b, &primary))?; // warm-up
+    let hits = (t.closest)(b, &primary)?;
     let diffuse = bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
-    let (mut p, mut d) = (Vec::new(), Vec::new());
-    for _ in 0..repeats {
-        p.push(timed(b, |b| closest(b, &primary))?.0);
-        d.push(timed(b, |b| closest(b, &diffuse))?.0);
-    }
+    let p = traced_ms(b, &primary, repeats, t)?;
+    let d = traced_ms(b, &diffuse, repeats, t)?;
     let mrays = |n: usize, ms: f64| n as f64 / ms / 1e3;
-    Ok((mrays(primary.len(), median(p)), mrays(diffuse.len(), median(d)), primary.len(), diffuse.len()))
+    Ok((mrays(primary.len(), p), mrays(diffuse.len(), d), primary.len(), diffuse.len()))
 }
 
 /// `bench instances` on `b`: see the module doc.
@@ -164,7 +192,7 @@ pub(crate) fn bench_instances<B: Backend>(
 
     // The mesh alone.
     let single = Tracer::build(b, &[], mesh, Quality::High)?;
-    let (sp, sd, sn, sdn) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| single.closest_hits(b, r))?;
+    let (sp, sd, sn, sdn) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| single.closest_hits(b, r), on_device: &|b, r, n| single.closest_hits_on_device(b, r, n) })?;
     let check_rays = camera_rays((lo, hi), OBLIQUE, size);
     let expected = single.closest_hits(b, &check_rays)?;
     drop(single);
@@ -172,7 +200,7 @@ pub(crate) fn bench_instances<B: Backend>(
     let got = one.closest_hits(b, &check_rays)?;
     // The same walk through the same tree: every hit the same.
     let in_place_differ = expected.iter().zip(&got).filter(|(e, g)| (e.t, e.prim) != (g.t, g.prim)).count();
-    let (op, od, _, _) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &|b, r| one.closest_hits(b, r))?;
+    let (op, od, _, _) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| one.closest_hits(b, r), on_device: &|b, r, n| one.closest_hits_on_device(b, r, n) })?;
     drop(one);
 
     // A grid of copies, each turned about the vertical.
@@ -186,8 +214,8 @@ pub(crate) fn bench_instances<B: Backend>(
         let at = Vec3::new(i.transform[0][3], i.transform[1][3], i.transform[2][3]);
         [at + centre - Vec3::splat(extent * 0.5), at + centre + Vec3::splat(extent * 0.5)]
     }));
-    let (ip, id, ins, idn) = rays_per_second(b, (framing, OBLIQUE), size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
-    let (ap, ad, _, _) = rays_per_second(b, (framing, ABOVE), size, extent, repeats, &|b, r| scene_tracer.closest_hits(b, r))?;
+    let (ip, id, ins, idn) = rays_per_second(b, (framing, OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| scene_tracer.closest_hits(b, r), on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n) })?;
+    let (ap, ad, _, _) = rays_per_second(b, (framing, ABOVE), size, extent, repeats, &Traced { closest: &|b, r| scene_tracer.closest_hits(b, r), on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n) })?;
 
     // Top-level rebuilds of scattered copies (one warm-up each).
     let mut top_level = Vec::new();

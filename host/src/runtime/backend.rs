@@ -128,6 +128,13 @@ pub trait Backend: Send {
     /// primitives): the backend never hands them out again, and forgets
     /// them, so they are freed when the caller drops them.
     fn keep(&mut self, _buffers: &[&Self::Buffer]) {}
+
+    /// Hands `buffers` (taken since the last build, and no longer needed by
+    /// any dispatch not yet waited for) back to the pool now, rather than at
+    /// the next build: what a caller that traces batch after batch without
+    /// building does with each batch's buffers, so that memory does not
+    /// grow with every batch.
+    fn release(&mut self, _buffers: &[&Self::Buffer]) {}
     /// Builds the pipelines of `kernels` ahead of the work that uses them,
     /// several at once where the device compiles them (a GPU's driver);
     /// returns the wall seconds it took. Kernels left out are built when

@@ -73,7 +73,11 @@ pub(super) fn read_batch<B: Backend>(
 ) -> Result<Vec<[f32; 4]>> {
     let buffer = b.upload("rays", &device_rays(rays)?)?;
     cast(b, &buffer)?;
-    b.read(&buffer, 2 * rays.len())
+    let out = b.read(&buffer, 2 * rays.len());
+    // Waited for: the buffer serves the next batch (without this, every
+    // batch took a new one until the next build: 66 MB a 1080p frame).
+    b.release(&[&buffer]);
+    out
 }
 
 /// The image a batch of `count` rays is cast as (the cast kernels walk one).

@@ -283,6 +283,15 @@ impl Backend for GpuBackend {
         }
     }
 
+    fn release(&mut self, buffers: &[&wgpu::Buffer]) {
+        for b in buffers {
+            if let Some(i) = self.used.iter().position(|(_, u)| u == *b) {
+                let (key, buffer) = self.used.swap_remove(i);
+                self.free.entry(key).or_default().push(buffer);
+            }
+        }
+    }
+
     fn begin_build(&mut self) {
         self.free.clear();
         for (key, buffer) in self.used.drain(..) {
