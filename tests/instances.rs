@@ -20,7 +20,9 @@ fn meshes(rng: &mut impl Rng, sizes: &[usize]) -> Vec<Vec<Triangle>> {
         .map(|&n| {
             (0..n)
                 .map(|_| {
-                    let mut p = || Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let mut p = || {
+                        Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+                    };
                     let a = p();
                     let (b, c) = (a + p() * 0.3, a + p() * 0.3);
                     Triangle::new(a.into(), b.into(), c.into())
@@ -33,7 +35,13 @@ fn meshes(rng: &mut impl Rng, sizes: &[usize]) -> Vec<Vec<Triangle>> {
 /// A random rotation, scale (unequal per axis, one in four mirrored), a
 /// little shear, and a translation within [0, 40]^3.
 fn transform(rng: &mut impl Rng) -> [[f32; 4]; 3] {
-    let q = Quat::from_xyzw(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize();
+    let q = Quat::from_xyzw(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    )
+    .normalize();
     let mut scale = Vec3::new(rng.random_range(0.5..3.0), rng.random_range(0.5..3.0), rng.random_range(0.5..3.0));
     if rng.random_range(0..4) == 0 {
         scale.x = -scale.x;
@@ -50,7 +58,10 @@ fn instances(rng: &mut impl Rng, n: usize, meshes: usize) -> Vec<Instance> {
 
 /// Point `v` of a mesh placed by `m`, in f64 then rounded.
 fn place(m: &[[f32; 4]; 3], v: [f32; 3]) -> [f32; 3] {
-    [0, 1, 2].map(|r| (m[r][0] as f64 * v[0] as f64 + m[r][1] as f64 * v[1] as f64 + m[r][2] as f64 * v[2] as f64 + m[r][3] as f64) as f32)
+    [0, 1, 2].map(|r| {
+        (m[r][0] as f64 * v[0] as f64 + m[r][1] as f64 * v[1] as f64 + m[r][2] as f64 * v[2] as f64 + m[r][3] as f64)
+            as f32
+    })
 }
 
 /// The scene as one mesh, and for each of its triangles (instance, triangle in the mesh).
@@ -122,18 +133,19 @@ fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> Vec<RayHit>
     let refs: Vec<&[Triangle]> = m.iter().map(|m| m.as_slice()).collect();
     let mut scene = InstancedTracer::build(b, &refs, &placed, quality).unwrap();
     let mut all = Vec::new();
-    let mut check_now = |b: &mut B, scene: &InstancedTracer<B>, m: &[Vec<Triangle>], placed: &[Instance], stage: &str| {
-        let flat = flatten(m, placed);
-        let flat_hits = Tracer::build(b, &[], &flat.0, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
-        let hits = scene.closest_hits(b, &rays).unwrap();
-        check(&format!("{what}, {stage}"), &hits, &flat_hits, &flat, &rays);
-        // Occlusion: exactly the rays whose closest hit is within t_max.
-        let occluded = scene.occluded(b, &rays).unwrap();
-        for ((r, h), o) in rays.iter().zip(&hits).zip(&occluded) {
-            assert_eq!(*o, h.is_hit(), "{what}, {stage}: ray {r:?}: occluded {o}, closest hit {h:?}");
-        }
-        all.extend(hits);
-    };
+    let mut check_now =
+        |b: &mut B, scene: &InstancedTracer<B>, m: &[Vec<Triangle>], placed: &[Instance], stage: &str| {
+            let flat = flatten(m, placed);
+            let flat_hits = Tracer::build(b, &[], &flat.0, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+            let hits = scene.closest_hits(b, &rays).unwrap();
+            check(&format!("{what}, {stage}"), &hits, &flat_hits, &flat, &rays);
+            // Occlusion: exactly the rays whose closest hit is within t_max.
+            let occluded = scene.occluded(b, &rays).unwrap();
+            for ((r, h), o) in rays.iter().zip(&hits).zip(&occluded) {
+                assert_eq!(*o, h.is_hit(), "{what}, {stage}: ray {r:?}: occluded {o}, closest hit {h:?}");
+            }
+            all.extend(hits);
+        };
     check_now(b, &scene, &m, &placed, "built");
     // Next frame: other instances, fewer of them; the meshes' trees stay.
     let moved = instances(&mut rng, 90, m.len());
@@ -159,7 +171,11 @@ fn instanced_scenes_hit_what_the_flattened_scene_hits() {
             let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);
             // Same kernels, same trees: the same hits but for rounding.
             let same = cpu.iter().zip(&gpu).filter(|(c, g)| (c.instance, c.prim) == (g.instance, g.prim)).count();
-            assert!(same as f64 >= 0.999 * cpu.len() as f64, "{quality:?} seed {seed}: GPU and CPU agree on {same} hits of {}", cpu.len());
+            assert!(
+                same as f64 >= 0.999 * cpu.len() as f64,
+                "{quality:?} seed {seed}: GPU and CPU agree on {same} hits of {}",
+                cpu.len()
+            );
         }
     }
 }
@@ -169,9 +185,12 @@ fn instanced_scenes_hit_what_the_flattened_scene_hits() {
 fn in_place<B: Backend>(b: &mut B, seed: u64) {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let m = meshes(&mut rng, &[500]);
-    let rays: Vec<Ray> = rays(&mut rng, 2000).into_iter().map(|r| Ray { origin: r.origin.map(|x| x / 20.0 - 1.0), ..r }).collect();
+    let rays: Vec<Ray> =
+        rays(&mut rng, 2000).into_iter().map(|r| Ray { origin: r.origin.map(|x| x / 20.0 - 1.0), ..r }).collect();
     let plain = Tracer::build(b, &[], &m[0], Quality::High).unwrap().closest_hits(b, &rays).unwrap();
-    let placed = InstancedTracer::build(b, &[&m[0]], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High).unwrap();
+    let placed =
+        InstancedTracer::build(b, &[&m[0]], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High)
+            .unwrap();
     let hits = placed.closest_hits(b, &rays).unwrap();
     let mut n = 0;
     for ((r, p), h) in rays.iter().zip(&plain).zip(&hits) {

@@ -56,7 +56,8 @@ pub fn trace_instances(
 ) -> InstanceHit {
     let top = Level { nodes: top_nodes, leaves: top_leaves, instances };
     let mesh = Level { nodes, leaves, instances: &NoInstances };
-    let (hit, instance) = walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, &top, &mesh);
+    let (hit, instance) =
+        walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, &top, &mesh);
     if hit.is_hit() {
         InstanceHit { t: hit.t, prim: hit.prim, instance }
     } else {

@@ -12,8 +12,8 @@ use anyhow::{bail, Result};
 use glam::{Mat3, Vec3};
 use rand::{Rng, SeedableRng};
 use treelet::runtime::backend::{Backend, DeviceClass};
-use treelet::scene::Scene;
 use treelet::runtime::kernels::Kernel;
+use treelet::scene::Scene;
 use treelet::tracer::{batch_slots, device_rays};
 use treelet::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer, Triangle};
 use treelet_core::geometry::buffers::CopyParams;
@@ -53,7 +53,14 @@ pub(crate) struct InstancesRow {
 /// and translations within a cube, as a frame of moving instances.
 fn scattered(count: usize, extent: f32, rng: &mut impl Rng) -> Vec<Instance> {
     let side = extent * (count as f32).cbrt() * 1.5;
-    (0..count).map(|_| placed(rng.random_range(0.0..std::f32::consts::TAU), Vec3::new(rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..side)))).collect()
+    (0..count)
+        .map(|_| {
+            placed(
+                rng.random_range(0.0..std::f32::consts::TAU),
+                Vec3::new(rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..side)),
+            )
+        })
+        .collect()
 }
 
 /// Mesh 0 turned by `angle` about the vertical, then moved by `at`.
@@ -192,21 +199,44 @@ pub(crate) fn bench_instances<B: Backend>(
 
     // The mesh alone.
     let single = Tracer::build(b, &[], mesh, Quality::High)?;
-    let (sp, sd, sn, sdn) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| single.closest_hits(b, r), on_device: &|b, r, n| single.closest_hits_on_device(b, r, n) })?;
+    let (sp, sd, sn, sdn) = rays_per_second(
+        b,
+        ((lo, hi), OBLIQUE),
+        size,
+        extent,
+        repeats,
+        &Traced {
+            closest: &|b, r| single.closest_hits(b, r),
+            on_device: &|b, r, n| single.closest_hits_on_device(b, r, n),
+        },
+    )?;
     let check_rays = camera_rays((lo, hi), OBLIQUE, size);
     let expected = single.closest_hits(b, &check_rays)?;
     drop(single);
-    let one = InstancedTracer::build(b, &[mesh], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High)?;
+    let one =
+        InstancedTracer::build(b, &[mesh], &[Instance { mesh: 0, transform: Instance::IDENTITY }], Quality::High)?;
     let got = one.closest_hits(b, &check_rays)?;
     // The same walk through the same tree: every hit the same.
     let in_place_differ = expected.iter().zip(&got).filter(|(e, g)| (e.t, e.prim) != (g.t, g.prim)).count();
-    let (op, od, _, _) = rays_per_second(b, ((lo, hi), OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| one.closest_hits(b, r), on_device: &|b, r, n| one.closest_hits_on_device(b, r, n) })?;
+    let (op, od, _, _) = rays_per_second(
+        b,
+        ((lo, hi), OBLIQUE),
+        size,
+        extent,
+        repeats,
+        &Traced { closest: &|b, r| one.closest_hits(b, r), on_device: &|b, r, n| one.closest_hits_on_device(b, r, n) },
+    )?;
     drop(one);
 
     // A grid of copies, each turned about the vertical.
     let step = 1.25 * extent;
     let copies: Vec<Instance> = (0..grid * grid)
-        .map(|k| placed(rng.random_range(0.0..std::f32::consts::TAU), Vec3::new((k % grid) as f32 * step, 0.0, (k / grid) as f32 * step)))
+        .map(|k| {
+            placed(
+                rng.random_range(0.0..std::f32::consts::TAU),
+                Vec3::new((k % grid) as f32 * step, 0.0, (k / grid) as f32 * step),
+            )
+        })
         .collect();
     let mut scene_tracer = InstancedTracer::build(b, &[mesh], &copies, Quality::High)?;
     let centre = (lo + hi) * 0.5;
@@ -214,8 +244,28 @@ pub(crate) fn bench_instances<B: Backend>(
         let at = Vec3::new(i.transform[0][3], i.transform[1][3], i.transform[2][3]);
         [at + centre - Vec3::splat(extent * 0.5), at + centre + Vec3::splat(extent * 0.5)]
     }));
-    let (ip, id, ins, idn) = rays_per_second(b, (framing, OBLIQUE), size, extent, repeats, &Traced { closest: &|b, r| scene_tracer.closest_hits(b, r), on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n) })?;
-    let (ap, ad, _, _) = rays_per_second(b, (framing, ABOVE), size, extent, repeats, &Traced { closest: &|b, r| scene_tracer.closest_hits(b, r), on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n) })?;
+    let (ip, id, ins, idn) = rays_per_second(
+        b,
+        (framing, OBLIQUE),
+        size,
+        extent,
+        repeats,
+        &Traced {
+            closest: &|b, r| scene_tracer.closest_hits(b, r),
+            on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n),
+        },
+    )?;
+    let (ap, ad, _, _) = rays_per_second(
+        b,
+        (framing, ABOVE),
+        size,
+        extent,
+        repeats,
+        &Traced {
+            closest: &|b, r| scene_tracer.closest_hits(b, r),
+            on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n),
+        },
+    )?;
 
     // Top-level rebuilds of scattered copies (one warm-up each).
     let mut top_level = Vec::new();

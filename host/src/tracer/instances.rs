@@ -27,8 +27,8 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
-use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
 use super::primitives::{Quality, Tracer};
+use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
 use crate::bvh::layout::{Layout, TracedTree};
 use crate::bvh::lbvh;
 use crate::bvh::tree::BuiltTree;
@@ -164,7 +164,8 @@ impl<B: Backend> InstancedTracer<B> {
         // given as a triangle whose box it is (corners `min`, `max`, `min`):
         // the builders need nothing but the boxes. One instance a leaf: each
         // costs a walk of its mesh's tree.
-        let boxes: Vec<Triangle> = instances.iter().map(|i| world_box(&self.bounds[i.mesh as usize], &i.transform)).collect();
+        let boxes: Vec<Triangle> =
+            instances.iter().map(|i| world_box(&self.bounds[i.mesh as usize], &i.transform)).collect();
         let all = Primitives { spheres: &[], triangles: &boxes };
         let (bvh, mut stages) = lbvh::build_primitives_on_device(b, all)?;
         let built = BuiltTree { bvh, max_leaf: 1, build_ms: stages.total() };
@@ -254,7 +255,14 @@ impl<B: Backend> InstancedTracer<B> {
             let p = RenderParams { width, height, cast_mode, instances: 0, ..Default::default() };
             return self.dispatch(b, &p, rays, None);
         };
-        let p = RenderParams { width, height, triangles: self.gathered.triangle_count, cast_mode, instances: top.count, ..Default::default() };
+        let p = RenderParams {
+            width,
+            height,
+            triangles: self.gathered.triangle_count,
+            cast_mode,
+            instances: top.count,
+            ..Default::default()
+        };
         self.dispatch(b, &p, rays, Some(top))
     }
 
@@ -403,7 +411,8 @@ fn copy_mesh<B: Backend>(b: &mut B, t: &Tracer<B>, g: &Gathered<B>, m: usize) ->
         (&t.prims.triangles, &g.triangles, triangle_base, 12, triangles),
     ] {
         let len = count * words_each;
-        let p = b.upload("copy params", &[CopyParams { len, src_offset: 0, dst_offset: base * words_each, _pad0: 0 }])?;
+        let p =
+            b.upload("copy params", &[CopyParams { len, src_offset: 0, dst_offset: base * words_each, _pad0: 0 }])?;
         b.dispatch(Kernel::CopyWords, &[&p, src, dst], groups_for(len, WORKGROUP_SIZE));
     }
     Ok(())

@@ -99,7 +99,11 @@ pub fn device_rays(rays: &[Ray]) -> Result<Vec<[f32; 4]>> {
     let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
     for (k, r) in rays.iter().enumerate() {
         let d = glam::Vec3::from(r.dir);
-        let o = if r.t_min > 0.0 && d.length() > 0.0 { glam::Vec3::from(r.origin) + d.normalize() * r.t_min } else { r.origin.into() };
+        let o = if r.t_min > 0.0 && d.length() > 0.0 {
+            glam::Vec3::from(r.origin) + d.normalize() * r.t_min
+        } else {
+            r.origin.into()
+        };
         data[2 * k] = [o.x, o.y, o.z, r.t_max - r.t_min];
         data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
     }
