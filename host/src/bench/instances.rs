@@ -11,15 +11,11 @@ use std::time::Instant;
 use anyhow::{bail, Result};
 use glam::{Mat3, Vec3};
 use rand::{Rng, SeedableRng};
-use treelet::runtime::backend::{Backend, DeviceClass};
-use treelet::runtime::kernels::Kernel;
+use treelet::runtime::backend::Backend;
 use treelet::scene::Scene;
-use treelet::tracer::{batch_slots, device_rays};
 use treelet::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer, Triangle};
-use treelet_core::geometry::buffers::CopyParams;
-use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
-use super::measure::median;
+use super::measure::{median, traced_in_place_ms};
 
 /// Medians (ms: device time, `last_update_ms` and the trace stage's
 /// timestamps on a GPU; wall clock on the CPU runner).
@@ -128,35 +124,6 @@ struct Traced<'a, B: Backend> {
     on_device: &'a dyn Fn(&mut B, &B::Buffer, usize) -> Result<()>,
 }
 
-/// Device ms of tracing `rays` (median of `repeats`), each repeat a fresh
-/// copy of them made on the device right before, with no host work in
-/// between: at 1080p an upload and read-back of the rays leaves the GPU
-/// idle long enough for its clock to fall (H100: a traversal timed that
-/// way ran 5.5x slower, 1980 against 345 MHz). Half a second of untimed
-/// repeats first brings the clock up.
-fn traced_ms<B: Backend>(b: &mut B, rays: &[Ray], repeats: usize, t: &Traced<B>) -> Result<f64> {
-    let pristine = b.upload("bench rays", &device_rays(rays)?)?;
-    let work = b.scratch("bench rays in place", 2 * batch_slots(rays.len())? as u64 * 16)?;
-    let words = 2 * batch_slots(rays.len())? as u32 * 4;
-    let copy = b.upload("bench copy", &[CopyParams { len: words, ..Default::default() }])?;
-    let cpu = b.class() == DeviceClass::CpuRunner;
-    let once = |b: &mut B| -> Result<f64> {
-        b.take_times()?;
-        b.stage("copy");
-        b.dispatch(Kernel::CopyWords, &[&copy, &pristine, &work], groups_for(words, WORKGROUP_SIZE));
-        let start = Instant::now();
-        (t.on_device)(b, &work, rays.len())?;
-        let stages = b.take_times()?;
-        Ok(if cpu { start.elapsed().as_secs_f64() * 1e3 } else { stages.get("trace") })
-    };
-    let warm = Instant::now();
-    while warm.elapsed().as_secs_f64() < if cpu { 0.0 } else { 0.5 } {
-        once(b)?;
-    }
-    let times = (0..repeats).map(|_| once(b)).collect::<Result<Vec<f64>>>()?;
-    Ok(median(times))
-}
-
 /// Primary and diffuse M rays/s (medians of `repeats`) through `t`, and the
 /// numbers of rays.
 fn rays_per_second<B: Backend>(
@@ -170,8 +137,8 @@ fn rays_per_second<B: Backend>(
     let primary = camera_rays(framing, view, size);
     let hits = (t.closest)(b, &primary)?;
     let diffuse = bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
-    let p = traced_ms(b, &primary, repeats, t)?;
-    let d = traced_ms(b, &diffuse, repeats, t)?;
+    let p = traced_in_place_ms(b, &primary, repeats, 0.5, t.on_device)?;
+    let d = traced_in_place_ms(b, &diffuse, repeats, 0.5, t.on_device)?;
     let mrays = |n: usize, ms: f64| n as f64 / ms / 1e3;
     Ok((mrays(primary.len(), p), mrays(diffuse.len(), d), primary.len(), diffuse.len()))
 }

@@ -13,6 +13,13 @@ use treelet::render::variant::KernelChoice;
 use treelet::runtime::kernels::{render_entry_point_name, Method};
 use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
+use std::time::Instant;
+use treelet::runtime::backend::DeviceClass;
+use treelet::runtime::kernels::Kernel;
+use treelet::tracer::{batch_slots, device_rays};
+use treelet::Ray;
+use treelet_core::geometry::buffers::CopyParams;
+use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
 /// One device build of `builder` (`config`: the treelet rounds of trbvh,
 /// and of hploc where it has any; the leaf collapse of both), the tree left
@@ -452,5 +459,41 @@ pub(crate) fn time_casts<B: Backend>(
         occlusion.push(t.get("occlusion"));
     }
     Ok((median(primary), median(diffuse), median(occlusion), diffuse_rays))
+}
+
+/// Device ms of tracing `rays` (median of `repeats`), each repeat a fresh
+/// copy of them made on the device right before, with no host work in
+/// between: at 1080p an upload and read-back of the rays leaves the GPU
+/// idle long enough for its clock to fall (H100: a traversal timed that
+/// way ran 5.5x slower, 1980 against 345 MHz). `warm_s` seconds of untimed
+/// repeats first bring the clock up (not on the CPU runner). `on_device`
+/// traces the batch in place (`Tracer::closest_hits_on_device` and kin).
+pub(crate) fn traced_in_place_ms<B: Backend>(
+    b: &mut B,
+    rays: &[Ray],
+    repeats: usize,
+    warm_s: f64,
+    on_device: &dyn Fn(&mut B, &B::Buffer, usize) -> Result<()>,
+) -> Result<f64> {
+    let pristine = b.upload("bench rays", &device_rays(rays)?)?;
+    let work = b.scratch("bench rays in place", 2 * batch_slots(rays.len())? as u64 * 16)?;
+    let words = 2 * batch_slots(rays.len())? as u32 * 4;
+    let copy = b.upload("bench copy", &[CopyParams { len: words, ..Default::default() }])?;
+    let cpu = b.class() == DeviceClass::CpuRunner;
+    let once = |b: &mut B| -> Result<f64> {
+        b.take_times()?;
+        b.stage("copy");
+        b.dispatch(Kernel::CopyWords, &[&copy, &pristine, &work], groups_for(words, WORKGROUP_SIZE));
+        let start = Instant::now();
+        on_device(b, &work, rays.len())?;
+        let stages = b.take_times()?;
+        Ok(if cpu { start.elapsed().as_secs_f64() * 1e3 } else { stages.get("trace") })
+    };
+    let warm = Instant::now();
+    while !cpu && warm.elapsed().as_secs_f64() < warm_s {
+        once(b)?;
+    }
+    let times = (0..repeats.max(1)).map(|_| once(b)).collect::<Result<Vec<f64>>>()?;
+    Ok(median(times))
 }
 
