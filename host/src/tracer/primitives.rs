@@ -185,7 +185,7 @@ impl<B: Backend> Tracer<B> {
     /// b2): a triangle's barycentric coordinates of the hit as in [`RayHit`]
     /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0:
     /// the bits of instance 0); for a miss (inf, bits of `u32::MAX`, 0, 0)
-    /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`]`(count)` such pairs; pairs past
+    /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`](crate::tracer::batch_slots)`(count)` such pairs; pairs past
     /// `count` must be zero. Submitted, not waited for.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_RAYS)

@@ -25,9 +25,9 @@ impl Ray {
 }
 
 /// The closest hit of a ray: the primitive (spheres first, then triangles,
-/// in the order given to [`Tracer::build`]; in an instanced scene the
+/// in the order given to [`Tracer::build`](crate::tracer::Tracer::build); in an instanced scene the
 /// triangle's index within its mesh), the instance hit (0 for a
-/// [`Tracer`], which is one), the distance along the normalized direction,
+/// [`Tracer`](crate::tracer::Tracer), which is one), the distance along the normalized direction,
 /// a triangle's barycentric coordinates of the hit (of `v1` and `v2`: the
 /// point is `(1 - b1 - b2) v0 + b1 v1 + b2 v2`; 0 for a sphere), to
 /// interpolate vertex normals and texture coordinates, and the geometric
@@ -89,7 +89,7 @@ pub(super) fn batch_dims(count: usize) -> Result<(u32, u32)> {
 /// Rays a device batch holds per row (the cast kernels walk an image).
 pub(super) const BATCH_WIDTH: u32 = 1024;
 
-/// `rays` as [`Tracer::closest_hits_on_device`] reads them from a device
+/// `rays` as [`Tracer::closest_hits_on_device`](crate::tracer::Tracer::closest_hits_on_device) reads them from a device
 /// buffer: two `[f32; 4]` a ray, padded with zeros to [`batch_slots`] pairs.
 /// The device layout has no `t_min`: a ray is moved `t_min` along its
 /// direction and its `t_max` shortened by as much (hit distances then count
