@@ -44,22 +44,46 @@ pub fn reduce_bounds_phase(
     }
 }
 
-/// Kernel: the first pass of the bounds fused with the primitive boxes:
-/// each invocation computes and stores the boxes of its `REDUCE_ITEMS`
-/// primitives (as [`crate::construct::primitive_boxes::primitive_boxes_kernel`]
+/// What the first pass of the bounds reads: the box of each of its items.
+/// Primitives ([`PrimitiveBoxes`]) or placed meshes
+/// ([`crate::construct::instances::InstanceBoxes`], which also write each
+/// instance's record on the way).
+pub trait BoxSource {
+    fn box_of(&mut self, i: u32) -> Aabb;
+}
+
+/// The boxes of a scene's primitives: sphere `i` below `spheres`, else
+/// triangle `i - spheres`.
+/// The split by value: a reference to a `Split` made in a shader loses
+/// its contents under rust-gpu (see `crate::geometry::split`).
+pub struct PrimitiveBoxes<'a> {
+    pub spheres: u32,
+    pub sphere_data: &'a [Sphere],
+    pub triangles: Split<'a, Triangle>,
+}
+
+impl BoxSource for PrimitiveBoxes<'_> {
+    #[inline]
+    fn box_of(&mut self, i: u32) -> Aabb {
+        primitive_box(i, self.spheres, self.sphere_data, &self.triangles)
+    }
+}
+
+/// Kernel: the first pass of the bounds fused with the items' boxes: each
+/// invocation computes and stores the boxes of its `REDUCE_ITEMS` items
+/// (for primitives, as [`crate::construct::primitive_boxes::primitive_boxes_kernel`]
 /// does) and reduces their centroids, so the boxes are not read again;
 /// `output[group]` = the centroid bounds of the group's tile of the `n`
-/// primitives. H100, the bounds stage (boxes and every pass) as two
+/// items. H100, the bounds stage (boxes and every pass) as two
 /// kernels, then fused: 1M primitives 0.047 -> 0.030 ms, 4M 0.170 ->
 /// 0.088, 16M 0.590 -> 0.294 (`docs/results/h100-agglomerate-subgroup/log_fused_bounds.txt`).
 #[allow(clippy::too_many_arguments)]
-pub fn primitive_bounds_phase<B: RecordStore<Aabb> + ?Sized>(
+pub fn primitive_bounds_phase<S: BoxSource, B: RecordStore<Aabb> + ?Sized>(
     phase: u32,
     lid: u32,
     group: u32,
-    params: &BuildParams,
-    spheres: &[Sphere],
-    triangles: &Split<Triangle>,
+    n: u32,
+    source: &mut S,
     boxes: &mut B,
     output: &mut [Aabb],
     shared: &mut [Aabb; WG],
@@ -68,15 +92,15 @@ pub fn primitive_bounds_phase<B: RecordStore<Aabb> + ?Sized>(
         let mut acc = Aabb::EMPTY;
         for k in 0..REDUCE_ITEMS {
             let i = group * REDUCE_TILE + k * WORKGROUP_SIZE + lid;
-            if i < params.n {
-                let b = primitive_box(i, params.spheres, spheres, triangles);
+            if i < n {
+                let b = source.box_of(i);
                 boxes.store(i as usize, &b);
                 acc = acc.union(&Aabb::point(b.centroid()));
             }
         }
         shared[lid as usize] = acc;
     } else {
-        reduce_and_write(phase, lid, group, params.n, output, shared);
+        reduce_and_write(phase, lid, group, n, output, shared);
     }
 }
 

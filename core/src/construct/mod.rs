@@ -15,6 +15,7 @@
 //! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
 //! | SAH leaf collapse, depth-first compaction | [`collapse`] | Karras & Aila 2013, section 4.4 |
 //! | SAH cost | [`sah`] | MacDonald & Booth 1990 |
+//! | an instanced scene's top level: instance records and world boxes | [`instances`] | |
 //! | buffer fills (the fit's arrival counters) | [`fill`] | |
 //!
 //! Node layout: `n` leaves and `n - 1` internal nodes in one array of
@@ -30,6 +31,7 @@ pub mod collapse;
 pub mod fill;
 pub mod fit;
 pub mod hploc;
+pub mod instances;
 pub mod morton;
 pub mod multisplit;
 pub mod primitive_boxes;

@@ -321,6 +321,37 @@ impl InstanceRecord {
     }
 }
 
+/// A placed copy of a mesh as an engine gives it, before the top level is
+/// built ([`crate::construct::instances`]): the rows of the 3x4 matrix that
+/// takes the mesh's points into the world (`x = row · (x', 1)`), and which
+/// mesh. repr(C), Pod, 64 bytes (the last 12 unused).
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct PlacedMesh {
+    pub world_from_object: [[f32; 4]; 3],
+    pub mesh: u32,
+    pub _pad: [u32; 3],
+}
+const _: () = assert!(core::mem::size_of::<PlacedMesh>() == 64);
+
+/// A mesh of an instanced scene as the top level's build reads it: its box
+/// in its own space, and where its tree, leaf primitives and triangles
+/// start in the buffers that hold every mesh's one after another.
+/// repr(C), Pod, 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct MeshRecord {
+    pub min: [f32; 3],
+    pub node_base: u32,
+    pub max: [f32; 3],
+    pub leaf_base: u32,
+    pub triangle_base: u32,
+    pub _pad: [u32; 3],
+}
+const _: () = assert!(core::mem::size_of::<MeshRecord>() == 48);
+
 /// A binary node holding both children's boxes (Aila & Laine 2009), so a
 /// ray tests both children with the one load that reached their parent.
 /// repr(C), Pod, 64 bytes.

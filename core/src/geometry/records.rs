@@ -12,7 +12,7 @@
 //! the CPU runner as records; the tests below check both give the same
 //! bytes.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, Node, WideNode};
+use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, MeshRecord, Node, PlacedMesh, WideNode};
 use crate::gpu::unchecked::{at, put};
 use glam::Vec4;
 
@@ -153,6 +153,36 @@ impl RecordLoad<InstanceRecord> for [Vec4] {
     }
 }
 
+impl RecordStore<InstanceRecord> for [Vec4] {
+    #[inline]
+    fn store(&mut self, i: usize, r: &InstanceRecord) {
+        for k in 0..3 {
+            put(self, 4 * i + k, Vec4::from_array(r.object_from_world[k]));
+        }
+        // Not `[..].map`: rust-gpu cannot compile arrays' map.
+        let w = Vec4::new(f32::from_bits(r.node_base), f32::from_bits(r.leaf_base), f32::from_bits(r.triangle_base), f32::from_bits(r.mesh));
+        put(self, 4 * i + 3, w);
+    }
+}
+
+impl RecordLoad<PlacedMesh> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> PlacedMesh {
+        let row = |k: usize| at(self, 4 * i + k).to_array();
+        PlacedMesh { world_from_object: [row(0), row(1), row(2)], mesh: at(self, 4 * i + 3).x.to_bits(), _pad: [0; 3] }
+    }
+}
+
+impl RecordLoad<MeshRecord> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> MeshRecord {
+        let (min, node_base) = parts(at(self, 3 * i));
+        let (max, leaf_base) = parts(at(self, 3 * i + 1));
+        let triangle_base = at(self, 3 * i + 2).x.to_bits();
+        MeshRecord { min, node_base, max, leaf_base, triangle_base, _pad: [0; 3] }
+    }
+}
+
 impl RecordLoad<WideNode> for [Vec4] {
     #[inline]
     fn load(&self, i: usize) -> WideNode {
@@ -209,6 +239,7 @@ mod tests {
         same_bytes(*bytemuck::from_bytes::<LeafPrim>(bytemuck::cast_slice(&words[..12])), 3);
         let more: Vec<u32> = (0..20).map(|k| 0x27d4_eb2fu32.wrapping_mul(k + 3)).collect();
         same_bytes(*bytemuck::from_bytes::<WideNode>(bytemuck::cast_slice(&more)), 5);
+        same_bytes(*bytemuck::from_bytes::<InstanceRecord>(bytemuck::cast_slice(&words)), 4);
     }
 
     #[test]
@@ -227,5 +258,12 @@ mod tests {
         let wide: &[WideNode] = bytemuck::cast_slice(&words[..20]);
         let loaded: WideNode = vectors[..].load(0);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&wide[0]));
+        // The instance inputs' unused words read as zero.
+        let mut placed = *bytemuck::from_bytes::<PlacedMesh>(bytemuck::cast_slice(&words[..16]));
+        placed._pad = [0; 3];
+        assert_eq!(RecordLoad::<PlacedMesh>::load(&vectors[..], 0), placed);
+        let mut mesh = *bytemuck::from_bytes::<MeshRecord>(bytemuck::cast_slice(&words[12..24]));
+        mesh._pad = [0; 3];
+        assert_eq!(RecordLoad::<MeshRecord>::load(&vectors[..], 1), mesh);
     }
 }

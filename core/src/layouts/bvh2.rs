@@ -17,6 +17,7 @@ use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
 use crate::geometry::split::Split;
 use crate::geometry::triangle::Triangle;
+use crate::gpu::unchecked::at;
 
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
 /// nodes, root 0, depth-first order: a left child follows its parent, a
@@ -79,6 +80,52 @@ fn child_ref(c: &Node, internal_index: u32) -> (u32, u32) {
     } else {
         (internal_index, 0)
     }
+}
+
+/// Kernel, one invocation per internal node `i < n - 1` of a tree over
+/// `n` instances in the LBVH layout (as built: root 0, leaf of slot `j` at
+/// `n - 1 + j`): the top level of an instanced scene
+/// ([`crate::trace::instances`]) in the [`Bvh2Node`] layout, node `i` at
+/// `i`, without the collapse's depth-first compaction or leaf primitives:
+/// a leaf child refers to its instance directly (`prim_indices[j]`, count
+/// 1). One tree of one leaf gets a root whose second child is an empty box.
+pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> + ?Sized>(
+    i: u32,
+    n: u32,
+    nodes: &N,
+    prim_indices: &[u32],
+    out: &mut O,
+) {
+    if n == 1 {
+        if i == 0 {
+            let leaf = nodes.load(0);
+            let mut root = Bvh2Node { left: at(prim_indices, 0), left_count: 1, ..Default::default() };
+            (root.left_min, root.left_max) = (leaf.min, leaf.max);
+            (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
+            root.right_count = 1; // a leaf that no ray reaches
+            out.store(0, &root);
+        }
+        return;
+    }
+    if i + 1 >= n {
+        return;
+    }
+    let node = nodes.load(i as usize);
+    let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
+    let child = |index: u32, c: &Node| if c.is_leaf() { (at(prim_indices, c.left as usize), 1) } else { (index, 0) };
+    let (left, left_count) = child(node.left, &l);
+    let (right, right_count) = child(node.right, &r);
+    let record = Bvh2Node {
+        left_min: l.min,
+        left,
+        left_max: l.max,
+        right,
+        right_min: r.min,
+        left_count,
+        right_max: r.max,
+        right_count,
+    };
+    out.store(i as usize, &record);
 }
 
 /// Kernel, one invocation per primitive slot `j < n`: the primitive of

@@ -129,7 +129,6 @@ pub fn cast_instances_kernel(
     invocation: u32,
     params: &RenderParams,
     top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
-    top_leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
@@ -145,7 +144,7 @@ pub fn cast_instances_kernel(
         return;
     }
     let hit = if query.t_max >= 0.0 && params.instances > 0 {
-        trace_instances(o, d, query, top_nodes, top_leaves, instances, nodes, leaves, prims)
+        trace_instances(o, d, query, top_nodes, instances, nodes, leaves, prims)
     } else {
         InstanceHit { t: MISS, prim: u32::MAX, instance: u32::MAX }
     };

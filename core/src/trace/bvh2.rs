@@ -126,8 +126,19 @@ impl RecordLoad<InstanceRecord> for NoInstances {
     }
 }
 
-/// A top-level leaf's index with this bit: the instance there, walked to
-/// as a node is (entered rather than tested).
+/// The leaf primitives of a top level, which has none: its leaves refer
+/// to their instances directly.
+pub struct NoLeafPrims;
+
+impl RecordLoad<LeafPrim> for NoLeafPrims {
+    #[inline]
+    fn load(&self, _: usize) -> LeafPrim {
+        LeafPrim::default()
+    }
+}
+
+/// A top-level leaf's instance with this bit, walked to as a node is
+/// (entered rather than tested).
 const ENTER: u32 = 1 << 31;
 
 /// The walk every traversal of this layout shares, nearer child first (see
@@ -166,7 +177,9 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     let mut node = 0u32;
     loop {
         if INSTANCED && !inside && node & ENTER != 0 {
-            current = top.leaves.load((node & !ENTER) as usize).prim;
+            // The top level's leaves refer to their instances directly
+            // (`crate::layouts::bvh2::top_level_node_kernel`).
+            current = node & !ENTER;
             let record = top.instances.load(current as usize);
             (node_base, leaf_base) = (record.node_base, record.leaf_base);
             let (o2, d2) = record.to_object(o, d);

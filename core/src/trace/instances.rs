@@ -2,8 +2,9 @@
 //! ([`InstanceRecord`]), each copy entered with the ray taken into its
 //! mesh's space, where the mesh's own (bottom-level) tree is walked. Both
 //! levels are trees in the [`crate::trace::bvh2`] layout and share its walk
-//! ([`walk`]); the top level's leaf primitives are the instances' world
-//! boxes, their `prim` the instance's index. The bottom-level trees of
+//! ([`walk`]); the top level's leaves are the instances' world boxes, and
+//! refer to the instances directly
+//! ([`crate::layouts::bvh2::top_level_node_kernel`]). The bottom-level trees of
 //! every mesh lie one after another in one node buffer and one leaf
 //! buffer; an instance says where its mesh's start.
 //!
@@ -16,7 +17,7 @@ use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim};
 use crate::geometry::features;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::records::RecordLoad;
-use crate::trace::bvh2::{walk, Level, NoInstances};
+use crate::trace::bvh2::{walk, Level, NoInstances, NoLeafPrims};
 use crate::trace::hit::{Query, STACK_DEPTH};
 
 /// The closest (or, for an occlusion query, the first found) hit in an
@@ -37,7 +38,7 @@ impl InstanceHit {
 }
 
 /// Traces `o + t d` (`d` of unit length, so that `t` is a distance) through
-/// the top-level tree `top_nodes`/`top_leaves` over `instances`, and into
+/// the top-level tree `top_nodes` over `instances`, and into
 /// the bottom-level trees of their meshes (`nodes`, `leaves`, triangles
 /// only: `prims` holds no spheres), in one walk on one stack
 /// ([`walk`]: a nested walk per instance crashed NVIDIA's shader compiler).
@@ -48,13 +49,12 @@ pub fn trace_instances(
     d: Vec3,
     query: Query,
     top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
-    top_leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     prims: &Prims,
 ) -> InstanceHit {
-    let top = Level { nodes: top_nodes, leaves: top_leaves, instances };
+    let top = Level { nodes: top_nodes, leaves: &NoLeafPrims, instances };
     let mesh = Level { nodes, leaves, instances: &NoInstances };
     let (hit, instance) =
         walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, &top, &mesh);

@@ -176,6 +176,48 @@ pub fn build_primitives_with<B: Backend>(
         };
         return Ok((bvh, b.take_times()?));
     }
+    let mut params = BuildParams { spheres: prims.spheres.len() as u32, ..Default::default() };
+    let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
+    let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
+    // The boxes and the first pass of their centroid bounds in one kernel.
+    let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, partials: &B::Buffer, groups| {
+        b.dispatch(Kernel::PrimitiveBounds, &[p, &spheres, &triangles, boxes, partials], groups);
+        Ok(())
+    };
+    params.n = n;
+    let (mut bvh, times) = build_from_first_pass(b, params, hierarchy, first_pass)?;
+    bvh.prims = Some((spheres, triangles));
+    Ok((bvh, times))
+}
+
+/// The LBVH over `n` boxes that `first_pass` makes on the device (an
+/// instanced scene's top level: the instances' world boxes), with the
+/// default hierarchy for `n`; `first_pass(b, params, boxes, partials,
+/// groups)` dispatches a kernel that writes the `n` boxes (32 bytes each)
+/// and the first pass of their centroid bounds (one box per group of
+/// `REDUCE_TILE`), as [`Kernel::PrimitiveBounds`] does. Starts a new build
+/// on `b`. The tree's `prims` is `None`.
+pub fn build_over_boxes<B: Backend>(
+    b: &mut B,
+    n: u32,
+    first_pass: impl FnOnce(&mut B, &B::Buffer, &B::Buffer, &B::Buffer, u32) -> Result<()>,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    anyhow::ensure!(n >= 1 && n <= MAX_PRIMITIVES, "{n} boxes: the LBVH takes 1 to {MAX_PRIMITIVES}");
+    b.begin_build();
+    let hierarchy = Hierarchy::for_device(b, n as usize);
+    build_from_first_pass(b, BuildParams { n, ..Default::default() }, hierarchy, first_pass)
+}
+
+/// The build after its inputs are on the device: `first_pass` makes the
+/// boxes and their first centroid partials, the rest is the same for every
+/// input.
+fn build_from_first_pass<B: Backend>(
+    b: &mut B,
+    mut params: BuildParams,
+    hierarchy: Hierarchy,
+    first_pass: impl FnOnce(&mut B, &B::Buffer, &B::Buffer, &B::Buffer, u32) -> Result<()>,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    let n = params.n;
     let node_count = 2 * n as u64 - 1;
     // Fail before any GPU work when the largest buffer does not fit.
     check_fits(b, "nodes", node_count * std::mem::size_of::<Node>() as u64)?;
@@ -187,20 +229,16 @@ pub fn build_primitives_with<B: Backend>(
         .and_then(|v| v.parse().ok())
         .unwrap_or(SORTED_KEY_BITS)
         .clamp(1, KEY_BITS);
-    let mut params = BuildParams { n, key_shift: KEY_BITS - key_bits, ..Default::default() };
-    params.spheres = prims.spheres.len() as u32;
+    params.key_shift = KEY_BITS - key_bits;
     if hierarchy == Hierarchy::Hploc {
         (params.cluster_keep, params.cluster_radius) = hploc_settings();
     }
-    let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
-    let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
-    // The boxes and the first pass of their centroid bounds in one kernel,
-    // then partial boxes reduced until one remains.
+    // The first pass, then partial boxes reduced until one remains.
     let groups = groups_for(n, REDUCE_TILE);
     let partials = b.scratch("bounds partials", groups as u64 * 32)?;
-    b.dispatch(Kernel::PrimitiveBounds, &[&p, &spheres, &triangles, &boxes, &partials], groups);
+    first_pass(b, &p, &boxes, &partials, groups)?;
     let (mut input, mut len) = (partials, groups);
     let centroid_bounds = loop {
         if len == 1 {
@@ -279,8 +317,7 @@ pub fn build_primitives_with<B: Backend>(
 
     let times = b.take_times()?;
     let node_count = node_count as u32;
-    let prims = Some((spheres, triangles));
-    Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds, prims }, times))
+    Ok((DeviceBvh { n, node_count, nodes, parents, prim_indices: values, sorted_keys: keys, centroid_bounds, prims: None }, times))
 }
 
 /// H-PLOC's most clusters a merged range keeps (the paper: half the

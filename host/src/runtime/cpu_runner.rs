@@ -353,7 +353,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fill::copy_words_kernel(id, &p, src, dst);
             }
         }
-        (Kernel::CastInstances, [p, top_nodes, top_leaves, instances, nodes, leaves, spheres, triangles, rays]) => {
+        (Kernel::CastInstances, [p, top_nodes, instances, nodes, leaves, spheres, triangles, rays]) => {
             use treelet_core::{Bvh2Node, LeafPrim};
             let p: treelet_core::RenderParams = params(p);
             let prims = treelet_core::geometry::prims::Prims {
@@ -362,11 +362,30 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 triangles: Split::whole(view(triangles)),
                 triangle_count: p.triangles,
             };
-            let (top_nodes, top_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(top_nodes), view(top_leaves));
+            let top_nodes: &[Bvh2Node] = view(top_nodes);
             let (nodes, leaves): (&[Bvh2Node], &[LeafPrim]) = (view(nodes), view(leaves));
             let (instances, rays): (&[treelet_core::InstanceRecord], _) = (view(instances), view(rays));
             for id in ids(groups) {
-                treelet_core::render::rays::cast_instances_kernel(id, &p, top_nodes, top_leaves, instances, nodes, leaves, &prims, rays);
+                treelet_core::render::rays::cast_instances_kernel(id, &p, top_nodes, instances, nodes, leaves, &prims, rays);
+            }
+        }
+        (Kernel::InstanceBounds, [p, placed, meshes, records, boxes, output]) => {
+            use treelet_core::geometry::buffers::{InstanceRecord, MeshRecord, PlacedMesh};
+            let p: treelet_core::BuildParams = params(p);
+            let (placed, meshes): (&[PlacedMesh], &[MeshRecord]) = (view(placed), view(meshes));
+            let (records, boxes, output) = (view::<InstanceRecord>(records), view::<Aabb>(boxes), view(output));
+            let mut source = treelet_core::construct::instances::InstanceBoxes { placed, meshes, records };
+            let mut shared = [Aabb::EMPTY; WG];
+            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
+                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, output, &mut shared)
+            });
+        }
+        (Kernel::TopLevelNodes, [p, nodes, prim_indices, out]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, prim_indices) = (view::<treelet_core::Node>(nodes), view(prim_indices));
+            let out = view::<treelet_core::Bvh2Node>(out);
+            for id in ids(groups) {
+                bvh2::top_level_node_kernel(id, p.n, nodes, prim_indices, out);
             }
         }
         (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {
@@ -381,8 +400,10 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (spheres, triangles) = (view(spheres), view(triangles));
             let (boxes, output) = (view::<Aabb>(boxes), view(output));
             let mut shared = [Aabb::EMPTY; WG];
+            let triangles = Split::whole(triangles);
+            let mut source = bounds::PrimitiveBoxes { spheres: p.spheres, sphere_data: spheres, triangles };
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, &p, spheres, &Split::whole(triangles), boxes, output, &mut shared)
+                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, output, &mut shared)
             });
         }
         (Kernel::ReduceBounds, [p, input, output]) => {

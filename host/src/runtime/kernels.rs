@@ -174,13 +174,21 @@ pub enum Kernel {
     /// An engine's rays through an instanced scene (a top-level tree over
     /// instances of meshes, `bvh2` layout at both levels).
     CastInstances,
+    /// An instanced scene's top level: each instance's record and world
+    /// box, and the first pass of their centroid bounds.
+    InstanceBounds,
+    /// An instanced scene's top level in the two-box layout, from its LBVH
+    /// as built (leaves refer to instances).
+    TopLevelNodes,
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 56] = [
+    const FIXED: [Kernel; 58] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
+        Kernel::InstanceBounds,
+        Kernel::TopLevelNodes,
         Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
         Kernel::ReduceBounds,
@@ -257,6 +265,8 @@ impl Kernel {
             Kernel::Fill => "fill::fill_cs",
             Kernel::CopyWords => "fill::copy_words_cs",
             Kernel::CastInstances => "render::cast_instances_cs",
+            Kernel::InstanceBounds => "bounds::instance_bounds_cs",
+            Kernel::TopLevelNodes => "bvh2::top_level_nodes_cs",
             Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
             Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
@@ -344,7 +354,9 @@ impl Kernel {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
             Kernel::CopyWords => &[Read, Read, ReadWrite],
-            Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::ReduceBounds => &[Read, Read, ReadWrite],

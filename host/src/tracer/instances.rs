@@ -21,20 +21,19 @@
 //! # anyhow::Ok(())
 //! ```
 use anyhow::{bail, Context, Result};
-use treelet_core::geometry::buffers::{CopyParams, InstanceRecord, RenderParams};
+use treelet_core::geometry::buffers::{CopyParams, LayoutParams, MeshRecord, PlacedMesh, RenderParams};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
+use treelet_core::trace::hit::STACK_DEPTH;
 
 use super::primitives::{Quality, Tracer};
 use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
-use crate::bvh::layout::{Layout, TracedTree};
+use crate::bvh::layout::tree_depth;
 use crate::bvh::lbvh;
-use crate::bvh::tree::BuiltTree;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
-use crate::scene::primitives::Primitives;
 
 /// A placed copy of mesh `mesh` (its index in the list given to
 /// [`InstancedTracer::build`]): `transform` takes the mesh's points into
@@ -67,6 +66,8 @@ struct Gathered<B: Backend> {
     nodes: B::Buffer,
     leaves: B::Buffer,
     triangles: B::Buffer,
+    /// Per mesh: its box and bases, as the top level's build reads them.
+    meshes: B::Buffer,
     /// Per mesh: first node, first leaf primitive, first triangle.
     bases: Vec<[u32; 3]>,
     /// Per mesh: its layout's node count (a refit may change it: the SAH
@@ -75,10 +76,10 @@ struct Gathered<B: Backend> {
     triangle_count: u32,
 }
 
-/// The top-level tree over the instances' world boxes (leaf primitive `k`
-/// is instance `k`) and the instances as the kernel reads them.
+/// The top-level tree over the instances' world boxes (`bvh2` nodes whose
+/// leaves refer to instances) and the instances as the kernel reads them.
 struct TopLevel<B: Backend> {
-    tree: TracedTree<B>,
+    nodes: B::Buffer,
     records: B::Buffer,
     count: u32,
 }
@@ -86,14 +87,13 @@ struct TopLevel<B: Backend> {
 /// Meshes placed many times, on one device, for closest hits and occlusion
 /// queries: see the module doc.
 ///
-/// Speed, as measured (H100, `treelet bench instances`): correct, but the
-/// instanced walk runs at about a sixth of the plain walk's rays/s on the
-/// same work (one copy in place; the plain walk in the same kernel runs at
-/// full speed), for a reason in NVIDIA's compilation not found yet; the
-/// top level takes about 1 ms to rebuild at 1 000 instances, 1.7 ms at
-/// 100 000 (its LBVH's fixed costs). Refit or place meshes with this type
-/// where the scene needs instances; a mesh alone traces faster with
-/// [`Tracer`].
+/// Speed, as measured (H100, `treelet bench instances`, and
+/// `docs/benchmarks.md`): the mesh as one instance in place traces at
+/// about two thirds of the rays/s of the mesh alone in a [`Tracer`] (the
+/// walk's own cost); the top level is built on the device from the
+/// transforms (records and world boxes there too), an LBVH of one instance
+/// a leaf. Place meshes with this type where the scene needs instances; a
+/// mesh alone traces faster with [`Tracer`].
 pub struct InstancedTracer<B: Backend> {
     meshes: Vec<Tracer<B>>,
     /// Each mesh's box in its own space.
@@ -104,7 +104,7 @@ pub struct InstancedTracer<B: Backend> {
     /// Placeholders: the kernel's sphere binding (instanced meshes are
     /// triangles), and its top-level bindings while there are no instances.
     no_spheres: B::Buffer,
-    no_top: [B::Buffer; 3],
+    no_top: [B::Buffer; 2],
     update_ms: f64,
     top_stages: StageTimes,
 }
@@ -130,10 +130,10 @@ impl<B: Backend> InstancedTracer<B> {
             trees.push(tracer);
             bounds.push(mesh_bounds(triangles));
         }
-        let gathered = gather(b, &trees)?;
+        let gathered = gather(b, &trees, &bounds)?;
         let no_spheres = b.upload("no spheres", &[treelet_core::Sphere::default()])?;
-        let no_top = [b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?];
-        b.keep(&[&no_spheres, &no_top[0], &no_top[1], &no_top[2]]);
+        let no_top = [b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?];
+        b.keep(&[&no_spheres, &no_top[0], &no_top[1]]);
         let mut scene = InstancedTracer {
             meshes: trees,
             bounds,
@@ -153,30 +153,15 @@ impl<B: Backend> InstancedTracer<B> {
     /// Places the meshes anew (any number of instances, any transforms):
     /// rebuilds the top-level tree only.
     pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> Result<()> {
-        let records = self.records(instances)?;
+        let placed = self.placed(instances)?;
         self.instances = instances.to_vec();
         self.top = None;
         self.update_ms = 0.0;
         if instances.is_empty() {
             return Ok(());
         }
-        // The top level is an LBVH over the instances' world boxes, each
-        // given as a triangle whose box it is (corners `min`, `max`, `min`):
-        // the builders need nothing but the boxes. One instance a leaf: each
-        // costs a walk of its mesh's tree.
-        let boxes: Vec<Triangle> =
-            instances.iter().map(|i| world_box(&self.bounds[i.mesh as usize], &i.transform)).collect();
-        let all = Primitives { spheres: &[], triangles: &boxes };
-        let (bvh, mut stages) = lbvh::build_primitives_on_device(b, all)?;
-        let built = BuiltTree { bvh, max_leaf: 1, build_ms: stages.total() };
-        let prims = built.prim_buffers(b, all)?;
-        let (tree, layout) = built.lay_out_timed(b, Layout::Bvh2, &prims)?;
-        for s in &layout.order {
-            stages.add(s, layout.get(s));
-        }
-        let records = b.upload("instances", &records)?;
-        b.keep(&[&tree.nodes, &tree.prims, &records]);
-        self.top = Some(TopLevel { tree, records, count: instances.len() as u32 });
+        let (top, stages) = build_top_level(b, &placed, &self.gathered.meshes)?;
+        self.top = Some(top);
         self.update_ms = stages.total();
         self.top_stages = stages;
         Ok(())
@@ -196,9 +181,10 @@ impl<B: Backend> InstancedTracer<B> {
         let nodes = self.meshes[mesh].tree.as_ref().map_or(0, |t| t.node_count);
         if nodes == self.gathered.node_counts[mesh] {
             copy_mesh(b, &self.meshes[mesh], &self.gathered, mesh)?;
+            self.gathered.meshes = mesh_records(b, &self.gathered.bases, &self.bounds)?;
         } else {
             // The mesh's layout changed size: every mesh moves.
-            self.gathered = gather(b, &self.meshes)?;
+            self.gathered = gather(b, &self.meshes, &self.bounds)?;
         }
         let instances = std::mem::take(&mut self.instances);
         self.set_instances(b, &instances)?;
@@ -212,7 +198,9 @@ impl<B: Backend> InstancedTracer<B> {
         self.update_ms
     }
 
-    /// The stages of the last top-level build, device ms each (LBVH, collapse, layout).
+    /// The stages of the last top-level build, device ms each (the LBVH's,
+    /// whose `bounds` makes the instances' records and boxes; `depth`;
+    /// `layout`).
     pub fn top_level_stages(&self) -> &StageTimes {
         &self.top_stages
     }
@@ -270,21 +258,21 @@ impl<B: Backend> InstancedTracer<B> {
         let params = b.upload("trace params", &[*p])?;
         let g = &self.gathered;
         // With no instances, the top level's bindings are never read.
-        let (top_nodes, top_leaves, records) = match top {
-            Some(t) => (&t.tree.nodes, &t.tree.prims, &t.records),
-            None => (&self.no_top[0], &self.no_top[1], &self.no_top[2]),
+        let (top_nodes, records) = match top {
+            Some(t) => (&t.nodes, &t.records),
+            None => (&self.no_top[0], &self.no_top[1]),
         };
         b.stage("trace");
         b.dispatch(
             Kernel::CastInstances,
-            &[&params, top_nodes, top_leaves, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
+            &[&params, top_nodes, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
             groups_for(tiled_invocations(p.width, p.height), WORKGROUP_SIZE),
         );
         Ok(())
     }
 
-    /// The kernel's records of `instances`, after checking them.
-    fn records(&self, instances: &[Instance]) -> Result<Vec<InstanceRecord>> {
+    /// `instances` as the top level's build reads them, after checking them.
+    fn placed(&self, instances: &[Instance]) -> Result<Vec<PlacedMesh>> {
         if instances.len() > (u32::MAX / 2) as usize {
             bail!("{} instances: at most {} are supported", instances.len(), u32::MAX / 2);
         }
@@ -292,45 +280,74 @@ impl<B: Backend> InstancedTracer<B> {
             .iter()
             .enumerate()
             .map(|(k, i)| {
-                let Some(&[node_base, leaf_base, triangle_base]) = self.gathered.bases.get(i.mesh as usize) else {
+                if i.mesh as usize >= self.meshes.len() {
                     bail!("instance {k} places mesh {}, but there are {} meshes", i.mesh, self.meshes.len());
-                };
-                let inverse = inverse(&i.transform).with_context(|| format!("instance {k}"))?;
-                Ok(InstanceRecord { object_from_world: inverse, node_base, leaf_base, triangle_base, mesh: i.mesh })
+                }
+                check_transform(&i.transform).with_context(|| format!("instance {k}"))?;
+                Ok(PlacedMesh { world_from_object: i.transform, mesh: i.mesh, _pad: [0; 3] })
             })
             .collect()
     }
 }
 
-/// The rows of the inverse of the affine map `m` (in f64, rounded once),
-/// or an error for a non-finite or singular one.
-fn inverse(m: &[[f32; 4]; 3]) -> Result<[[f32; 4]; 3]> {
+/// The top level over `placed` (at least one), on the device: the
+/// instances' records and world boxes (`treelet_core::construct::instances`)
+/// as the LBVH's first pass, the LBVH (one instance a leaf), its depth
+/// checked against the walk's stack, and its `bvh2` nodes in the LBVH's
+/// order (no compaction: leaves refer to instances).
+fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], meshes: &B::Buffer) -> Result<(TopLevel<B>, StageTimes)> {
+    let n = placed.len() as u32;
+    let mut records = None;
+    let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, partials, groups| {
+        let input = b.upload("placed meshes", placed)?;
+        let out = b.scratch("instance records", n as u64 * 64)?;
+        b.dispatch(Kernel::InstanceBounds, &[p, &input, meshes, &out, boxes, partials], groups);
+        records = Some(out);
+        Ok(())
+    })?;
+    let records = records.context("internal: the top level's first pass did not run")?;
+    b.stage("depth");
+    let deepest = tree_depth(b, &bvh)?;
+    if deepest as usize + 1 > STACK_DEPTH {
+        bail!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
+    }
+    b.stage("layout");
+    let internal = (n - 1).max(1);
+    let nodes = b.scratch("top-level nodes", internal as u64 * 64)?;
+    let p = b.upload("layout params", &[LayoutParams { n, nodes: bvh.node_count, ..Default::default() }])?;
+    b.dispatch(Kernel::TopLevelNodes, &[&p, &bvh.nodes, &bvh.prim_indices, &nodes], groups_for(internal, WORKGROUP_SIZE));
+    let rest = b.take_times()?;
+    for stage in &rest.order {
+        stages.add(stage, rest.get(stage));
+    }
+    b.keep(&[&nodes, &records]);
+    Ok((TopLevel { nodes, records, count: n }, stages))
+}
+
+/// Refuses a non-finite or singular transform (in f64, relative to the
+/// matrix's own scale: a flattened copy has no inside, and its inverse no
+/// meaning). The device inverts it.
+fn check_transform(m: &[[f32; 4]; 3]) -> Result<()> {
     if m.iter().flatten().any(|x| !x.is_finite()) {
         bail!("the transform has a non-finite entry: {m:?}");
     }
     let a = |r: usize, c: usize| m[r][c] as f64;
-    // The adjugate's rows (cofactors, transposed), then the determinant.
     let cof = |r: usize, c: usize| {
         let (r1, r2, c1, c2) = ((r + 1) % 3, (r + 2) % 3, (c + 1) % 3, (c + 2) % 3);
         a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)
     };
     let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
-    // Singular relative to the matrix's own scale: a flattened copy has no
-    // inside, and its inverse no meaning.
     let scale = (0..9).map(|k| a(k / 3, k % 3).abs()).fold(0.0f64, f64::max);
     if !(det.abs() > 1e-12 * scale * scale * scale) {
         bail!("the transform is singular (determinant {det:e}): it flattens the mesh");
     }
-    let inv = |r: usize, c: usize| cof(c, r) / det;
-    let mut out = [[0f32; 4]; 3];
-    for (r, row) in out.iter_mut().enumerate() {
-        let shift = -(0..3).map(|c| inv(r, c) * a(c, 3)).sum::<f64>();
-        *row = [inv(r, 0) as f32, inv(r, 1) as f32, inv(r, 2) as f32, shift as f32];
-    }
-    if out.iter().flatten().any(|x| !x.is_finite()) {
+    // The inverse's entries are cofactors over the determinant.
+    let largest = (0..9).map(|k| cof(k / 3, k % 3).abs()).fold(0.0f64, f64::max) / det.abs();
+    let shift = (0..3).map(|r| a(r, 3).abs()).fold(0.0f64, f64::max);
+    if !(largest * (1.0 + shift) * 3.0 < f32::MAX as f64) {
         bail!("the transform's inverse overflows f32: {m:?}");
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The box of a mesh's triangles, in f64.
@@ -348,28 +365,8 @@ fn mesh_bounds(triangles: &[Triangle]) -> [[f64; 3]; 2] {
     [lo, hi]
 }
 
-/// The world box of a mesh box under `m`, as the triangle the top level is
-/// built over (`min`, `max`, `min`). Widened past f32 rounding: the ray is
-/// taken into the mesh's space in f32, so a box only just touching the mesh
-/// in exact arithmetic could cull a hit the mesh's tree would find.
-fn world_box([lo, hi]: &[[f64; 3]; 2], m: &[[f32; 4]; 3]) -> Triangle {
-    let mut min = [f64::INFINITY; 3];
-    let mut max = [f64::NEG_INFINITY; 3];
-    for corner in 0..8 {
-        let p = [0, 1, 2].map(|k| if corner >> k & 1 == 0 { lo[k] } else { hi[k] });
-        for r in 0..3 {
-            let w = m[r][0] as f64 * p[0] + m[r][1] as f64 * p[1] + m[r][2] as f64 * p[2] + m[r][3] as f64;
-            min[r] = min[r].min(w);
-            max[r] = max[r].max(w);
-        }
-    }
-    let size = (0..3).map(|k| (max[k] - min[k]).max(min[k].abs()).max(max[k].abs())).fold(0.0f64, f64::max);
-    let pad = size * 1e-5;
-    Triangle::new(min.map(|x| (x - pad) as f32), max.map(|x| (x + pad) as f32), min.map(|x| (x - pad) as f32))
-}
-
 /// Gathers every mesh's layout and triangles into one buffer each.
-fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>]) -> Result<Gathered<B>> {
+fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>], bounds: &[[[f64; 3]; 2]]) -> Result<Gathered<B>> {
     let mut bases = Vec::with_capacity(meshes.len());
     let mut node_counts = Vec::with_capacity(meshes.len());
     let (mut nodes, mut leaves, mut triangles) = (0u64, 0u64, 0u64);
@@ -385,6 +382,7 @@ fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>]) -> Result<Gathered<B>> {
         }
     }
     let gathered = Gathered {
+        meshes: mesh_records(b, &bases, bounds)?,
         nodes: b.scratch("instanced nodes", nodes * 64)?,
         leaves: b.scratch("instanced leaf primitives", leaves * 48)?,
         triangles: b.scratch("instanced triangles", triangles * 48)?,
@@ -416,4 +414,24 @@ fn copy_mesh<B: Backend>(b: &mut B, t: &Tracer<B>, g: &Gathered<B>, m: usize) ->
         b.dispatch(Kernel::CopyWords, &[&p, src, dst], groups_for(len, WORKGROUP_SIZE));
     }
     Ok(())
+}
+
+/// The meshes' boxes and bases, on the device (kept).
+fn mesh_records<B: Backend>(b: &mut B, bases: &[[u32; 3]], bounds: &[[[f64; 3]; 2]]) -> Result<B::Buffer> {
+    let records: Vec<MeshRecord> = bases
+        .iter()
+        .zip(bounds)
+        .map(|(&[node_base, leaf_base, triangle_base], [lo, hi])| MeshRecord {
+            // f32 vertices' extremes: exact in f32.
+            min: lo.map(|x| x as f32),
+            node_base,
+            max: hi.map(|x| x as f32),
+            leaf_base,
+            triangle_base,
+            _pad: [0; 3],
+        })
+        .collect();
+    let buffer = b.upload("instanced meshes", &records)?;
+    b.keep(&[&buffer]);
+    Ok(buffer)
 }
