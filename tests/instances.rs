@@ -159,6 +159,11 @@ fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> Vec<RayHit>
     }
     scene.refit_mesh(b, 0, &m[0]).unwrap();
     check_now(b, &scene, &m, &moved, "mesh refit");
+    // More instances than the top level had room for: the meshes are
+    // gathered again behind a larger one.
+    let more = instances(&mut rng, 700, m.len());
+    scene.set_instances(b, &more).unwrap();
+    check_now(b, &scene, &m, &more, "instances grew");
     all
 }
 

@@ -182,18 +182,17 @@ pub fn cast_instances_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] top_nodes: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] instances: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] leaves: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] spheres: &[Sphere],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] rays: &mut [[f32; 4]],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] instances: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] leaves: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] spheres: &[Sphere],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] rays: &mut [[f32; 4]],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     // Bound whole: the part past the split (the same slice) is never read.
     let prims = Prims { spheres, sphere_count: 0, triangles: Split::new(triangles, triangles), triangle_count: params.triangles };
     treelet_core::render::rays::cast_instances_kernel(
-        id, params, top_nodes, instances, nodes, leaves, &prims, rays,
+        id, params, instances, nodes, leaves, &prims, rays,
     );
 }

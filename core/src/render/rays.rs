@@ -128,7 +128,6 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
 pub fn cast_instances_kernel(
     invocation: u32,
     params: &RenderParams,
-    top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
@@ -144,7 +143,7 @@ pub fn cast_instances_kernel(
         return;
     }
     let hit = if query.t_max >= 0.0 && params.instances > 0 {
-        trace_instances(o, d, query, top_nodes, instances, nodes, leaves, prims)
+        trace_instances(o, d, query, instances, nodes, leaves, prims)
     } else {
         InstanceHit { t: MISS, prim: u32::MAX, instance: u32::MAX }
     };

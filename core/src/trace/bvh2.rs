@@ -103,17 +103,17 @@ pub fn trace_bvh2<const F: u32>(
     if prims.count() == 0 {
         return query.start();
     }
-    // One level: the top-level arguments are never read.
-    let one = Level { nodes, leaves: leaf_prims, instances: &NoInstances };
-    walk::<F, false, { 2 * STACK_DEPTH }>(o, d, from, &query, prims, &one, &one).0
+    // One level: the instances are never read.
+    let one = Level { nodes, leaves: leaf_prims };
+    walk::<F, false, { 2 * STACK_DEPTH }>(o, d, from, &query, prims, &NoInstances, &one).0
 }
 
-/// The buffers of one level of a walk: a tree's nodes and leaf
-/// primitives, and for an instanced scene's top level its instances.
-pub struct Level<'a, N: ?Sized, L: ?Sized, I: ?Sized> {
+/// The buffers a walk reads: the nodes of its trees (for an instanced
+/// scene, the top level's from node 0, then every mesh's) and their leaf
+/// primitives.
+pub struct Level<'a, N: ?Sized, L: ?Sized> {
     pub nodes: &'a N,
     pub leaves: &'a L,
-    pub instances: &'a I,
 }
 
 /// The instances of a walk without any ([`trace_bvh2`]).
@@ -126,31 +126,23 @@ impl RecordLoad<InstanceRecord> for NoInstances {
     }
 }
 
-/// The leaf primitives of a top level, which has none: its leaves refer
-/// to their instances directly.
-pub struct NoLeafPrims;
-
-impl RecordLoad<LeafPrim> for NoLeafPrims {
-    #[inline]
-    fn load(&self, _: usize) -> LeafPrim {
-        LeafPrim::default()
-    }
-}
-
 /// A top-level leaf's instance with this bit, walked to as a node is
 /// (entered rather than tested).
 const ENTER: u32 = 1 << 31;
 
 /// The walk every traversal of this layout shares, nearer child first (see
-/// the module doc), from `query.start()`. With `INSTANCED`, the walk
-/// starts in `top`, a tree over instances ([`crate::trace::instances`]):
-/// a top-level leaf is an instance, entered when the walk gets to it by
-/// taking the ray into its mesh's space and going on in the mesh's tree
-/// (in `mesh`, at the instance's bases), on the same stack, until the
-/// stack is back at its height on entering. Without, `mesh` is the one
-/// tree (bases 0) and `top` is never read: the same code as a plain walk.
-/// `STACK`: words of the stack (two an entry; [`STACK_DEPTH`] entries a
-/// level). Returns the hit and its instance (`u32::MAX` without).
+/// the module doc), from `query.start()`. With `INSTANCED`, `trees` holds
+/// an instanced scene's top level from node 0 (a tree over `instances`,
+/// [`crate::trace::instances`]) and every mesh's tree after it: a top-level
+/// leaf is an instance, entered when the walk gets to it by taking the ray
+/// into its mesh's space and going on in the mesh's tree (at the
+/// instance's bases), on the same stack, until the stack is back at its
+/// height on entering. One buffer for both levels, so every node is read
+/// by the one load (two loads under a branch made the walk slower).
+/// Without, `trees` is the one tree and `instances` is never read: the
+/// same code as a plain walk. `STACK`: words of the stack (two an entry;
+/// [`STACK_DEPTH`] entries a level). Returns the hit and its instance
+/// (`u32::MAX` without).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
@@ -159,8 +151,8 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     from: Origin,
     query: &Query,
     prims: &Prims,
-    top: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized, impl RecordLoad<InstanceRecord> + ?Sized>,
-    mesh: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized, impl RecordLoad<InstanceRecord> + ?Sized>,
+    instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
+    trees: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized>,
 ) -> (Hit, u32) {
     let mut hit = query.start();
     let (mut found_in, mut current) = (u32::MAX, u32::MAX);
@@ -180,7 +172,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             // The top level's leaves refer to their instances directly
             // (`crate::layouts::bvh2::top_level_node_kernel`).
             current = node & !ENTER;
-            let record = top.instances.load(current as usize);
+            let record = instances.load(current as usize);
             (node_base, leaf_base) = (record.node_base, record.leaf_base);
             let (o2, d2) = record.to_object(o, d);
             (slabs, ray, at_ray) = (SlabRay::new(o2, d2), WatertightRay::new(o2, d2), (o2, d2, Origin::NONE));
@@ -188,7 +180,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             floor = top_len;
             node = 0;
         }
-        let n = if inside { mesh.nodes.load((node_base + node) as usize) } else { top.nodes.load(node as usize) };
+        let n = trees.nodes.load((node_base + node) as usize);
         let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
         let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
@@ -196,7 +188,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
         if inside {
             // Leaves are tested at once; only internal children are walked.
             let before = hit;
-            let leaves = (leaf_base, query, &ray, prims, mesh.leaves);
+            let leaves = (leaf_base, query, &ray, prims, trees.leaves);
             if go_left && n.left_count > 0 {
                 leaf::<F>(&mut hit, leaves.0 + n.left, n.left_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
                 go_left = false;
@@ -239,6 +231,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             while next == u32::MAX {
                 if INSTANCED && inside && top_len == floor {
                     inside = false;
+                    node_base = 0;
                     slabs = SlabRay::new(o, d);
                 }
                 if top_len == 0 {

@@ -4,9 +4,10 @@
 //! levels are trees in the [`crate::trace::bvh2`] layout and share its walk
 //! ([`walk`]); the top level's leaves are the instances' world boxes, and
 //! refer to the instances directly
-//! ([`crate::layouts::bvh2::top_level_node_kernel`]). The bottom-level trees of
-//! every mesh lie one after another in one node buffer and one leaf
-//! buffer; an instance says where its mesh's start.
+//! ([`crate::layouts::bvh2::top_level_node_kernel`]). The top level lies
+//! at the start of one node buffer, the bottom-level trees of every mesh
+//! one after another behind it (and their leaf primitives in one leaf
+//! buffer); an instance says where its mesh's start.
 //!
 //! Hits are the closest over all instances; at equal distances the lower
 //! primitive index wins, then the instance the walk met first (the same
@@ -17,7 +18,7 @@ use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim};
 use crate::geometry::features;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::records::RecordLoad;
-use crate::trace::bvh2::{walk, Level, NoInstances, NoLeafPrims};
+use crate::trace::bvh2::{walk, Level};
 use crate::trace::hit::{Query, STACK_DEPTH};
 
 /// The closest (or, for an occlusion query, the first found) hit in an
@@ -38,9 +39,9 @@ impl InstanceHit {
 }
 
 /// Traces `o + t d` (`d` of unit length, so that `t` is a distance) through
-/// the top-level tree `top_nodes` over `instances`, and into
-/// the bottom-level trees of their meshes (`nodes`, `leaves`, triangles
-/// only: `prims` holds no spheres), in one walk on one stack
+/// the top-level tree over `instances` (`nodes` from 0), and into the
+/// bottom-level trees of their meshes (further on in `nodes`; `leaves`,
+/// triangles only: `prims` holds no spheres), in one walk on one stack
 /// ([`walk`]: a nested walk per instance crashed NVIDIA's shader compiler).
 #[allow(clippy::too_many_arguments)]
 #[inline]
@@ -48,16 +49,14 @@ pub fn trace_instances(
     o: Vec3,
     d: Vec3,
     query: Query,
-    top_nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     nodes: &(impl RecordLoad<Bvh2Node> + ?Sized),
     leaves: &(impl RecordLoad<LeafPrim> + ?Sized),
     prims: &Prims,
 ) -> InstanceHit {
-    let top = Level { nodes: top_nodes, leaves: &NoLeafPrims, instances };
-    let mesh = Level { nodes, leaves, instances: &NoInstances };
+    let trees = Level { nodes, leaves };
     let (hit, instance) =
-        walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, &top, &mesh);
+        walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, instances, &trees);
     if hit.is_hit() {
         InstanceHit { t: hit.t, prim: hit.prim, instance }
     } else {

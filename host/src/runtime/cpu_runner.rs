@@ -353,7 +353,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fill::copy_words_kernel(id, &p, src, dst);
             }
         }
-        (Kernel::CastInstances, [p, top_nodes, instances, nodes, leaves, spheres, triangles, rays]) => {
+        (Kernel::CastInstances, [p, instances, nodes, leaves, spheres, triangles, rays]) => {
             use treelet_core::{Bvh2Node, LeafPrim};
             let p: treelet_core::RenderParams = params(p);
             let prims = treelet_core::geometry::prims::Prims {
@@ -362,11 +362,10 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 triangles: Split::whole(view(triangles)),
                 triangle_count: p.triangles,
             };
-            let top_nodes: &[Bvh2Node] = view(top_nodes);
             let (nodes, leaves): (&[Bvh2Node], &[LeafPrim]) = (view(nodes), view(leaves));
             let (instances, rays): (&[treelet_core::InstanceRecord], _) = (view(instances), view(rays));
             for id in ids(groups) {
-                treelet_core::render::rays::cast_instances_kernel(id, &p, top_nodes, instances, nodes, leaves, &prims, rays);
+                treelet_core::render::rays::cast_instances_kernel(id, &p, instances, nodes, leaves, &prims, rays);
             }
         }
         (Kernel::InstanceBounds, [p, placed, meshes, records, boxes, output]) => {

@@ -354,7 +354,7 @@ impl Kernel {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
             Kernel::CopyWords => &[Read, Read, ReadWrite],
-            Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
             Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],

@@ -61,9 +61,12 @@ impl Instance {
 }
 
 /// Every mesh's tree and triangles, one mesh after another in one buffer
-/// each (what the instanced kernel binds), and where each mesh's start.
+/// each (what the instanced kernel binds), and where each mesh's start;
+/// the node buffer holds the top level first (rebuilt in place).
 struct Gathered<B: Backend> {
     nodes: B::Buffer,
+    /// Nodes at the start of `nodes` for the top level.
+    top_capacity: u32,
     leaves: B::Buffer,
     triangles: B::Buffer,
     /// Per mesh: its box and bases, as the top level's build reads them.
@@ -76,10 +79,10 @@ struct Gathered<B: Backend> {
     triangle_count: u32,
 }
 
-/// The top-level tree over the instances' world boxes (`bvh2` nodes whose
-/// leaves refer to instances) and the instances as the kernel reads them.
+/// The instances as the kernel reads them; their top-level tree (`bvh2`
+/// nodes whose leaves refer to instances) is at the start of the gathered
+/// nodes.
 struct TopLevel<B: Backend> {
-    nodes: B::Buffer,
     records: B::Buffer,
     count: u32,
 }
@@ -102,9 +105,9 @@ pub struct InstancedTracer<B: Backend> {
     top: Option<TopLevel<B>>,
     instances: Vec<Instance>,
     /// Placeholders: the kernel's sphere binding (instanced meshes are
-    /// triangles), and its top-level bindings while there are no instances.
+    /// triangles), and its instances' while there are none.
     no_spheres: B::Buffer,
-    no_top: [B::Buffer; 2],
+    no_instances: B::Buffer,
     update_ms: f64,
     top_stages: StageTimes,
 }
@@ -130,10 +133,10 @@ impl<B: Backend> InstancedTracer<B> {
             trees.push(tracer);
             bounds.push(mesh_bounds(triangles));
         }
-        let gathered = gather(b, &trees, &bounds)?;
+        let gathered = gather(b, &trees, &bounds, top_nodes_for(instances.len()))?;
         let no_spheres = b.upload("no spheres", &[treelet_core::Sphere::default()])?;
-        let no_top = [b.zeroed("no instances", 64)?, b.zeroed("no instances", 64)?];
-        b.keep(&[&no_spheres, &no_top[0], &no_top[1]]);
+        let no_instances = b.zeroed("no instances", 64)?;
+        b.keep(&[&no_spheres, &no_instances]);
         let mut scene = InstancedTracer {
             meshes: trees,
             bounds,
@@ -141,7 +144,7 @@ impl<B: Backend> InstancedTracer<B> {
             top: None,
             instances: Vec::new(),
             no_spheres,
-            no_top,
+            no_instances,
             update_ms: 0.0,
             top_stages: StageTimes::default(),
         };
@@ -160,7 +163,13 @@ impl<B: Backend> InstancedTracer<B> {
         if instances.is_empty() {
             return Ok(());
         }
-        let (top, stages) = build_top_level(b, &placed, &self.gathered.meshes)?;
+        let needed = top_nodes_for(placed.len());
+        if needed > self.gathered.top_capacity {
+            // Room for twice as many, so that a growing scene gathers its
+            // meshes again only now and then.
+            self.gathered = gather(b, &self.meshes, &self.bounds, needed.saturating_mul(2))?;
+        }
+        let (top, stages) = build_top_level(b, &placed, &self.gathered)?;
         self.top = Some(top);
         self.update_ms = stages.total();
         self.top_stages = stages;
@@ -184,7 +193,7 @@ impl<B: Backend> InstancedTracer<B> {
             self.gathered.meshes = mesh_records(b, &self.gathered.bases, &self.bounds)?;
         } else {
             // The mesh's layout changed size: every mesh moves.
-            self.gathered = gather(b, &self.meshes, &self.bounds)?;
+            self.gathered = gather(b, &self.meshes, &self.bounds, self.gathered.top_capacity)?;
         }
         let instances = std::mem::take(&mut self.instances);
         self.set_instances(b, &instances)?;
@@ -257,15 +266,12 @@ impl<B: Backend> InstancedTracer<B> {
     fn dispatch(&self, b: &mut B, p: &RenderParams, rays: &B::Buffer, top: Option<&TopLevel<B>>) -> Result<()> {
         let params = b.upload("trace params", &[*p])?;
         let g = &self.gathered;
-        // With no instances, the top level's bindings are never read.
-        let (top_nodes, records) = match top {
-            Some(t) => (&t.nodes, &t.records),
-            None => (&self.no_top[0], &self.no_top[1]),
-        };
+        // With no instances, the instances' binding is never read.
+        let records = top.map_or(&self.no_instances, |t| &t.records);
         b.stage("trace");
         b.dispatch(
             Kernel::CastInstances,
-            &[&params, top_nodes, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
+            &[&params, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
             groups_for(tiled_invocations(p.width, p.height), WORKGROUP_SIZE),
         );
         Ok(())
@@ -294,14 +300,15 @@ impl<B: Backend> InstancedTracer<B> {
 /// instances' records and world boxes (`treelet_core::construct::instances`)
 /// as the LBVH's first pass, the LBVH (one instance a leaf), its depth
 /// checked against the walk's stack, and its `bvh2` nodes in the LBVH's
-/// order (no compaction: leaves refer to instances).
-fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], meshes: &B::Buffer) -> Result<(TopLevel<B>, StageTimes)> {
+/// order (no compaction: leaves refer to instances), written at the start
+/// of the gathered nodes.
+fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>) -> Result<(TopLevel<B>, StageTimes)> {
     let n = placed.len() as u32;
     let mut records = None;
     let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, partials, groups| {
         let input = b.upload("placed meshes", placed)?;
         let out = b.scratch("instance records", n as u64 * 64)?;
-        b.dispatch(Kernel::InstanceBounds, &[p, &input, meshes, &out, boxes, partials], groups);
+        b.dispatch(Kernel::InstanceBounds, &[p, &input, &g.meshes, &out, boxes, partials], groups);
         records = Some(out);
         Ok(())
     })?;
@@ -312,16 +319,21 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], meshes: &B::Buf
         bail!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
     }
     b.stage("layout");
-    let internal = (n - 1).max(1);
-    let nodes = b.scratch("top-level nodes", internal as u64 * 64)?;
+    let internal = top_nodes_for(placed.len());
+    anyhow::ensure!(internal <= g.top_capacity, "internal: no room for the top level");
     let p = b.upload("layout params", &[LayoutParams { n, nodes: bvh.node_count, ..Default::default() }])?;
-    b.dispatch(Kernel::TopLevelNodes, &[&p, &bvh.nodes, &bvh.prim_indices, &nodes], groups_for(internal, WORKGROUP_SIZE));
+    b.dispatch(Kernel::TopLevelNodes, &[&p, &bvh.nodes, &bvh.prim_indices, &g.nodes], groups_for(internal, WORKGROUP_SIZE));
     let rest = b.take_times()?;
     for stage in &rest.order {
         stages.add(stage, rest.get(stage));
     }
-    b.keep(&[&nodes, &records]);
-    Ok((TopLevel { nodes, records, count: n }, stages))
+    b.keep(&[&records]);
+    Ok((TopLevel { records, count: n }, stages))
+}
+
+/// `bvh2` nodes of the top level over `instances` (one for none or one).
+fn top_nodes_for(instances: usize) -> u32 {
+    instances.saturating_sub(1).clamp(1, u32::MAX as usize) as u32
 }
 
 /// Refuses a non-finite or singular transform (in f64, relative to the
@@ -366,10 +378,10 @@ fn mesh_bounds(triangles: &[Triangle]) -> [[f64; 3]; 2] {
 }
 
 /// Gathers every mesh's layout and triangles into one buffer each.
-fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>], bounds: &[[[f64; 3]; 2]]) -> Result<Gathered<B>> {
+fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>], bounds: &[[[f64; 3]; 2]], top_capacity: u32) -> Result<Gathered<B>> {
     let mut bases = Vec::with_capacity(meshes.len());
     let mut node_counts = Vec::with_capacity(meshes.len());
-    let (mut nodes, mut leaves, mut triangles) = (0u64, 0u64, 0u64);
+    let (mut nodes, mut leaves, mut triangles) = (top_capacity as u64, 0u64, 0u64);
     for t in meshes {
         let tree = t.tree.as_ref().context("internal: an instanced mesh without a tree")?;
         bases.push([nodes, leaves, triangles].map(|x| x as u32));
@@ -384,6 +396,7 @@ fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>], bounds: &[[[f64; 3]; 2]])
     let gathered = Gathered {
         meshes: mesh_records(b, &bases, bounds)?,
         nodes: b.scratch("instanced nodes", nodes * 64)?,
+        top_capacity,
         leaves: b.scratch("instanced leaf primitives", leaves * 48)?,
         triangles: b.scratch("instanced triangles", triangles * 48)?,
         bases,
