@@ -37,11 +37,7 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
     let node = nodes.load(i as usize);
     if node.is_leaf() {
         if node_count == 1 {
-            let mut root = Bvh2Node { left: node.left, left_count: node.prim_count(), ..Default::default() };
-            (root.left_min, root.left_max) = (node.min, node.max);
-            (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
-            root.right_count = 1; // a leaf that no ray reaches
-            out.store(0, &root);
+            out.store(0, &single_leaf_root(&node, node.left, node.prim_count()));
         }
         return;
     }
@@ -56,19 +52,26 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
         x = p;
     }
     let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
-    let (left, left_count) = child_ref(&l, index + 1);
-    let (right, right_count) = child_ref(&r, index + (node.right - i) / 2);
-    let record = Bvh2Node {
-        left_min: l.min,
-        left,
-        left_max: l.max,
-        right,
-        right_min: r.min,
-        left_count,
-        right_max: r.max,
-        right_count,
-    };
+    let record = two_boxes(&l, &r, child_ref(&l, index + 1), child_ref(&r, index + (node.right - i) / 2));
     out.store(index as usize, &record);
+}
+
+/// The node of children `l` and `r`, referred to as given (a leaf by its
+/// first primitive and count, an internal node by its index and 0).
+#[inline]
+fn two_boxes(l: &Node, r: &Node, (left, left_count): (u32, u32), (right, right_count): (u32, u32)) -> Bvh2Node {
+    Bvh2Node { left_min: l.min, left, left_max: l.max, right, right_min: r.min, left_count, right_max: r.max, right_count }
+}
+
+/// The root of a tree of one leaf: that leaf (as `left`, `count`), and a
+/// second child with an empty box, a leaf that no ray reaches.
+#[inline]
+fn single_leaf_root(leaf: &Node, left: u32, count: u32) -> Bvh2Node {
+    let mut root = Bvh2Node { left, left_count: count, ..Default::default() };
+    (root.left_min, root.left_max) = (leaf.min, leaf.max);
+    (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
+    root.right_count = 1;
+    root
 }
 
 /// A child as its parent refers to it: a leaf by its first primitive and
@@ -98,12 +101,7 @@ pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2No
 ) {
     if n == 1 {
         if i == 0 {
-            let leaf = nodes.load(0);
-            let mut root = Bvh2Node { left: at(prim_indices, 0), left_count: 1, ..Default::default() };
-            (root.left_min, root.left_max) = (leaf.min, leaf.max);
-            (root.right_min, root.right_max) = ([f32::MAX; 3], [-f32::MAX; 3]);
-            root.right_count = 1; // a leaf that no ray reaches
-            out.store(0, &root);
+            out.store(0, &single_leaf_root(&nodes.load(0), at(prim_indices, 0), 1));
         }
         return;
     }
@@ -113,19 +111,7 @@ pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2No
     let node = nodes.load(i as usize);
     let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
     let child = |index: u32, c: &Node| if c.is_leaf() { (at(prim_indices, c.left as usize), 1) } else { (index, 0) };
-    let (left, left_count) = child(node.left, &l);
-    let (right, right_count) = child(node.right, &r);
-    let record = Bvh2Node {
-        left_min: l.min,
-        left,
-        left_max: l.max,
-        right,
-        right_min: r.min,
-        left_count,
-        right_max: r.max,
-        right_count,
-    };
-    out.store(i as usize, &record);
+    out.store(i as usize, &two_boxes(&l, &r, child(node.left, &l), child(node.right, &r)));
 }
 
 /// Kernel, one invocation per primitive slot `j < n`: the primitive of
