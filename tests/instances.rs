@@ -245,3 +245,42 @@ fn instanced_tracer_rejects_bad_input_by_name() {
     let e = format!("{:#}", scene.refit_mesh(b, 0, &[tri[0], tri[0]]).unwrap_err());
     assert!(e.contains("mesh 0") && e.contains("refit with 0 spheres and 2 triangles"), "{e}");
 }
+
+/// Stiff transforms: copies squashed a hundred-thousandfold along one axis, then
+/// sheared and turned (the inverse taken on the device in f32, the
+/// flattened scene's points in f64).
+fn stiff<B: Backend>(b: &mut B, seed: u64) -> Vec<RayHit> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let m = meshes(&mut rng, &[300]);
+    let placed: Vec<Instance> = (0..80)
+        .map(|k| {
+            let mut transform = transform(&mut rng);
+            for row in &mut transform {
+                row[k % 3] *= 1e-5;
+            }
+            Instance { mesh: 0, transform }
+        })
+        .collect();
+    let rays = rays(&mut rng, 4000);
+    let scene = InstancedTracer::build(b, &[&m[0]], &placed, Quality::Fast).unwrap();
+    let flat = flatten(&m, &placed);
+    let flat_hits = Tracer::build(b, &[], &flat.0, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+    let hits = scene.closest_hits(b, &rays).unwrap();
+    check(&format!("{} stiff, seed {seed}", b.adapter()), &hits, &flat_hits, &flat, &rays);
+    hits
+}
+
+#[test]
+fn stiff_transforms_hit_what_the_flattened_scene_hits() {
+    let seed = fresh_seed();
+    let cpu = stiff(&mut CpuBackend::new(), seed);
+    if let Some(ctx) = gpu() {
+        let gpu = stiff(&mut GpuBackend::new(ctx), seed);
+        let same = cpu.iter().zip(&gpu).filter(|(c, g)| (c.instance, c.prim) == (g.instance, g.prim)).count();
+        assert!(
+            same as f64 >= 0.999 * cpu.len() as f64,
+            "seed {seed}: GPU and CPU agree on {same} hits of {}",
+            cpu.len()
+        );
+    }
+}
