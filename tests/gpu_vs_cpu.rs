@@ -17,6 +17,44 @@ fn lbvh_matches_cpu_on_random_scenes() {
     }
 }
 
+/// The build sorts its keys by their high digits first and settles the
+/// ties after (`treelet_core::construct::sort_ties`), or sorts every digit
+/// when a run of ties is too long: both give the full sort's order
+/// (`compare_builds` checks it against keys recomputed on the host), on
+/// spheres whose keys tie in short runs (three to a centre), and on a dense
+/// cluster inside a huge scene, whose keys all share their high digits.
+#[test]
+fn lbvh_sorts_every_bit_with_short_and_long_runs_of_ties() {
+    let seed = treelet_tests::fresh_seed();
+    let mut triples = random_spheres(20_000, seed);
+    for (k, s) in triples.iter_mut().enumerate() {
+        s.center = [(k / 3 % 29) as f32 * 1.7, (k / 3 / 29 % 31) as f32 * 0.9, (k / 3 / 29 / 31) as f32 * 1.3];
+    }
+    // The longest run of keys tied in their high 32 bits, in the CPU build.
+    let longest_run = |spheres: &[treelet_core::Sphere]| {
+        let keys = treelet_tests::build_cpu_checked(spheres, "runs").sorted_keys;
+        let (mut longest, mut run) = (1, 1);
+        for w in keys.windows(2) {
+            run = if w[0] >> 32 == w[1] >> 32 { run + 1 } else { 1 };
+            longest = longest.max(run);
+        }
+        longest
+    };
+    use treelet_core::construct::sort_ties::MAX_TIE_RUN;
+    assert!((2..=MAX_TIE_RUN).contains(&longest_run(&triples)), "runs of ties to settle");
+    compare_builds(&triples, &format!("three spheres a centre, seed {seed}"));
+    let mut room = random_spheres(3000, seed ^ 1);
+    for s in room.iter_mut() {
+        s.center = s.center.map(|c| c * 1e-3);
+        s.radius *= 1e-3;
+    }
+    room.push(treelet_core::Sphere { center: [1e5, 0.0, 0.0], radius: 1e5 - 10.0, ..room[0] });
+    room.push(treelet_core::Sphere { center: [-1e5, 0.0, 0.0], radius: 1e5 - 10.0, ..room[0] });
+    assert!(longest_run(&room) > MAX_TIE_RUN, "a run too long to settle: every digit sorted");
+    compare_builds(&room, &format!("a dense cluster in a huge room, seed {seed}"));
+    compare_builds(&clustered_spheres(seed), &format!("5000 spheres on 7 centres, seed {seed}"));
+}
+
 /// Random spheres, `n` of them for each `n` of `sizes`, named by size and seed.
 fn random_sphere_scenes(sizes: &[usize], seed: u64) -> Vec<(String, Vec<treelet_core::Sphere>)> {
     sizes.iter().map(|&n| (format!("random:{n}:{seed}"), random_spheres(n, seed ^ n as u64))).collect()
@@ -144,6 +182,20 @@ fn sort_matches_cpu_and_std_on_random_keys() {
     }
 }
 
+/// Keys whose high 32 bits take few values, so that the sort by high
+/// digits first leaves runs of ties of every length up to and past what one
+/// invocation settles, across tiles and workgroups.
+#[test]
+fn sort_by_high_digits_settles_runs_of_ties() {
+    let Some(ctx) = gpu() else { return };
+    let seed = treelet_tests::fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    for (n, highs) in [(2u32, 1u64), (100, 40), (5000, 2500), (70_000, 30_000), (70_000, 2_000), (70_000, 60_000)] {
+        let keys: Vec<u64> = (0..n).map(|_| rng.random_range(0..highs) << 32 | rng.random_range(0..8u64) << 29 | rng.random::<u32>() as u64 & 0xff).collect();
+        check_sort(&ctx, &keys, 63, &format!("{n} keys, {highs} high values, seed {seed}"));
+    }
+}
+
 /// The shapes a radix sort gets wrong: all keys equal (one digit takes
 /// every key of every tile), already sorted, reversed, and keys of fewer
 /// bits than the sort's passes cover or more than it sorts.
@@ -235,6 +287,56 @@ fn check_sort(ctx: &std::sync::Arc<treelet::runtime::gpu::GpuContext>, keys: &[u
         assert!(g.0 == ek, "gpu keys, {tiles:?} tiles, {what}");
         assert!(g.1 == ev, "gpu values (stability), {tiles:?} tiles, {what}");
     }
+    check_high_first(ctx, keys, key_bits, (&ek, &ev), what);
+}
+
+/// The sort by high digits first, then ties ([`treelet::bvh::sort::radix_sort_high_first`]),
+/// on the CPU runner and the GPU, against the expected order `(ek, ev)`: the
+/// same, or `None` exactly where a run of keys tied in the high digits is
+/// longer than one invocation settles (counted here from the expected order).
+fn check_high_first(
+    ctx: &std::sync::Arc<treelet::runtime::gpu::GpuContext>,
+    keys: &[u64],
+    key_bits: u32,
+    (ek, ev): (&[u64], &[u32]),
+    what: &str,
+) {
+    use treelet_core::construct::sort_ties::MAX_TIE_RUN;
+    let passes = key_bits.div_ceil(8);
+    let sorted = |k: u64| if passes >= 8 { k } else { k & ((1u64 << (8 * passes)) - 1) };
+    let high = |k: u64| sorted(k) >> (8 * (passes / 2));
+    let mut longest = 1;
+    let mut run = 1;
+    for w in ek.windows(2) {
+        run = if high(w[0]) == high(w[1]) { run + 1 } else { 1 };
+        longest = longest.max(run);
+    }
+    let settles = passes < 2 || longest <= MAX_TIE_RUN;
+    let values: Vec<u32> = (0..keys.len() as u32).collect();
+    let check = |got: Option<(Vec<u64>, Vec<u32>)>, on: &str| match got {
+        Some((k, v)) => {
+            assert!(settles, "{on}: settled a run of {longest} ties, {what}");
+            assert!(k == ek && v == ev, "{on}: high digits first, then ties, {what}");
+        }
+        None => assert!(!settles, "{on}: gave up on runs of at most {longest} ties, {what}"),
+    };
+    check(run_sort_high_first(&mut CpuBackend::new(), keys, &values, key_bits, SortTiles::Large), "cpu");
+    check(run_sort_high_first(&mut CpuBackend::with_subgroup_size(32), keys, &values, key_bits, SortTiles::Multisplit), "cpu, ranked by subgroups");
+    check(run_sort_high_first(&mut GpuBackend::new(ctx.clone()), keys, &values, key_bits, SortTiles::Auto), "gpu");
+}
+
+fn run_sort_high_first<B: Backend>(
+    b: &mut B,
+    keys: &[u64],
+    values: &[u32],
+    key_bits: u32,
+    tiles: SortTiles,
+) -> Option<(Vec<u64>, Vec<u32>)> {
+    let n = keys.len() as u32;
+    let kb = b.upload("keys", keys).unwrap();
+    let vb = b.upload("values", values).unwrap();
+    let (k, v) = treelet::bvh::sort::radix_sort_high_first_tiled(b, &kb, &vb, n, key_bits, tiles).unwrap()?;
+    Some((b.read(&k, n as usize).unwrap(), b.read(&v, n as usize).unwrap()))
 }
 
 fn run_sort<B: Backend>(

@@ -41,7 +41,27 @@ pub fn build_cpu_checked(spheres: &[Sphere], what: &str) -> Bvh {
     let (c, _) = lbvh::build(&mut CpuBackend::new(), spheres).unwrap();
     let v = validate(spheres, &c.nodes, &c.parents, &c.prim_indices);
     assert!(v.is_valid(), "{what}: CPU tree invalid: {:?}", v.errors);
+    assert_fully_sorted(spheres, &c, what);
     c
+}
+
+/// The build's order is the stable sort of every bit of the primitives'
+/// Morton keys, recomputed here from the spheres: keys in order, equal keys
+/// by primitive index, every primitive once. (The sort takes its high
+/// digits first and settles ties after: this holds it to the full order.)
+pub fn assert_fully_sorted(spheres: &[Sphere], bvh: &Bvh, what: &str) {
+    use treelet_core::construct::morton::MortonFrame;
+    let frame = MortonFrame::new(&bvh.centroid_bounds);
+    let mut seen = vec![false; spheres.len()];
+    for (i, (&key, &prim)) in bvh.sorted_keys.iter().zip(&bvh.prim_indices).enumerate() {
+        let centroid = spheres[prim as usize].aabb().centroid();
+        assert_eq!(key, frame.code(centroid), "{what}: sorted key {i} is not primitive {prim}'s code");
+        assert!(!std::mem::replace(&mut seen[prim as usize], true), "{what}: primitive {prim} sorted twice");
+        if i > 0 {
+            let before = (bvh.sorted_keys[i - 1], bvh.prim_indices[i - 1]);
+            assert!(before < (key, prim), "{what}: keys {} and {i} out of order: {before:?} then {:?}", i - 1, (key, prim));
+        }
+    }
 }
 
 /// Builds on the GPU and on the CPU runner; requires identical keys, order,

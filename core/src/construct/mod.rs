@@ -7,7 +7,7 @@
 //! | primitive boxes | [`primitive_boxes`] | |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
-//! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone) | Adinets & Merrill 2022 (Onesweep) |
+//! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone), [`sort_ties`] (high digits first, then ties) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`]; [`climb_queue`] (climbs handed from one kernel to the next) | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
@@ -40,5 +40,6 @@ pub mod sah;
 pub mod scan;
 pub mod sort;
 pub mod sort_multisplit;
+pub mod sort_ties;
 pub mod treelet;
 pub mod treelet_kernels;

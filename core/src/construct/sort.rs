@@ -161,8 +161,9 @@ const INCLUSIVE: u32 = 2 << FLAG_SHIFT;
 /// Phases of [`histogram_phase`]: clear, count, add.
 pub const HISTOGRAM_PHASES: u32 = 3;
 
-/// Kernel: digit counts of every pass over one tile of
-/// [`histogram_tile`] keys, added to the state's counts.
+/// Kernel: digit counts of every pass from `params.pass` on (0 for a sort of
+/// every digit; see [`super::sort_ties`] for one of the high digits) over one
+/// tile of [`histogram_tile`] keys, added to the state's counts.
 pub fn histogram_phase(
     phase: u32,
     lid: u32,
@@ -196,7 +197,7 @@ pub fn histogram_phase(
                 });
                 unrolled_8!(b, {
                     if first + (b as u32) * WORKGROUP_SIZE < params.n {
-                        for p in 0..params.passes {
+                        for p in params.pass..params.passes {
                             let d = digit(batch[b], p * RADIX_BITS);
                             atomics::add_workgroup(&mut counts[(p * RADIX + d) as usize], 1);
                         }
@@ -206,7 +207,7 @@ pub fn histogram_phase(
             }
         }
         _ => {
-            for p in 0..params.passes {
+            for p in params.pass..params.passes {
                 let c = counts[(p * RADIX) as usize + l];
                 if c != 0 {
                     atomics::add_device(&mut sort_state[(state::COUNTS + p * RADIX + lid) as usize], c);

@@ -259,7 +259,21 @@ fn build_from_first_pass<B: Backend>(
     b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
-    let (keys, values) = crate::bvh::sort::radix_sort(b, &keys, &values, n, key_bits)?;
+    let high_first = if crate::bvh::sort::high_first_by_default() {
+        crate::bvh::sort::radix_sort_high_first(b, &keys, &values, n, key_bits)?
+    } else {
+        None
+    };
+    let (keys, values) = match high_first {
+        Some(sorted) => sorted,
+        None => {
+            if crate::bvh::sort::high_first_by_default() {
+                // Ties too long to settle: codes again, and every digit sorted.
+                b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
+            }
+            crate::bvh::sort::radix_sort(b, &keys, &values, n, key_bits)?
+        }
+    };
 
     let nodes = b.scratch("nodes", node_count * 32)?;
     let parents = b.scratch("parents", node_count * 4)?;

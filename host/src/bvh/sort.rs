@@ -7,7 +7,7 @@ use treelet_core::construct::sort_multisplit::{
     MEDIUM_MULTISPLIT_SORT_TILE, MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE, SMALL_MULTISPLIT_SORT_TILE,
 };
 use treelet_core::geometry::buffers::{ScanParams, SortParams};
-use treelet_core::gpu::workgroup::groups_for;
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
@@ -15,7 +15,7 @@ use crate::runtime::kernels::Kernel;
 /// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b` (the
 /// same question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep];
+    let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep, Kernel::SortSettleTies];
     if b.look_back_works() {
         k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
         if multisplit_by_default(b) {
@@ -162,13 +162,72 @@ pub fn radix_sort_tiled<B: Backend>(
     key_bits: u32,
     tile_size: SortTiles,
 ) -> Result<(B::Buffer, B::Buffer)> {
+    anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
+    sort_passes(b, keys, values, n, 0..passes_for(key_bits), tile_size)
+}
+
+/// Sorts as [`radix_sort`] does, in about half the passes where few keys
+/// agree in their high digits: a stable sort by the high half of the
+/// digits, then each run of keys tied in those ordered by the low ones
+/// (`treelet_core::construct::sort_ties`): the same result. Returns `None`
+/// when a run of ties was too long to settle that way; the buffers then hold
+/// the pairs sorted by the high digits only, and the caller sorts every
+/// digit from its inputs again. One word is read back (the run flag).
+pub fn radix_sort_high_first<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    key_bits: u32,
+) -> Result<Option<(B::Buffer, B::Buffer)>> {
+    radix_sort_high_first_tiled(b, keys, values, n, key_bits, SortTiles::Auto)
+}
+
+/// [`radix_sort_high_first`] with the given tiles.
+pub fn radix_sort_high_first_tiled<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    key_bits: u32,
+    tile_size: SortTiles,
+) -> Result<Option<(B::Buffer, B::Buffer)>> {
+    anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
+    let passes = passes_for(key_bits);
+    if passes < 2 || n < 2 {
+        return sort_passes(b, keys, values, n, 0..passes, tile_size).map(Some);
+    }
+    let first = passes / 2;
+    let sorted = sort_passes(b, keys, values, n, first..passes, tile_size)?;
+    let params = b.upload("sort params", &[SortParams { n, tiles: 0, pass: first, passes }])?;
+    let overflow = b.zeroed("sort tie overflow", 4)?;
+    b.dispatch(Kernel::SortSettleTies, &[&params, &sorted.0, &sorted.1, &overflow], groups_for(n, WORKGROUP_SIZE));
+    Ok((b.read::<u32>(&overflow, 1)?[0] == 0).then_some(sorted))
+}
+
+/// Whether builds sort by the high digits first ([`radix_sort_high_first`]):
+/// yes, unless `TREELET_SORT_HIGH_FIRST=0` (to measure against).
+pub fn high_first_by_default() -> bool {
+    std::env::var("TREELET_SORT_HIGH_FIRST").map_or(true, |v| v != "0")
+}
+
+/// Stable sort of `n` pairs by the digits `passes` (a range of
+/// `0..passes_for(key_bits)`): every digit for a full sort, the high ones
+/// for [`radix_sort_high_first`].
+fn sort_passes<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    passes: std::ops::Range<u32>,
+    tile_size: SortTiles,
+) -> Result<(B::Buffer, B::Buffer)> {
     let mut src = (keys.clone(), values.clone());
-    if n < 2 {
+    if n < 2 || passes.is_empty() {
         return Ok(src);
     }
     anyhow::ensure!(n <= MAX_KEYS, "{n} keys: the radix sort takes at most {MAX_KEYS}");
-    anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
-    let passes = passes_for(key_bits);
+    let (first, passes) = (passes.start, passes.end);
     // Small tiles where large ones would leave the GPU idle (look-back only).
     let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_by_default(b)) } else { SortTiles::Large };
     let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall | SortTiles::MultisplitMedium);
@@ -200,7 +259,7 @@ pub fn radix_sort_tiled<B: Backend>(
     if !b.look_back_works() {
         // Reduce, then scan, then the same pass kernel without look-back.
         let tile_counts = b.scratch("sort tile counts", RADIX as u64 * tiles as u64 * 4)?;
-        for pass in 0..passes {
+        for pass in first..passes {
             let p = b.upload("sort params", &[params(pass)])?;
             b.dispatch(Kernel::SortTileCounts, &[&p, &src.0, &tile_counts], tiles);
             exclusive_scan(b, &tile_counts, RADIX * tiles)?;
@@ -210,11 +269,15 @@ pub fn radix_sort_tiled<B: Backend>(
         return Ok(src);
     }
     let sort_state = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
-    b.zero_words(&sort_state, state::zeroed_words(tiles))?;
-    let p = b.upload("sort params", &[params(0)])?;
+    // A pass uses the status region of its parity and clears the other for
+    // the next: a first pass of odd parity finds its region cleared too.
+    let zeroed = if first % 2 == 0 { state::zeroed_words(tiles) } else { state::words(tiles) };
+    b.zero_words(&sort_state, zeroed)?;
+    // The histogram counts the digits of passes `first..` (its `pass`).
+    let p = b.upload("sort params", &[params(first)])?;
     b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
     b.dispatch(Kernel::SortOffsets, &[&p, &sort_state], passes);
-    for pass in 0..passes {
+    for pass in first..passes {
         let p = b.upload("sort params", &[params(pass)])?;
         b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
         std::mem::swap(&mut src, &mut dst);

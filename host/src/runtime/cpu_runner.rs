@@ -436,6 +436,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
             });
         }
+        (Kernel::SortSettleTies, [p, keys, values, overflow]) => {
+            let p: treelet_core::SortParams = params(p);
+            let (keys, values, overflow) = (view(keys), view(values), view(overflow));
+            for id in ids(groups) {
+                treelet_core::construct::sort_ties::settle_ties_kernel(id, &p, keys, values, overflow);
+            }
+        }
         (Kernel::Multisplit, [p, keys, ranks, counts, sizes]) => {
             let p: treelet_core::SortParams = params(p);
             let (keys, ranks, counts, sizes) = (view(keys), view(ranks), view(counts), view(sizes));

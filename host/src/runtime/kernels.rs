@@ -77,6 +77,8 @@ pub enum Kernel {
     SortHistogram,
     /// Radix sort: where each digit starts, per pass.
     SortOffsets,
+    /// Sort: runs of keys tied in their high digits ordered by their low ones.
+    SortSettleTies,
     /// Radix sort: one pass (one sweep with decoupled look-back).
     SortOnesweep,
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
@@ -183,7 +185,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 58] = [
+    const FIXED: [Kernel; 59] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -195,6 +197,7 @@ impl Kernel {
         Kernel::Morton,
         Kernel::SortHistogram,
         Kernel::SortOffsets,
+        Kernel::SortSettleTies,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
@@ -273,6 +276,7 @@ impl Kernel {
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
             Kernel::SortOffsets => "sort::sort_offsets_cs",
+            Kernel::SortSettleTies => "sort::sort_settle_ties_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
@@ -366,6 +370,7 @@ impl Kernel {
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
+            Kernel::SortSettleTies => &[Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortOnesweep
             | Kernel::SortOnesweepSmall
             | Kernel::SortOnesweepScanned
