@@ -30,12 +30,13 @@ fn lbvh_sorts_every_bit_with_short_and_long_runs_of_ties() {
     for (k, s) in triples.iter_mut().enumerate() {
         s.center = [(k / 3 % 29) as f32 * 1.7, (k / 3 / 29 % 31) as f32 * 0.9, (k / 3 / 29 / 31) as f32 * 1.3];
     }
-    // The longest run of keys tied in their high 32 bits, in the CPU build.
+    // The longest run of keys tied in the digits sorted first, in the CPU build.
     let longest_run = |spheres: &[treelet_core::Sphere]| {
         let keys = treelet_tests::build_cpu_checked(spheres, "runs").sorted_keys;
+        let low_bits = 8 * treelet_core::construct::sort_ties::first_high_digit(keys.len() as u32, 8);
         let (mut longest, mut run) = (1, 1);
         for w in keys.windows(2) {
-            run = if w[0] >> 32 == w[1] >> 32 { run + 1 } else { 1 };
+            run = if w[0] >> low_bits == w[1] >> low_bits { run + 1 } else { 1 };
             longest = longest.max(run);
         }
         longest
@@ -182,7 +183,7 @@ fn sort_matches_cpu_and_std_on_random_keys() {
     }
 }
 
-/// Keys whose high 32 bits take few values, so that the sort by high
+/// Keys whose high digits take few values, so that the sort by high
 /// digits first leaves runs of ties of every length up to and past what one
 /// invocation settles, across tiles and workgroups.
 #[test]
@@ -191,7 +192,11 @@ fn sort_by_high_digits_settles_runs_of_ties() {
     let seed = treelet_tests::fresh_seed();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     for (n, highs) in [(2u32, 1u64), (100, 40), (5000, 2500), (70_000, 30_000), (70_000, 2_000), (70_000, 60_000)] {
-        let keys: Vec<u64> = (0..n).map(|_| rng.random_range(0..highs) << 32 | rng.random_range(0..8u64) << 29 | rng.random::<u32>() as u64 & 0xff).collect();
+        // The digits sorted first take `highs` values; below them, few bits vary.
+        let low_bits = 8 * treelet_core::construct::sort_ties::first_high_digit(n, 8);
+        let keys: Vec<u64> = (0..n)
+            .map(|_| rng.random_range(0..highs) << low_bits | rng.random_range(0..8u64) << (low_bits - 3) | rng.random::<u8>() as u64)
+            .collect();
         check_sort(&ctx, &keys, 63, &format!("{n} keys, {highs} high values, seed {seed}"));
     }
 }
@@ -304,14 +309,15 @@ fn check_high_first(
     use treelet_core::construct::sort_ties::MAX_TIE_RUN;
     let passes = key_bits.div_ceil(8);
     let sorted = |k: u64| if passes >= 8 { k } else { k & ((1u64 << (8 * passes)) - 1) };
-    let high = |k: u64| sorted(k) >> (8 * (passes / 2));
+    let first = treelet_core::construct::sort_ties::first_high_digit(keys.len() as u32, passes);
+    let high = |k: u64| sorted(k) >> (8 * first);
     let mut longest = 1;
     let mut run = 1;
     for w in ek.windows(2) {
         run = if high(w[0]) == high(w[1]) { run + 1 } else { 1 };
         longest = longest.max(run);
     }
-    let settles = passes < 2 || longest <= MAX_TIE_RUN;
+    let settles = first == 0 || longest <= MAX_TIE_RUN;
     let values: Vec<u32> = (0..keys.len() as u32).collect();
     let check = |got: Option<(Vec<u64>, Vec<u32>)>, on: &str| match got {
         Some((k, v)) => {

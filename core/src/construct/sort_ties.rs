@@ -8,9 +8,10 @@
 //! input order: runs of ties. Ordering each run by its keys' low bits,
 //! stably, gives exactly the order of the full sort (a stable sort has one
 //! result), so the trees built from it are the same bit for bit. With
-//! ~10.7 bits per axis in the top half, ties are rare and short on the
+//! eight bits more than `log2(n)` in the high digits, ties are rare and short on the
 //! meshes and point sets measured (runs of two or three keys); so the host
-//! sorts the high passes (`pass..passes` of [`SortParams`]), then
+//! sorts the high passes (`pass..passes` of [`SortParams`]; how many:
+//! [`first_high_digit`]), then
 //! [`settle_ties_kernel`] orders each run in place, one invocation per run.
 //!
 //! A run longer than [`MAX_TIE_RUN`] is not settled: the kernel raises a
@@ -27,6 +28,25 @@ use crate::gpu::atomics;
 
 /// Longest run of ties one invocation settles (insertion sort in place).
 pub const MAX_TIE_RUN: u32 = 32;
+
+/// Bits the high digits keep beyond `log2(n)`: `n` keys spread evenly over
+/// `2^(log2 n + 8)` cells share one with a chance of 1 in 256, and keys
+/// crowded onto a mesh's surface still seldom fill 32 of one.
+pub const TIE_MARGIN_BITS: u32 = 8;
+
+/// The first of the high digits a sort of `n` keys over `passes` digits
+/// takes first: enough of them for `log2(n) + TIE_MARGIN_BITS` bits (three
+/// of eight digits up to 65 536 keys, four up to 2^24, five beyond).
+#[inline]
+pub const fn first_high_digit(n: u32, passes: u32) -> u32 {
+    let log2 = 32 - n.saturating_sub(1).leading_zeros();
+    let high = (log2 + TIE_MARGIN_BITS).div_ceil(RADIX_BITS);
+    if high >= passes {
+        0
+    } else {
+        passes - high
+    }
+}
 
 /// The bits of `key` the sort orders by (the low `passes` digits), moved to
 /// the top of the word: comparing them compares what the sort compares.
@@ -94,6 +114,17 @@ mod tests {
             settle_ties_kernel(i, &params, keys, values, &mut overflow);
         }
         overflow[0] == 1
+    }
+
+    #[test]
+    fn high_digits_cover_log2_n_and_the_margin() {
+        assert_eq!(first_high_digit(65_536, 8), 5); // 24 bits
+        assert_eq!(first_high_digit(65_537, 8), 4);
+        assert_eq!(first_high_digit(1_000_000, 8), 4); // 32 bits
+        assert_eq!(first_high_digit(1 << 24, 8), 4);
+        assert_eq!(first_high_digit((1 << 24) + 1, 8), 3);
+        assert_eq!(first_high_digit(1000, 2), 0); // every digit
+        assert_eq!(first_high_digit(2, 8), 6);
     }
 
     #[test]

@@ -167,8 +167,8 @@ pub fn radix_sort_tiled<B: Backend>(
 }
 
 /// Sorts as [`radix_sort`] does, in about half the passes where few keys
-/// agree in their high digits: a stable sort by the high half of the
-/// digits, then each run of keys tied in those ordered by the low ones
+/// agree in their high digits: a stable sort by the high digits (enough for
+/// `log2(n)` and eight bits more), then each run of keys tied in those ordered by the low ones
 /// (`treelet_core::construct::sort_ties`): the same result. Returns `None`
 /// when a run of ties was too long to settle that way; the buffers then hold
 /// the pairs sorted by the high digits only, and the caller sorts every
@@ -197,7 +197,10 @@ pub fn radix_sort_high_first_tiled<B: Backend>(
     if passes < 2 || n < 2 {
         return sort_passes(b, keys, values, n, 0..passes, tile_size).map(Some);
     }
-    let first = passes / 2;
+    let first = treelet_core::construct::sort_ties::first_high_digit(n, passes);
+    if first == 0 {
+        return sort_passes(b, keys, values, n, 0..passes, tile_size).map(Some);
+    }
     let sorted = sort_passes(b, keys, values, n, first..passes, tile_size)?;
     let params = b.upload("sort params", &[SortParams { n, tiles: 0, pass: first, passes }])?;
     let overflow = b.zeroed("sort tie overflow", 4)?;
