@@ -3,8 +3,11 @@
 //! moves, the tree is refit and the rays traced again. Every hit is checked
 //! against a scan of every primitive (`treelet_core`'s reference). Then a
 //! frame loop: refit or rebuild, camera rays, shadow rays as occlusion
-//! queries, and the device time of each (there are no instances yet: the
-//! moving balls are part of the one tree).
+//! queries, and the device time of each (the moving balls part of the one
+//! tree). Last, the same frame loop with instances: the waves one mesh,
+//! refit every frame, and a rock mesh placed 48 times, the copies moving
+//! every frame (the top level rebuilt over them); hits are checked against
+//! a scan of the scene flattened into world triangles.
 //!
 //!     cargo run --release -p treelet --example tracer            # the first Vulkan adapter
 //!     cargo run --release -p treelet --example tracer -- cpu     # the CPU runner
@@ -12,7 +15,10 @@
 //! `cargo test` runs it on both (it is also the example's test).
 use anyhow::{ensure, Result};
 use glam::Vec3;
-use treelet::{Backend, CpuBackend, GpuBackend, GpuContext, Quality, Ray, RayHit, Sphere, Tracer, Triangle};
+use treelet::{
+    Backend, CpuBackend, GpuBackend, GpuContext, Instance, InstancedTracer, Quality, Ray, RayHit, Sphere, Tracer,
+    Triangle,
+};
 // The reference every hit is checked against: treelet-core's scan.
 use treelet_core::geometry::prims::{Origin, Prims};
 use treelet_core::trace::classic::closest_hit_linear;
@@ -47,7 +53,12 @@ fn rays() -> Vec<Ray> {
 }
 
 /// Traces `rays` through `tracer` and checks every hit against the scan.
-fn trace_and_check<B: Backend>(b: &mut B, tracer: &Tracer<B>, scene: &(Vec<Sphere>, Vec<Triangle>), rays: &[Ray]) -> Result<Vec<RayHit>> {
+fn trace_and_check<B: Backend>(
+    b: &mut B,
+    tracer: &Tracer<B>,
+    scene: &(Vec<Sphere>, Vec<Triangle>),
+    rays: &[Ray],
+) -> Result<Vec<RayHit>> {
     let hits = tracer.closest_hits(b, rays)?;
     let (spheres, triangles) = scene;
     let prims = Prims::new(spheres, triangles);
@@ -130,7 +141,125 @@ fn frame_loop<B: Backend>(b: &mut B, frames: usize) -> Result<()> {
         );
         ensure!(shadow.len() > rays.len() / 2, "most rays should hit the waves");
         let in_shadow = shadowed.iter().filter(|&&s| s).count();
-        ensure!(in_shadow > 0 && in_shadow < shadow.len() / 2, "{in_shadow} of {} points in shadow: the balls shade a part of the waves", shadow.len());
+        ensure!(
+            in_shadow > 0 && in_shadow < shadow.len() / 2,
+            "{in_shadow} of {} points in shadow: the balls shade a part of the waves",
+            shadow.len()
+        );
+    }
+    Ok(())
+}
+
+/// A rock: an octahedron of radius 1 about the origin, 8 triangles.
+fn rock() -> Vec<Triangle> {
+    let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    let neg = |v: [f32; 3]| v.map(|c| -c);
+    let mut t = Vec::new();
+    for (a, b) in [(x, z), (z, neg(x)), (neg(x), neg(z)), (neg(z), x)] {
+        t.push(Triangle::new(a, b, y));
+        t.push(Triangle::new(b, a, neg(y)));
+    }
+    t
+}
+
+/// Copy `k` of the rock at frame time `time`: in a ring above the waves,
+/// turning about y, squashed, swinging round and bobbing.
+fn rock_copy(k: usize, time: f32) -> Instance {
+    let angle = k as f32 / 48.0 * std::f32::consts::TAU + 0.3 * time;
+    let centre = Vec3::new(32.0 + 20.0 * angle.cos(), 6.0 + (2.0 * time + k as f32).sin(), 32.0 + 20.0 * angle.sin());
+    let m = glam::Affine3A::from_scale_rotation_translation(
+        Vec3::new(1.5, 0.8, 1.2),
+        glam::Quat::from_rotation_y(angle * 3.0),
+        centre,
+    );
+    let c = m.matrix3;
+    let t = m.translation;
+    Instance {
+        mesh: 1,
+        transform: [
+            [c.x_axis.x, c.y_axis.x, c.z_axis.x, t.x],
+            [c.x_axis.y, c.y_axis.y, c.z_axis.y, t.y],
+            [c.x_axis.z, c.y_axis.z, c.z_axis.z, t.z],
+        ],
+    }
+}
+
+/// Instances in an engine's frame loop: mesh 0 (the waves) deforms and is
+/// refit every frame, mesh 1 (a rock) is placed 48 times and the copies
+/// move every frame (the top level is rebuilt over them, the rock's own
+/// tree never). Each frame traces camera rays and shadow rays towards a sun
+/// as occlusion queries, prints the device time of each step, and checks
+/// the hits against a scan of the scene flattened into world triangles.
+fn instanced_frame_loop<B: Backend>(b: &mut B, frames: usize) -> Result<()> {
+    let rays = rays();
+    let sun = Vec3::new(0.3, 1.0, 0.2).normalize();
+    let rock = rock();
+    let place = |time: f32| -> Vec<Instance> {
+        let mut instances = vec![Instance { mesh: 0, transform: Instance::IDENTITY }];
+        instances.extend((0..48).map(|k| rock_copy(k, time)));
+        instances
+    };
+    let waves = geometry(0.0).1;
+    let mut scene = InstancedTracer::build(b, &[&waves, &rock], &place(0.0), Quality::Fast)?;
+    for frame in 1..=frames {
+        let time = frame as f32 * 0.2;
+        let waves = geometry(time).1;
+        scene.refit_mesh(b, 0, &waves)?;
+        let refit_ms = scene.last_update_ms();
+        let instances = place(time);
+        scene.set_instances(b, &instances)?;
+        let top_ms = scene.last_update_ms();
+        b.take_times()?;
+        let hits = scene.closest_hits(b, &rays)?;
+        let shadow: Vec<Ray> = rays
+            .iter()
+            .zip(&hits)
+            .filter(|(_, h)| h.is_hit())
+            .map(|(r, h)| {
+                let d = Vec3::from(r.dir).normalize();
+                let n = Vec3::from(h.normal);
+                let facing = if n.dot(d) < 0.0 { n } else { -n };
+                Ray::new((Vec3::from(r.origin) + d * h.t + facing * 1e-3).into(), sun.into())
+            })
+            .collect();
+        let shadowed = scene.occluded(b, &shadow)?;
+        let trace_ms = b.take_times()?.get("trace");
+        // The scene flattened: every instance's triangles in the world.
+        let world: Vec<Triangle> = instances
+            .iter()
+            .flat_map(|i| {
+                let mesh = if i.mesh == 0 { &waves } else { &rock };
+                let m = i.transform;
+                let apply = move |p: [f32; 3]| -> [f32; 3] {
+                    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+                };
+                mesh.iter().map(move |t| Triangle::new(apply(t.v0), apply(t.v1), apply(t.v2)))
+            })
+            .collect();
+        let prims = Prims::new(&[], &world);
+        let mut differ = 0;
+        for (r, h) in rays.iter().zip(&hits) {
+            let d = Vec3::from(r.dir).normalize();
+            let scan = closest_hit_linear(Vec3::from(r.origin), d, Origin::NONE, &prims);
+            let same = h.is_hit() == scan.is_hit() && (!h.is_hit() || (h.t - scan.t).abs() <= 1e-3 * scan.t.max(1.0));
+            differ += usize::from(!same);
+        }
+        // Rays through a shared edge may land on either triangle, and the
+        // placed mesh is intersected in its own space: a few may differ.
+        ensure!(
+            differ * 200 <= rays.len(),
+            "frame {frame}: {differ} of {} hits differ from the flattened scene's",
+            rays.len()
+        );
+        let on_rocks = hits.iter().filter(|h| h.is_hit() && h.instance > 0).count();
+        println!(
+            "instanced frame {frame}: refit of the waves + top level {refit_ms:.3} ms, top level of {} instances {top_ms:.3} ms, {} rays ({on_rocks} on rocks) and {} shadow rays in {trace_ms:.3} ms, {} in shadow",
+            instances.len(),
+            rays.len(),
+            shadow.len(),
+            shadowed.iter().filter(|&&s| s).count()
+        );
+        ensure!(on_rocks > 0, "frame {frame}: the rocks should stand in some rays' way");
     }
     Ok(())
 }
@@ -157,7 +286,11 @@ fn on_device(ctx: std::sync::Arc<GpuContext>) -> Result<()> {
     let out: Vec<[f32; 4]> = b.read(&buffer, 2 * rays.len())?;
     let from_host = tracer.closest_hits(b, &rays)?;
     for (k, h) in from_host.iter().enumerate() {
-        ensure!(out[2 * k][1].to_bits() == h.prim && (out[2 * k][0] == h.t), "ray {k}: on the device {:?}, from the host {h:?}", out[2 * k]);
+        ensure!(
+            out[2 * k][1].to_bits() == h.prim && (out[2 * k][0] == h.t),
+            "ray {k}: on the device {:?}, from the host {h:?}",
+            out[2 * k]
+        );
     }
     println!("{} rays traced in a wgpu buffer: the same hits as from host slices", rays.len());
     Ok(())
@@ -167,20 +300,23 @@ fn main() -> Result<()> {
     if std::env::args().nth(1).as_deref() == Some("cpu") {
         let b = &mut CpuBackend::new();
         run(b)?;
-        return frame_loop(b, 8);
+        frame_loop(b, 8)?;
+        return instanced_frame_loop(b, 8);
     }
     match GpuContext::new() {
         Ok(ctx) => {
             let b = &mut GpuBackend::new(ctx.clone());
             run(b)?;
             frame_loop(b, 8)?;
+            instanced_frame_loop(b, 8)?;
             on_device(ctx)
         }
         Err(e) => {
             eprintln!("note: {e}: running on the CPU runner instead");
             let b = &mut CpuBackend::new();
             run(b)?;
-            frame_loop(b, 8)
+            frame_loop(b, 8)?;
+            instanced_frame_loop(b, 8)
         }
     }
 }
@@ -193,6 +329,7 @@ mod tests {
     fn runs_on_the_cpu_runner() {
         run(&mut CpuBackend::new()).unwrap();
         frame_loop(&mut CpuBackend::new(), 4).unwrap();
+        instanced_frame_loop(&mut CpuBackend::new(), 3).unwrap();
     }
 
     /// With `CI` set, a machine without a usable adapter fails this test.
@@ -201,6 +338,7 @@ mod tests {
         match GpuContext::new() {
             Ok(ctx) => {
                 run(&mut GpuBackend::new(ctx.clone())).unwrap();
+                instanced_frame_loop(&mut GpuBackend::new(ctx.clone()), 3).unwrap();
                 on_device(ctx).unwrap();
             }
             Err(e) if std::env::var_os("CI").is_some() => panic!("CI is set and no GPU adapter is usable: {e:#}"),
