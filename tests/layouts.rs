@@ -281,6 +281,88 @@ fn gpu_layouts_equal_cpu() {
     }
 }
 
+/// A `bvh2` tree refit in place after its primitives moved
+/// (`treelet::bvh::refit::refit_bvh2`: the collapsed tree's boxes bottom-up,
+/// then its nodes and leaf primitives written again, no new collapse): valid
+/// for the moved primitives, every child box exactly its subtree's, each
+/// ray hitting what the scan of the moved primitives hits; the GPU writes
+/// what the CPU runner writes.
+#[test]
+fn bvh2_refit_in_place_fits_the_moved_primitives() {
+    let seed = treelet_tests::fresh_seed();
+    let spheres = random_spheres(3000, seed);
+    let tris = terrain(4000);
+    // Every sphere moved and resized, every vertex lifted by a different wave.
+    let moved_spheres: Vec<Sphere> = spheres
+        .iter()
+        .enumerate()
+        .map(|(k, s)| Sphere { center: [s.center[0] + (k as f32 * 0.37).sin() * 30.0, s.center[1] - 12.0, s.center[2]], radius: s.radius * 1.5, ..*s })
+        .collect();
+    let lift = |v: [f32; 3]| [v[0], v[1] + 3.0 * (v[0] * 0.05).sin() * (v[2] * 0.07).cos() + 0.5, v[2]];
+    let moved_tris: Vec<Triangle> = tris.iter().map(|t| Triangle::new(lift(t.v0), lift(t.v1), lift(t.v2))).collect();
+    let cases = [
+        ("spheres", Primitives::spheres(&spheres), Primitives::spheres(&moved_spheres)),
+        ("terrain", Primitives::triangles(&tris), Primitives::triangles(&moved_tris)),
+        ("both", Primitives { spheres: &spheres, triangles: &tris }, Primitives { spheres: &moved_spheres, triangles: &moved_tris }),
+    ];
+    let gpu = treelet_tests::gpu();
+    for (what, prims, moved) in cases {
+        let scene = moved.as_core();
+        let boxes = moved.boxes();
+        let bounds = boxes.iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
+        let probes = rays(&scene, bounds.lo(), bounds.hi(), seed as u32, 300);
+        for accel in [Accel::Lbvh, Accel::Trbvh] {
+            let what = format!("{what}, {accel:?}, seed {seed}");
+            let c = refit_in_place(&mut CpuBackend::new(), prims, moved, accel);
+            c.validate(moved);
+            let HostTree::Bvh2(nodes, leaf) = &c else { unreachable!() };
+            tight_boxes(nodes, leaf, &boxes, 0, &what);
+            for (k, &(o, d, from, scan)) in probes.iter().enumerate() {
+                let hit = c.trace(o, d, from, &scene);
+                assert!(hit.t == scan.t && hit.prim == scan.prim, "{what}: refit tree, ray {k}: {} at {}, the scan {} at {}", hit.prim, hit.t, scan.prim, scan.t);
+            }
+            if let Some(ctx) = &gpu {
+                let mut b = GpuBackend::new(ctx.clone());
+                let fused = !b.runs_on_cpu();
+                let g = refit_in_place(&mut b, prims, moved, accel);
+                g.validate(moved);
+                if let (HostTree::Bvh2(gn, gl), true) = (&g, fused) {
+                    assert!(gn == nodes && gl == leaf, "{what}: GPU and CPU refit trees differ");
+                }
+            }
+        }
+    }
+}
+
+/// Builds over `prims` in `bvh2`, then refits in place for `moved`.
+fn refit_in_place<B: Backend>(b: &mut B, prims: Primitives, moved: Primitives, accel: Accel) -> HostTree {
+    let (tree, _, _) = traced_tree(b, prims, accel, Layout::Bvh2).unwrap();
+    assert!(tree.collapsed.is_some(), "a bvh2 layout keeps its collapsed tree");
+    let buffers = treelet::bvh::layout::PrimBuffers::upload(b, moved).unwrap();
+    treelet::bvh::refit::refit_bvh2(b, &tree, &buffers).unwrap();
+    read(b, &tree, moved.len())
+}
+
+/// Every child box of node `i` equals the union of its primitives' boxes
+/// (`boxes`, by primitive index), bit for bit; returns node `i`'s box.
+fn tight_boxes(nodes: &[Bvh2Node], leaf: &[LeafPrim], boxes: &[treelet_core::Aabb], i: usize, what: &str) -> treelet_core::Aabb {
+    let node = nodes[i];
+    let mut all = treelet_core::Aabb::EMPTY;
+    for (index, count, lo, hi) in [(node.left, node.left_count, node.left_min, node.left_max), (node.right, node.right_count, node.right_min, node.right_max)] {
+        if lo[0] > hi[0] {
+            continue; // the empty second child of a one-leaf root
+        }
+        let exact = if count > 0 {
+            leaf[index as usize..(index + count) as usize].iter().fold(treelet_core::Aabb::EMPTY, |a, p| a.union(&boxes[p.prim as usize]))
+        } else {
+            tight_boxes(nodes, leaf, boxes, index as usize, what)
+        };
+        assert!(exact.min == lo && exact.max == hi, "{what}: node {i}: child box {lo:?}..{hi:?}, its primitives' {:?}..{:?}", exact.min, exact.max);
+        all = all.union(&exact);
+    }
+    all
+}
+
 /// The kernels a render's pipelines are built ahead for
 /// (`treelet::render::prepared::kernels`) are every kernel the render
 /// dispatches, for each tree and layout: on the CPU runner, which asks the

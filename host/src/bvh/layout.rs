@@ -111,6 +111,10 @@ pub struct TracedTree<B: Backend> {
     /// Nodes in the layout (an upper bound for cwbvh, whose buffer is sized
     /// before the count is known; see [`wide_node_count`]).
     pub node_count: u32,
+    /// For `bvh2`: the collapsed tree it was made from, kept so that a refit
+    /// ([`crate::bvh::refit::refit_bvh2`]) rewrites the layout's boxes and
+    /// primitives without collapsing again.
+    pub collapsed: Option<DeviceBvh<B>>,
 }
 
 /// Lays out `bvh`, a tree of one primitive per leaf in the LBVH layout (as
@@ -143,7 +147,7 @@ pub fn lay_out<B: Backend>(
         }
         _ if max_leaf <= 1 && layout == Layout::Classic => {
             check_depth(b, &bvh)?;
-            Ok(TracedTree { layout, node_count: bvh.node_count, nodes: bvh.nodes, prims: bvh.prim_indices })
+            Ok(TracedTree { layout, node_count: bvh.node_count, nodes: bvh.nodes, prims: bvh.prim_indices, collapsed: None })
         }
         _ => {
             b.stage("collapse");
@@ -155,6 +159,7 @@ pub fn lay_out<B: Backend>(
                     node_count: collapsed.node_count,
                     nodes: collapsed.nodes,
                     prims: collapsed.prim_indices,
+                    collapsed: None,
                 });
             }
             b.stage("layout");
@@ -232,29 +237,34 @@ fn bvh2<B: Backend>(b: &mut B, collapsed: &DeviceBvh<B>, prims: &PrimBuffers<B>)
     let internal = (collapsed.node_count / 2).max(1); // 2 L - 1 nodes, L - 1 internal
     check_fits(b, "two-box nodes", internal as u64 * std::mem::size_of::<Bvh2Node>() as u64)?;
     check_fits(b, "leaf primitives", collapsed.n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
-    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
     let nodes = b.scratch("two-box nodes", internal as u64 * std::mem::size_of::<Bvh2Node>() as u64)?;
-    b.dispatch(
-        Kernel::Bvh2Nodes,
-        &[&p, &collapsed.nodes, &collapsed.parents, &nodes],
-        groups_for(collapsed.node_count, WORKGROUP_SIZE),
-    );
-    let leaf_prims = leaf_prims(b, &p, &collapsed.prim_indices, collapsed.n, prims)?;
-    Ok(TracedTree { layout: Layout::Bvh2, nodes, prims: leaf_prims, node_count: internal })
+    let leaf_prims = b.scratch("leaf primitives", collapsed.n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
+    write_bvh2(b, collapsed, prims, &nodes, &leaf_prims)?;
+    Ok(TracedTree { layout: Layout::Bvh2, nodes, prims: leaf_prims, node_count: internal, collapsed: Some(collapsed.clone()) })
 }
 
-/// The primitives of slots `0..n` (`prim_indices`, in leaf order) as
-/// [`LeafPrim`]s.
-fn leaf_prims<B: Backend>(
+/// Writes the two-box nodes of `collapsed` into `nodes` and its primitives
+/// in leaf order into `leaf_prims` (a layout, or its refit).
+pub(crate) fn write_bvh2<B: Backend>(
     b: &mut B,
-    p: &B::Buffer,
-    prim_indices: &B::Buffer,
-    n: u32,
+    collapsed: &DeviceBvh<B>,
     prims: &PrimBuffers<B>,
-) -> Result<B::Buffer> {
-    let out = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
-    b.dispatch(Kernel::LeafPrims, &[p, prim_indices, &prims.spheres, &prims.triangles, &out], groups_for(n, WORKGROUP_SIZE));
-    Ok(out)
+    nodes: &B::Buffer,
+    leaf_prims: &B::Buffer,
+) -> Result<()> {
+    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
+    b.dispatch(
+        Kernel::Bvh2Nodes,
+        &[&p, &collapsed.nodes, &collapsed.parents, nodes],
+        groups_for(collapsed.node_count, WORKGROUP_SIZE),
+    );
+    let n = collapsed.n;
+    b.dispatch(
+        Kernel::LeafPrims,
+        &[&p, &collapsed.prim_indices, &prims.spheres, &prims.triangles, leaf_prims],
+        groups_for(n, WORKGROUP_SIZE),
+    );
+    Ok(())
 }
 
 /// The compressed wide BVH of a tree of one primitive per leaf (see
@@ -321,7 +331,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
         ],
         groups,
     );
-    Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal })
+    Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal, collapsed: None })
 }
 
 /// The nodes of a wide tree that are in use: those reachable from the root

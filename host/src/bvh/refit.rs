@@ -5,10 +5,10 @@
 //! treelet-restructured one included (Karras 2012, section 4, applied to an
 //! existing hierarchy).
 use anyhow::{bail, Result};
-use treelet_core::geometry::buffers::BuildParams;
+use treelet_core::geometry::buffers::{BuildParams, LayoutParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::bvh::layout::PrimBuffers;
+use crate::bvh::layout::{PrimBuffers, TracedTree, write_bvh2};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -43,5 +43,40 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
     let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
     let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
     b.dispatch(fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    b.take_times()
+}
+
+/// Refits a tree laid out in `bvh2` in place, from the collapsed tree it was
+/// made from ([`TracedTree::collapsed`]), for `prims`, the primitives it was
+/// built over (same count and order), moved: the primitives' boxes, then
+/// the collapsed tree's boxes bottom-up (a leaf's box is the union of its
+/// primitives'; `treelet_core::construct::fit::refit_leaves_kernel`), then
+/// its two-box nodes and leaf primitives written again. No collapse and no
+/// depth check: the shape is the one laid out.
+pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
+    let Some(collapsed) = &tree.collapsed else {
+        bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
+    };
+    let n = collapsed.n;
+    if prims.sphere_count + prims.triangle_count != n {
+        bail!("refit with {} primitives: the tree was built over {n}", prims.sphere_count + prims.triangle_count);
+    }
+    b.stage("bounds");
+    let params = BuildParams { n, spheres: prims.sphere_count, ..Default::default() };
+    let p = b.upload("refit params", &[params])?;
+    let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
+    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.stage("fit");
+    let nodes = collapsed.node_count;
+    let lp = b.upload("refit params", &[LayoutParams { n, nodes, spheres: prims.sphere_count, ..Default::default() }])?;
+    let flags = b.zeroed("fit flags", nodes as u64 * 4)?;
+    let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
+    b.dispatch(
+        refit,
+        &[&lp, &collapsed.prim_indices, &boxes, &collapsed.nodes, &collapsed.parents, &flags],
+        groups_for(nodes, WORKGROUP_SIZE),
+    );
+    b.stage("layout");
+    write_bvh2(b, collapsed, prims, &tree.nodes, &tree.prims)?;
     b.take_times()
 }

@@ -108,6 +108,7 @@ pub fn traced_tree<B: Backend>(
             nodes: b.upload("no nodes", &[Node::default()])?,
             prims: b.upload("no indices", &[0u32])?,
             node_count: 0,
+            collapsed: None,
         };
         return Ok((tree, buffers, 0.0));
     };

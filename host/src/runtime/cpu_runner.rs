@@ -546,6 +546,14 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
+        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prims, boxes, nodes, parents, flags]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
+            let (parents, flags) = (view(parents), view(flags));
+            for id in ids(groups) {
+                fit::refit_leaves_kernel::<true>(id, p.nodes, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
+            }
+        }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
             let p: treelet_core::BuildParams = params(p);
             let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view(nodes));

@@ -113,6 +113,10 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
+    /// New boxes for a collapsed tree (leaves of several primitives), its shape kept.
+    RefitLeaves,
+    /// [`Kernel::RefitLeaves`] with relaxed counters, for CPU adapters.
+    RefitLeavesRelaxed,
     /// Hierarchy and boxes in one bottom-up pass (Apetrei 2014).
     Agglomerate,
     /// [`Kernel::Agglomerate`] with relaxed exchanges, for CPU adapters.
@@ -185,7 +189,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 59] = [
+    const FIXED: [Kernel; 61] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -215,6 +219,8 @@ impl Kernel {
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
+        Kernel::RefitLeaves,
+        Kernel::RefitLeavesRelaxed,
         Kernel::Agglomerate,
         Kernel::AgglomerateRelaxed,
         Kernel::AgglomerateSubgroup,
@@ -294,6 +300,8 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
+            Kernel::RefitLeaves => "fit::refit_leaves_cs",
+            Kernel::RefitLeavesRelaxed => "fit::refit_leaves_relaxed_cs",
             Kernel::Agglomerate => "fit::agglomerate_cs",
             Kernel::AgglomerateRelaxed => "fit::agglomerate_relaxed_cs",
             Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
@@ -337,7 +345,7 @@ impl Kernel {
     pub fn split_bindings(self) -> &'static [usize] {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
-            Kernel::Fit | Kernel::FitRelaxed => &[3],
+            Kernel::Fit | Kernel::FitRelaxed | Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
@@ -384,6 +392,7 @@ impl Kernel {
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, ReadWrite, Read, ReadWrite],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }

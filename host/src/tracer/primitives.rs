@@ -9,7 +9,7 @@ use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 use super::rays::{batch_dims, check_rays, hit_record, read_batch, Ray, RayHit};
 use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
-use crate::bvh::refit::refit_uploaded;
+use crate::bvh::refit::{refit_bvh2, refit_uploaded};
 use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
 use crate::runtime::backend::{Backend, DeviceClass};
 use crate::runtime::kernels::{Kernel, Method};
@@ -87,8 +87,9 @@ impl<B: Backend> Tracer<B> {
     }
 
     /// Moves the primitives: the same counts, in the same order, at new
-    /// places. The tree keeps its shape and gets new boxes (bottom-up, the
-    /// build's own fit kernel), then a new layout. A refit tree stays
+    /// places. The tree keeps its shape and gets new boxes bottom-up, written
+    /// into its layout in place (its leaves' primitives too: see
+    /// [`crate::bvh::refit::refit_bvh2`]). A refit tree stays
     /// correct however far things move, but its rays slow down as it drifts
     /// from what a new build would make: rebuild after large changes.
     pub fn refit(&mut self, b: &mut B, spheres: &[Sphere], triangles: &[Triangle]) -> Result<()> {
@@ -109,11 +110,12 @@ impl<B: Backend> Tracer<B> {
         b.begin_build();
         // Uploaded once, for the refit and for tracing.
         self.prims = PrimBuffers::upload(b, all)?;
-        let refit_ms = match &self.built {
-            Some(built) => refit_uploaded(b, &built.bvh, &self.prims)?.total(),
-            None => 0.0,
+        self.update_ms = match (&self.tree, &self.built) {
+            // The layout's boxes and primitives rewritten in place.
+            (Some(tree), _) if tree.collapsed.is_some() => refit_bvh2(b, tree, &self.prims)?.total(),
+            (_, Some(built)) => refit_uploaded(b, &built.bvh, &self.prims)?.total() + self.lay_out(b)?,
+            _ => 0.0,
         };
-        self.update_ms = refit_ms + self.lay_out(b)?;
         self.keep_buffers(b);
         Ok(())
     }
@@ -128,6 +130,9 @@ impl<B: Backend> Tracer<B> {
         }
         if let Some(tree) = &self.tree {
             kept.extend([&tree.nodes, &tree.prims]);
+            if let Some(c) = &tree.collapsed {
+                kept.extend([&c.nodes, &c.parents, &c.prim_indices]);
+            }
         }
         b.keep(&kept);
     }
