@@ -276,11 +276,24 @@ fn stiff_transforms_hit_what_the_flattened_scene_hits() {
     let cpu = stiff(&mut CpuBackend::new(), seed);
     if let Some(ctx) = gpu() {
         let gpu = stiff(&mut GpuBackend::new(ctx), seed);
-        let same = cpu.iter().zip(&gpu).filter(|(c, g)| (c.instance, c.prim) == (g.instance, g.prim)).count();
+        // Squashed copies stack their triangles a hundred-thousandth apart:
+        // where the device's fused multiply-adds round a ray's distances
+        // differently, it may hit another triangle (or copy) at the same
+        // distance (on the H100, 5 to 8 rays in 4 000 for some seeds). What
+        // must agree is whether a ray hits and where.
+        let same = cpu
+            .iter()
+            .zip(&gpu)
+            .filter(|(c, g)| {
+                (c.instance, c.prim) == (g.instance, g.prim) || (c.is_hit() && g.is_hit() && (c.t - g.t).abs() <= 1e-4 * c.t.max(1.0))
+            })
+            .count();
         assert!(
             same as f64 >= 0.999 * cpu.len() as f64,
             "seed {seed}: GPU and CPU agree on {same} hits of {}",
             cpu.len()
         );
+        let exact = cpu.iter().zip(&gpu).filter(|(c, g)| (c.instance, c.prim) == (g.instance, g.prim)).count();
+        assert!(exact as f64 >= 0.99 * cpu.len() as f64, "seed {seed}: GPU and CPU hit the same triangle for {exact} rays of {}", cpu.len());
     }
 }
