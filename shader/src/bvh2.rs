@@ -2,6 +2,7 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{LayoutParams, Node, Sphere};
 use treelet_core::geometry::split::{Split, SplitMut};
+use treelet_core::geometry::prims::Prims;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
 
@@ -56,3 +57,47 @@ pub fn leaf_prims_cs(
     let out = &mut SplitMut::new(out, out_hi);
     treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
 }
+
+/// A layout's refit in place: each leaf of the collapsed tree writes its
+/// primitives and box, then climbs (`treelet_core::layouts::bvh2::refit_kernel`);
+/// `$ordered` as for the build's fit kernels.
+macro_rules! refit_kernel {
+    ($name:ident, $ordered:literal) => {
+        #[spirv(compute(threads(256)))]
+        pub fn $name(
+            #[spirv(global_invocation_id)] gid: UVec3,
+            #[spirv(num_workgroups)] groups: UVec3,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] prim_indices: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &mut [Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &[u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] flags: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out: &mut [Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &mut [Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_hi: &mut [Vec4],
+        ) {
+            let id = linear_id(gid.x, gid.y, groups.x);
+            let prims = Prims {
+                spheres,
+                sphere_count: params.spheres,
+                triangles: Split::new(triangles, triangles_hi),
+                triangle_count: params.n - params.spheres,
+            };
+            treelet_core::layouts::bvh2::refit_kernel::<$ordered, _>(
+                id,
+                params.nodes,
+                &prims,
+                prim_indices,
+                &mut SplitMut::new(nodes, nodes_hi),
+                parents,
+                flags,
+                &mut SplitMut::new(out, out_hi),
+            );
+        }
+    };
+}
+refit_kernel!(refit_cs, true);
+refit_kernel!(refit_relaxed_cs, false);

@@ -1,6 +1,6 @@
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{BuildParams, LayoutParams};
+use treelet_core::geometry::buffers::BuildParams;
 use treelet_core::gpu::workgroup::{linear_id, WG};
 use treelet_core::geometry::split::SplitMut;
 use treelet_core::{Aabb, Node};
@@ -63,38 +63,6 @@ macro_rules! agglomerate_kernel {
 
 fit_kernel!(fit_cs, true);
 fit_kernel!(fit_relaxed_cs, false);
-
-/// A refit of a collapsed tree (leaves of several primitives), its shape
-/// kept; `$ordered` as for `fit_kernel!`.
-macro_rules! refit_leaves_kernel {
-    ($name:ident, $ordered:literal) => {
-        #[spirv(compute(threads(256)))]
-        pub fn $name(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] prim_indices: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] prim_boxes: &[Aabb],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] nodes_hi: &mut [Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            treelet_core::construct::fit::refit_leaves_kernel::<$ordered>(
-                id,
-                params.nodes,
-                prim_indices,
-                prim_boxes,
-                &mut SplitMut::new(nodes, nodes_hi),
-                parents,
-                flags,
-            );
-        }
-    };
-}
-refit_leaves_kernel!(refit_leaves_cs, true);
-refit_leaves_kernel!(refit_leaves_relaxed_cs, false);
 agglomerate_kernel!(agglomerate_cs, true);
 agglomerate_kernel!(agglomerate_relaxed_cs, false);
 

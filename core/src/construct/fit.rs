@@ -87,41 +87,12 @@ pub fn fit_kernel<const ORDERED: bool>(
     climb_boxes::<ORDERED>(leaf_node(n, i), b, nodes, parents, flags);
 }
 
-/// Kernel: new boxes for a tree whose leaves hold several primitives (the
-/// collapsed tree a layout is made from, [`crate::construct::collapse`]),
-/// its shape kept: one invocation per node `i` of `node_count`; a leaf
-/// writes the union of its primitives' boxes
-/// (`prim_boxes[prim_indices[first..first + count]]`) and climbs as
-/// [`fit_kernel`] does. `flags` holds one zeroed counter per node.
-pub fn refit_leaves_kernel<const ORDERED: bool>(
-    i: u32,
-    node_count: u32,
-    prim_indices: &[u32],
-    prim_boxes: &[Aabb],
-    nodes: &mut SplitMut<Node>,
-    parents: &[u32],
-    flags: &mut [u32],
-) {
-    if i >= node_count {
-        return;
-    }
-    let (first, right) = nodes.with(i as usize, |node| (node.left, node.right));
-    if right & LEAF_BIT == 0 {
-        return;
-    }
-    let mut own = Aabb::EMPTY;
-    for k in 0..right & !LEAF_BIT {
-        own = own.union(&prim_boxes[prim_indices[(first + k) as usize] as usize]);
-    }
-    nodes.with_mut(i as usize, |node| store_box(node, &own));
-    climb_boxes::<ORDERED>(i, own, nodes, parents, flags);
-}
-
-/// The climb of [`fit_kernel`] and [`refit_leaves_kernel`] from node
-/// `start`, whose box `own` is written: each internal node it arrives at
-/// second gets the union of its children's boxes.
+/// The climb of [`fit_kernel`] (and of the `bvh2` layout's refit,
+/// `crate::layouts::bvh2::refit_kernel`) from node `start`, whose box `own`
+/// is written: each internal node it arrives at second gets the union of
+/// its children's boxes.
 #[inline]
-fn climb_boxes<const ORDERED: bool>(start: u32, own: Aabb, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
+pub(crate) fn climb_boxes<const ORDERED: bool>(start: u32, own: Aabb, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
     // The climber keeps its subtree's box and reads only the sibling's.
     let mut own = own;
     let mut climb = Climb::<ORDERED>::new(start);

@@ -12,10 +12,13 @@
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
 //! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use crate::construct::fit::{climb_boxes, store_box};
+use crate::construct::primitive_boxes::primitive_box;
+use crate::geometry::aabb::Aabb;
 use crate::geometry::records::{RecordLoad, RecordStore};
-use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
+use crate::geometry::buffers::{Bvh2Node, LEAF_BIT, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
-use crate::geometry::split::Split;
+use crate::geometry::split::{Split, SplitMut};
 use crate::geometry::triangle::Triangle;
 use crate::gpu::unchecked::at;
 
@@ -54,6 +57,40 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
     let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
     let record = two_boxes(&l, &r, child_ref(&l, index + 1), child_ref(&r, index + (node.right - i) / 2));
     out.store(index as usize, &record);
+}
+
+/// Kernel: the refit of a layout in place, over the collapsed tree it was
+/// made from (its shape kept; `prims` moved): one invocation per node `i` of
+/// `node_count`; a leaf writes its primitives' [`LeafPrim`]s again (slots
+/// `first..first + count` of `out`) and its box, the union of theirs, then
+/// climbs as the build's fit does ([`crate::construct::fit`]). `flags` holds
+/// one zeroed counter per node. [`bvh2_node_kernel`] then writes the nodes.
+#[allow(clippy::too_many_arguments)]
+pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized>(
+    i: u32,
+    node_count: u32,
+    prims: &Prims,
+    prim_indices: &[u32],
+    nodes: &mut SplitMut<Node>,
+    parents: &[u32],
+    flags: &mut [u32],
+    out: &mut O,
+) {
+    if i >= node_count {
+        return;
+    }
+    let (first, right) = nodes.with(i as usize, |node| (node.left, node.right));
+    if right & LEAF_BIT == 0 {
+        return;
+    }
+    let mut own = Aabb::EMPTY;
+    for slot in first..first + (right & !LEAF_BIT) {
+        let prim = prim_indices[slot as usize];
+        out.store(slot as usize, &prims.leaf_prim(prim));
+        own = own.union(&primitive_box(prim, prims.sphere_count, prims.spheres, &prims.triangles));
+    }
+    nodes.with_mut(i as usize, |node| store_box(node, &own));
+    climb_boxes::<ORDERED>(i, own, nodes, parents, flags);
 }
 
 /// The node of children `l` and `r`, referred to as given (a leaf by its

@@ -244,20 +244,15 @@ fn bvh2<B: Backend>(b: &mut B, collapsed: &DeviceBvh<B>, prims: &PrimBuffers<B>)
 }
 
 /// Writes the two-box nodes of `collapsed` into `nodes` and its primitives
-/// in leaf order into `leaf_prims` (a layout, or its refit).
-pub(crate) fn write_bvh2<B: Backend>(
+/// in leaf order into `leaf_prims`.
+fn write_bvh2<B: Backend>(
     b: &mut B,
     collapsed: &DeviceBvh<B>,
     prims: &PrimBuffers<B>,
     nodes: &B::Buffer,
     leaf_prims: &B::Buffer,
 ) -> Result<()> {
-    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
-    b.dispatch(
-        Kernel::Bvh2Nodes,
-        &[&p, &collapsed.nodes, &collapsed.parents, nodes],
-        groups_for(collapsed.node_count, WORKGROUP_SIZE),
-    );
+    let p = write_bvh2_nodes(b, collapsed, prims, nodes)?;
     let n = collapsed.n;
     b.dispatch(
         Kernel::LeafPrims,
@@ -265,6 +260,23 @@ pub(crate) fn write_bvh2<B: Backend>(
         groups_for(n, WORKGROUP_SIZE),
     );
     Ok(())
+}
+
+/// Writes the two-box nodes of `collapsed` into `nodes`; returns the
+/// layout's parameters.
+pub(crate) fn write_bvh2_nodes<B: Backend>(
+    b: &mut B,
+    collapsed: &DeviceBvh<B>,
+    prims: &PrimBuffers<B>,
+    nodes: &B::Buffer,
+) -> Result<B::Buffer> {
+    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
+    b.dispatch(
+        Kernel::Bvh2Nodes,
+        &[&p, &collapsed.nodes, &collapsed.parents, nodes],
+        groups_for(collapsed.node_count, WORKGROUP_SIZE),
+    );
+    Ok(p)
 }
 
 /// The compressed wide BVH of a tree of one primitive per leaf (see

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::{BuildParams, LayoutParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::bvh::layout::{PrimBuffers, TracedTree, write_bvh2};
+use crate::bvh::layout::{PrimBuffers, TracedTree, write_bvh2_nodes};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -48,11 +48,12 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
 
 /// Refits a tree laid out in `bvh2` in place, from the collapsed tree it was
 /// made from ([`TracedTree::collapsed`]), for `prims`, the primitives it was
-/// built over (same count and order), moved: the primitives' boxes, then
-/// the collapsed tree's boxes bottom-up (a leaf's box is the union of its
-/// primitives'; `treelet_core::construct::fit::refit_leaves_kernel`), then
-/// its two-box nodes and leaf primitives written again. No collapse and no
-/// depth check: the shape is the one laid out.
+/// built over (same count and order), moved: each leaf of the collapsed
+/// tree writes its primitives again and its box (their union), then the
+/// boxes climb as the build's fit does
+/// (`treelet_core::layouts::bvh2::refit_kernel`), then the two-box nodes are
+/// written again. No collapse and no depth check: the shape is the one
+/// laid out.
 pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
     let Some(collapsed) = &tree.collapsed else {
         bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
@@ -61,11 +62,6 @@ pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffe
     if prims.sphere_count + prims.triangle_count != n {
         bail!("refit with {} primitives: the tree was built over {n}", prims.sphere_count + prims.triangle_count);
     }
-    b.stage("bounds");
-    let params = BuildParams { n, spheres: prims.sphere_count, ..Default::default() };
-    let p = b.upload("refit params", &[params])?;
-    let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
-    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
     b.stage("fit");
     let nodes = collapsed.node_count;
     let lp = b.upload("refit params", &[LayoutParams { n, nodes, spheres: prims.sphere_count, ..Default::default() }])?;
@@ -73,10 +69,10 @@ pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffe
     let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
     b.dispatch(
         refit,
-        &[&lp, &collapsed.prim_indices, &boxes, &collapsed.nodes, &collapsed.parents, &flags],
+        &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &flags, &tree.prims],
         groups_for(nodes, WORKGROUP_SIZE),
     );
     b.stage("layout");
-    write_bvh2(b, collapsed, prims, &tree.nodes, &tree.prims)?;
+    write_bvh2_nodes(b, collapsed, prims, &tree.nodes)?;
     b.take_times()
 }

@@ -546,12 +546,18 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
-        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prims, boxes, nodes, parents, flags]) => {
+        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
-            let (parents, flags) = (view(parents), view(flags));
+            let (prim_indices, spheres, triangles, nodes) = (view(prim_indices), view(spheres), view(triangles), view(nodes));
+            let (parents, flags, out) = (view(parents), view(flags), view::<treelet_core::LeafPrim>(out));
+            let prims = treelet_core::geometry::prims::Prims {
+                spheres,
+                sphere_count: p.spheres,
+                triangles: Split::whole(triangles),
+                triangle_count: p.n - p.spheres,
+            };
             for id in ids(groups) {
-                fit::refit_leaves_kernel::<true>(id, p.nodes, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
+                bvh2::refit_kernel::<true, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {

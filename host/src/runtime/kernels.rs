@@ -113,7 +113,7 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
-    /// New boxes for a collapsed tree (leaves of several primitives), its shape kept.
+    /// A `bvh2` layout's refit in place: its collapsed tree's leaf primitives and boxes, bottom-up.
     RefitLeaves,
     /// [`Kernel::RefitLeaves`] with relaxed counters, for CPU adapters.
     RefitLeavesRelaxed,
@@ -300,8 +300,8 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
-            Kernel::RefitLeaves => "fit::refit_leaves_cs",
-            Kernel::RefitLeavesRelaxed => "fit::refit_leaves_relaxed_cs",
+            Kernel::RefitLeaves => "bvh2::refit_cs",
+            Kernel::RefitLeavesRelaxed => "bvh2::refit_relaxed_cs",
             Kernel::Agglomerate => "fit::agglomerate_cs",
             Kernel::AgglomerateRelaxed => "fit::agglomerate_relaxed_cs",
             Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
@@ -345,7 +345,8 @@ impl Kernel {
     pub fn split_bindings(self) -> &'static [usize] {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
-            Kernel::Fit | Kernel::FitRelaxed | Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3],
+            Kernel::Fit | Kernel::FitRelaxed => &[3],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
@@ -392,7 +393,7 @@ impl Kernel {
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, ReadWrite, Read, ReadWrite],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }
