@@ -94,6 +94,22 @@ fn run<B: Backend>(b: &mut B) -> Result<()> {
     Ok(())
 }
 
+/// Shadow rays: from each hit, a little off the surface on the side the
+/// camera ray came from (the geometric normal's side depends on the
+/// triangle's winding), towards the sun.
+fn shadow_rays(rays: &[Ray], hits: &[RayHit], sun: Vec3) -> Vec<Ray> {
+    rays.iter()
+        .zip(hits)
+        .filter(|(_, h)| h.is_hit())
+        .map(|(r, h)| {
+            let d = Vec3::from(r.dir).normalize();
+            let n = Vec3::from(h.normal);
+            let facing = if n.dot(d) < 0.0 { n } else { -n };
+            Ray::new((Vec3::from(r.origin) + d * h.t + facing * 1e-3).into(), sun.into())
+        })
+        .collect()
+}
+
 /// An engine's frame loop: the waves and balls move every frame; the tree
 /// is refit each frame and rebuilt every fourth (a refit tree slows down as
 /// the geometry drifts from what it was built for); each frame traces its
@@ -116,21 +132,7 @@ fn frame_loop<B: Backend>(b: &mut B, frames: usize) -> Result<()> {
         let update_ms = tracer.last_update_ms();
         b.take_times()?;
         let hits = tracer.closest_hits(b, &rays)?;
-        // Shadow rays leave each hit a little off the surface, on the side
-        // the camera ray came from (the geometric normal's side depends on
-        // the triangle's winding), towards the sun.
-        let shadow: Vec<Ray> = rays
-            .iter()
-            .zip(&hits)
-            .filter(|(_, h)| h.is_hit())
-            .map(|(r, h)| {
-                let d = Vec3::from(r.dir).normalize();
-                let n = Vec3::from(h.normal);
-                let facing = if n.dot(d) < 0.0 { n } else { -n };
-                let x = Vec3::from(r.origin) + d * h.t + facing * 1e-3;
-                Ray::new(x.into(), sun.into())
-            })
-            .collect();
+        let shadow = shadow_rays(&rays, &hits, sun);
         let shadowed = tracer.occluded(b, &shadow)?;
         let trace_ms = b.take_times()?.get("trace");
         println!(
@@ -211,17 +213,7 @@ fn instanced_frame_loop<B: Backend>(b: &mut B, frames: usize) -> Result<()> {
         let top_ms = scene.last_update_ms();
         b.take_times()?;
         let hits = scene.closest_hits(b, &rays)?;
-        let shadow: Vec<Ray> = rays
-            .iter()
-            .zip(&hits)
-            .filter(|(_, h)| h.is_hit())
-            .map(|(r, h)| {
-                let d = Vec3::from(r.dir).normalize();
-                let n = Vec3::from(h.normal);
-                let facing = if n.dot(d) < 0.0 { n } else { -n };
-                Ray::new((Vec3::from(r.origin) + d * h.t + facing * 1e-3).into(), sun.into())
-            })
-            .collect();
+        let shadow = shadow_rays(&rays, &hits, sun);
         let shadowed = scene.occluded(b, &shadow)?;
         let trace_ms = b.take_times()?.get("trace");
         // The scene flattened: every instance's triangles in the world.
