@@ -37,10 +37,10 @@ pub fn sort_settle_ties_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &mut [u64],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] overflow: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] sort_state: &mut [u32],
 ) {
     let id = treelet_core::gpu::workgroup::linear_id(gid.x, gid.y, groups.x);
-    treelet_core::construct::sort_ties::settle_ties_kernel(id, params, keys, values, overflow);
+    treelet_core::construct::sort_ties::settle_ties_kernel(id, params, keys, values, sort_state);
 }
 
 #[spirv(compute(threads(256)))]

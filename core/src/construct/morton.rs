@@ -133,8 +133,22 @@ pub fn interleave(x: u32, y: u32, z: u32) -> u64 {
     (spread_bits(x) << 2) | (spread_bits(y) << 1) | spread_bits(z)
 }
 
-/// Kernel: the key of primitive `id` and its index as the sort's value.
-pub fn morton_kernel(id: u32, params: &BuildParams, boxes: &[Aabb], keys: &mut [u64], values: &mut [u32]) {
+/// Kernel: the key of primitive `id` and its index as the sort's value;
+/// and, where `params.zero_slots` is 1, `slots[id]` zeroed for `id < n - 1`:
+/// the hierarchy's per-node arrival slots (the climbs' `ends`, the fit's
+/// flags), zeroed here because a fill of their own was one more dispatch in
+/// the build (H100, 65 536 primitives: 0.157 -> 0.154 ms).
+pub fn morton_kernel(
+    id: u32,
+    params: &BuildParams,
+    boxes: &[Aabb],
+    keys: &mut [u64],
+    values: &mut [u32],
+    slots: &mut [u32],
+) {
+    if params.zero_slots != 0 && id + 1 < params.n {
+        slots[id as usize] = 0;
+    }
     if id < params.n {
         let frame = MortonFrame::from_params(params);
         keys[id as usize] = frame.code(boxes[id as usize].centroid()) >> params.key_shift;

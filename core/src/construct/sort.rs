@@ -130,8 +130,13 @@ pub mod state {
     pub const COUNTS: u32 = 0;
     /// Ticket counter of each pass.
     pub const TICKETS: u32 = MAX_PASSES * RADIX;
+    /// Set to 1 by `construct::sort_ties` where a run of ties is too long to
+    /// settle: a spare word of the tickets' region, so that the flag is
+    /// zeroed with the state rather than by a fill dispatch of its own.
+    pub const TIE_OVERFLOW: u32 = TICKETS + MAX_PASSES;
     /// First status region.
     pub const STATUS: u32 = TICKETS + RADIX;
+    const _: () = assert!(TIE_OVERFLOW < STATUS);
     /// Words of the state of a sort of `tiles` tiles.
     #[inline]
     pub const fn words(tiles: u32) -> u32 {

@@ -22,7 +22,7 @@
 //!
 //! The idea is an MSD-first split of an LSD sort; Onesweep (Adinets &
 //! Merrill 2022) sorts every digit, as CUB does unless asked for fewer bits.
-use crate::construct::sort::RADIX_BITS;
+use crate::construct::sort::{RADIX_BITS, state};
 use crate::geometry::buffers::SortParams;
 use crate::gpu::atomics;
 
@@ -64,9 +64,10 @@ fn high(key: u64, params: &SortParams) -> u64 {
 /// Kernel, one invocation per key `i` of `params.n`, after a stable sort by
 /// the high digits: the first key of a run of keys with equal high digits
 /// orders the run by the low digits (insertion sort, stable), in place; a
-/// run longer than [`MAX_TIE_RUN`] sets `overflow[0]` to 1 and stays as it
-/// is. `params.pass` is the first high digit, `params.passes` all of them.
-pub fn settle_ties_kernel(i: u32, params: &SortParams, keys: &mut [u64], values: &mut [u32], overflow: &mut [u32]) {
+/// run longer than [`MAX_TIE_RUN`] sets `sort_state[state::TIE_OVERFLOW]`
+/// to 1 and stays as it is (`sort_state`: the sort's state, or zeroed words).
+/// `params.pass` is the first high digit, `params.passes` all of them.
+pub fn settle_ties_kernel(i: u32, params: &SortParams, keys: &mut [u64], values: &mut [u32], sort_state: &mut [u32]) {
     let n = params.n;
     if i >= n {
         return;
@@ -81,7 +82,7 @@ pub fn settle_ties_kernel(i: u32, params: &SortParams, keys: &mut [u64], values:
         end += 1;
     }
     if end - first > MAX_TIE_RUN as usize {
-        atomics::store_u32(&mut overflow[0], 1);
+        atomics::store_u32(&mut sort_state[state::TIE_OVERFLOW as usize], 1);
         return;
     }
     let mut j = first + 1;
@@ -109,11 +110,11 @@ mod tests {
 
     fn settle(keys: &mut [u64], values: &mut [u32], pass: u32, passes: u32) -> bool {
         let params = SortParams { n: keys.len() as u32, tiles: 0, pass, passes };
-        let mut overflow = [0u32];
+        let mut sort_state = vec![0u32; state::TIE_OVERFLOW as usize + 1];
         for i in 0..params.n {
-            settle_ties_kernel(i, &params, keys, values, &mut overflow);
+            settle_ties_kernel(i, &params, keys, values, &mut sort_state);
         }
-        overflow[0] == 1
+        sort_state[state::TIE_OVERFLOW as usize] == 1
     }
 
     #[test]

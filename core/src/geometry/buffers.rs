@@ -92,7 +92,11 @@ pub struct BuildParams {
     /// H-PLOC: how far apart (in cluster order) two clusters may be to be
     /// merged (0: any two of the range).
     pub cluster_radius: u32,
-    pub _pad0: [u32; 2],
+    /// 1: the Morton kernel zeroes the hierarchy's arrival slots; 0: the
+    /// hierarchy's first kernel does (`construct::agglomerate_subgroup`,
+    /// where they are still in L2 when its climb uses them).
+    pub zero_slots: u32,
+    pub _pad0: u32,
 }
 const _: () = assert!(core::mem::size_of::<BuildParams>() == 64);
 

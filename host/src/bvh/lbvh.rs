@@ -233,6 +233,8 @@ fn build_from_first_pass<B: Backend>(
     if hierarchy == Hierarchy::Hploc {
         (params.cluster_keep, params.cluster_radius) = hploc_settings();
     }
+    // The subgroup hierarchy zeroes its slots itself, just before its climb.
+    params.zero_slots = u32::from(hierarchy != Hierarchy::AgglomerativeSubgroup);
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
     // The first pass, then partial boxes reduced until one remains.
@@ -256,20 +258,21 @@ fn build_from_first_pass<B: Backend>(
     let p = b.upload("build params", &[params])?;
     let keys = b.scratch("morton keys", n as u64 * 8)?;
     let values = b.scratch("primitive indices", n as u64 * 4)?;
-    b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
+    // The hierarchy's arrival slots (one per internal node): the climbs'
+    // `ends`, the fit's flags (zeroed by the Morton kernel, see `zero_slots`).
+    let slots = b.scratch("hierarchy slots", (n as u64 - 1).max(1) * 4)?;
+    let morton = [&p, &boxes, &keys, &values, &slots];
+    b.dispatch(Kernel::Morton, &morton, groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
-    let high_first = if crate::bvh::sort::high_first_by_default() {
-        crate::bvh::sort::radix_sort_high_first(b, &keys, &values, n, key_bits)?
-    } else {
-        None
-    };
-    let (keys, values) = match high_first {
+    let high_first = crate::bvh::sort::high_first_by_default();
+    let sorted = if high_first { crate::bvh::sort::radix_sort_high_first(b, &keys, &values, n, key_bits)? } else { None };
+    let (keys, values) = match sorted {
         Some(sorted) => sorted,
         None => {
-            if crate::bvh::sort::high_first_by_default() {
+            if high_first {
                 // Ties too long to settle: codes again, and every digit sorted.
-                b.dispatch(Kernel::Morton, &[&p, &boxes, &keys, &values], groups_for(n, WORKGROUP_SIZE));
+                b.dispatch(Kernel::Morton, &morton, groups_for(n, WORKGROUP_SIZE));
             }
             crate::bvh::sort::radix_sort(b, &keys, &values, n, key_bits)?
         }
@@ -283,16 +286,14 @@ fn build_from_first_pass<B: Backend>(
             b.stage("tree");
             b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
             b.stage("fit");
-            let flags = b.zeroed("fit flags", (n as u64 - 1) * 4)?;
             let fit = if ordered { Kernel::Fit } else { Kernel::FitRelaxed };
-            b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &flags], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Agglomerative => {
             // One kernel makes both: its time is the fit's, the tree's is none.
             b.stage("fit");
-            let ends = b.zeroed("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
             let k = if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed };
-            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Hploc => {
             b.stage("fit");
@@ -303,16 +304,13 @@ fn build_from_first_pass<B: Backend>(
                     b.min_subgroup_size()
                 );
             }
-            let ends = b.zeroed("hploc ends", (n as u64 - 1).max(1) * 4)?;
             let words = treelet_core::construct::hploc::lists_words(n) as u64;
             let lists = b.scratch("hploc clusters", words * 4)?;
             let k = if ordered { Kernel::Hploc } else { Kernel::HplocRelaxed };
-            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &ends, &lists], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots, &lists], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::AgglomerativeSubgroup => {
             b.stage("fit");
-            // Zeroed by the first kernel.
-            let ends = b.scratch("agglomerate ends", (n as u64 - 1).max(1) * 4)?;
             // At most one cluster per leaf is left to climb (where no two
             // leaves of a subgroup are siblings): each queue has room for
             // its workgroups' leaves, the climb's dispatch covers every
@@ -322,10 +320,10 @@ fn build_from_first_pass<B: Backend>(
             let queue = b.scratch("agglomerate queues", places as u64 * 8)?;
             let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
             let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
-            let all = [&p, &keys, &values, &boxes, &nodes, &parents, &ends, &queue, &queued];
+            let all = [&p, &keys, &values, &boxes, &nodes, &parents, &slots, &queue, &queued];
             b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));
             let climb = if ordered { Kernel::ClimbQueued } else { Kernel::ClimbQueuedRelaxed };
-            b.dispatch(climb, &[&p, &keys, &nodes, &parents, &ends, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
+            b.dispatch(climb, &[&p, &keys, &nodes, &parents, &slots, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
         }
     }
 

@@ -163,7 +163,7 @@ pub fn radix_sort_tiled<B: Backend>(
     tile_size: SortTiles,
 ) -> Result<(B::Buffer, B::Buffer)> {
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
-    sort_passes(b, keys, values, n, 0..passes_for(key_bits), tile_size)
+    Ok(sort_passes(b, keys, values, n, 0..passes_for(key_bits), tile_size)?.0)
 }
 
 /// Sorts as [`radix_sort`] does, in about half the passes where few keys
@@ -194,18 +194,22 @@ pub fn radix_sort_high_first_tiled<B: Backend>(
 ) -> Result<Option<(B::Buffer, B::Buffer)>> {
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
     let passes = passes_for(key_bits);
-    if passes < 2 || n < 2 {
-        return sort_passes(b, keys, values, n, 0..passes, tile_size).map(Some);
-    }
-    let first = treelet_core::construct::sort_ties::first_high_digit(n, passes);
+    let first = if passes < 2 || n < 2 { 0 } else { treelet_core::construct::sort_ties::first_high_digit(n, passes) };
     if first == 0 {
-        return sort_passes(b, keys, values, n, 0..passes, tile_size).map(Some);
+        return Ok(Some(sort_passes(b, keys, values, n, 0..passes, tile_size)?.0));
     }
-    let sorted = sort_passes(b, keys, values, n, first..passes, tile_size)?;
+    let (sorted, sort_state) = sort_passes(b, keys, values, n, first..passes, tile_size)?;
+    // The run flag: a word of the sort's state, zeroed with it (no fill of
+    // its own); without look-back there is no state, and a word is zeroed.
+    let flag_words = state::TIE_OVERFLOW + 1;
+    let sort_state = match sort_state {
+        Some(s) => s,
+        None => b.zeroed("sort tie overflow", flag_words as u64 * 4)?,
+    };
     let params = b.upload("sort params", &[SortParams { n, tiles: 0, pass: first, passes }])?;
-    let overflow = b.zeroed("sort tie overflow", 4)?;
-    b.dispatch(Kernel::SortSettleTies, &[&params, &sorted.0, &sorted.1, &overflow], groups_for(n, WORKGROUP_SIZE));
-    Ok((b.read::<u32>(&overflow, 1)?[0] == 0).then_some(sorted))
+    b.dispatch(Kernel::SortSettleTies, &[&params, &sorted.0, &sorted.1, &sort_state], groups_for(n, WORKGROUP_SIZE));
+    let flags = b.read::<u32>(&sort_state, flag_words as usize)?;
+    Ok((flags[state::TIE_OVERFLOW as usize] == 0).then_some(sorted))
 }
 
 /// Whether builds sort by the high digits first ([`radix_sort_high_first`]):
@@ -216,7 +220,8 @@ pub fn high_first_by_default() -> bool {
 
 /// Stable sort of `n` pairs by the digits `passes` (a range of
 /// `0..passes_for(key_bits)`): every digit for a full sort, the high ones
-/// for [`radix_sort_high_first`].
+/// for [`radix_sort_high_first`]. Also returns the sort's state buffer,
+/// where it has one (with look-back).
 fn sort_passes<B: Backend>(
     b: &mut B,
     keys: &B::Buffer,
@@ -224,10 +229,10 @@ fn sort_passes<B: Backend>(
     n: u32,
     passes: std::ops::Range<u32>,
     tile_size: SortTiles,
-) -> Result<(B::Buffer, B::Buffer)> {
+) -> Result<((B::Buffer, B::Buffer), Option<B::Buffer>)> {
     let mut src = (keys.clone(), values.clone());
     if n < 2 || passes.is_empty() {
-        return Ok(src);
+        return Ok((src, None));
     }
     anyhow::ensure!(n <= MAX_KEYS, "{n} keys: the radix sort takes at most {MAX_KEYS}");
     let (first, passes) = (passes.start, passes.end);
@@ -269,7 +274,7 @@ fn sort_passes<B: Backend>(
             b.dispatch(Kernel::SortOnesweepScanned, &[&p, &src.0, &src.1, &dst.0, &dst.1, &tile_counts], tiles);
             std::mem::swap(&mut src, &mut dst);
         }
-        return Ok(src);
+        return Ok((src, None));
     }
     let sort_state = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
     // A pass uses the status region of its parity and clears the other for
@@ -285,5 +290,5 @@ fn sort_passes<B: Backend>(
         b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);
         std::mem::swap(&mut src, &mut dst);
     }
-    Ok(src)
+    Ok((src, Some(sort_state)))
 }

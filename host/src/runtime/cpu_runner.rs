@@ -413,11 +413,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bounds::reduce_bounds_phase(phase, lid, g, &p, input, output, &mut shared)
             });
         }
-        (Kernel::Morton, [p, boxes, keys, values]) => {
+        (Kernel::Morton, [p, boxes, keys, values, slots]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (boxes, keys, values) = (view(boxes), view(keys), view(values));
+            let (boxes, keys, values, slots) = (view(boxes), view(keys), view(values), view(slots));
             for id in ids(groups) {
-                morton::morton_kernel(id, &p, boxes, keys, values);
+                morton::morton_kernel(id, &p, boxes, keys, values, slots);
             }
         }
         (Kernel::SortHistogram, [p, keys, sort_state]) => {
@@ -436,11 +436,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
             });
         }
-        (Kernel::SortSettleTies, [p, keys, values, overflow]) => {
+        (Kernel::SortSettleTies, [p, keys, values, sort_state]) => {
             let p: treelet_core::SortParams = params(p);
-            let (keys, values, overflow) = (view(keys), view(values), view(overflow));
+            let (keys, values, sort_state) = (view(keys), view(values), view(sort_state));
             for id in ids(groups) {
-                treelet_core::construct::sort_ties::settle_ties_kernel(id, &p, keys, values, overflow);
+                treelet_core::construct::sort_ties::settle_ties_kernel(id, &p, keys, values, sort_state);
             }
         }
         (Kernel::Multisplit, [p, keys, ranks, counts, sizes]) => {
