@@ -78,8 +78,7 @@ impl Node {
 pub struct BuildParams {
     /// Number of primitives (leaves).
     pub n: u32,
-    /// Number of elements the bounds reduction reads in this pass.
-    pub reduce_len: u32,
+    pub _pad1: u32,
     /// H-PLOC (`construct::hploc`): most clusters a finished range keeps
     /// (0: half the subgroup, the most there is room for).
     pub cluster_keep: u32,

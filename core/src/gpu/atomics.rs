@@ -113,6 +113,21 @@ pub fn max_device(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
+/// Lowers a storage-buffer word to at most `value` with device scope,
+/// relaxed; returns the previous value.
+#[inline]
+pub fn min_device(slot: &mut u32, value: u32) -> u32 {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        spirv_std::arch::atomic_u_min::<u32, DEVICE, RELAXED>(slot, value)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        use core::sync::atomic::Ordering;
+        host_atomic(slot).fetch_min(value, Ordering::Relaxed)
+    }
+}
+
 /// Adds `value` to a workgroup-memory counter (relaxed: a barrier follows).
 #[inline]
 pub fn add_workgroup(slot: &mut u32, value: u32) -> u32 {

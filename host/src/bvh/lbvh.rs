@@ -3,7 +3,7 @@
 //! radix tree → bottom-up fit (or both at once, [`Hierarchy`]). The kernels
 //! live in `treelet-core`.
 use anyhow::Result;
-use treelet_core::construct::bounds::REDUCE_TILE;
+use treelet_core::construct::bounds::{BOUNDS_START, BOUNDS_WORDS, REDUCE_TILE, bounds_from_words};
 use treelet_core::construct::morton::{KEY_BITS, MortonFrame, SORTED_KEY_BITS};
 use treelet_core::geometry::aabb::Aabb;
 use treelet_core::geometry::buffers::{BuildParams, Node, Sphere};
@@ -128,7 +128,7 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 /// questions of `b` as it asks), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let ordered = b.ordered_atomics_in_divergent_flow();
-    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::ReduceBounds, Kernel::Morton];
+    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
     k.extend(crate::bvh::sort::kernels(b));
     match Hierarchy::from_env() {
         Some(h) => k.extend(h.kernels(ordered)),
@@ -145,7 +145,7 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
 
 /// The kernels [`build_primitives_with`] dispatches on `b` for `hierarchy`.
 pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
-    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::ReduceBounds, Kernel::Morton];
+    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
     k.extend(crate::bvh::sort::kernels(b));
     k.extend(hierarchy.kernels(b.ordered_atomics_in_divergent_flow()));
     k
@@ -179,9 +179,9 @@ pub fn build_primitives_with<B: Backend>(
     let mut params = BuildParams { spheres: prims.spheres.len() as u32, ..Default::default() };
     let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
-    // The boxes and the first pass of their centroid bounds in one kernel.
-    let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, partials: &B::Buffer, groups| {
-        b.dispatch(Kernel::PrimitiveBounds, &[p, &spheres, &triangles, boxes, partials], groups);
+    // The boxes and their centroid bounds in one kernel.
+    let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
+        b.dispatch(Kernel::PrimitiveBounds, &[p, &spheres, &triangles, boxes, bounds], groups);
         Ok(())
     };
     params.n = n;
@@ -194,8 +194,9 @@ pub fn build_primitives_with<B: Backend>(
 /// instanced scene's top level: the instances' world boxes), with the
 /// default hierarchy for `n`; `first_pass(b, params, boxes, partials,
 /// groups)` dispatches a kernel that writes the `n` boxes (32 bytes each)
-/// and the first pass of their centroid bounds (one box per group of
-/// `REDUCE_TILE`), as [`Kernel::PrimitiveBounds`] does. Starts a new build
+/// and merges their centroid bounds into `bounds` (one workgroup per
+/// `REDUCE_TILE` boxes; see `treelet_core::construct::bounds`), as
+/// [`Kernel::PrimitiveBounds`] does. Starts a new build
 /// on `b`. The tree's `prims` is `None`.
 pub fn build_over_boxes<B: Backend>(
     b: &mut B,
@@ -209,8 +210,7 @@ pub fn build_over_boxes<B: Backend>(
 }
 
 /// The build after its inputs are on the device: `first_pass` makes the
-/// boxes and their first centroid partials, the rest is the same for every
-/// input.
+/// boxes and their centroid bounds, the rest is the same for every input.
 fn build_from_first_pass<B: Backend>(
     b: &mut B,
     mut params: BuildParams,
@@ -237,21 +237,12 @@ fn build_from_first_pass<B: Backend>(
     params.zero_slots = u32::from(hierarchy != Hierarchy::AgglomerativeSubgroup);
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let p = b.upload("build params", &[params])?;
-    // The first pass, then partial boxes reduced until one remains.
-    let groups = groups_for(n, REDUCE_TILE);
-    let partials = b.scratch("bounds partials", groups as u64 * 32)?;
-    first_pass(b, &p, &boxes, &partials, groups)?;
-    let (mut input, mut len) = (partials, groups);
-    let centroid_bounds = loop {
-        if len == 1 {
-            break b.read::<Aabb>(&input, 1)?[0];
-        }
-        let groups = groups_for(len, REDUCE_TILE);
-        let output = b.scratch("bounds partials", groups as u64 * 32)?;
-        let rp = b.upload("reduce params", &[BuildParams { reduce_len: len, ..params }])?;
-        b.dispatch(Kernel::ReduceBounds, &[&rp, &input, &output], groups);
-        (input, len) = (output, groups);
-    };
+    // Merged by atomics into words that start as the empty box (uploaded
+    // with the parameters, no dispatch).
+    let bounds = b.upload("centroid bounds", &BOUNDS_START)?;
+    first_pass(b, &p, &boxes, &bounds, groups_for(n, REDUCE_TILE))?;
+    let words: [u32; BOUNDS_WORDS] = b.read::<u32>(&bounds, BOUNDS_WORDS)?.try_into().expect("six words read");
+    let centroid_bounds = bounds_from_words(&words);
 
     b.stage("morton");
     MortonFrame::new(&centroid_bounds).to_params(&mut params);

@@ -368,15 +368,15 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 treelet_core::render::rays::cast_instances_kernel(id, &p, instances, nodes, leaves, &prims, rays);
             }
         }
-        (Kernel::InstanceBounds, [p, placed, meshes, records, boxes, output]) => {
+        (Kernel::InstanceBounds, [p, placed, meshes, records, boxes, bounds_words]) => {
             use treelet_core::geometry::buffers::{InstanceRecord, MeshRecord, PlacedMesh};
             let p: treelet_core::BuildParams = params(p);
             let (placed, meshes): (&[PlacedMesh], &[MeshRecord]) = (view(placed), view(meshes));
-            let (records, boxes, output) = (view::<InstanceRecord>(records), view::<Aabb>(boxes), view(output));
+            let (records, boxes, bounds_words) = (view::<InstanceRecord>(records), view::<Aabb>(boxes), view(bounds_words));
             let mut source = treelet_core::construct::instances::InstanceBoxes { placed, meshes, records };
             let mut shared = [Aabb::EMPTY; WG];
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, output, &mut shared)
+                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
         (Kernel::TopLevelNodes, [p, nodes, prim_indices, out]) => {
@@ -394,23 +394,15 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, &Split::whole(triangles), boxes);
             }
         }
-        (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, output]) => {
+        (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, bounds_words]) => {
             let p: treelet_core::BuildParams = params(p);
             let (spheres, triangles) = (view(spheres), view(triangles));
-            let (boxes, output) = (view::<Aabb>(boxes), view(output));
+            let (boxes, bounds_words) = (view::<Aabb>(boxes), view(bounds_words));
             let mut shared = [Aabb::EMPTY; WG];
             let triangles = Split::whole(triangles);
             let mut source = bounds::PrimitiveBoxes { spheres: p.spheres, sphere_data: spheres, triangles };
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, output, &mut shared)
-            });
-        }
-        (Kernel::ReduceBounds, [p, input, output]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (input, output) = (view(input), view(output));
-            let mut shared = [Aabb::EMPTY; WG];
-            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::reduce_bounds_phase(phase, lid, g, &p, input, output, &mut shared)
+                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
         (Kernel::Morton, [p, boxes, keys, values, slots]) => {

@@ -68,10 +68,8 @@ fn render_entry_point(method: Method, variant: u8) -> &'static str {
 pub enum Kernel {
     Fill,
     PrimitiveBoxes,
-    /// [`Kernel::PrimitiveBoxes`] fused with the first pass of the centroid
-    /// bounds ([`Kernel::ReduceBounds`]).
+    /// [`Kernel::PrimitiveBoxes`] fused with the centroid bounds.
     PrimitiveBounds,
-    ReduceBounds,
     Morton,
     /// Radix sort: digit counts of every pass.
     SortHistogram,
@@ -189,7 +187,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 61] = [
+    const FIXED: [Kernel; 60] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -197,7 +195,6 @@ impl Kernel {
         Kernel::TopLevelNodes,
         Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
-        Kernel::ReduceBounds,
         Kernel::Morton,
         Kernel::SortHistogram,
         Kernel::SortOffsets,
@@ -278,7 +275,6 @@ impl Kernel {
             Kernel::TopLevelNodes => "bvh2::top_level_nodes_cs",
             Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
-            Kernel::ReduceBounds => "bounds::reduce_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
             Kernel::SortOffsets => "sort::sort_offsets_cs",
@@ -372,7 +368,6 @@ impl Kernel {
             Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::ReduceBounds => &[Read, Read, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
             Kernel::ScanReduce => &[Read, Read, ReadWrite],

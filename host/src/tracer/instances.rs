@@ -306,10 +306,10 @@ impl<B: Backend> InstancedTracer<B> {
 fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>) -> Result<(TopLevel<B>, StageTimes)> {
     let n = placed.len() as u32;
     let mut records = None;
-    let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, partials, groups| {
+    let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, bounds, groups| {
         let input = b.upload("placed meshes", placed)?;
         let out = b.scratch("instance records", n as u64 * 64)?;
-        b.dispatch(Kernel::InstanceBounds, &[p, &input, &g.meshes, &out, boxes, partials], groups);
+        b.dispatch(Kernel::InstanceBounds, &[p, &input, &g.meshes, &out, boxes, bounds], groups);
         records = Some(out);
         Ok(())
     })?;
