@@ -13,7 +13,8 @@ pub fn morton_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] keys: &mut [u64],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] values: &mut [u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] slots: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] zeroed: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::construct::morton::morton_kernel(id, params, boxes, keys, values, slots);
+    treelet_core::construct::morton::morton_kernel(id, params, boxes, keys, values, slots, zeroed);
 }

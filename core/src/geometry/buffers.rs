@@ -78,7 +78,9 @@ impl Node {
 pub struct BuildParams {
     /// Number of primitives (leaves).
     pub n: u32,
-    pub _pad1: u32,
+    /// Words of the Morton kernel's `zeroed` buffer it zeroes (the sort's
+    /// state; see `construct::morton::morton_kernel`).
+    pub zero_words: u32,
     /// H-PLOC (`construct::hploc`): most clusters a finished range keeps
     /// (0: half the subgroup, the most there is room for).
     pub cluster_keep: u32,

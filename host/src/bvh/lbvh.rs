@@ -246,18 +246,31 @@ fn build_from_first_pass<B: Backend>(
 
     b.stage("morton");
     MortonFrame::new(&centroid_bounds).to_params(&mut params);
-    let p = b.upload("build params", &[params])?;
     let keys = b.scratch("morton keys", n as u64 * 8)?;
     let values = b.scratch("primitive indices", n as u64 * 4)?;
     // The hierarchy's arrival slots (one per internal node): the climbs'
     // `ends`, the fit's flags (zeroed by the Morton kernel, see `zero_slots`).
     let slots = b.scratch("hierarchy slots", (n as u64 - 1).max(1) * 4)?;
-    let morton = [&p, &boxes, &keys, &values, &slots];
+    // The sort's state, also zeroed by the Morton kernel.
+    let high_first = crate::bvh::sort::high_first_by_default();
+    let sort_state = if high_first { crate::bvh::sort::high_first_state(b, n, key_bits)? } else { None };
+    let zeroed = match &sort_state {
+        Some(s) => {
+            params.zero_words = s.zeroed_words;
+            s.buffer.clone()
+        }
+        None => b.scratch("no words to zero", 4)?,
+    };
+    let p = b.upload("build params", &[params])?;
+    let morton = [&p, &boxes, &keys, &values, &slots, &zeroed];
     b.dispatch(Kernel::Morton, &morton, groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
-    let high_first = crate::bvh::sort::high_first_by_default();
-    let sorted = if high_first { crate::bvh::sort::radix_sort_high_first(b, &keys, &values, n, key_bits)? } else { None };
+    let sorted = if high_first {
+        crate::bvh::sort::radix_sort_high_first_zeroed(b, &keys, &values, n, key_bits, sort_state)?
+    } else {
+        None
+    };
     let (keys, values) = match sorted {
         Some(sorted) => sorted,
         None => {

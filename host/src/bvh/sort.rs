@@ -163,7 +163,7 @@ pub fn radix_sort_tiled<B: Backend>(
     tile_size: SortTiles,
 ) -> Result<(B::Buffer, B::Buffer)> {
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
-    Ok(sort_passes(b, keys, values, n, 0..passes_for(key_bits), tile_size)?.0)
+    Ok(sort_passes(b, keys, values, n, 0..passes_for(key_bits), tile_size, None)?.0)
 }
 
 /// Sorts as [`radix_sort`] does, in about half the passes where few keys
@@ -183,6 +183,53 @@ pub fn radix_sort_high_first<B: Backend>(
     radix_sort_high_first_tiled(b, keys, values, n, key_bits, SortTiles::Auto)
 }
 
+/// The state of a sort's look-back, for a caller that zeroes it along with
+/// work of its own (the LBVH's Morton kernel) rather than by a fill
+/// dispatch: `zeroed_words` words of `buffer` must be zero.
+pub struct SortState<Buf> {
+    pub buffer: Buf,
+    pub zeroed_words: u32,
+    tiles: u32,
+}
+
+/// The state [`radix_sort_high_first_zeroed`] uses for `n` keys of
+/// `key_bits` bits, where it uses one (with look-back).
+pub fn high_first_state<B: Backend>(b: &mut B, n: u32, key_bits: u32) -> Result<Option<SortState<B::Buffer>>> {
+    if n < 2 || !b.look_back_works() || passes_for(key_bits) == 0 {
+        return Ok(None);
+    }
+    let first = high_first_digit(n, passes_for(key_bits));
+    let tiles = groups_for(n, pass_kernel(b, n, SortTiles::Auto)?.1);
+    let buffer = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
+    Ok(Some(SortState { buffer, zeroed_words: zeroed_words(first, tiles), tiles }))
+}
+
+/// [`radix_sort_high_first`] with the state of [`high_first_state`],
+/// zeroed by the caller.
+pub fn radix_sort_high_first_zeroed<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    key_bits: u32,
+    state: Option<SortState<B::Buffer>>,
+) -> Result<Option<(B::Buffer, B::Buffer)>> {
+    high_first(b, keys, values, n, key_bits, SortTiles::Auto, state)
+}
+
+/// The first digit the sort by high digits sorts (0: every digit).
+fn high_first_digit(n: u32, passes: u32) -> u32 {
+    if passes < 2 || n < 2 { 0 } else { treelet_core::construct::sort_ties::first_high_digit(n, passes) }
+}
+
+/// Words of a sort's state that must be zero before it, where its first
+/// pass is `first`: a pass uses the status region of its parity and clears
+/// the other for the next, so a first pass of odd parity finds its region
+/// cleared too.
+fn zeroed_words(first: u32, tiles: u32) -> u32 {
+    if first % 2 == 0 { state::zeroed_words(tiles) } else { state::words(tiles) }
+}
+
 /// [`radix_sort_high_first`] with the given tiles.
 pub fn radix_sort_high_first_tiled<B: Backend>(
     b: &mut B,
@@ -192,13 +239,25 @@ pub fn radix_sort_high_first_tiled<B: Backend>(
     key_bits: u32,
     tile_size: SortTiles,
 ) -> Result<Option<(B::Buffer, B::Buffer)>> {
+    high_first(b, keys, values, n, key_bits, tile_size, None)
+}
+
+fn high_first<B: Backend>(
+    b: &mut B,
+    keys: &B::Buffer,
+    values: &B::Buffer,
+    n: u32,
+    key_bits: u32,
+    tile_size: SortTiles,
+    zeroed: Option<SortState<B::Buffer>>,
+) -> Result<Option<(B::Buffer, B::Buffer)>> {
     anyhow::ensure!(key_bits <= 64, "{key_bits}-bit keys: the radix sort takes at most 64 bits");
     let passes = passes_for(key_bits);
-    let first = if passes < 2 || n < 2 { 0 } else { treelet_core::construct::sort_ties::first_high_digit(n, passes) };
+    let first = high_first_digit(n, passes);
     if first == 0 {
-        return Ok(Some(sort_passes(b, keys, values, n, 0..passes, tile_size)?.0));
+        return Ok(Some(sort_passes(b, keys, values, n, 0..passes, tile_size, zeroed)?.0));
     }
-    let (sorted, sort_state) = sort_passes(b, keys, values, n, first..passes, tile_size)?;
+    let (sorted, sort_state) = sort_passes(b, keys, values, n, first..passes, tile_size, zeroed)?;
     // The run flag: a word of the sort's state, zeroed with it (no fill of
     // its own); without look-back there is no state, and a word is zeroed.
     let flag_words = state::TIE_OVERFLOW + 1;
@@ -221,7 +280,7 @@ pub fn high_first_by_default() -> bool {
 /// Stable sort of `n` pairs by the digits `passes` (a range of
 /// `0..passes_for(key_bits)`): every digit for a full sort, the high ones
 /// for [`radix_sort_high_first`]. Also returns the sort's state buffer,
-/// where it has one (with look-back).
+/// where it has one (with look-back): `zeroed` where the caller zeroed it.
 fn sort_passes<B: Backend>(
     b: &mut B,
     keys: &B::Buffer,
@@ -229,6 +288,7 @@ fn sort_passes<B: Backend>(
     n: u32,
     passes: std::ops::Range<u32>,
     tile_size: SortTiles,
+    zeroed: Option<SortState<B::Buffer>>,
 ) -> Result<((B::Buffer, B::Buffer), Option<B::Buffer>)> {
     let mut src = (keys.clone(), values.clone());
     if n < 2 || passes.is_empty() {
@@ -236,31 +296,7 @@ fn sort_passes<B: Backend>(
     }
     anyhow::ensure!(n <= MAX_KEYS, "{n} keys: the radix sort takes at most {MAX_KEYS}");
     let (first, passes) = (passes.start, passes.end);
-    // Small tiles where large ones would leave the GPU idle (look-back only).
-    let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_by_default(b)) } else { SortTiles::Large };
-    let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall | SortTiles::MultisplitMedium);
-    if multisplit && !multisplit_runs_on(b) {
-        anyhow::bail!(
-            "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",
-            b.adapter(),
-            b.min_subgroup_size(),
-            if b.look_back_works() { "" } else { " and runs the sort without look-back" }
-        );
-    }
-    let (kernel, tile) = match tile_size {
-        SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
-        SortTiles::Multisplit if b.subgroup_partitioned() => (Kernel::SortMultisplitPartitioned, MULTISPLIT_SORT_TILE),
-        SortTiles::Multisplit => (Kernel::SortMultisplit, MULTISPLIT_SORT_TILE),
-        SortTiles::MultisplitSmall if b.subgroup_partitioned() => {
-            (Kernel::SortMultisplitSmallPartitioned, SMALL_MULTISPLIT_SORT_TILE)
-        }
-        SortTiles::MultisplitSmall => (Kernel::SortMultisplitSmall, SMALL_MULTISPLIT_SORT_TILE),
-        SortTiles::MultisplitMedium if b.subgroup_partitioned() => {
-            (Kernel::SortMultisplitMediumPartitioned, MEDIUM_MULTISPLIT_SORT_TILE)
-        }
-        SortTiles::MultisplitMedium => (Kernel::SortMultisplitMedium, MEDIUM_MULTISPLIT_SORT_TILE),
-        _ => (Kernel::SortOnesweep, SORT_TILE),
-    };
+    let (kernel, tile) = pass_kernel(b, n, tile_size)?;
     let tiles = groups_for(n, tile);
     let mut dst = (b.scratch("sort keys scratch", n as u64 * 8)?, b.scratch("sort values scratch", n as u64 * 4)?);
     let params = |pass| SortParams { n, tiles, pass, passes };
@@ -276,11 +312,20 @@ fn sort_passes<B: Backend>(
         }
         return Ok((src, None));
     }
-    let sort_state = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
-    // A pass uses the status region of its parity and clears the other for
-    // the next: a first pass of odd parity finds its region cleared too.
-    let zeroed = if first % 2 == 0 { state::zeroed_words(tiles) } else { state::words(tiles) };
-    b.zero_words(&sort_state, zeroed)?;
+    let sort_state = match zeroed {
+        Some(s) => {
+            anyhow::ensure!(
+                s.tiles == tiles && s.zeroed_words >= zeroed_words(first, tiles),
+                "internal: the sort's state was made for another sort"
+            );
+            s.buffer
+        }
+        None => {
+            let s = b.scratch("sort state", state::words(tiles) as u64 * 4)?;
+            b.zero_words(&s, zeroed_words(first, tiles))?;
+            s
+        }
+    };
     // The histogram counts the digits of passes `first..` (its `pass`).
     let p = b.upload("sort params", &[params(first)])?;
     b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
@@ -291,4 +336,33 @@ fn sort_passes<B: Backend>(
         std::mem::swap(&mut src, &mut dst);
     }
     Ok((src, Some(sort_state)))
+}
+
+/// The pass kernel of a sort of `n` keys on `b` and its keys per tile.
+fn pass_kernel<B: Backend>(b: &B, n: u32, tile_size: SortTiles) -> Result<(Kernel, u32)> {
+    // Small tiles where large ones would leave the GPU idle (look-back only).
+    let tile_size = if b.look_back_works() { tile_size.resolve(n, multisplit_by_default(b)) } else { SortTiles::Large };
+    let multisplit = matches!(tile_size, SortTiles::Multisplit | SortTiles::MultisplitSmall | SortTiles::MultisplitMedium);
+    if multisplit && !multisplit_runs_on(b) {
+        anyhow::bail!(
+            "the sort ranked by subgroups needs look-back and subgroups of at least {MIN_SUBGROUP_SIZE} lanes; `{}` has subgroups of {} or more lanes{}",
+            b.adapter(),
+            b.min_subgroup_size(),
+            if b.look_back_works() { "" } else { " and runs the sort without look-back" }
+        );
+    }
+    Ok(match tile_size {
+        SortTiles::Small => (Kernel::SortOnesweepSmall, SMALL_SORT_TILE),
+        SortTiles::Multisplit if b.subgroup_partitioned() => (Kernel::SortMultisplitPartitioned, MULTISPLIT_SORT_TILE),
+        SortTiles::Multisplit => (Kernel::SortMultisplit, MULTISPLIT_SORT_TILE),
+        SortTiles::MultisplitSmall if b.subgroup_partitioned() => {
+            (Kernel::SortMultisplitSmallPartitioned, SMALL_MULTISPLIT_SORT_TILE)
+        }
+        SortTiles::MultisplitSmall => (Kernel::SortMultisplitSmall, SMALL_MULTISPLIT_SORT_TILE),
+        SortTiles::MultisplitMedium if b.subgroup_partitioned() => {
+            (Kernel::SortMultisplitMediumPartitioned, MEDIUM_MULTISPLIT_SORT_TILE)
+        }
+        SortTiles::MultisplitMedium => (Kernel::SortMultisplitMedium, MEDIUM_MULTISPLIT_SORT_TILE),
+        _ => (Kernel::SortOnesweep, SORT_TILE),
+    })
 }

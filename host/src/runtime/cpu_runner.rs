@@ -405,11 +405,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
-        (Kernel::Morton, [p, boxes, keys, values, slots]) => {
+        (Kernel::Morton, [p, boxes, keys, values, slots, zeroed]) => {
             let p: treelet_core::BuildParams = params(p);
-            let (boxes, keys, values, slots) = (view(boxes), view(keys), view(values), view(slots));
+            let (boxes, keys, values, slots, zeroed) = (view(boxes), view(keys), view(values), view(slots), view(zeroed));
             for id in ids(groups) {
-                morton::morton_kernel(id, &p, boxes, keys, values, slots);
+                morton::morton_kernel(id, &p, boxes, keys, values, slots, zeroed);
             }
         }
         (Kernel::SortHistogram, [p, keys, sort_state]) => {

@@ -368,7 +368,7 @@ impl Kernel {
             Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
             Kernel::ScanReduce => &[Read, Read, ReadWrite],
             Kernel::ScanSpine => &[Read, ReadWrite],
