@@ -106,8 +106,14 @@ pub trait Backend: Send {
     /// (kernels overwrite it). May be a buffer of an earlier build.
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer>;
     /// A buffer of at least `bytes` bytes (a multiple of 4), zeroed by a
-    /// fill dispatch in the current stage, so the cost shows in its time.
+    /// fill dispatch in the current stage, so the cost shows in its time;
+    /// up to [`SMALL_ZEROED_BYTES`] (counters and flags) written from the
+    /// host instead, as parameters are, where a fill's cost would be its
+    /// launch and not its writes.
     fn zeroed(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer> {
+        if bytes <= SMALL_ZEROED_BYTES {
+            return self.upload(label, &vec![0u32; bytes.div_ceil(4).max(1) as usize]);
+        }
         let buffer = self.scratch(label, bytes)?;
         let len = u32::try_from(bytes / 4).map_err(|_| anyhow::anyhow!("buffer `{label}` too large to fill"))?;
         self.zero_words(&buffer, len)?;
@@ -151,6 +157,15 @@ pub trait Backend: Send {
     /// Waits for all work so far and returns the stage times since the last call.
     fn take_times(&mut self) -> Result<StageTimes>;
 }
+
+/// Largest buffer [`Backend::zeroed`] writes from the host rather than by a
+/// fill dispatch (flags and single counters): a dispatch costs about 3 µs on
+/// the H100 before its first write (a quarter of the depth check of a `bvh2`
+/// layout, whose one word it zeroed: 0.013 -> 0.010 ms). Not larger: with
+/// 4 KiB, the TRBVH's per-round level counts (1 KiB) were written so, and
+/// its collapse stage ran 24 µs slower on the H100, for a reason not found
+/// (`docs/results/h100-lbvh-dispatches-2026-11-27/log_small_zeroed.txt`).
+pub const SMALL_ZEROED_BYTES: u64 = 64;
 
 /// Checks that a buffer of `bytes` fits the device; names the buffer if not.
 pub fn check_fits<B: Backend>(backend: &B, label: &str, bytes: u64) -> Result<()> {
