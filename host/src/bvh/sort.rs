@@ -76,8 +76,9 @@ impl SortTiles {
     /// The tiles a sort of `n` keys takes (`multisplit`: whether large sorts
     /// take the pass ranked by subgroups, [`multisplit_by_default`]).
     ///
-    /// Small tiles up to [`SMALL_TILES_UP_TO`] keys, then tiles ranked by
-    /// subgroups where the device runs them, small ones up to
+    /// Small tiles up to [`SMALL_TILES_BESIDE_MULTISPLIT_UP_TO`] keys where
+    /// the device runs tiles ranked by subgroups ([`SMALL_TILES_UP_TO`]
+    /// elsewhere), then those tiles, small ones up to
     /// [`SMALL_MULTISPLIT_UP_TO`], medium ones up to [`MEDIUM_MULTISPLIT_UP_TO`]: on the H100 (one machine, `bench build
     /// --per-kernel`, medians of 11 and 21, 2026-11-26) the 8 passes ranked
     /// by subgroups take 0.202 / 0.351 / 0.990 / 3.25 ms at 65 536 / 1M /
@@ -96,7 +97,9 @@ impl SortTiles {
             Ok("multisplit") => SortTiles::Multisplit,
             Ok("multisplit-small") => SortTiles::MultisplitSmall,
             Ok("multisplit-medium") => SortTiles::MultisplitMedium,
-            _ if n <= SMALL_TILES_UP_TO => SortTiles::Small,
+            _ if n <= if multisplit { SMALL_TILES_BESIDE_MULTISPLIT_UP_TO } else { SMALL_TILES_UP_TO } => {
+                SortTiles::Small
+            }
             _ if multisplit && n <= SMALL_MULTISPLIT_UP_TO => SortTiles::MultisplitSmall,
             _ if multisplit && n <= MEDIUM_MULTISPLIT_UP_TO => SortTiles::MultisplitMedium,
             _ if multisplit => SortTiles::Multisplit,
@@ -132,7 +135,16 @@ const SMALL_MULTISPLIT_UP_TO: u32 = 600_000;
 /// (`docs/results/h100-agglomerate-subgroup/log_sort_tiles.txt`).
 const MEDIUM_MULTISPLIT_UP_TO: u32 = 4_000_000;
 
-/// Largest sort that takes small tiles by default: on the H100 small tiles
+/// Largest sort that takes small tiles by default where tiles ranked by
+/// subgroups run: on the H100 (2026-11-27, the builds' sort of the high
+/// digits, three or four passes) small tiles ranked by subgroups made the
+/// LBVH faster at 65 536 / 100 000 / 131 072 / 200 000 primitives: 0.147 /
+/// 0.174 / 0.184 / 0.217 ms against 0.149 / 0.177 / 0.191 / 0.224, and the
+/// instanced top level of 10 000 took 0.143 against 0.142
+/// (`docs/results/h100-lbvh-dispatches-2026-11-27/log_knobs.txt`).
+const SMALL_TILES_BESIDE_MULTISPLIT_UP_TO: u32 = 50_000;
+
+/// Largest sort that takes small tiles by default elsewhere: on the H100 small tiles
 /// sorted 65 536 keys in 0.165 ms (large: 0.274) and 131 072 in 0.187 (0.279),
 /// both the same at 262 144, large ones 1M in 0.58 ms (small: 0.72). With
 /// their phases unrolled, small tiles take 0.137 ms at 65 536 and 0.578 at
