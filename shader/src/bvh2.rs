@@ -24,8 +24,8 @@ pub fn bvh2_nodes_cs(
     treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, &nodes, parents, out);
 }
 
-/// One internal node of an instanced scene's top level (its LBVH as built)
-/// into the two-box layout.
+/// One node of an instanced scene's top level (its LBVH as built): an
+/// internal one into the two-box layout, a leaf's depth checked.
 #[spirv(compute(threads(256)))]
 pub fn top_level_nodes_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -34,9 +34,11 @@ pub fn top_level_nodes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] prim_indices: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] deepest: &mut [u32],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
-    treelet_core::layouts::bvh2::top_level_node_kernel(id, params.n, nodes, prim_indices, out);
+    treelet_core::layouts::bvh2::top_level_kernel(id, params.n, nodes, parents, prim_indices, out, deepest);
 }
 
 /// One primitive, in leaf order, as its leaf stores it.

@@ -379,12 +379,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
-        (Kernel::TopLevelNodes, [p, nodes, prim_indices, out]) => {
+        (Kernel::TopLevelNodes, [p, nodes, prim_indices, out, parents, deepest]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, prim_indices) = (view::<treelet_core::Node>(nodes), view(prim_indices));
-            let out = view::<treelet_core::Bvh2Node>(out);
+            let (out, parents, deepest) = (view::<treelet_core::Bvh2Node>(out), view(parents), view(deepest));
             for id in ids(groups) {
-                bvh2::top_level_node_kernel(id, p.n, nodes, prim_indices, out);
+                bvh2::top_level_kernel(id, p.n, nodes, parents, prim_indices, out, deepest);
             }
         }
         (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {

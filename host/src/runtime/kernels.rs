@@ -365,7 +365,7 @@ impl Kernel {
             Kernel::CopyWords => &[Read, Read, ReadWrite],
             Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
             Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite],
+            Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite, Read, ReadWrite],
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],

@@ -30,7 +30,6 @@ use treelet_core::trace::hit::STACK_DEPTH;
 
 use super::primitives::{Quality, Tracer};
 use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
-use crate::bvh::layout::tree_depth;
 use crate::bvh::lbvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -209,8 +208,8 @@ impl<B: Backend> InstancedTracer<B> {
     }
 
     /// The stages of the last top-level build, device ms each (the LBVH's,
-    /// whose `bounds` makes the instances' records and boxes; `depth`;
-    /// `layout`).
+    /// whose `bounds` makes the instances' records and boxes; `layout`,
+    /// with the depth check).
     pub fn top_level_stages(&self) -> &StageTimes {
         &self.top_stages
     }
@@ -299,10 +298,10 @@ impl<B: Backend> InstancedTracer<B> {
 
 /// The top level over `placed` (at least one), on the device: the
 /// instances' records and world boxes (`treelet_core::construct::instances`)
-/// as the LBVH's first pass, the LBVH (one instance a leaf), its depth
-/// checked against the walk's stack, and its `bvh2` nodes in the LBVH's
-/// order (no compaction: leaves refer to instances), written at the start
-/// of the gathered nodes.
+/// as the LBVH's first pass, the LBVH (one instance a leaf), and its `bvh2`
+/// nodes in the LBVH's order (no compaction: leaves refer to instances),
+/// written at the start of the gathered nodes, its depth checked against
+/// the walk's stack in the same dispatch.
 fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>) -> Result<(TopLevel<B>, StageTimes)> {
     let n = placed.len() as u32;
     let mut records = None;
@@ -314,16 +313,19 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>
         Ok(())
     })?;
     let records = records.context("internal: the top level's first pass did not run")?;
-    b.stage("depth");
-    let deepest = tree_depth(b, &bvh)?;
-    if deepest as usize + 1 > STACK_DEPTH {
-        bail!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
-    }
+    // The nodes, and the depth checked in the same dispatch (the scene is
+    // refused after, if too deep: nothing traces the nodes before).
     b.stage("layout");
     let internal = top_nodes_for(placed.len());
     anyhow::ensure!(internal <= g.top_capacity, "internal: no room for the top level");
     let p = b.upload("layout params", &[LayoutParams { n, nodes: bvh.node_count, ..Default::default() }])?;
-    b.dispatch(Kernel::TopLevelNodes, &[&p, &bvh.nodes, &bvh.prim_indices, &g.nodes], groups_for(internal, WORKGROUP_SIZE));
+    let deepest = b.zeroed("tree depth", 4)?;
+    let bindings = [&p, &bvh.nodes, &bvh.prim_indices, &g.nodes, &bvh.parents, &deepest];
+    b.dispatch(Kernel::TopLevelNodes, &bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
+    let deepest = b.read::<u32>(&deepest, 1)?[0];
+    if deepest as usize + 1 > STACK_DEPTH {
+        bail!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
+    }
     let rest = b.take_times()?;
     for stage in &rest.order {
         stages.add(stage, rest.get(stage));
