@@ -112,7 +112,8 @@ fn check(what: &str, hits: &[RayHit], flat: &[RayHit], scene: &(Vec<Triangle>, V
         let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
         // A triangle's plane rounded by d moves a hit along the ray by
         // d / cos(angle to the normal): grazing hits get that much more room
-        // (a seed failed at 1e-4 flat on a grazing ray).
+        // (a seed failed here at 1e-4 flat, ray not kept; grazing rays are
+        // where a flat room is too small).
         let cos = Vec3::from(r.dir).normalize().dot((b - a).cross(c - a).normalize()).abs().max(1e-3);
         let room = 1e-4 * f.t.max(1.0) / cos;
         assert!((h.t - f.t).abs() <= room, "{what}: ray {r:?}: instanced {h:?}, flattened {f:?}");
