@@ -192,7 +192,7 @@ pub fn build_primitives_with<B: Backend>(
 
 /// The LBVH over `n` boxes that `first_pass` makes on the device (an
 /// instanced scene's top level: the instances' world boxes), with the
-/// default hierarchy for `n`; `first_pass(b, params, boxes, partials,
+/// default hierarchy for `n`; `first_pass(b, params, boxes, bounds,
 /// groups)` dispatches a kernel that writes the `n` boxes (32 bytes each)
 /// and merges their centroid bounds into `bounds` (one workgroup per
 /// `REDUCE_TILE` boxes; see `treelet_core::construct::bounds`), as
