@@ -101,7 +101,7 @@ pub fn treelet_scatter_cs(
 }
 
 /// Restructures the treelets of one height, a team of 32 lanes each.
-#[spirv(compute(threads(256)))]
+#[spirv(compute(threads(128)))]
 pub fn treelet_restructure_cs(
     #[spirv(local_invocation_index)] lid: u32,
     #[spirv(subgroup_size)] subgroup_size: u32,

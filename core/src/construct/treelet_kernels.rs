@@ -283,7 +283,14 @@ pub fn subset_of_rank(mut rank: u32, n: u32, size: u32) -> u32 {
 /// treelet, not idle lanes, bounds this kernel.
 pub const TEAM: u32 = 32;
 /// Treelets per workgroup.
-pub const TEAMS: u32 = WORKGROUP_SIZE / TEAM;
+pub const TEAMS: u32 = RESTRUCTURE_THREADS / TEAM;
+/// Invocations per workgroup of the team kernel (at least [`SUBSETS`]: its
+/// first phase copies the subset order, an entry per invocation). Its 56
+/// registers an invocation (H100) allow 36 warps an SM: 4 workgroups of 256
+/// held 32 of them, 9 of 128 hold all 36 (TRBVH 1M 8.87 -> 8.60 ms, 4M 30.04
+/// -> 29.25; `docs/results/h100-treelet-2026-11-27`).
+pub const RESTRUCTURE_THREADS: u32 = 128;
+const _: () = assert!(RESTRUCTURE_THREADS as usize >= SUBSETS);
 /// Workgroup memory: the staged treelets (see [`crate::construct::treelet`]'s `T_*`
 /// words), their DP costs and their packed partitions, one row per team
 /// (odd strides, so that the teams' rows start on different banks).
@@ -368,16 +375,23 @@ fn keep(
 const P_CHOOSE: u32 = 7;
 const P_REWIRE: u32 = 8;
 pub const RESTRUCTURE_PHASES: u32 = P_REWIRE + 1;
+/// Lanes that share the whole treelet's partitions (up to 63), each
+/// keeping its cheapest for one lane to compare: few, so that comparing is
+/// short, yet enough that each share is. On the H100 (1M random spheres,
+/// gamma 3) comparing all 32 lanes' shares took 0.36 to 0.71 of the first
+/// round's 3.83 ms above height 2; with 8 voters TRBVH 1M 9.22 -> 8.88 ms,
+/// 4M 31.35 -> 29.95 (`docs/results/h100-treelet-2026-11-27`).
+pub const VOTERS: u32 = 8;
 /// Workgroup memory for each lane's best partition of the whole treelet
 /// (cost bits, then partition number), per team.
-pub const TEAM_VOTES: usize = TEAMS as usize * 2 * TEAM as usize;
+pub const TEAM_VOTES: usize = TEAMS as usize * 2 * VOTERS as usize;
 
 /// Kernel ([`TEAMS`] teams of [`TEAM`] lanes per workgroup, phase by
 /// phase): restructures the treelets of `roots[level_offset..][..level_count]`,
 /// one per team. One lane forms the treelet into workgroup memory; the team
 /// solves the subsets of one size per phase, dealt round-robin to its lanes
 /// (`subsets` is [`subset_order`], copied to `order`), and the whole
-/// treelet's partitions dealt to all lanes (their best in `votes`); one lane
+/// treelet's partitions dealt to [`VOTERS`] lanes (their best in `votes`); one lane
 /// picks the best of those and, if that lowers the treelet's cost, plans the
 /// new topology, which a lane per internal node rewires, or else it stores
 /// the root's current cost and height. `marks` (see
@@ -454,7 +468,7 @@ pub fn treelet_restructure_phase(
     if n == 0 {
         return;
     }
-    let vb = team as usize * 2 * TEAM as usize;
+    let vb = team as usize * 2 * VOTERS as usize;
     if phase < P_CHOOSE {
         let size = phase + 1;
         if size > n {
@@ -462,11 +476,14 @@ pub fn treelet_restructure_phase(
         }
         if size == n {
             // The whole treelet, after every smaller subset: its many
-            // partitions dealt to the lanes, the best of each lane kept
-            // (the first of equal costs) for the next phase to choose from.
-            let (best, m) = best_whole_partition(n, lane, TEAM, cost, cb);
-            votes[vb + lane as usize] = best.to_bits();
-            votes[vb + (TEAM + lane) as usize] = m;
+            // partitions dealt to the first VOTERS lanes, the best of each
+            // kept (the first of equal costs) for the next phase to
+            // choose from.
+            if lane < VOTERS {
+                let (best, m) = best_whole_partition(n, lane, VOTERS, cost, cb);
+                votes[vb + lane as usize] = best.to_bits();
+                votes[vb + (VOTERS + lane) as usize] = m;
+            }
             return;
         }
         // Subsets of one size, dealt round-robin to the lanes.
@@ -483,12 +500,12 @@ pub fn treelet_restructure_phase(
     }
     if phase == P_CHOOSE {
         if lane == 0 {
-            // The lanes' best partitions: the cheapest, the first of equal
+            // The voters' best partitions: the cheapest, the first of equal
             // costs, as one lane enumerating them all would find.
             let mut vote = (f32::MAX, u32::MAX);
             let mut l = 0;
-            while l < TEAM as usize {
-                let lane_vote = (f32::from_bits(get(votes, vb + l)), get(votes, vb + TEAM as usize + l));
+            while l < VOTERS as usize {
+                let lane_vote = (f32::from_bits(get(votes, vb + l)), get(votes, vb + VOTERS as usize + l));
                 vote = first_cheapest(vote, lane_vote);
                 l += 1;
             }

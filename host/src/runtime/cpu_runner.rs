@@ -116,10 +116,15 @@ fn subgroup_workgroups(groups: u32, phases: u32, size: u32, op: impl Fn(u32) -> 
 /// Runs a phased workgroup kernel: for each workgroup, each phase, each local
 /// id, `f(group, phase, local_id)`. Workgroup memory is the caller's, reused
 /// across workgroups as on the GPU (where it starts undefined).
-fn workgroups(groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
+fn workgroups(groups: u32, phases: u32, f: impl FnMut(u32, u32, u32)) {
+    workgroups_of(WORKGROUP_SIZE, groups, phases, f)
+}
+
+/// [`workgroups`] for a kernel of `size` invocations per workgroup.
+fn workgroups_of(size: u32, groups: u32, phases: u32, mut f: impl FnMut(u32, u32, u32)) {
     for group in 0..groups {
         for phase in 0..phases {
-            for lid in 0..WORKGROUP_SIZE {
+            for lid in 0..size {
                 f(group, phase, lid);
             }
         }
@@ -676,7 +681,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let mut parts = [0u32; treelet_kernels::TEAM_PARTS];
             let mut order = [0u32; treelet_core::construct::treelet::SUBSETS];
             let mut votes = [0u32; treelet_kernels::TEAM_VOTES];
-            workgroups(groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
+            workgroups_of(treelet_kernels::RESTRUCTURE_THREADS, groups, treelet_kernels::RESTRUCTURE_PHASES, |group, phase, lid| {
                 treelet_kernels::treelet_restructure_phase(
                     phase, lid, group, &p, roots, subsets, nodes, parents, counts, costs, heights, marks, &mut stage,
                     &mut cost, &mut parts, &mut order, &mut votes,
