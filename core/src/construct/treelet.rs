@@ -395,10 +395,11 @@ pub fn first_cheapest(a: (f32, u32), b: (f32, u32)) -> (f32, u32) {
 
 /// The optimal tree over a treelet's leaves: `cost[s]` is the cost of the
 /// best subtree over subset `s`; its root splits `s` into `p` and `s ^ p`,
-/// `p` = [`packed_partition`]`(&parts, 0, s)`.
-pub struct TreeletSolution {
-    pub cost: [f32; SUBSETS],
-    pub parts: [u32; PACKED_WORDS],
+/// `p` = [`packed_partition`]`(&parts, 0, s)`. Tables for up to seven leaves
+/// by default; `C` costs and `P` packed words hold `log2(C)` leaves.
+pub struct TreeletSolution<const C: usize = SUBSETS, const P: usize = PACKED_WORDS> {
+    pub cost: [f32; C],
+    pub parts: [u32; P],
 }
 
 /// Algorithm 2's dynamic program over the subsets of the leaves of the
@@ -407,11 +408,23 @@ pub struct TreeletSolution {
 /// subset of `s` is smaller than `s`, so its parts are solved before it.
 #[inline]
 pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts) -> TreeletSolution {
-    let mut sol = TreeletSolution { cost: [0.0; SUBSETS], parts: [0u32; PACKED_WORDS] };
+    optimize_sized(stage, b, costs)
+}
+
+/// [`optimize`] into tables of `C` costs and `P` packed words, which must
+/// hold the staged treelet's subsets (`2^n <= C`): smaller tables for
+/// small treelets cost less private memory to clear.
+#[inline]
+pub fn optimize_sized<const N: usize, const C: usize, const P: usize>(
+    stage: &[u32; N],
+    b: usize,
+    costs: &TreeletCosts,
+) -> TreeletSolution<C, P> {
+    let mut sol = TreeletSolution { cost: [0.0; C], parts: [0u32; P] };
     let n = stage[b + T_COUNT];
     let mut i = 0;
     while i < n as usize {
-        sol.cost[1 << i] = f32::from_bits(stage[b + T_COSTS + i]);
+        set(&mut sol.cost, 1 << i, f32::from_bits(stage[b + T_COSTS + i]));
         i += 1;
     }
     let full = (1u32 << n) - 1;
@@ -420,7 +433,9 @@ pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts
         if s & (s - 1) != 0 {
             let area = costs.area(&subset_box(s, n, stage, b));
             let p = solve_subset(s, 0, area, subset_count(s, n, stage, b), &mut sol.cost, costs);
-            sol.parts[(s / 4) as usize] |= packed_bits(s, p);
+            let w = (s / 4) as usize;
+            let word = get(&sol.parts, w) | packed_bits(s, p);
+            set(&mut sol.parts, w, word);
         }
         s += 1;
     }
