@@ -41,7 +41,11 @@ impl TreeletTradeOff {
     ///   4 096 / 65 536 / 262 144 / 1M primitives: 1.4 ms plus 7.6 ns a
     ///   primitive more, a least-squares line within 0.16 ms of each (it
     ///   was 1.5 ms plus 8.5 ns; the layouts: 0.72 against 0.56 ms at 1M,
-    ///   left out).
+    ///   left out). After the faster treelet kernels of 2026-11-27
+    ///   (`docs/results/h100-treelet-2026-11-27/log_choice_builds.txt`):
+    ///   0.114 / 0.147 / 0.230 / 0.415 ms against 1.314 / 1.992 / 3.352 /
+    ///   8.460 ms, 1.3 ms plus 6.8 ns a primitive more (within 0.13 ms of
+    ///   each).
     /// - CPU Vulkan adapter (lavapipe on two cores, `cwbvh`):
     ///   `terrain:50000` in the room, 128x96 at 4 and 20 spp: 5.04 against
     ///   4.88 µs a path; builds 47 ms against 2 567 ms; `bench rays` at
@@ -63,8 +67,8 @@ impl TreeletTradeOff {
     pub fn of(class: DeviceClass) -> Self {
         match class {
             DeviceClass::Gpu => TreeletTradeOff {
-                extra_build_ms: 1.4,
-                extra_build_ns_per_prim: 7.6,
+                extra_build_ms: 1.3,
+                extra_build_ns_per_prim: 6.8,
                 saved_ns_per_path: 1.51,
                 saved_ns_per_ray: 0.131,
             },
