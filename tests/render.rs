@@ -415,3 +415,31 @@ fn many_samples_per_pixel_on_a_small_image() {
         }
     }
 }
+
+/// With `--layout auto`, a render on a Vulkan device (here: the GPU, or
+/// lavapipe) of at least `PILOT_MIN_SPP` samples
+/// through a tree first times one sample of every pixel through each
+/// layout and renders through the faster: the plan names it and the times,
+/// and the image is, bit for bit, the same render with that layout asked
+/// for (the pilot's samples are not in it). A shorter render runs no pilot.
+#[test]
+fn layout_pilot_keeps_the_faster_layout_and_leaves_no_trace() {
+    let Some(ctx) = gpu() else { return };
+    let room = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/room_disk.json");
+    let scene = Scene::from_spec(room).expect(room);
+    let s = RenderSettings {
+        integrator: Integrator::Nee,
+        error_each_pass: false,
+        ..settings(24, 16, treelet::render::prepared::PILOT_MIN_SPP, 3, Accel::Lbvh)
+    };
+    let auto = render(&mut GpuBackend::new(ctx.clone()), &scene, &s, None, |_| {}).unwrap();
+    let reason = &auto.plan.layout_reason;
+    assert!(reason.contains("the faster of") && reason.contains("bvh2 ") && reason.contains("cwbvh "), "no pilot: {reason}");
+    assert!(matches!(auto.plan.layout, Layout::Bvh2 | Layout::Cwbvh), "{:?}", auto.plan.layout);
+    let asked = render(&mut GpuBackend::new(ctx.clone()), &scene, &RenderSettings { layout: auto.plan.layout, ..s }, None, |_| {}).unwrap();
+    assert_eq!(auto.image.pixels, asked.image.pixels, "the pilot changed the image ({reason})");
+    assert!(auto.image.pixels.iter().flatten().any(|&v| v > 0.0), "the room rendered black");
+    let short = RenderSettings { spp: treelet::render::prepared::PILOT_MIN_SPP - 1, ..s };
+    let plain = render(&mut GpuBackend::new(ctx), &scene, &short, None, |_| {}).unwrap();
+    assert!(!plain.plan.layout_reason.contains("the faster of"), "a pilot below the threshold: {}", plain.plan.layout_reason);
+}

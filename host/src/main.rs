@@ -389,6 +389,9 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             eprintln!("           slowest pipelines: {}", slowest.join(", "));
         }
     }
+    if args.explain && args.layout == Layout::Auto && result.plan.accel != Accel::None {
+        eprintln!("layout     {} (as rendered): {}", result.plan.layout.name(), result.plan.layout_reason);
+    }
     // Wall time of the whole run so far: start-up, device, pipelines, render, image.
     let process_s = PROCESS_START.get().map_or(0.0, |t| t.elapsed().as_secs_f64());
     let spp = done.end - done.start;

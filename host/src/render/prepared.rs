@@ -1,7 +1,7 @@
 //! One device's part of a render before its first sample: the tree built
 //! and laid out, the scene and light table uploaded, the kernel chosen, and
 //! the accumulation buffer of per-pixel sums that its dispatches add to.
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use treelet_core::geometry::buffers::RenderParams;
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
@@ -11,7 +11,9 @@ use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
 use super::variant::{self, Plan};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
-use crate::bvh::tree::traced_tree;
+use crate::bvh::layout::Layout;
+use crate::bvh::tree::{binary_tree, traced_tree};
+use crate::runtime::backend::DeviceClass;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
 use crate::runtime::memory::human;
@@ -76,8 +78,38 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
 /// seconds, so all at once ([`Backend::prepare_kernels`]).
 pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
     let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class());
-    let kernels = kernels(b, &plan);
+    let mut kernels = kernels(b, &plan);
+    if pilots_layout(settings, &plan, b.class()) {
+        for layout in PILOT_LAYOUTS {
+            let other = Plan { layout, ..plan.clone() };
+            kernels.extend(self::kernels(b, &other));
+        }
+    }
     b.prepare_kernels(&kernels);
+}
+
+/// The layouts a pilot times (see [`pilots_layout`]).
+const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
+
+/// Samples per pixel from which a render on a Vulkan device (a GPU or
+/// lavapipe; not the CPU runner) with `--layout auto` lays its tree out both ways and keeps the layout whose render kernel ran one
+/// sample of every pixel faster (the pilot's samples are thrown away: two
+/// samples' work, under 1% of the render's). Which is faster depends on
+/// the scene, not only on its size: on the H100 `cwbvh` renders
+/// `scenes/room_disk.json` 15% faster than `bvh2` and
+/// `scenes/cornell_mesh.json` 10% faster, while `bvh2` is faster for
+/// terrain in smallpt's room at every size from 256 to 1M triangles
+/// (`docs/results/h100-caustics-2026-11-27`).
+pub const PILOT_MIN_SPP: u32 = 256;
+
+/// Whether a render with `settings` following `plan` on a device of
+/// `class` times both layouts before it starts (see [`PILOT_MIN_SPP`]).
+pub fn pilots_layout(settings: &RenderSettings, plan: &Plan, class: DeviceClass) -> bool {
+    settings.layout == Layout::Auto
+        && class != DeviceClass::CpuRunner
+        && plan.accel != crate::bvh::tree::Accel::None
+        && plan.method().specialized()
+        && settings.spp >= PILOT_MIN_SPP
 }
 
 impl<B: Backend> Prepared<B> {
@@ -115,8 +147,7 @@ impl<B: Backend> Prepared<B> {
                 );
             }
         }
-        let plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class());
-        let (tree, buffers, build_ms) = traced_tree(b, all, plan.accel, plan.layout)?;
+        let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class());
         let materials = b.upload("materials", &scene.materials)?;
         let table = light_table(all, &scene.materials);
         let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
@@ -135,6 +166,12 @@ impl<B: Backend> Prepared<B> {
             integrator: integrator.code(),
             light_count: table.len() as u32,
             ..Default::default()
+        };
+        let (tree, buffers, build_ms) = if pilots_layout(settings, &plan, b.class()) {
+            let scene_buffers = (&materials, &lights, &params);
+            faster_layout(b, all, &mut plan, scene_buffers, pixels)?
+        } else {
+            traced_tree(b, all, plan.accel, plan.layout)?
         };
         Ok(Prepared {
             tree,
@@ -158,30 +195,79 @@ impl<B: Backend> Prepared<B> {
         let mut done = 0;
         while done < count {
             let samples = (count - done).min(self.per_dispatch);
-            let p =
-                b.upload("render params", &[RenderParams { samples, first_sample: first + done, ..self.params }])?;
-            let t = &self.tree;
-            b.dispatch(
-                self.kernel,
-                &[
-                    &p,
-                    &self.buffers.spheres,
-                    &self.materials,
-                    &t.nodes,
-                    &t.prims,
-                    &self.accum,
-                    &self.buffers.triangles,
-                    &self.lights,
-                ],
-                groups_for(tiled_invocations(self.params.width, self.params.height), WORKGROUP_SIZE),
-            );
+            let params = RenderParams { samples, first_sample: first + done, ..self.params };
+            let scene = (&self.materials, &self.lights, &params);
+            dispatch_render(b, self.kernel, &self.tree, &self.buffers, scene, &self.accum)?;
             done += samples;
         }
         Ok(())
+    }
+
+    /// The layout this render traces (`auto` resolved, by a pilot or not).
+    pub fn layout(&self) -> Layout {
+        self.plan.layout
     }
 
     /// The per-pixel sums so far (waits for the dispatches).
     pub fn read_sums(&self, b: &mut B) -> Result<Vec<[f32; 4]>> {
         b.read(&self.accum, self.pixels as usize)
     }
+}
+
+/// One dispatch of render kernel `kernel` with `params`' samples of every
+/// pixel through `tree`, adding to `accum`.
+fn dispatch_render<B: Backend>(
+    b: &mut B,
+    kernel: Kernel,
+    tree: &TracedTree<B>,
+    buffers: &PrimBuffers<B>,
+    (materials, lights, params): (&B::Buffer, &B::Buffer, &RenderParams),
+    accum: &B::Buffer,
+) -> Result<()> {
+    let p = b.upload("render params", &[*params])?;
+    b.dispatch(
+        kernel,
+        &[&p, &buffers.spheres, materials, &tree.nodes, &tree.prims, accum, &buffers.triangles, lights],
+        groups_for(tiled_invocations(params.width, params.height), WORKGROUP_SIZE),
+    );
+    Ok(())
+}
+
+/// Builds `plan`'s tree once, lays it out in each of [`PILOT_LAYOUTS`],
+/// renders one sample of every pixel through each into a scratch buffer
+/// (GPU timestamps), and keeps the faster, saying so in `plan`.
+fn faster_layout<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    plan: &mut Plan,
+    (materials, lights, params): (&B::Buffer, &B::Buffer, &RenderParams),
+    pixels: u64,
+) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
+    let builder = plan.accel.builder()?.context("a layout pilot needs a tree")?;
+    let built = binary_tree(b, all, builder)?;
+    let buffers = built.prim_buffers(b, all)?;
+    let scratch = b.zeroed("layout pilot accumulation", pixels * 16)?;
+    let pilot = RenderParams { samples: 1, first_sample: 0, ..*params };
+    let mut best: Option<(f64, f64, TracedTree<B>, Layout)> = None;
+    let mut measured = Vec::new();
+    for layout in PILOT_LAYOUTS {
+        let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
+        b.take_times()?;
+        b.stage("layout pilot");
+        let kernel = Kernel::Render(layout.method(), plan.variant as u8);
+        dispatch_render(b, kernel, &tree, &buffers, (materials, lights, &pilot), &scratch)?;
+        let ms = b.take_times()?.get("layout pilot");
+        measured.push(format!("{} {ms:.2} ms", layout.name()));
+        if best.as_ref().is_none_or(|(fastest, ..)| ms < *fastest) {
+            best = Some((ms, layout_ms, tree, layout));
+        }
+    }
+    b.release(&[&scratch]);
+    let (_, layout_ms, tree, layout) = best.context("the pilot timed no layout")?;
+    plan.layout = layout;
+    plan.layout_reason = format!(
+        "the faster of one sample per pixel through each layout, timed before the render ({}; at {PILOT_MIN_SPP} spp or more, see `treelet::render::prepared::PILOT_MIN_SPP`)",
+        measured.join(", ")
+    );
+    Ok((tree, buffers, built.build_ms + layout_ms))
 }
