@@ -147,15 +147,13 @@ impl<B: Backend> Prepared<B> {
                 );
             }
         }
+        if let Some(sums) = base.filter(|sums| sums.len() as u64 != pixels) {
+            bail!("the sums to resume from are of {} pixels, the image has {pixels}", sums.len());
+        }
         let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class());
         let materials = b.upload("materials", &scene.materials)?;
         let table = light_table(all, &scene.materials);
         let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
-        let accum = match base {
-            Some(sums) if sums.len() as u64 == pixels => b.upload("accumulation", sums)?,
-            Some(sums) => bail!("the sums to resume from are of {} pixels, the image has {pixels}", sums.len()),
-            None => b.zeroed("accumulation", pixels * 16)?,
-        };
         let params = RenderParams {
             width,
             height,
@@ -172,6 +170,11 @@ impl<B: Backend> Prepared<B> {
             faster_layout(b, all, &mut plan, scene_buffers, pixels)?
         } else {
             traced_tree(b, all, plan.accel, plan.layout)?
+        };
+        // After the pilot, whose scratch sums (as large) are released by then.
+        let accum = match base {
+            Some(sums) => b.upload("accumulation", sums)?,
+            None => b.zeroed("accumulation", pixels * 16)?,
         };
         Ok(Prepared {
             tree,
