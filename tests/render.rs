@@ -430,7 +430,7 @@ fn layout_pilot_keeps_the_faster_layout_and_leaves_no_trace() {
     let s = RenderSettings {
         integrator: Integrator::Nee,
         error_each_pass: false,
-        ..settings(24, 16, treelet::render::prepared::PILOT_MIN_SPP, 3, Accel::Lbvh)
+        ..settings(24, 16, treelet::render::variant::PILOT_MIN_SPP, 3, Accel::Lbvh)
     };
     let auto = render(&mut GpuBackend::new(ctx.clone()), &scene, &s, None, |_| {}).unwrap();
     let reason = &auto.plan.layout_reason;
@@ -439,7 +439,7 @@ fn layout_pilot_keeps_the_faster_layout_and_leaves_no_trace() {
     let asked = render(&mut GpuBackend::new(ctx.clone()), &scene, &RenderSettings { layout: auto.plan.layout, ..s }, None, |_| {}).unwrap();
     assert_eq!(auto.image.pixels, asked.image.pixels, "the pilot changed the image ({reason})");
     assert!(auto.image.pixels.iter().flatten().any(|&v| v > 0.0), "the room rendered black");
-    let short = RenderSettings { spp: treelet::render::prepared::PILOT_MIN_SPP - 1, ..s };
+    let short = RenderSettings { spp: treelet::render::variant::PILOT_MIN_SPP - 1, ..s };
     let plain = render(&mut GpuBackend::new(ctx), &scene, &short, None, |_| {}).unwrap();
     assert!(!plain.plan.layout_reason.contains("the faster of"), "a pilot below the threshold: {}", plain.plan.layout_reason);
 }

@@ -22,7 +22,7 @@ use crate::scene::primitives::Primitives;
 pub enum Layout {
     /// The fastest measured on the device: bvh2 on GPUs and the CPU runner,
     /// cwbvh on lavapipe (see [`Layout::resolve`]); a long render on a
-    /// Vulkan device times both first (`crate::render::prepared::PILOT_MIN_SPP`).
+    /// Vulkan device times both first (`crate::render::variant::PILOT_MIN_SPP`).
     Auto,
     /// The seed's: 32-byte nodes that hold their own box; leaves name their
     /// primitives through an index array.

@@ -8,7 +8,7 @@ use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::lights::{light_power, Light};
 
 use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
-use super::variant::{self, Plan};
+use super::variant::{self, Plan, PILOT_MIN_SPP};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
 use crate::bvh::layout::Layout;
@@ -91,16 +91,6 @@ pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &Render
 /// The layouts a pilot times (see [`pilots_layout`]).
 const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
 
-/// Samples per pixel from which a render on a Vulkan device (a GPU or
-/// lavapipe; not the CPU runner) with `--layout auto` lays its tree out both ways and keeps the layout whose render kernel ran one
-/// sample of every pixel faster (the pilot's samples are thrown away: two
-/// samples' work, under 1% of the render's). Which is faster depends on
-/// the scene, not only on its size: on the H100 `cwbvh` renders
-/// `scenes/room_disk.json` 15% faster than `bvh2` and
-/// `scenes/cornell_mesh.json` 10% faster, while `bvh2` is faster for
-/// terrain in smallpt's room at every size from 256 to 1M triangles
-/// (`docs/results/h100-caustics-2026-11-27`).
-pub const PILOT_MIN_SPP: u32 = 256;
 
 /// Whether a render with `settings` following `plan` on a device of
 /// `class` times both layouts before it starts (see [`PILOT_MIN_SPP`]).
@@ -269,7 +259,7 @@ fn faster_layout<B: Backend>(
     let (_, layout_ms, tree, layout) = best.context("the pilot timed no layout")?;
     plan.layout = layout;
     plan.layout_reason = format!(
-        "the faster of one sample per pixel through each layout, timed before the render ({}; at {PILOT_MIN_SPP} spp or more, see `treelet::render::prepared::PILOT_MIN_SPP`)",
+        "the faster of one sample per pixel through each layout, timed before the render ({}; at {PILOT_MIN_SPP} spp or more, see `treelet::render::variant::PILOT_MIN_SPP`)",
         measured.join(", ")
     );
     Ok((tree, buffers, built.build_ms + layout_ms))

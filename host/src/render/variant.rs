@@ -140,6 +140,18 @@ pub const TRIANGLE_SCAN_WEIGHT: usize = 8;
 /// 4.5 s). The CPU runner uses it too (not measured separately).
 pub const LINEAR_MAX_CPU: usize = 512;
 
+/// Samples per pixel from which a render on a Vulkan device (a GPU or
+/// lavapipe; not the CPU runner) with `--layout auto` lays its tree out
+/// both ways and keeps the layout whose render kernel ran one sample of
+/// every pixel faster (`super::prepared::pilots_layout`; the pilot's
+/// samples are thrown away: two samples' work, under 1% of the render's). Which is faster depends on
+/// the scene, not only on its size: on the H100 `cwbvh` renders
+/// `scenes/room_disk.json` 15% faster than `bvh2` and
+/// `scenes/cornell_mesh.json` 10% faster, while `bvh2` is faster for
+/// terrain in smallpt's room at every size from 256 to 1M triangles
+/// (`docs/results/h100-caustics-2026-11-27`).
+pub const PILOT_MIN_SPP: u32 = 256;
+
 /// What the render will run, and why.
 #[derive(Clone, Debug, Serialize)]
 pub struct Plan {
@@ -203,7 +215,7 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
                 DeviceClass::CpuAdapter => "CPU Vulkan adapters (lavapipe)",
                 DeviceClass::CpuRunner => "the CPU runner",
             };
-            let pilot = if class != DeviceClass::CpuRunner { format!("; renders of {} spp or more time both layouts first and keep the faster", crate::render::prepared::PILOT_MIN_SPP) } else { String::new() };
+            let pilot = if class != DeviceClass::CpuRunner { format!("; renders of {} spp or more time both layouts first and keep the faster", PILOT_MIN_SPP) } else { String::new() };
             (chosen, format!("the layout that renders fastest on {on}, as measured (see `treelet::bvh::layout::Layout::resolve`){pilot}"))
         }
         other => (other, "as asked (--layout)".to_string()),
