@@ -28,6 +28,26 @@ fn mesh() -> Scene {
     mesh_scene("octahedron", &tris)
 }
 
+/// `scene` with 24 disks of random places, sizes and orientations (every
+/// fourth a lamp) added to its flat primitives.
+fn with_disks(mut scene: Scene, seed: u64) -> Scene {
+    let mut state = seed | 1;
+    let mut r = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for i in 0..24 {
+        let center = [10.0 + 80.0 * r(), 5.0 + 70.0 * r(), 20.0 + 120.0 * r()];
+        let normal = [r() - 0.5, r() - 0.5, r() - 0.5];
+        scene.triangles.push(Triangle::disk(center, normal, 2.0 + 6.0 * r()));
+        let color = [r(), r(), r()].map(|c| 0.2 + 0.7 * c);
+        let emission = if i % 4 == 0 { [8.0; 3] } else { [0.0; 3] };
+        scene.materials.push(Material { emission, ..diffuse(color) });
+    }
+    scene.name = format!("{} with disks", scene.name);
+    scene
+}
+
 fn settings(width: u32, height: u32, spp: u32, seed: u32, accel: Accel) -> RenderSettings {
     RenderSettings {
         width,
@@ -67,6 +87,7 @@ fn gpu_render_matches_cpu() {
         (cornell(), Accel::None),
         (random_scene("random:300", 300, seed as u64), Accel::Lbvh),
         (mesh(), Accel::Trbvh),
+        (with_disks(mesh(), seed as u64), Accel::Hploc),
     ] {
         let s = settings(48, 36, 16, seed, accel);
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
@@ -92,8 +113,8 @@ fn gpu_render_matches_cpu() {
 #[test]
 fn every_tree_and_layout_renders_what_the_scan_renders() {
     let seed = treelet_tests::fresh_seed();
-    // Spheres alone, then triangles and spheres in one tree.
-    for scene in [random_scene("random:400", 400, seed), mesh()] {
+    // Spheres alone, then triangles and spheres in one tree, then disks too.
+    for scene in [random_scene("random:400", 400, seed), mesh(), with_disks(mesh(), seed)] {
         let s = |accel| settings(40, 30, 8, seed as u32, accel);
         let none = pixels(&mut CpuBackend::new(), &scene, &s(Accel::None));
         assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{}: NaN or negative pixels", scene.name);
@@ -287,7 +308,8 @@ fn balls() -> Vec<(Sphere, Material)> {
 
 /// The scenes the light sampler must get right: smallpt's cornell (a sphere
 /// light mostly hidden by the ceiling), a small square light of two
-/// triangles under the ceiling, a light inside a glass ball (shadow rays
+/// triangles under the ceiling, a disk light (one primitive, sampled by
+/// area) tilted under the ceiling, a light inside a glass ball (shadow rays
 /// cannot reach it: only paths through the glass may), a mesh that is the
 /// only light, and a room with no light at all.
 fn light_scenes() -> Vec<Scene> {
@@ -311,6 +333,7 @@ fn light_scenes() -> Vec<Scene> {
     vec![
         cornell(),
         room_with("square light", balls(), square(81.0)),
+        room_with("disk light", balls(), vec![(Triangle::disk([50.0, 78.0, 80.0], [0.3, -1.0, 0.2], 12.0), emitter(30.0))]),
         room_with("light in glass", glass_lamp, square(81.0)),
         lit_mesh,
         room_with("no light", balls(), Vec::new()),
@@ -376,7 +399,7 @@ fn nee_converges_to_the_smallpt_estimate() {
 fn nee_gpu_matches_cpu() {
     let Some(ctx) = gpu() else { return };
     let seed = treelet_tests::fresh_seed() as u32;
-    for scene in light_scenes().into_iter().take(3) {
+    for scene in light_scenes().into_iter().take(4) {
         let s = with_integrator(settings(48, 36, 16, seed, Accel::None), Integrator::Nee);
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
         let c = pixels(&mut CpuBackend::new(), &scene, &s);

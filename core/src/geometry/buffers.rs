@@ -275,7 +275,8 @@ pub struct LeafPrim {
     pub p0: [f32; 3],
     pub prim: u32,
     pub p1: [f32; 3],
-    pub _pad1: u32,
+    /// A flat primitive's [`crate::geometry::triangle::Triangle::shape`] (0 for a sphere).
+    pub shape: u32,
     pub p2: [f32; 3],
     pub _pad2: u32,
 }

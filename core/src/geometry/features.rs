@@ -16,8 +16,12 @@ pub const TRIANGLES: u32 = 2;
 pub const MIRROR: u32 = 4;
 /// The scene has glass (refraction).
 pub const GLASS: u32 = 8;
+/// The scene has disks (flat primitives stored as triangles are, see
+/// [`crate::geometry::disk`]): without it a kernel tests every flat
+/// primitive as a triangle.
+pub const DISKS: u32 = 16;
 /// Everything: the general kernel.
-pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS;
+pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | DISKS;
 
 /// Whether `features` includes `feature`.
 #[inline]

@@ -3,6 +3,7 @@
 use glam::Vec3;
 
 use crate::geometry::buffers::{LeafPrim, Sphere};
+use crate::geometry::disk::ray_disk;
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{ray_sphere_mode, MISS};
 use crate::geometry::split::Split;
@@ -75,8 +76,19 @@ impl<'a> Prims<'a> {
         } else if prim == from.prim {
             MISS // a flat triangle cannot be hit again by a ray leaving it
         } else {
-            ray_triangle(ray, &self.triangle(prim - self.sphere_count), t_max)
+            flat_distance::<F>(o, d, ray, &self.triangle(prim - self.sphere_count), t_max)
         }
+    }
+}
+
+/// Distance to a flat primitive: the watertight triangle test, or the disk
+/// test where `F` has disks and `tri` is one.
+#[inline]
+fn flat_distance<const F: u32>(o: Vec3, d: Vec3, ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
+    if has(F, features::DISKS) && tri.is_disk() {
+        ray_disk(o, d, tri, t_max)
+    } else {
+        ray_triangle(ray, tri, t_max)
     }
 }
 
@@ -100,7 +112,8 @@ impl Prims<'_> {
         } else if prim == from.prim {
             MISS
         } else {
-            ray_triangle(ray, &Triangle::new(leaf.p0, leaf.p1, leaf.p2), t_max)
+            let tri = Triangle { v0: leaf.p0, shape: leaf.shape, v1: leaf.p1, _pad1: 0, v2: leaf.p2, _pad2: 0 };
+            flat_distance::<F>(o, d, ray, &tri, t_max)
         }
     }
 
@@ -112,7 +125,7 @@ impl Prims<'_> {
             LeafPrim { p0: s.center, prim, p1: [s.radius, 0.0, 0.0], ..Default::default() }
         } else {
             let t = self.triangle(prim - self.sphere_count);
-            LeafPrim { p0: t.v0, prim, p1: t.v1, p2: t.v2, ..Default::default() }
+            LeafPrim { p0: t.v0, prim, p1: t.v1, shape: t.shape, p2: t.v2, ..Default::default() }
         }
     }
 }

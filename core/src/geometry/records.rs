@@ -65,7 +65,7 @@ impl RecordStore<LeafPrim> for [Vec4] {
     #[inline]
     fn store(&mut self, i: usize, p: &LeafPrim) {
         put(self, 3 * i, vector(p.p0, p.prim));
-        put(self, 3 * i + 1, vector(p.p1, p._pad1));
+        put(self, 3 * i + 1, vector(p.p1, p.shape));
         put(self, 3 * i + 2, vector(p.p2, p._pad2));
     }
 }
@@ -137,9 +137,9 @@ impl RecordLoad<LeafPrim> for [Vec4] {
     #[inline]
     fn load(&self, i: usize) -> LeafPrim {
         let (p0, prim) = parts(at(self, 3 * i));
-        let (p1, _pad1) = parts(at(self, 3 * i + 1));
+        let (p1, shape) = parts(at(self, 3 * i + 1));
         let (p2, _pad2) = parts(at(self, 3 * i + 2));
-        LeafPrim { p0, prim, p1, _pad1, p2, _pad2 }
+        LeafPrim { p0, prim, p1, shape, p2, _pad2 }
     }
 }
 

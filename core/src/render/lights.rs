@@ -8,7 +8,8 @@
 //! probability proportional to its power (luminance times area), from a
 //! table the host builds once per scene ([`Light`], sorted by primitive).
 //! Spheres are sampled by the solid angle of the cone they subtend, as
-//! smallpt's "explicit" variant does; triangles uniformly by area. Either
+//! smallpt's "explicit" variant does; triangles and disks uniformly by
+//! area (a disk lamp as one shape, not a fan of triangles). Either
 //! way the density is expressed per unit solid angle at the shading point.
 use glam::Vec3;
 
@@ -44,15 +45,9 @@ pub fn light_power(prims: &Prims, materials: &[Material], prim: u32) -> f32 {
         let r = prims.spheres[prim as usize].radius;
         4.0 * core::f32::consts::PI * r * r
     } else {
-        triangle_area(&prims.triangle(prim - prims.sphere_count))
+        prims.triangle(prim - prims.sphere_count).area()
     };
     e * area
-}
-
-#[inline]
-fn triangle_area(t: &Triangle) -> f32 {
-    let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
-    0.5 * (b - a).cross(c - a).length()
 }
 
 /// Index of the light `u` in `[0, 1)` selects: the first whose `cdf`
@@ -136,9 +131,15 @@ pub fn sample_light(prims: &Prims, prim: u32, x: Vec3, u1: f32, u2: f32) -> Ligh
     } else {
         let t = &prims.triangle(prim - prims.sphere_count);
         let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
-        // Uniform on the triangle (Turk's square-root parametrization).
         let su = libm::sqrtf(u1);
-        let y = a * (1.0 - su) + b * (su * (1.0 - u2)) + c * (su * u2);
+        let y = if t.is_disk() {
+            // Uniform on the disk: radius sqrt(u1), angle u2 turns.
+            let (s, co) = sin_cos_turns(u2);
+            a + (b - a) * (su * co) + (c - a) * (su * s)
+        } else {
+            // Uniform on the triangle (Turk's square-root parametrization).
+            a * (1.0 - su) + b * (su * (1.0 - u2)) + c * (su * u2)
+        };
         let to = y - x;
         let d2 = to.length_squared();
         if !(d2 > 0.0) {
@@ -150,17 +151,19 @@ pub fn sample_light(prims: &Prims, prim: u32, x: Vec3, u1: f32, u2: f32) -> Ligh
 }
 
 /// Density per unit solid angle of reaching a point at squared distance
-/// `d2` in direction `dir` on triangle `t` by uniform area sampling.
+/// `d2` in direction `dir` on triangle (or disk) `t` by uniform area
+/// sampling.
 #[inline]
 fn triangle_pdf(t: &Triangle, dir: Vec3, d2: f32) -> f32 {
     let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
     let n = (b - a).cross(c - a);
-    let double_area = n.length();
-    let cos = (n.dot(dir) / double_area).abs();
-    if !(double_area > 0.0) || !(cos > 0.0) {
+    let parallelogram = n.length();
+    let cos = (n.dot(dir) / parallelogram).abs();
+    if !(parallelogram > 0.0) || !(cos > 0.0) {
         return 0.0;
     }
-    d2 / (0.5 * double_area * cos)
+    let area = if t.is_disk() { core::f32::consts::PI * parallelogram } else { 0.5 * parallelogram };
+    d2 / (area * cos)
 }
 
 /// Density per unit solid angle with which [`sample_light`] from `x` would
@@ -202,14 +205,17 @@ mod tests {
     fn inverse_pdf_integrates_to_the_solid_angle() {
         let spheres = [Sphere::new([0.0, 0.0, 10.0], 2.0)];
         // Behind the shading point, so that neither hides the other.
-        let triangles = [Triangle::new([-1.0, -1.0, -5.0], [3.0, -1.0, -5.0], [-1.0, 2.0, -6.0])];
-        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: crate::geometry::split::Split::whole(&triangles), triangle_count: 1 };
+        let triangles = [
+            Triangle::new([-1.0, -1.0, -5.0], [3.0, -1.0, -5.0], [-1.0, 2.0, -6.0]),
+            Triangle::disk([4.0, 3.0, 1.0], [-1.0, -0.5, 0.3], 1.5),
+        ];
+        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: crate::geometry::split::Split::whole(&triangles), triangle_count: 2 };
         let x = Vec3::new(0.3, -0.2, 0.0);
         // Sphere: 2π(1 - cos θmax).
         let d = Vec3::from_array(spheres[0].center) - x;
         let exact = 2.0 * core::f64::consts::PI * (1.0 - (1.0 - 4.0 / d.length_squared() as f64).sqrt());
         let n = 200_000;
-        for prim in [0u32, 1] {
+        for prim in [0u32, 1, 2] {
             let mut sum = 0.0f64;
             let mut hits = 0;
             for i in 0..n {
@@ -229,6 +235,25 @@ mod tests {
             let mean = sum / n as f64;
             if prim == 0 {
                 assert!((mean / exact - 1.0).abs() < 1e-4, "sphere: {mean} against {exact}");
+            } else if prim == 2 {
+                // A solid angle by quadrature over the disk, in polar
+                // coordinates (area element |e1 × e2| ρ dρ dφ).
+                let t = &triangles[1];
+                let (c, e1, e2) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1) - Vec3::from_array(t.v0), Vec3::from_array(t.v2) - Vec3::from_array(t.v0));
+                let nrm = e1.cross(e2);
+                let (mut omega, m) = (0.0f64, 400);
+                for i in 0..m {
+                    let rho = (i as f64 + 0.5) / m as f64;
+                    for j in 0..4 * m {
+                        let phi = (j as f64 + 0.5) / (4 * m) as f64 * core::f64::consts::TAU;
+                        let y = c + e1 * (rho * libm::cos(phi)) as f32 + e2 * (rho * libm::sin(phi)) as f32;
+                        let to = y - x;
+                        let cos = (nrm.normalize().dot(to.normalize())).abs() as f64;
+                        let da = nrm.length() as f64 * rho / m as f64 * core::f64::consts::TAU / (4 * m) as f64;
+                        omega += da * cos / to.length_squared() as f64;
+                    }
+                }
+                assert!((mean / omega - 1.0).abs() < 0.01, "disk: {mean} against {omega}");
             } else {
                 // A solid angle by fine quadrature over the triangle.
                 let t = &triangles[0];

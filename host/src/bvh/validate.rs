@@ -30,6 +30,13 @@ fn sphere_box(s: &Sphere) -> ([f32; 3], [f32; 3]) {
 }
 
 fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
+    if t.is_disk() {
+        // The ellipse c + x e1 + y e2 (x² + y² <= 1) reaches |(e1ₖ, e2ₖ)|
+        // either side of c; a hair less here, as a GPU's square root may
+        // round either way.
+        let reach = |k: usize| ((t.v1[k] - t.v0[k]) as f64).hypot((t.v2[k] - t.v0[k]) as f64) * (1.0 - 1e-5);
+        return ([0, 1, 2].map(|k| (t.v0[k] as f64 - reach(k)) as f32), [0, 1, 2].map(|k| (t.v0[k] as f64 + reach(k)) as f32));
+    }
     let lo = [0, 1, 2].map(|k| t.v0[k].min(t.v1[k]).min(t.v2[k]));
     let hi = [0, 1, 2].map(|k| t.v0[k].max(t.v1[k]).max(t.v2[k]));
     (lo, hi)

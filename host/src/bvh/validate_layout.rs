@@ -59,7 +59,7 @@ impl<'a> Check<'a> {
             }
             Some(t) => {
                 let t = &self.prims.triangles[t];
-                p.p0 == t.v0 && p.p1 == t.v1 && p.p2 == t.v2
+                p.p0 == t.v0 && p.p1 == t.v1 && p.p2 == t.v2 && p.shape == t.shape
             }
         };
         if !same {

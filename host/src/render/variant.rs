@@ -18,7 +18,9 @@ use crate::scene::Scene;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct SceneFeatures {
     pub spheres: usize,
+    /// Flat primitives: triangles, and the disks among them.
     pub triangles: usize,
+    pub disks: usize,
     /// Primitives by material kind.
     pub diffuse: usize,
     pub mirror: usize,
@@ -29,7 +31,8 @@ pub struct SceneFeatures {
 
 impl SceneFeatures {
     pub fn of(scene: &Scene) -> Self {
-        let mut f = SceneFeatures { spheres: scene.spheres.len(), triangles: scene.triangles.len(), ..Default::default() };
+        let disks = scene.triangles.iter().filter(|t| t.is_disk()).count();
+        let mut f = SceneFeatures { spheres: scene.spheres.len(), triangles: scene.triangles.len(), disks, ..Default::default() };
         for m in &scene.materials {
             match m.kind {
                 DIFFUSE => f.diffuse += 1,
@@ -61,6 +64,7 @@ impl SceneFeatures {
             (self.triangles, features::TRIANGLES),
             (self.mirror, features::MIRROR),
             (self.glass, features::GLASS),
+            (self.disks, features::DISKS),
         ] {
             if count > 0 {
                 bits |= bit;
@@ -77,6 +81,7 @@ fn optional(bits: u32) -> String {
         (features::TRIANGLES, "triangles"),
         (features::MIRROR, "mirror"),
         (features::GLASS, "glass"),
+        (features::DISKS, "disks"),
     ]
     .iter()
     .filter(|(bit, _)| bits & bit != 0)
@@ -259,12 +264,17 @@ impl Plan {
         let accel = serde_json::to_value(self.accel).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
         let layout = if self.accel == Accel::None { "-" } else { self.layout.name() };
         format!(
-            "features   {} spheres, {} triangles; materials: {} diffuse, {} mirror, {} glass, {} emissive\n\
+            "features   {} spheres, {} triangles{}; materials: {} diffuse, {} mirror, {} glass, {} emissive\n\
              accel      {accel}: {}\n\
              layout     {layout}: {}\n\
              kernel     {} ({}): {}",
             f.spheres,
-            f.triangles,
+            f.triangles - f.disks,
+            match f.disks {
+                0 => String::new(),
+                1 => ", 1 disk".to_string(),
+                n => format!(", {n} disks"),
+            },
             f.diffuse,
             f.mirror,
             f.glass,

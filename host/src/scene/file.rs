@@ -14,9 +14,15 @@
 //!   "meshes": [
 //!     { "path": "pyramid.obj", "material": "glass",
 //!       "scale": [20, 20, 20], "rotate": [0, 30, 0], "translate": [60, 0, 90] }
+//!   ],
+//!   "disks": [
+//!     { "center": [50, 81.5, 81.6], "normal": [0, -1, 0], "radius": 18, "material": "lamp" }
 //!   ]
 //! }
 //! ```
+//! A disk is one primitive (intersected, bounded and, as a lamp, sampled as
+//! one shape: `treelet_core::geometry::disk`), not a fan of triangles; both
+//! its faces are surfaces, the normal only orients it.
 //! A mesh (`.obj` or `.ply`, its path relative to the scene file) is scaled,
 //! then rotated about x, y and z (degrees, in that order), then translated;
 //! all three are optional. `scenes/cornell.json` in the repository is
@@ -40,6 +46,17 @@ struct SceneFile {
     spheres: Vec<SphereSpec>,
     #[serde(default)]
     meshes: Vec<MeshSpec>,
+    #[serde(default)]
+    disks: Vec<DiskSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DiskSpec {
+    center: [f32; 3],
+    normal: [f32; 3],
+    radius: f32,
+    material: String,
 }
 
 #[derive(Deserialize)]
@@ -153,8 +170,8 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         let ior = if kind == GLASS { m.ior } else { 0.0 }; // meaningful for glass alone
         materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior });
     }
-    if file.spheres.is_empty() && file.meshes.is_empty() {
-        bail!("scene file {name}: no spheres and no meshes");
+    if file.spheres.is_empty() && file.meshes.is_empty() && file.disks.is_empty() {
+        bail!("scene file {name}: no spheres, no meshes and no disks");
     }
     let mut spheres = Vec::with_capacity(file.spheres.len());
     let mut sphere_materials = Vec::with_capacity(file.spheres.len());
@@ -184,6 +201,27 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
     Primitives::triangles(&triangles)
         .check()
         .with_context(|| format!("scene file {name}: after the mesh transforms"))?;
+    for (i, d) in file.disks.iter().enumerate() {
+        let m = materials
+            .get(&d.material)
+            .with_context(|| format!("scene file {name}: disk {i} uses unknown material `{}`", d.material))?;
+        if d.center.iter().chain(&d.normal).any(|v| !v.is_finite()) {
+            bail!("scene file {name}: disk {i} has a non-finite centre or normal");
+        }
+        let n = glam::Vec3::from_array(d.normal);
+        if !(n.length() > 0.0) || !n.normalize().is_finite() {
+            bail!("scene file {name}: disk {i} has normal {:?}, which gives no direction", d.normal);
+        }
+        if !(d.radius > 0.0 && d.radius.is_finite()) {
+            bail!("scene file {name}: disk {i} has radius {} (must be positive and finite)", d.radius);
+        }
+        let disk = treelet_core::geometry::triangle::Triangle::disk(d.center, d.normal, d.radius);
+        if !disk.aabb().extent().is_finite() {
+            bail!("scene file {name}: disk {i}: its bounding box overflows f32 (centre {:?}, radius {})", d.center, d.radius);
+        }
+        triangles.push(disk);
+        triangle_materials.push(*m);
+    }
     let c = &file.camera;
     if c.origin.iter().chain(&c.direction).chain([&c.near, &c.fov]).any(|v| !v.is_finite())
         || c.direction.iter().all(|&v| v == 0.0)
@@ -232,7 +270,7 @@ mod tests {
             parse(r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {}, "spheres": []}"#, "z.json")
                 .unwrap_err()
                 .to_string();
-        assert!(e.contains("no spheres and no meshes"), "{e}");
+        assert!(e.contains("no spheres, no meshes and no disks"), "{e}");
     }
 
     #[test]
@@ -247,6 +285,33 @@ mod tests {
         assert!((top - 30.0).abs() < 1e-4, "apex at {top}");
         let bottom = scene.triangles.iter().flat_map(|t| [t.v0, t.v1, t.v2]).fold(f32::MAX, |a, v| a.min(v[1]));
         assert!(bottom.abs() < 1e-4, "base at {bottom}");
+    }
+
+    #[test]
+    fn disks_are_one_primitive_each_and_bad_ones_are_named() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/room_disk.json");
+        let scene = load(Path::new(path)).unwrap();
+        let disks: Vec<_> = scene.triangles.iter().filter(|t| t.is_disk()).collect();
+        assert_eq!(disks.len(), 1);
+        let d = disks[0];
+        assert_eq!(d.v0, [50.0, 81.5, 81.6]);
+        assert!((d.area() - std::f32::consts::PI * 18.0 * 18.0).abs() < 0.05, "{}", d.area());
+        let (lo, hi) = (d.aabb().lo(), d.aabb().hi());
+        assert!((lo.y - 81.5).abs() < 1e-4 && (hi.y - 81.5).abs() < 1e-4 && (hi.x - 68.0).abs() < 1e-3, "{lo} {hi}");
+        // Its material is the lamp's: the scene's last primitive emits.
+        assert!(scene.materials.last().unwrap().emission[0] > 0.0);
+
+        let base = r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "disks": ["#;
+        let case = |disk: &str| format!("{:#}", parse(&format!("{base}{disk}]}}"), "d.json").unwrap_err());
+        let e = case(r#"{"center": [0,0,5], "normal": [0,0,0], "radius": 1, "material": "w"}"#);
+        assert!(e.contains("d.json") && e.contains("disk 0") && e.contains("normal"), "{e}");
+        let e = case(r#"{"center": [0,0,5], "normal": [0,0,1], "radius": -1, "material": "w"}"#);
+        assert!(e.contains("disk 0") && e.contains("radius -1"), "{e}");
+        let e = case(r#"{"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "w"}, {"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "x"}"#);
+        assert!(e.contains("disk 1 uses unknown material `x`"), "{e}");
+        let e = case(r#"{"center": [3e38,0,5], "normal": [1,1,0], "radius": 3e38, "material": "w"}"#);
+        assert!(e.contains("disk 0") && e.contains("overflows"), "{e}");
+        assert!(parse(&format!("{base}{}]}}", r#"{"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "w"}"#), "ok.json").is_ok());
     }
 
     #[test]
