@@ -28,9 +28,9 @@ fn mesh() -> Scene {
     mesh_scene("octahedron", &tris)
 }
 
-/// `scene` with 24 disks of random places, sizes and orientations (every
-/// fourth a lamp) added to its flat primitives.
-fn with_disks(mut scene: Scene, seed: u64) -> Scene {
+/// `scene` with 24 disks and parallelograms of random places, sizes and
+/// orientations (every fourth a lamp) added to its flat primitives.
+fn with_flat_shapes(mut scene: Scene, seed: u64) -> Scene {
     let mut state = seed | 1;
     let mut r = move || {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -39,12 +39,13 @@ fn with_disks(mut scene: Scene, seed: u64) -> Scene {
     for i in 0..24 {
         let center = [10.0 + 80.0 * r(), 5.0 + 70.0 * r(), 20.0 + 120.0 * r()];
         let normal = [r() - 0.5, r() - 0.5, r() - 0.5];
-        scene.triangles.push(Triangle::disk(center, normal, 2.0 + 6.0 * r()));
+        let edge = [r() - 0.5, r() - 0.5, r() - 0.5].map(|x| 12.0 * x);
+        scene.triangles.push(if i % 2 == 0 { Triangle::disk(center, normal, 2.0 + 6.0 * r()) } else { Triangle::parallelogram(center, normal.map(|x| 10.0 * x), edge) });
         let color = [r(), r(), r()].map(|c| 0.2 + 0.7 * c);
         let emission = if i % 4 == 0 { [8.0; 3] } else { [0.0; 3] };
         scene.materials.push(Material { emission, ..diffuse(color) });
     }
-    scene.name = format!("{} with disks", scene.name);
+    scene.name = format!("{} with disks and parallelograms", scene.name);
     scene
 }
 
@@ -87,7 +88,7 @@ fn gpu_render_matches_cpu() {
         (cornell(), Accel::None),
         (random_scene("random:300", 300, seed as u64), Accel::Lbvh),
         (mesh(), Accel::Trbvh),
-        (with_disks(mesh(), seed as u64), Accel::Hploc),
+        (with_flat_shapes(mesh(), seed as u64), Accel::Hploc),
     ] {
         let s = settings(48, 36, 16, seed, accel);
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
@@ -113,8 +114,9 @@ fn gpu_render_matches_cpu() {
 #[test]
 fn every_tree_and_layout_renders_what_the_scan_renders() {
     let seed = treelet_tests::fresh_seed();
-    // Spheres alone, then triangles and spheres in one tree, then disks too.
-    for scene in [random_scene("random:400", 400, seed), mesh(), with_disks(mesh(), seed)] {
+    // Spheres alone, then triangles and spheres in one tree, then disks and
+    // parallelograms too.
+    for scene in [random_scene("random:400", 400, seed), mesh(), with_flat_shapes(mesh(), seed)] {
         let s = |accel| settings(40, 30, 8, seed as u32, accel);
         let none = pixels(&mut CpuBackend::new(), &scene, &s(Accel::None));
         assert!(none.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{}: NaN or negative pixels", scene.name);
@@ -308,8 +310,8 @@ fn balls() -> Vec<(Sphere, Material)> {
 
 /// The scenes the light sampler must get right: smallpt's cornell (a sphere
 /// light mostly hidden by the ceiling), a small square light of two
-/// triangles under the ceiling, a disk light (one primitive, sampled by
-/// area) tilted under the ceiling, a light inside a glass ball (shadow rays
+/// triangles under the ceiling, a tilted disk light and a rectangle light
+/// (one primitive each, sampled by area), a light inside a glass ball (shadow rays
 /// cannot reach it: only paths through the glass may), a mesh that is the
 /// only light, and a room with no light at all.
 fn light_scenes() -> Vec<Scene> {
@@ -333,7 +335,14 @@ fn light_scenes() -> Vec<Scene> {
     vec![
         cornell(),
         room_with("square light", balls(), square(81.0)),
-        room_with("disk light", balls(), vec![(Triangle::disk([50.0, 78.0, 80.0], [0.3, -1.0, 0.2], 12.0), emitter(30.0))]),
+        room_with(
+            "disk and rectangle lights",
+            balls(),
+            vec![
+                (Triangle::disk([50.0, 78.0, 80.0], [0.3, -1.0, 0.2], 12.0), emitter(30.0)),
+                (Triangle::parallelogram([5.0, 40.0, 60.0], [0.0, 0.0, 30.0], [2.0, 20.0, 0.0]), emitter(10.0)),
+            ],
+        ),
         room_with("light in glass", glass_lamp, square(81.0)),
         lit_mesh,
         room_with("no light", balls(), Vec::new()),

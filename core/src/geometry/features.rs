@@ -16,12 +16,12 @@ pub const TRIANGLES: u32 = 2;
 pub const MIRROR: u32 = 4;
 /// The scene has glass (refraction).
 pub const GLASS: u32 = 8;
-/// The scene has disks (flat primitives stored as triangles are, see
-/// [`crate::geometry::disk`]): without it a kernel tests every flat
-/// primitive as a triangle.
-pub const DISKS: u32 = 16;
+/// The scene has disks or parallelograms (flat primitives stored as
+/// triangles are, see [`crate::geometry::flat`]): without it a kernel tests
+/// every flat primitive as a triangle.
+pub const SHAPES: u32 = 16;
 /// Everything: the general kernel.
-pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | DISKS;
+pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES;
 
 /// Whether `features` includes `feature`.
 #[inline]

@@ -4,13 +4,13 @@
 //! ([`buffers`]: `#[repr(C)]`, `Pod`, sizes asserted), boxes ([`aabb`]),
 //! spheres and triangles and their intersection with rays ([`intersect`],
 //! after Ize 2013 for robust slabs; [`triangle`], after Woop, Benthin &
-//! Wald 2013 for watertight triangles; [`disk`], disks stored as
-//! triangles are, for lights sampled as one shape), the primitive set a ray is traced
+//! Wald 2013 for watertight triangles; [`flat`], disks and
+//! parallelograms stored as triangles are), the primitive set a ray is traced
 //! against ([`prims`]), and the feature bits that say which primitive kinds
 //! and materials a scene has ([`features`]).
 pub mod aabb;
 pub mod buffers;
-pub mod disk;
+pub mod flat;
 pub mod features;
 pub mod intersect;
 pub mod prims;

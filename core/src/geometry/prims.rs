@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use crate::geometry::buffers::{LeafPrim, Sphere};
-use crate::geometry::disk::ray_disk;
+use crate::geometry::flat::ray_shape;
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{ray_sphere_mode, MISS};
 use crate::geometry::split::Split;
@@ -81,12 +81,12 @@ impl<'a> Prims<'a> {
     }
 }
 
-/// Distance to a flat primitive: the watertight triangle test, or the disk
-/// test where `F` has disks and `tri` is one.
+/// Distance to a flat primitive: the watertight triangle test, or the
+/// disk's or parallelogram's where `F` has them and `tri` is one.
 #[inline]
 fn flat_distance<const F: u32>(o: Vec3, d: Vec3, ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
-    if has(F, features::DISKS) && tri.is_disk() {
-        ray_disk(o, d, tri, t_max)
+    if has(F, features::SHAPES) && !tri.is_triangle() {
+        ray_shape(o, d, tri, t_max)
     } else {
         ray_triangle(ray, tri, t_max)
     }

@@ -26,17 +26,18 @@ use crate::geometry::aabb::Aabb;
 use crate::geometry::intersect::MISS;
 
 /// A flat primitive spanned by three points: the triangle `v0 v1 v2`
-/// ([`SHAPE_TRIANGLE`], what meshes are made of), or the disk (an ellipse)
-/// of centre `v0` and semi-axes `v1 - v0`, `v2 - v0` ([`SHAPE_DISK`], see
-/// [`crate::geometry::disk`]). Both share the triangle's buffers, indices,
-/// normal `(v1 - v0) × (v2 - v0)` and frame, so a scene's disk lights cost
-/// no binding of their own. repr(C), Pod, 48 bytes (16-byte rows).
+/// ([`SHAPE_TRIANGLE`], what meshes are made of), or a disk or a
+/// parallelogram on the same three points ([`SHAPE_DISK`],
+/// [`SHAPE_PARALLELOGRAM`], see [`crate::geometry::flat`]). All share the
+/// triangle's buffers, indices, normal `(v1 - v0) × (v2 - v0)` and frame,
+/// so a scene's disk lamps and rectangular walls cost no binding of their
+/// own. repr(C), Pod, 48 bytes (16-byte rows).
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
 pub struct Triangle {
     pub v0: [f32; 3],
-    /// [`SHAPE_TRIANGLE`] (0) or [`SHAPE_DISK`].
+    /// [`SHAPE_TRIANGLE`] (0), [`SHAPE_DISK`] or [`SHAPE_PARALLELOGRAM`].
     pub shape: u32,
     pub v1: [f32; 3],
     pub _pad1: u32,
@@ -50,40 +51,32 @@ pub const SHAPE_TRIANGLE: u32 = 0;
 /// [`Triangle::shape`] of a disk (or ellipse): centre `v0`, semi-axes
 /// `v1 - v0` and `v2 - v0`.
 pub const SHAPE_DISK: u32 = 1;
+/// [`Triangle::shape`] of a parallelogram: corner `v0`, edges `v1 - v0`
+/// and `v2 - v0`.
+pub const SHAPE_PARALLELOGRAM: u32 = 2;
 
 impl Triangle {
     pub const fn new(v0: [f32; 3], v1: [f32; 3], v2: [f32; 3]) -> Self {
         Self { v0, shape: SHAPE_TRIANGLE, v1, _pad1: 0, v2, _pad2: 0 }
     }
 
-    /// Whether this is a disk rather than a triangle.
+    /// Whether this is a triangle (not another flat shape).
     #[inline]
-    pub fn is_disk(&self) -> bool {
-        self.shape == SHAPE_DISK
+    pub fn is_triangle(&self) -> bool {
+        self.shape == SHAPE_TRIANGLE
     }
 
-    /// The primitive's bounding box (a disk's is its ellipse's, not its
+    /// The primitive's bounding box (a disk's or parallelogram's, not its
     /// three points').
     #[inline]
     pub fn aabb(&self) -> Aabb {
-        let (a, b, c) = (Vec3::from_array(self.v0), Vec3::from_array(self.v1), Vec3::from_array(self.v2));
-        if self.is_disk() {
-            return crate::geometry::disk::disk_aabb(a, b - a, c - a);
-        }
-        Aabb::new(a.min(b).min(c), a.max(b).max(c))
+        crate::geometry::flat::flat_aabb(self)
     }
 
-    /// The primitive's area: half the parallelogram of its two edges for a
-    /// triangle, π times it for a disk.
+    /// The primitive's area.
     #[inline]
     pub fn area(&self) -> f32 {
-        let (a, b, c) = (Vec3::from_array(self.v0), Vec3::from_array(self.v1), Vec3::from_array(self.v2));
-        let parallelogram = (b - a).cross(c - a).length();
-        if self.is_disk() {
-            core::f32::consts::PI * parallelogram
-        } else {
-            0.5 * parallelogram
-        }
+        crate::geometry::flat::flat_area(self)
     }
 }
 

@@ -8,8 +8,8 @@
 //! probability proportional to its power (luminance times area), from a
 //! table the host builds once per scene ([`Light`], sorted by primitive).
 //! Spheres are sampled by the solid angle of the cone they subtend, as
-//! smallpt's "explicit" variant does; triangles and disks uniformly by
-//! area (a disk lamp as one shape, not a fan of triangles). Either
+//! smallpt's "explicit" variant does; triangles, disks and parallelograms
+//! uniformly by area (a disk lamp as one shape, not a fan of triangles). Either
 //! way the density is expressed per unit solid angle at the shading point.
 use glam::Vec3;
 
@@ -130,16 +130,7 @@ pub fn sample_light(prims: &Prims, prim: u32, x: Vec3, u1: f32, u2: f32) -> Ligh
         LightSample { dir, pdf: 1.0 / (2.0 * core::f32::consts::PI * width) }
     } else {
         let t = &prims.triangle(prim - prims.sphere_count);
-        let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
-        let su = libm::sqrtf(u1);
-        let y = if t.is_disk() {
-            // Uniform on the disk: radius sqrt(u1), angle u2 turns.
-            let (s, co) = sin_cos_turns(u2);
-            a + (b - a) * (su * co) + (c - a) * (su * s)
-        } else {
-            // Uniform on the triangle (Turk's square-root parametrization).
-            a * (1.0 - su) + b * (su * (1.0 - u2)) + c * (su * u2)
-        };
+        let y = crate::geometry::flat::flat_point(t, u1, u2, sin_cos_turns);
         let to = y - x;
         let d2 = to.length_squared();
         if !(d2 > 0.0) {
@@ -151,8 +142,7 @@ pub fn sample_light(prims: &Prims, prim: u32, x: Vec3, u1: f32, u2: f32) -> Ligh
 }
 
 /// Density per unit solid angle of reaching a point at squared distance
-/// `d2` in direction `dir` on triangle (or disk) `t` by uniform area
-/// sampling.
+/// `d2` in direction `dir` on flat primitive `t` by uniform area sampling.
 #[inline]
 fn triangle_pdf(t: &Triangle, dir: Vec3, d2: f32) -> f32 {
     let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
@@ -162,8 +152,7 @@ fn triangle_pdf(t: &Triangle, dir: Vec3, d2: f32) -> f32 {
     if !(parallelogram > 0.0) || !(cos > 0.0) {
         return 0.0;
     }
-    let area = if t.is_disk() { core::f32::consts::PI * parallelogram } else { 0.5 * parallelogram };
-    d2 / (area * cos)
+    d2 / (parallelogram * crate::geometry::flat::area_factor(t.shape) * cos)
 }
 
 /// Density per unit solid angle with which [`sample_light`] from `x` would
@@ -208,14 +197,15 @@ mod tests {
         let triangles = [
             Triangle::new([-1.0, -1.0, -5.0], [3.0, -1.0, -5.0], [-1.0, 2.0, -6.0]),
             Triangle::disk([4.0, 3.0, 1.0], [-1.0, -0.5, 0.3], 1.5),
+            Triangle::parallelogram([-4.0, 2.0, 2.0], [0.5, 0.3, 2.0], [0.2, 1.5, -0.4]),
         ];
-        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: crate::geometry::split::Split::whole(&triangles), triangle_count: 2 };
+        let prims = Prims { spheres: &spheres, sphere_count: 1, triangles: crate::geometry::split::Split::whole(&triangles), triangle_count: 3 };
         let x = Vec3::new(0.3, -0.2, 0.0);
         // Sphere: 2π(1 - cos θmax).
         let d = Vec3::from_array(spheres[0].center) - x;
         let exact = 2.0 * core::f64::consts::PI * (1.0 - (1.0 - 4.0 / d.length_squared() as f64).sqrt());
         let n = 200_000;
-        for prim in [0u32, 1, 2] {
+        for prim in [0u32, 1, 2, 3] {
             let mut sum = 0.0f64;
             let mut hits = 0;
             for i in 0..n {
@@ -254,6 +244,21 @@ mod tests {
                     }
                 }
                 assert!((mean / omega - 1.0).abs() < 0.01, "disk: {mean} against {omega}");
+            } else if prim == 3 {
+                // A solid angle by the midpoint rule over the parallelogram.
+                let t = &triangles[2];
+                let (c, e1, e2) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1) - Vec3::from_array(t.v0), Vec3::from_array(t.v2) - Vec3::from_array(t.v0));
+                let nrm = e1.cross(e2);
+                let (mut omega, m) = (0.0f64, 400);
+                let da = nrm.length() as f64 / (m * m) as f64;
+                for i in 0..m {
+                    for j in 0..m {
+                        let y = c + e1 * ((i as f32 + 0.5) / m as f32) + e2 * ((j as f32 + 0.5) / m as f32);
+                        let to = y - x;
+                        omega += da * (nrm.normalize().dot(to.normalize())).abs() as f64 / to.length_squared() as f64;
+                    }
+                }
+                assert!((mean / omega - 1.0).abs() < 0.01, "parallelogram: {mean} against {omega}");
             } else {
                 // A solid angle by fine quadrature over the triangle.
                 let t = &triangles[0];

@@ -2,7 +2,7 @@
 //! builders: it recomputes primitive boxes itself and walks the tree from the
 //! root with an explicit stack.
 use treelet_core::geometry::buffers::{Node, Sphere};
-use treelet_core::geometry::triangle::Triangle;
+use treelet_core::geometry::triangle::{Triangle, SHAPE_DISK, SHAPE_PARALLELOGRAM};
 
 use crate::scene::primitives::Primitives;
 
@@ -30,7 +30,7 @@ fn sphere_box(s: &Sphere) -> ([f32; 3], [f32; 3]) {
 }
 
 fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
-    if t.is_disk() {
+    if t.shape == SHAPE_DISK {
         // The ellipse c + x e1 + y e2 (x² + y² <= 1) reaches |(e1ₖ, e2ₖ)|
         // either side of c; a hair less here, as a GPU's square root may
         // round either way.
@@ -39,6 +39,11 @@ fn triangle_box(t: &Triangle) -> ([f32; 3], [f32; 3]) {
     }
     let lo = [0, 1, 2].map(|k| t.v0[k].min(t.v1[k]).min(t.v2[k]));
     let hi = [0, 1, 2].map(|k| t.v0[k].max(t.v1[k]).max(t.v2[k]));
+    if t.shape == SHAPE_PARALLELOGRAM {
+        // The fourth corner, v1 + v2 - v0.
+        let d = [0, 1, 2].map(|k| t.v1[k] + (t.v2[k] - t.v0[k]));
+        return ([0, 1, 2].map(|k| lo[k].min(d[k])), [0, 1, 2].map(|k| hi[k].max(d[k])));
+    }
     (lo, hi)
 }
 

@@ -18,9 +18,11 @@ use crate::scene::Scene;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct SceneFeatures {
     pub spheres: usize,
-    /// Flat primitives: triangles, and the disks among them.
+    /// Flat primitives: triangles, and the disks and parallelograms among
+    /// them (`treelet_core::geometry::flat`).
     pub triangles: usize,
     pub disks: usize,
+    pub parallelograms: usize,
     /// Primitives by material kind.
     pub diffuse: usize,
     pub mirror: usize,
@@ -31,8 +33,15 @@ pub struct SceneFeatures {
 
 impl SceneFeatures {
     pub fn of(scene: &Scene) -> Self {
-        let disks = scene.triangles.iter().filter(|t| t.is_disk()).count();
-        let mut f = SceneFeatures { spheres: scene.spheres.len(), triangles: scene.triangles.len(), disks, ..Default::default() };
+        use treelet_core::geometry::triangle::{SHAPE_DISK, SHAPE_PARALLELOGRAM};
+        let count = |shape| scene.triangles.iter().filter(|t| t.shape == shape).count();
+        let mut f = SceneFeatures {
+            spheres: scene.spheres.len(),
+            triangles: scene.triangles.len(),
+            disks: count(SHAPE_DISK),
+            parallelograms: count(SHAPE_PARALLELOGRAM),
+            ..Default::default()
+        };
         for m in &scene.materials {
             match m.kind {
                 DIFFUSE => f.diffuse += 1,
@@ -64,7 +73,7 @@ impl SceneFeatures {
             (self.triangles, features::TRIANGLES),
             (self.mirror, features::MIRROR),
             (self.glass, features::GLASS),
-            (self.disks, features::DISKS),
+            (self.disks + self.parallelograms, features::SHAPES),
         ] {
             if count > 0 {
                 bits |= bit;
@@ -81,7 +90,7 @@ fn optional(bits: u32) -> String {
         (features::TRIANGLES, "triangles"),
         (features::MIRROR, "mirror"),
         (features::GLASS, "glass"),
-        (features::DISKS, "disks"),
+        (features::SHAPES, "disks and parallelograms"),
     ]
     .iter()
     .filter(|(bit, _)| bits & bit != 0)
@@ -269,12 +278,12 @@ impl Plan {
              layout     {layout}: {}\n\
              kernel     {} ({}): {}",
             f.spheres,
-            f.triangles - f.disks,
-            match f.disks {
-                0 => String::new(),
-                1 => ", 1 disk".to_string(),
-                n => format!(", {n} disks"),
-            },
+            f.triangles - f.disks - f.parallelograms,
+            [(f.disks, "disk"), (f.parallelograms, "parallelogram")]
+                .iter()
+                .filter(|(n, _)| *n > 0)
+                .map(|(n, what)| format!(", {n} {what}{}", if *n == 1 { "" } else { "s" }))
+                .collect::<String>(),
             f.diffuse,
             f.mirror,
             f.glass,

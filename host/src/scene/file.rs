@@ -17,12 +17,18 @@
 //!   ],
 //!   "disks": [
 //!     { "center": [50, 81.5, 81.6], "normal": [0, -1, 0], "radius": 18, "material": "lamp" }
+//!   ],
+//!   "parallelograms": [
+//!     { "corner": [0, 0, 0], "edges": [[100, 0, 0], [0, 0, 170]], "material": "white" }
 //!   ]
 //! }
 //! ```
-//! A disk is one primitive (intersected, bounded and, as a lamp, sampled as
-//! one shape: `treelet_core::geometry::disk`), not a fan of triangles; both
-//! its faces are surfaces, the normal only orients it.
+//! A disk or a parallelogram (a rectangle when its edges are square) is one
+//! primitive (intersected, bounded and, as a lamp, sampled as one shape:
+//! `treelet_core::geometry::flat`), not a fan or a pair of triangles; both
+//! faces are surfaces, the normal (a parallelogram's `edges[0] × edges[1]`)
+//! only orients it. Unlike a mesh's triangles, such shapes share no edges:
+//! let walls overlap at their corners so that no ray slips between them.
 //! A mesh (`.obj` or `.ply`, its path relative to the scene file) is scaled,
 //! then rotated about x, y and z (degrees, in that order), then translated;
 //! all three are optional. `scenes/cornell.json` in the repository is
@@ -48,6 +54,16 @@ struct SceneFile {
     meshes: Vec<MeshSpec>,
     #[serde(default)]
     disks: Vec<DiskSpec>,
+    #[serde(default)]
+    parallelograms: Vec<ParallelogramSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParallelogramSpec {
+    corner: [f32; 3],
+    edges: [[f32; 3]; 2],
+    material: String,
 }
 
 #[derive(Deserialize)]
@@ -170,8 +186,8 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         let ior = if kind == GLASS { m.ior } else { 0.0 }; // meaningful for glass alone
         materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior });
     }
-    if file.spheres.is_empty() && file.meshes.is_empty() && file.disks.is_empty() {
-        bail!("scene file {name}: no spheres, no meshes and no disks");
+    if file.spheres.is_empty() && file.meshes.is_empty() && file.disks.is_empty() && file.parallelograms.is_empty() {
+        bail!("scene file {name}: no spheres, meshes, disks or parallelograms");
     }
     let mut spheres = Vec::with_capacity(file.spheres.len());
     let mut sphere_materials = Vec::with_capacity(file.spheres.len());
@@ -222,6 +238,24 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         triangles.push(disk);
         triangle_materials.push(*m);
     }
+    for (i, p) in file.parallelograms.iter().enumerate() {
+        let m = materials
+            .get(&p.material)
+            .with_context(|| format!("scene file {name}: parallelogram {i} uses unknown material `{}`", p.material))?;
+        if p.corner.iter().chain(p.edges.iter().flatten()).any(|v| !v.is_finite()) {
+            bail!("scene file {name}: parallelogram {i} has a non-finite corner or edge");
+        }
+        let [e1, e2] = p.edges.map(glam::Vec3::from_array);
+        if !(e1.cross(e2).length() > 0.0) {
+            bail!("scene file {name}: parallelogram {i} has edges {:?} and {:?}, which span no area", p.edges[0], p.edges[1]);
+        }
+        let shape = treelet_core::geometry::triangle::Triangle::parallelogram(p.corner, p.edges[0], p.edges[1]);
+        if !shape.aabb().extent().is_finite() || !shape.area().is_finite() {
+            bail!("scene file {name}: parallelogram {i}: its size overflows f32 (corner {:?}, edges {:?})", p.corner, p.edges);
+        }
+        triangles.push(shape);
+        triangle_materials.push(*m);
+    }
     let c = &file.camera;
     if c.origin.iter().chain(&c.direction).chain([&c.near, &c.fov]).any(|v| !v.is_finite())
         || c.direction.iter().all(|&v| v == 0.0)
@@ -270,7 +304,7 @@ mod tests {
             parse(r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {}, "spheres": []}"#, "z.json")
                 .unwrap_err()
                 .to_string();
-        assert!(e.contains("no spheres, no meshes and no disks"), "{e}");
+        assert!(e.contains("no spheres, meshes, disks or parallelograms"), "{e}");
     }
 
     #[test]
@@ -291,15 +325,18 @@ mod tests {
     fn disks_are_one_primitive_each_and_bad_ones_are_named() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/room_disk.json");
         let scene = load(Path::new(path)).unwrap();
-        let disks: Vec<_> = scene.triangles.iter().filter(|t| t.is_disk()).collect();
+        let disks: Vec<_> = scene.triangles.iter().filter(|t| t.shape == treelet_core::geometry::triangle::SHAPE_DISK).collect();
         assert_eq!(disks.len(), 1);
         let d = disks[0];
         assert_eq!(d.v0, [50.0, 81.5, 81.6]);
         assert!((d.area() - std::f32::consts::PI * 18.0 * 18.0).abs() < 0.05, "{}", d.area());
         let (lo, hi) = (d.aabb().lo(), d.aabb().hi());
         assert!((lo.y - 81.5).abs() < 1e-4 && (hi.y - 81.5).abs() < 1e-4 && (hi.x - 68.0).abs() < 1e-3, "{lo} {hi}");
-        // Its material is the lamp's: the scene's last primitive emits.
-        assert!(scene.materials.last().unwrap().emission[0] > 0.0);
+        // Its material is the lamp's, and the walls are six rectangles.
+        let at = scene.triangles.iter().position(|t| t.shape == treelet_core::geometry::triangle::SHAPE_DISK).unwrap();
+        assert!(scene.materials[scene.spheres.len() + at].emission[0] > 0.0);
+        let walls = scene.triangles.iter().filter(|t| t.shape == treelet_core::geometry::triangle::SHAPE_PARALLELOGRAM);
+        assert_eq!(walls.count(), 6);
 
         let base = r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "disks": ["#;
         let case = |disk: &str| format!("{:#}", parse(&format!("{base}{disk}]}}"), "d.json").unwrap_err());
@@ -312,6 +349,17 @@ mod tests {
         let e = case(r#"{"center": [3e38,0,5], "normal": [1,1,0], "radius": 3e38, "material": "w"}"#);
         assert!(e.contains("disk 0") && e.contains("overflows"), "{e}");
         assert!(parse(&format!("{base}{}]}}", r#"{"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "w"}"#), "ok.json").is_ok());
+
+        let base = base.replace("\"disks\"", "\"parallelograms\"");
+        let case = |p: &str| format!("{:#}", parse(&format!("{base}{p}]}}"), "p.json").unwrap_err());
+        let e = case(r#"{"corner": [0,0,5], "edges": [[1,0,0], [2,0,0]], "material": "w"}"#);
+        assert!(e.contains("p.json") && e.contains("parallelogram 0") && e.contains("span no area"), "{e}");
+        let e = case(r#"{"corner": [0,0,5], "edges": [[1,0,0], [0,1,0]], "material": "w"}, {"corner": [0,0,5], "edges": [[1,0,0], [0,"x",0]], "material": "w"}"#);
+        assert!(e.contains("p.json: line 1"), "{e}");
+        let e = case(r#"{"corner": [0,0,5], "edges": [[3e38,0,0], [0,3e38,0]], "material": "w"}"#);
+        assert!(e.contains("parallelogram 0") && e.contains("overflows"), "{e}");
+        let scene = parse(&format!("{base}{}]}}", r#"{"corner": [0,0,5], "edges": [[2,0,0], [0,3,0]], "material": "w"}"#), "ok.json").unwrap();
+        assert_eq!((scene.triangles.len(), scene.triangles[0].area()), (1, 6.0));
     }
 
     #[test]
