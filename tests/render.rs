@@ -475,3 +475,24 @@ fn layout_pilot_keeps_the_faster_layout_and_leaves_no_trace() {
     let plain = render(&mut GpuBackend::new(ctx), &scene, &short, None, |_| {}).unwrap();
     assert!(!plain.plan.layout_reason.contains("the faster of"), "a pilot below the threshold: {}", plain.plan.layout_reason);
 }
+
+/// A render scored against a reference measures its error at every pass
+/// end (4, 8, 16, ... samples), on the GPU and on the CPU runner, however
+/// large the chunks its device would take: `bench error` draws its curves
+/// from these rows.
+#[test]
+fn a_scored_render_has_a_row_at_every_pass() {
+    let Some(ctx) = gpu() else { return };
+    let scene = cornell();
+    let s = RenderSettings { error_each_pass: true, ..settings(32, 24, 256, 5, Accel::None) };
+    let reference = render(&mut CpuBackend::new(), &scene, &RenderSettings { seed: 6, ..s }, None, |_| {}).unwrap().image;
+    let cpu = render(&mut CpuBackend::new(), &scene, &s, Some(&reference), |_| {}).unwrap();
+    let gpu = render(&mut GpuBackend::new(ctx), &scene, &s, Some(&reference), |_| {}).unwrap();
+    for (name, r) in [("cpu", &cpu), ("gpu", &gpu)] {
+        let spp: Vec<u32> = r.rows.iter().map(|row| row.spp).collect();
+        assert_eq!(spp, vec![4, 8, 16, 32, 64, 128, 256], "{name}");
+        let rmse: Vec<f64> = r.rows.iter().map(|row| row.rmse.unwrap()).collect();
+        // Error falls with samples (by about sqrt 2 a pass, so 4 to 256 at least halves it).
+        assert!(rmse[6] < 0.5 * rmse[0], "{name}: {rmse:?}");
+    }
+}

@@ -123,6 +123,17 @@ impl SampleQueue {
     /// of a fair share of what is left, so that the end is shared too,
     /// rounded down to a grid point), or a range given back whole.
     pub fn take(&self, want: u32) -> Take {
+        self.take_up_to(want, false)
+    }
+
+    /// As [`SampleQueue::take`], but never past the end of the pass the
+    /// range starts in: a render that scores its image after every pass
+    /// needs its sums at each pass end.
+    pub fn take_in_pass(&self, want: u32) -> Take {
+        self.take_up_to(want, true)
+    }
+
+    fn take_up_to(&self, want: u32, in_pass: bool) -> Take {
         let mut s = self.lock();
         if let Some(r) = s.given_back.pop() {
             s.out += 1;
@@ -136,7 +147,10 @@ impl SampleQueue {
             return Take::Wait;
         }
         let fair = ((end - start) / (2 * self.devices)).max(1);
-        let limit = start.saturating_add(want.clamp(1, fair));
+        let mut limit = start.saturating_add(want.clamp(1, fair));
+        if in_pass {
+            limit = limit.min(self.grid.pass_end_after(start));
+        }
         let mut stop = self.grid.next_after(start);
         while stop < end {
             let next = self.grid.next_after(stop);
@@ -190,6 +204,25 @@ impl SampleQueue {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ranges_taken_in_pass_end_at_every_pass_end() {
+        // Passes of 0..100: 4, 8, 16, 32, 64, 100.
+        let q = SampleQueue::on_grid(Grid::new(0..100, 1), 0, 1);
+        let mut ranges = Vec::new();
+        while let Take::Range(r) = q.take_in_pass(1000) {
+            ranges.push(r);
+            q.finished();
+        }
+        let passes = [4, 8, 16, 32, 64, 100];
+        for end in passes {
+            assert!(ranges.iter().any(|r| r.end == end), "no range ends at {end}: {ranges:?}");
+        }
+        assert!(ranges.iter().all(|r| !passes.iter().any(|&p| r.start < p && p < r.end)), "{ranges:?}");
+        // Without it, a large want runs past pass ends.
+        let q = SampleQueue::on_grid(Grid::new(0..100, 1), 0, 1);
+        assert!(matches!(q.take(1000), Take::Range(r) if r.end > 4));
+    }
 
     #[test]
     fn grid_points_are_pass_ends_and_steps_within_passes() {

@@ -183,7 +183,9 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
     // The first chunk, a few samples, measures the device's rate.
     let (mut want, mut chunks) = (1u32, 0u32);
     let outcome: Result<()> = loop {
-        let range = match job.queue.take(want) {
+        // A render scored after every pass takes no range past a pass end.
+        let taken = if job.rows { job.queue.take_in_pass(want) } else { job.queue.take(want) };
+        let range = match taken {
             Take::Range(r) => r,
             Take::Wait => {
                 // Nothing new to take: read back what this device holds (the
