@@ -160,7 +160,8 @@ pub const LINEAR_MAX_CPU: usize = 512;
 /// every pixel faster (`super::prepared::pilots_layout`; the pilot's
 /// samples are thrown away: two samples' work, under 1% of the render's). Which is faster depends on
 /// the scene, not only on its size: on the H100 `cwbvh` renders
-/// `scenes/room_disk.json` 15% faster than `bvh2` and
+/// the disk-lit room with its lamp a fan of 64 triangles (before disks were
+/// one primitive) 15% faster than `bvh2` and
 /// `scenes/cornell_mesh.json` 10% faster, while `bvh2` is faster for
 /// terrain in smallpt's room at every size from 256 to 1M triangles
 /// (`docs/results/h100-caustics-2026-11-27`).
