@@ -313,12 +313,15 @@ fn balls() -> Vec<(Sphere, Material)> {
 /// triangles under the ceiling, a tilted disk light and a rectangle light
 /// (one primitive each, sampled by area), a light inside a glass ball (shadow rays
 /// cannot reach it: only paths through the glass may), a mesh that is the
-/// only light, and a room with no light at all.
+/// only light, the disk-lit room of `scenes/room_disk.json` (mirror and
+/// glass balls, rectangle walls, a disk lamp), and a room with no light at
+/// all.
 fn light_scenes() -> Vec<Scene> {
     let square = |y: f32| {
         let (a, b, c, d) = ([40.0, y, 70.0], [60.0, y, 70.0], [60.0, y, 90.0], [40.0, y, 90.0]);
         vec![(Triangle::new(a, b, c), emitter(40.0)), (Triangle::new(a, c, d), emitter(40.0))]
     };
+    let room = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/room_disk.json");
     let mut glass_lamp = balls();
     glass_lamp.push((Sphere::new([50.0, 60.0, 80.0], 10.0), Material { color: [0.999; 3], kind: GLASS, ior: 1.5, ..Default::default() }));
     glass_lamp.push((Sphere::new([50.0, 60.0, 80.0], 3.0), emitter(60.0)));
@@ -345,6 +348,7 @@ fn light_scenes() -> Vec<Scene> {
         ),
         room_with("light in glass", glass_lamp, square(81.0)),
         lit_mesh,
+        Scene::from_spec(room).expect(room),
         room_with("no light", balls(), Vec::new()),
     ]
 }

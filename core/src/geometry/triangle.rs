@@ -37,7 +37,9 @@ use crate::geometry::intersect::MISS;
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
 pub struct Triangle {
     pub v0: [f32; 3],
-    /// [`SHAPE_TRIANGLE`] (0), [`SHAPE_DISK`] or [`SHAPE_PARALLELOGRAM`].
+    /// [`SHAPE_TRIANGLE`] (0, as [`Triangle::new`] sets it), [`SHAPE_DISK`]
+    /// or [`SHAPE_PARALLELOGRAM`]. An engine that fills triangle buffers
+    /// itself leaves this word 0 (the host's checks refuse other values).
     pub shape: u32,
     pub v1: [f32; 3],
     pub _pad1: u32,

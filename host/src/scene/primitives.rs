@@ -1,7 +1,7 @@
 //! What a BVH is built over: spheres and triangles, in one index space
 //! (spheres first, then triangles), as the kernels see them.
 use anyhow::{bail, Result};
-use treelet_core::geometry::triangle::Triangle;
+use treelet_core::geometry::triangle::{Triangle, SHAPE_DISK, SHAPE_PARALLELOGRAM, SHAPE_TRIANGLE};
 use treelet_core::{Aabb, Sphere};
 
 /// Largest scene a build accepts: node indices must stay below `LEAF_BIT`.
@@ -60,9 +60,20 @@ impl<'a> Primitives<'a> {
         validate_spheres(self.spheres)?;
         // On all cores, as an engine checks every frame's mesh (1M triangles
         // took 10 ms on one core of the H100's host); the first bad one is named.
-        let bad = |t: &Triangle| [t.v0, t.v1, t.v2].iter().flatten().any(|x| !x.is_finite()) || !t.aabb().extent().is_finite();
+        let known = |t: &Triangle| matches!(t.shape, SHAPE_TRIANGLE | SHAPE_DISK | SHAPE_PARALLELOGRAM);
+        let bad = |t: &Triangle| {
+            !known(t) || [t.v0, t.v1, t.v2].iter().flatten().any(|x| !x.is_finite()) || !t.aabb().extent().is_finite()
+        };
         let Some(i) = self.triangles.par_iter().position_first(bad) else { return Ok(()) };
         let t = &self.triangles[i];
+        if !known(t) {
+            // Words an engine left in the padding (a w of 1.0, say) would
+            // otherwise make a triangle another shape.
+            bail!(
+                "triangle {i}: shape tag {:#x} is none of {SHAPE_TRIANGLE} (triangle), {SHAPE_DISK} (disk), {SHAPE_PARALLELOGRAM} (parallelogram); `Triangle::new` sets it",
+                t.shape
+            );
+        }
         for (k, v) in [t.v0, t.v1, t.v2].iter().enumerate() {
             if v.iter().any(|x| !x.is_finite()) {
                 bail!("triangle {i}: vertex {k} {v:?} is not finite");
@@ -115,5 +126,12 @@ mod tests {
         triangles[3].v1 = [f32::MAX, 0.0, 0.0];
         let e = format!("{:#}", all(&triangles).unwrap_err());
         assert_eq!(e, "triangle 3: its extent overflows f32");
+        triangles[3] = good;
+        triangles[2].shape = 1.0f32.to_bits();
+        let e = format!("{:#}", all(&triangles).unwrap_err());
+        assert!(e.starts_with("triangle 2: shape tag 0x3f800000 is none of"), "{e}");
+        triangles[2] = Triangle::disk([0.0; 3], [0.0, 0.0, 1.0], 1.0);
+        triangles[70_000] = Triangle::parallelogram([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        assert!(all(&triangles).is_ok());
     }
 }
