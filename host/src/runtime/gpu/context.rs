@@ -197,23 +197,22 @@ impl GpuContext {
 
     /// The names of the machine's Vulkan adapters, in index order.
     pub fn adapters() -> Vec<String> {
-        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN));
-        adapters.iter().map(|a| a.get_info().name).collect()
+        vulkan().1.iter().map(|a| a.get_info().name).collect()
     }
 
     /// The indices (as [`GpuContext::with_adapter`] takes them) of the
     /// Vulkan adapters that are GPUs, not CPU implementations such as lavapipe.
     pub fn gpu_adapters() -> Vec<usize> {
-        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN));
+        let adapters = &vulkan().1;
         (0..adapters.len()).filter(|&i| adapters[i].get_info().device_type != wgpu::DeviceType::Cpu).collect()
     }
 
     async fn new_async(index: Option<usize>) -> Result<Arc<Self>> {
         let start = Instant::now();
-        let instance = instance();
         let adapter = match index {
-            Some(i) => instance.enumerate_adapters(wgpu::Backends::VULKAN).await.into_iter().nth(i),
-            None => instance
+            Some(i) => vulkan().1.get(i).cloned(),
+            None => vulkan()
+                .0
                 .request_adapter(&wgpu::RequestAdapterOptions {
                     power_preference: wgpu::PowerPreference::HighPerformance,
                     ..Default::default()
@@ -380,12 +379,20 @@ impl GpuContext {
 /// largest offset alignment Vulkan allows).
 pub const SPLIT_UNIT: u64 = 768;
 
-/// A Vulkan instance (the backend Treelet's SPIR-V passthrough needs).
-fn instance() -> wgpu::Instance {
-    quiet_mesa_runtime_dir();
-    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-    desc.backends = wgpu::Backends::VULKAN;
-    wgpu::Instance::new(desc)
+/// The process's one Vulkan instance (the backend Treelet's SPIR-V
+/// passthrough needs) and its adapters, made on first use: a default render
+/// asked for them three times (are there GPUs, which, open it), and each new
+/// instance loads and queries the drivers again.
+fn vulkan() -> &'static (wgpu::Instance, Vec<wgpu::Adapter>) {
+    static VULKAN: std::sync::OnceLock<(wgpu::Instance, Vec<wgpu::Adapter>)> = std::sync::OnceLock::new();
+    VULKAN.get_or_init(|| {
+        quiet_mesa_runtime_dir();
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = wgpu::Backends::VULKAN;
+        let instance = wgpu::Instance::new(desc);
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+        (instance, adapters)
+    })
 }
 
 /// Mesa's Vulkan drivers print `error: XDG_RUNTIME_DIR is invalid or not
