@@ -1,5 +1,5 @@
 //! The engine API (`treelet::tracer`): closest hits of random rays through
-//! trees over random spheres and triangles, on the GPU and the CPU runner,
+//! trees over random spheres, triangles, disks and parallelograms, on the GPU and the CPU runner,
 //! each against the scan of every primitive (`treelet_core`, no tree), before
 //! and after a refit; and its errors.
 use glam::Vec3;
@@ -10,7 +10,7 @@ use treelet::runtime::gpu::GpuBackend;
 use treelet::tracer::{Quality, Ray, RayHit, Tracer};
 use treelet_core::geometry::buffers::Sphere;
 use treelet_core::geometry::prims::{Origin, Prims};
-use treelet_core::geometry::triangle::Triangle;
+use treelet_core::geometry::triangle::{Triangle, SHAPE_DISK, SHAPE_PARALLELOGRAM};
 use treelet_core::trace::classic::closest_hit_linear;
 use treelet_tests::{fresh_seed, gpu};
 
@@ -19,10 +19,18 @@ type Geometry = (Vec<Sphere>, Vec<Triangle>);
 fn geometry(rng: &mut impl Rng, spheres: usize, triangles: usize) -> Geometry {
     let mut p = || [rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32)];
     let s = (0..spheres).map(|_| Sphere::new(p(), 1.5)).collect();
+    // Every fifth a disk, every seventh a parallelogram (the flat shapes
+    // an engine may pass beside its triangles), on the same three points.
     let t = (0..triangles)
-        .map(|_| {
+        .map(|k| {
             let a = p();
-            Triangle::new(a, [a[0] + 4.0, a[1] + 1.0, a[2]], [a[0], a[1] + 3.0, a[2] + 4.0])
+            let (e1, e2) = ([4.0, 1.0, 0.0], [0.0, 3.0, 4.0]);
+            let t = Triangle::new(a, [a[0] + e1[0], a[1] + e1[1], a[2]], [a[0], a[1] + e2[1], a[2] + e2[2]]);
+            match k {
+                k if k % 5 == 0 => Triangle { shape: SHAPE_DISK, ..t },
+                k if k % 7 == 0 => Triangle::parallelogram(a, e1, e2),
+                _ => t,
+            }
         })
         .collect();
     (s, t)
@@ -34,7 +42,8 @@ fn moved(g: &Geometry, rng: &mut impl Rng) -> Geometry {
     let s = g.0.iter().map(|s| Sphere::new((Vec3::from(s.center) + off()).into(), s.radius)).collect();
     let t = g.1.iter().map(|t| {
         let o = off();
-        Triangle::new((Vec3::from(t.v0) + o).into(), (Vec3::from(t.v1) + o).into(), (Vec3::from(t.v2) + o).into())
+        let placed = Triangle::new((Vec3::from(t.v0) + o).into(), (Vec3::from(t.v1) + o).into(), (Vec3::from(t.v2) + o).into());
+        Triangle { shape: t.shape, ..placed }
     });
     (s, t.collect())
 }
@@ -86,9 +95,15 @@ fn check_record(what: &str, g: &Geometry, r: &Ray, h: &RayHit) {
             let t = &g.1[h.prim as usize - g.0.len()];
             let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
             let [b1, b2] = h.barycentrics;
-            assert!(b1 >= -1e-6 && b2 >= -1e-6 && b1 + b2 <= 1.0 + 1e-5, "{what}: ray {r:?}: barycentrics of {h:?}");
+            let inside = match t.shape {
+                SHAPE_DISK => b1 * b1 + b2 * b2 <= 1.0 + 1e-5,
+                SHAPE_PARALLELOGRAM => (-1e-6..=1.0 + 1e-6).contains(&b1) && (-1e-6..=1.0 + 1e-6).contains(&b2),
+                _ => b1 >= -1e-6 && b2 >= -1e-6 && b1 + b2 <= 1.0 + 1e-5,
+            };
+            assert!(inside, "{what}: ray {r:?}: barycentrics of {h:?}, shape {}", t.shape);
+            // v0 + b1 (v1 - v0) + b2 (v2 - v0), for every flat shape.
             let p = a * (1.0 - b1 - b2) + b * b1 + c * b2;
-            assert!((p - x).length() < tol, "{what}: ray {r:?}: triangle hit {h:?} at {x}, barycentrics give {p}");
+            assert!((p - x).length() < tol, "{what}: ray {r:?}: flat hit {h:?} at {x}, barycentrics give {p}");
             assert!((n - (b - a).cross(c - a).normalize()).length() < 1e-4, "{what}: ray {r:?}: normal of {h:?}");
         }
     }

@@ -13,6 +13,8 @@ use crate::trace::instances::{trace_instances, InstanceHit};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{WatertightRay, ray_triangle_barycentrics};
+use crate::geometry::flat::ray_plane_coordinates;
+use crate::geometry::features::{self, has};
 use crate::gpu::rng::BounceRng;
 use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel, trace};
 use crate::render::sampling::cosine_direction;
@@ -223,13 +225,19 @@ fn geometric_normal<const F: u32>(prims: &Prims, prim: u32, x: Vec3) -> Vec3 {
 }
 
 /// The barycentric coordinates (of `v1`, `v2`) where the ray `o + t d` hits
-/// primitive `prim`, by the traversal's own test; 0 for a sphere.
+/// primitive `prim`, by the traversal's own test; 0 for a sphere. For a
+/// disk or parallelogram, its coordinates along its two edges: the hit is
+/// `v0 + b1 (v1 - v0) + b2 (v2 - v0)` for every flat shape.
 #[inline]
 fn barycentrics<const F: u32>(prims: &Prims, prim: u32, o: Vec3, d: Vec3) -> (f32, f32) {
     if prims.is_sphere::<F>(prim) {
         return (0.0, 0.0);
     }
     let tri = &prims.triangle(prim - prims.sphere_count);
+    if has(F, features::SHAPES) && !tri.is_triangle() {
+        let (_, x, y) = ray_plane_coordinates(o, d, tri, MISS);
+        return (x, y);
+    }
     let (_, b1, b2) = ray_triangle_barycentrics(&WatertightRay::new(o, d), tri, MISS);
     (b1, b2)
 }
