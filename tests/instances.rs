@@ -239,6 +239,9 @@ fn instanced_tracer_rejects_bad_input_by_name() {
     let bad = [Triangle::new([0.0, f32::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
     let e = err(InstancedTracer::build(b, &[&tri, &bad], &[at(0)], Quality::Fast));
     assert!(e.contains("mesh 1") && e.contains("triangle 0"), "{e}");
+    let shapes = [tri[0], Triangle::disk([0.0; 3], [0.0, 0.0, 1.0], 1.0)];
+    let e = err(InstancedTracer::build(b, &[&tri, &shapes], &[at(0)], Quality::Fast));
+    assert!(e.contains("mesh 1") && e.contains("triangle 1") && e.contains("triangles only"), "{e}");
     // No instances: every ray misses, nothing is occluded.
     let mut scene = InstancedTracer::build(b, &[&tri], &[], Quality::Fast).unwrap();
     let ray = Ray::new([0.2, 0.2, -1.0], [0.0, 0.0, 1.0]);
@@ -250,6 +253,8 @@ fn instanced_tracer_rejects_bad_input_by_name() {
     assert!(e.contains("refit of mesh 2: there are 1 meshes"), "{e}");
     let e = format!("{:#}", scene.refit_mesh(b, 0, &[tri[0], tri[0]]).unwrap_err());
     assert!(e.contains("mesh 0") && e.contains("refit with 0 spheres and 2 triangles"), "{e}");
+    let e = format!("{:#}", scene.refit_mesh(b, 0, &[Triangle::parallelogram([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])]).unwrap_err());
+    assert!(e.contains("mesh 0") && e.contains("triangles only"), "{e}");
 }
 
 /// Stiff transforms: copies squashed a hundred-thousandfold along one axis, then

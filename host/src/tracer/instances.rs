@@ -128,6 +128,7 @@ impl<B: Backend> InstancedTracer<B> {
             if triangles.is_empty() {
                 bail!("mesh {m} has no triangles: every instanced mesh needs one");
             }
+            only_triangles(triangles).with_context(|| format!("mesh {m}"))?;
             let tracer = Tracer::build(b, &[], triangles, quality).with_context(|| format!("mesh {m}"))?;
             update_ms += tracer.last_update_ms();
             trees.push(tracer);
@@ -184,6 +185,7 @@ impl<B: Backend> InstancedTracer<B> {
         let Some(tracer) = self.meshes.get_mut(mesh) else {
             bail!("refit of mesh {mesh}: there are {} meshes", self.meshes.len());
         };
+        only_triangles(triangles).with_context(|| format!("mesh {mesh}"))?;
         tracer.refit(b, &[], triangles).with_context(|| format!("mesh {mesh}"))?;
         let refit_ms = tracer.last_update_ms();
         self.bounds[mesh] = mesh_bounds(triangles);
@@ -363,6 +365,15 @@ fn check_transform(m: &[[f32; 4]; 3]) -> Result<()> {
         bail!("the transform's inverse overflows f32: {m:?}");
     }
     Ok(())
+}
+
+/// Instanced meshes are walked by the triangle test alone (a kernel with
+/// fewer registers): a disk or parallelogram among them is refused by name.
+fn only_triangles(triangles: &[Triangle]) -> Result<()> {
+    match triangles.iter().position(|t| !t.is_triangle()) {
+        Some(i) => bail!("triangle {i} has shape {} (a disk or parallelogram): instanced meshes take triangles only", triangles[i].shape),
+        None => Ok(()),
+    }
 }
 
 /// The box of a mesh's triangles, in f64.
