@@ -21,6 +21,19 @@ use crate::geometry::intersect::MISS;
 use crate::geometry::triangle::{Triangle, SHAPE_DISK, SHAPE_PARALLELOGRAM, SHAPE_TRIANGLE};
 
 impl Triangle {
+    /// The primitive's bounding box (a disk's or parallelogram's, not its
+    /// three points').
+    #[inline]
+    pub fn aabb(&self) -> Aabb {
+        flat_aabb(self)
+    }
+
+    /// The primitive's area.
+    #[inline]
+    pub fn area(&self) -> f32 {
+        flat_area(self)
+    }
+
     /// The parallelogram with corner `corner` and edges `edge1`, `edge2`
     /// (its normal `edge1 × edge2`).
     pub fn parallelogram(corner: [f32; 3], edge1: [f32; 3], edge2: [f32; 3]) -> Triangle {

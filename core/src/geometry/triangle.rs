@@ -22,7 +22,6 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::geometry::aabb::Aabb;
 use crate::geometry::intersect::MISS;
 
 /// A flat primitive spanned by three points: the triangle `v0 v1 v2`
@@ -68,18 +67,8 @@ impl Triangle {
         self.shape == SHAPE_TRIANGLE
     }
 
-    /// The primitive's bounding box (a disk's or parallelogram's, not its
-    /// three points').
-    #[inline]
-    pub fn aabb(&self) -> Aabb {
-        crate::geometry::flat::flat_aabb(self)
-    }
-
-    /// The primitive's area.
-    #[inline]
-    pub fn area(&self) -> f32 {
-        crate::geometry::flat::flat_area(self)
-    }
+    // `aabb` and `area`, which depend on the shape, are with the shapes
+    // (`crate::geometry::flat`).
 }
 
 /// `a * b - c * d` within 1.5 ulps (W. Kahan), so its sign is exact, and
