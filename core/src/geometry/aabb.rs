@@ -97,7 +97,11 @@ impl Aabb {
             return 0.0;
         }
         let d = self.extent();
-        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+        // Explicit fused multiply-adds: a GPU compiler may fuse `a * b + c`
+        // on its own (lavapipe's LLVM does), the CPU does not, and builders
+        // that compare areas (H-PLOC's nearest neighbours) must pick the
+        // same pairs on both.
+        2.0 * libm::fmaf(d.x, d.y, libm::fmaf(d.y, d.z, d.z * d.x))
     }
     /// Half the surface area in f64: finite for every finite f32 box.
     #[inline]
