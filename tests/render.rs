@@ -376,8 +376,8 @@ fn block_means(p: &[[f32; 3]], w: usize, h: usize) -> Vec<f64> {
     out
 }
 
-/// Next-event estimation is unbiased: on every light scene its image
-/// matches smallpt's estimator's (whole-image mean within 3%, 8x6-pixel
+/// Next-event estimation, alone and with light paths for caustics, is
+/// unbiased: on every light scene its image matches smallpt's estimator's (whole-image mean within 3%, 8x6-pixel
 /// blocks within their noise) and has no NaN, infinite or negative pixel.
 /// A lost MIS weight (light counted twice), a wrong density (a factor of π
 /// or 2) or a light behind glass left dark all fail this.
@@ -387,41 +387,58 @@ fn nee_converges_to_the_smallpt_estimate() {
     let (w, h, spp) = (32usize, 24usize, 1024);
     for scene in light_scenes() {
         let s = settings(w as u32, h as u32, spp, seed, Accel::None);
-        let nee = pixels(&mut CpuBackend::new(), &scene, &with_integrator(s, Integrator::Nee));
         let plain = pixels(&mut CpuBackend::new(), &scene, &with_integrator(s, Integrator::Smallpt));
-        assert!(nee.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{}: NaN, infinite or negative pixels", scene.name);
-        let (bn, bp) = (block_means(&nee, w, h), block_means(&plain, w, h));
-        let (mn, mp) = (bn.iter().sum::<f64>() / bn.len() as f64, bp.iter().sum::<f64>() / bp.len() as f64);
-        eprintln!("{}: mean luminance nee {mn:.4}, smallpt {mp:.4}", scene.name);
-        if scene.name == "no light" {
-            assert!(mn == 0.0 && mp == 0.0, "no light: the image must be black (nee {mn}, smallpt {mp})");
-            continue;
-        }
-        assert!((mn / mp - 1.0).abs() < 0.03, "{}: mean luminance nee {mn}, smallpt {mp}", scene.name);
+        let bp = block_means(&plain, w, h);
+        let mp = bp.iter().sum::<f64>() / bp.len() as f64;
         // Blocks: the smallpt estimate's noise, from a second seed.
         let again = pixels(&mut CpuBackend::new(), &scene, &with_integrator(settings(w as u32, h as u32, spp, seed ^ 0x5555, Accel::None), Integrator::Smallpt));
         let ba = block_means(&again, w, h);
         let noise = (bp.iter().zip(&ba).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
-        let diff = (bp.iter().zip(&bn).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
-        assert!(diff < 1.5 * noise + 1e-3 * mp, "{}: blocks differ by {diff} (rms), smallpt's own noise {noise}", scene.name);
+        for integrator in [Integrator::Nee, Integrator::Caustics] {
+            let nee = pixels(&mut CpuBackend::new(), &scene, &with_integrator(s, integrator));
+            let name = integrator.name();
+            assert!(nee.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{} {name}: NaN, infinite or negative pixels", scene.name);
+            let bn = block_means(&nee, w, h);
+            let mn = bn.iter().sum::<f64>() / bn.len() as f64;
+            let diff = (bp.iter().zip(&bn).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
+            eprintln!("{}: mean luminance {name} {mn:.4}, smallpt {mp:.4}; blocks differ by {diff:.4} (rms), smallpt's own noise {noise:.4}", scene.name);
+            if scene.name == "no light" {
+                assert!(mn == 0.0 && mp == 0.0, "no light: the image must be black ({name} {mn}, smallpt {mp})");
+                continue;
+            }
+            assert!((mn / mp - 1.0).abs() < 0.03, "{} {name}: mean luminance {mn}, smallpt {mp}", scene.name);
+            // Light paths from a lamp mostly hidden in the ceiling (as
+            // cornell's) are noisier than smallpt's estimator: against the
+            // larger of the two noises.
+            let noise = if integrator == Integrator::Caustics {
+                let other = pixels(&mut CpuBackend::new(), &scene, &with_integrator(settings(w as u32, h as u32, spp, seed ^ 0x5555, Accel::None), integrator));
+                let bo = block_means(&other, w, h);
+                noise.max((bn.iter().zip(&bo).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bn.len() as f64).sqrt())
+            } else {
+                noise
+            };
+            assert!(diff < 1.5 * noise + 1e-3 * mp, "{} {name}: blocks differ by {diff} (rms), the larger noise {noise}", scene.name);
+        }
     }
 }
 
-/// Next-event estimation on the GPU equals the CPU runner's within noise.
+/// Next-event estimation, alone and with light paths, on the GPU equals the
+/// CPU runner's within noise (light paths land through atomics, in any order).
 #[test]
 fn nee_gpu_matches_cpu() {
     let Some(ctx) = gpu() else { return };
     let seed = treelet_tests::fresh_seed() as u32;
-    for scene in light_scenes().into_iter().take(4) {
-        let s = with_integrator(settings(48, 36, 16, seed, Accel::None), Integrator::Nee);
+    for (scene, integrator) in light_scenes().into_iter().take(4).flat_map(|s| [(s.clone(), Integrator::Nee), (s, Integrator::Caustics)]) {
+        let s = with_integrator(settings(48, 36, 16, seed, Accel::None), integrator);
         let g = pixels(&mut GpuBackend::new(ctx.clone()), &scene, &s);
         let c = pixels(&mut CpuBackend::new(), &scene, &s);
         let other = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { seed: seed.wrapping_add(1), ..s });
         let (gpu_cpu, noise) = (mean_abs(&g, &c), mean_abs(&c, &other));
         let same = 1.0 - mismatch_fraction(&g, &c, 1e-4);
-        eprintln!("{} nee: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}", scene.name, 100.0 * same);
-        assert!(same > 0.5, "{}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
-        assert!(gpu_cpu < 0.25 * noise, "{}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+        let name = integrator.name();
+        eprintln!("{} {name}: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}", scene.name, 100.0 * same);
+        assert!(same > 0.5, "{} {name}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
+        assert!(gpu_cpu < 0.25 * noise, "{} {name}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
     }
 }
 

@@ -315,6 +315,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             eprintln!("integrator {}", match args.integrator {
                 Integrator::Smallpt => "smallpt (emitters count where paths hit them; --integrator)",
                 Integrator::Nee => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
+                Integrator::Caustics => "caustics (nee, and one light path per camera path, traced through mirrors and glass to the diffuse points the camera sees: the caustics nee cannot find; --integrator)",
             });
         });
     }

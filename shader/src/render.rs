@@ -6,11 +6,31 @@ use treelet_core::geometry::features::{ALL, TRIANGLES};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
+use treelet_core::render::caustics::light_paths;
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
 use treelet_core::render::lights::Light;
 use treelet_core::trace::bvh2::Bvh2Tree;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
+
+/// What a pass of the render kernels adds to: the pixel sums (camera
+/// paths), or the light paths' landings (f32 bits, added with atomics).
+macro_rules! pass_target {
+    (camera) => { [f32; 4] };
+    (light) => { u32 };
+}
+
+/// A pass's work for one pixel: its camera paths, added to its sums, or
+/// its light paths (`treelet_core::render::caustics`), landing anywhere.
+macro_rules! pass_body {
+    (camera, $pixel:ident, $params:ident, $scene:ident, $lights:ident, $accum:ident, $features:expr) => {
+        let sums = render_pixel::<_, { $features }, 1>($pixel, $params, &$scene, $lights, &mut [0u32; 1], 0);
+        accumulate(&mut $accum[$pixel as usize], sums);
+    };
+    (light, $pixel:ident, $params:ident, $scene:ident, $lights:ident, $accum:ident, $features:expr) => {
+        light_paths::<_, { $features }, 1, [u32]>($pixel, $params, &$scene, $lights, $accum, &mut [0u32; 1], 0);
+    };
+}
 
 /// One path-tracing entry point: `render_pixel` for one closest-hit method
 /// (`$tree` made from bindings 3 and 4) and one feature set (see
@@ -22,7 +42,7 @@ macro_rules! render_kernel {
     // each pass one binding (`treelet_core::geometry::split`). The `cwbvh`
     // layout is not built past one binding yet, and its traversal lost 4%
     // of its diffuse rays/s to the split's branch (H100): it binds whole.
-    ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+    ($pass:ident $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -32,7 +52,7 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [pass_target!($pass)],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
@@ -43,14 +63,13 @@ macro_rules! render_kernel {
             if pixel != u32::MAX {
                 let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
                 let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
-                let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, lights, &mut [0u32; 1], 0);
-                accumulate(&mut accum[pixel as usize], sums);
+                pass_body!($pass, pixel, params, scene, lights, accum, $features);
             }
         }
     };
     // The scan, the seed's layout and `cwbvh`: their buffers in one
     // binding each, triangles still in one or two parts.
-    (whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+    ($pass:ident whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
         #[spirv(compute(threads(256)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -60,7 +79,7 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [[f32; 4]],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] accum: &mut [pass_target!($pass)],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
@@ -68,8 +87,7 @@ macro_rules! render_kernel {
             let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
             if pixel != u32::MAX {
                 let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
-                let sums = render_pixel::<_, { $features }, 1>(pixel, params, &scene, lights, &mut [0u32; 1], 0);
-                accumulate(&mut accum[pixel as usize], sums);
+                pass_body!($pass, pixel, params, scene, lights, accum, $features);
             }
         }
     };
@@ -83,9 +101,12 @@ macro_rules! render_entry_points {
         $(
             pub mod $name {
                 use super::*;
-                render_kernel!(whole linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
-                render_kernel!(bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
-                render_kernel!(whole cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
+                render_kernel!(camera whole linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                render_kernel!(camera bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                render_kernel!(camera whole cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
+                render_kernel!(light whole light_linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                render_kernel!(light light_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                render_kernel!(light whole light_cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
             }
         )*
     };
@@ -94,7 +115,7 @@ treelet_core::for_each_render_variant!(render_entry_points);
 
 // The seed's layout, kept for comparison: the general kernel only
 // (`render::classic_cs`).
-render_kernel!(whole classic_cs, Node, u32, ClassicTree::new, ALL);
+render_kernel!(camera whole classic_cs, Node, u32, ClassicTree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
 /// through one layout (`$tree` from bindings 3 and 4), its stack private,

@@ -215,7 +215,7 @@ pub struct RenderParams {
     /// Which rays [`crate::render::rays::cast_kernel`] casts (primary or diffuse).
     pub cast_mode: u32,
     pub camera: Camera,
-    /// [`SMALLPT`] or [`NEE`]: how the render kernels estimate radiance.
+    /// [`SMALLPT`], [`NEE`] or [`CAUSTICS`]: how the render kernels estimate radiance.
     pub integrator: u32,
     /// Entries of the light table ([`crate::render::lights::Light`]).
     pub light_count: u32,
@@ -230,6 +230,9 @@ const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
 pub const SMALLPT: u32 = 0;
 /// Next-event estimation with multiple importance sampling ([`crate::render::lights`]).
 pub const NEE: u32 = 1;
+/// [`NEE`], and light paths for the caustics it cannot find
+/// ([`crate::render::caustics`]): the camera paths leave those to them.
+pub const CAUSTICS: u32 = 2;
 
 /// Parameters of the treelet kernels. repr(C), Pod, 48 bytes.
 #[repr(C)]

@@ -68,6 +68,29 @@ pub fn add_device_acq_rel(slot: &mut u32, value: u32) -> u32 {
     }
 }
 
+/// Adds `value` to the f32 whose bits are in a storage-buffer word, with
+/// device scope, relaxed: a compare-exchange loop (float atomics need an
+/// extension not every device has).
+#[inline]
+pub fn add_f32_device(slot: &mut u32, value: f32) {
+    #[cfg(target_arch = "spirv")]
+    unsafe {
+        let mut old = spirv_std::arch::atomic_load::<u32, DEVICE, RELAXED>(slot);
+        loop {
+            let new = (f32::from_bits(old) + value).to_bits();
+            let seen = spirv_std::arch::atomic_compare_exchange::<u32, DEVICE, RELAXED, RELAXED>(slot, new, old);
+            if seen == old {
+                break;
+            }
+            old = seen;
+        }
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        *slot = (f32::from_bits(*slot) + value).to_bits();
+    }
+}
+
 /// Swaps `value` into a storage-buffer word with device scope, relaxed;
 /// returns the previous value.
 #[inline]

@@ -28,7 +28,7 @@
 //! [`crate::render::lights`]); both converge to the same image.
 use glam::Vec3;
 
-use crate::geometry::buffers::{Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
+use crate::geometry::buffers::{CAUSTICS, Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::split::Split;
@@ -177,7 +177,17 @@ pub struct Path {
     next_from: Origin,
     /// Roulette ended the path; a pending shadow ray is still traced.
     ended: bool,
+    /// Where the path stands among those light paths find instead
+    /// ([`CAUSTICS`]): [`SEEN_DIFFUSE`] after a diffuse first hit,
+    /// [`THEN_SPECULAR`] after mirror or glass bounces since; else 0.
+    caustic: u32,
 }
+
+/// [`Path::caustic`]: the camera's first hit was diffuse.
+const SEEN_DIFFUSE: u32 = 1;
+/// [`Path::caustic`]: then only mirror and glass bounces: the emitter such a
+/// path reaches is the light paths' to count.
+const THEN_SPECULAR: u32 = 2;
 
 impl Path {
     /// A path starting with the ray `(o, d)`, as sample `sample` of its pixel.
@@ -201,6 +211,7 @@ impl Path {
             next_d: d,
             next_from: Origin::NONE,
             ended: false,
+            caustic: 0,
         }
     }
 
@@ -231,7 +242,7 @@ impl Path {
         if (self.depth >= MAX_BOUNCES || self.ended) && self.shadow_light == NO_LIGHT {
             return false;
         }
-        let nee = params.integrator == NEE && params.light_count > 0;
+        let nee = (params.integrator == NEE || params.integrator == CAUSTICS) && params.light_count > 0;
         let shadow = self.shadow_light != NO_LIGHT;
         let occlusion = shadow && T::OCCLUSION_STOPS_EARLY;
         let query = if occlusion { Query::occlusion(self.shadow_t, self.shadow_light) } else { Query::CLOSEST };
@@ -258,7 +269,16 @@ impl Path {
         let nl = if n.dot(self.d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         let emission = Vec3::from_array(m.emission);
-        if nee && self.bsdf_pdf > 0.0 && emission != Vec3::ZERO {
+        // A light path ends on a diffuse point the camera sees after mirror
+        // or glass bounces from the side of an emitter it leaves from (any
+        // side of a flat one, the outside of a sphere): those paths are its
+        // (`crate::render::caustics`), not counted twice.
+        let theirs = has(F, features::MIRROR | features::GLASS)
+            && params.integrator == CAUSTICS
+            && self.caustic == THEN_SPECULAR
+            && (!scene.prims.is_sphere::<F>(hit.prim) || self.d.dot(n) < 0.0);
+        if theirs {
+        } else if nee && self.bsdf_pdf > 0.0 && emission != Vec3::ZERO {
             let light = light_pmf(lights, params.light_count, hit.prim)
                 * light_pdf(&scene.prims, hit.prim, self.last_x, self.d, hit.t);
             self.result += self.throughput * emission * power_heuristic(self.bsdf_pdf, light);
@@ -288,6 +308,7 @@ impl Path {
         // Branches for materials outside `F` are not compiled (the host
         // never runs such a kernel on a scene that has them).
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
+            self.caustic = if self.depth == 1 { SEEN_DIFFUSE } else { 0 };
             if nee {
                 let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
                 if s.light != NO_LIGHT && !T::OCCLUSION_STOPS_EARLY {
@@ -309,38 +330,15 @@ impl Path {
             self.bsdf_pdf = nl.dot(self.d).max(0.0) * core::f32::consts::FRAC_1_PI;
             self.last_x = x;
         } else if !has(F, features::GLASS) || (has(F, features::MIRROR) && m.kind == MIRROR) {
+            self.caustic = if self.caustic != 0 { THEN_SPECULAR } else { 0 };
             self.d = self.d - n * 2.0 * n.dot(self.d);
             self.o = x + nl * eps;
         } else {
-            let reflected = self.d - n * 2.0 * n.dot(self.d);
-            let into = n.dot(nl) > 0.0;
-            let (nc, nt) = (1.0, m.ior);
-            let nnt = if into { nc / nt } else { nt / nc };
-            let ddn = self.d.dot(nl);
-            let cos2t = 1.0 - nnt * nnt * (1.0 - ddn * ddn);
-            if cos2t < 0.0 {
-                // Total internal reflection.
-                self.d = reflected;
-                self.o = x + nl * eps;
-            } else {
-                let sign = if into { 1.0 } else { -1.0 };
-                let tdir = (self.d * nnt - n * (sign * (ddn * nnt + libm::sqrtf(cos2t)))).normalize();
-                let (a, b) = (nt - nc, nt + nc);
-                let r0 = a * a / (b * b);
-                let c = 1.0 - if into { -ddn } else { tdir.dot(n) };
-                let re = r0 + (1.0 - r0) * c * c * c * c * c;
-                let tr = 1.0 - re;
-                let p = 0.25 + 0.5 * re;
-                if rng.uniform(3) < p {
-                    self.throughput *= re / p;
-                    self.d = reflected;
-                    self.o = x + nl * eps;
-                } else {
-                    self.throughput *= tr / (1.0 - p);
-                    self.d = tdir;
-                    self.o = x - nl * eps;
-                }
-            }
+            self.caustic = if self.caustic != 0 { THEN_SPECULAR } else { 0 };
+            let b = glass_bounce(self.d, n, nl, m.ior, rng.uniform(3));
+            self.throughput *= b.weight;
+            self.d = b.d;
+            self.o = if b.refracted { x - nl * eps } else { x + nl * eps };
         }
         // The next ray leaves this sphere: into it when it heads against the
         // outward normal.
@@ -365,6 +363,48 @@ impl Path {
             (self.o, self.d, self.from) = (x + nl * eps, self.shadow_d, Origin { prim: hit.prim, into: self.shadow_d.dot(n) < 0.0 });
         }
         true
+    }
+}
+
+/// A bounce off smallpt's glass (Schlick's Fresnel): the new direction, the
+/// factor the path's throughput takes (reflection and refraction are picked
+/// with probability `P = 1/4 + Re/2` and weighted), and whether it
+/// refracted, with `eta`, the ratio of the indices on the side the ray comes
+/// from and the side it goes to. Camera paths and light paths
+/// ([`crate::render::caustics`]) take the same bounce.
+pub struct GlassBounce {
+    pub d: Vec3,
+    pub weight: f32,
+    pub refracted: bool,
+    pub eta: f32,
+}
+
+/// [`GlassBounce`] of a ray along `d` at a point of outward normal `n`
+/// (`nl` facing the ray), index of refraction `ior`, with the uniform `u`.
+#[inline]
+pub fn glass_bounce(d: Vec3, n: Vec3, nl: Vec3, ior: f32, u: f32) -> GlassBounce {
+    let reflected = d - n * 2.0 * n.dot(d);
+    let into = n.dot(nl) > 0.0;
+    let (nc, nt) = (1.0, ior);
+    let nnt = if into { nc / nt } else { nt / nc };
+    let ddn = d.dot(nl);
+    let cos2t = 1.0 - nnt * nnt * (1.0 - ddn * ddn);
+    if cos2t < 0.0 {
+        // Total internal reflection.
+        return GlassBounce { d: reflected, weight: 1.0, refracted: false, eta: 1.0 };
+    }
+    let sign = if into { 1.0 } else { -1.0 };
+    let tdir = (d * nnt - n * (sign * (ddn * nnt + libm::sqrtf(cos2t)))).normalize();
+    let (a, b) = (nt - nc, nt + nc);
+    let r0 = a * a / (b * b);
+    let c = 1.0 - if into { -ddn } else { tdir.dot(n) };
+    let re = r0 + (1.0 - r0) * c * c * c * c * c;
+    let tr = 1.0 - re;
+    let p = 0.25 + 0.5 * re;
+    if u < p {
+        GlassBounce { d: reflected, weight: re / p, refracted: false, eta: 1.0 }
+    } else {
+        GlassBounce { d: tdir, weight: tr / (1.0 - p), refracted: true, eta: nnt }
     }
 }
 

@@ -4,6 +4,8 @@
 //! - [`integrator`]: smallpt's estimator and next-event estimation with
 //!   multiple importance sampling, iterative, one path at a time per pixel
 //!   with path regeneration;
+//! - [`caustics`]: light paths for the caustics next-event estimation
+//!   cannot find, landing in the pixels the camera sees them in;
 //! - [`lights`]: light selection by power and sampling by solid angle or
 //!   area (Veach 1997, chapter 9; pbrt-v4's path integrator);
 //! - [`sampling`]: directions from uniform numbers, the same bits on both
@@ -11,6 +13,7 @@
 //! - [`rays`]: the ray-casting kernels (primary, diffuse, bounce rays, and
 //!   rays given by an engine);
 //! - [`variants`]: the feature sets render kernels are compiled for.
+pub mod caustics;
 pub mod integrator;
 pub mod lights;
 pub mod rays;

@@ -56,6 +56,10 @@ pub struct Prepared<B: Backend> {
     lights: B::Buffer,
     accum: B::Buffer,
     kernel: Kernel,
+    /// With `--integrator caustics` on a scene with mirrors or glass and
+    /// lights: the light paths' kernel and the buffer they land in (its
+    /// sums are added to `accum`'s when read).
+    light_paths: Option<(Kernel, B::Buffer)>,
     /// Render parameters but for the samples of a dispatch.
     params: RenderParams,
     per_dispatch: u32,
@@ -73,12 +77,23 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
     k
 }
 
+/// The light paths' kernel of a render with `integrator` following `plan`,
+/// if it traces any: caustics asked for, and mirrors or glass, and lights.
+fn light_kernel(integrator: super::Integrator, plan: &Plan, lights: bool) -> Option<Kernel> {
+    use treelet_core::geometry::features::{GLASS, MIRROR};
+    let specular = treelet_core::render::variants::VARIANTS[plan.variant].0 & (MIRROR | GLASS) != 0;
+    (integrator == super::Integrator::Caustics && specular && lights).then(|| Kernel::Light(plan.method(), plan.variant as u8))
+}
+
 /// Builds the pipelines of a render of `scene` with `settings` on `b`
 /// before its timed work: a fresh machine's driver compiles each for
 /// seconds, so all at once ([`Backend::prepare_kernels`]).
 pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
     let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class());
     let mut kernels = kernels(b, &plan);
+    let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
+    let lights = scene.materials.len() == all.len() && !light_table(all, &scene.materials).is_empty();
+    kernels.extend(light_kernel(settings.integrator, &plan, lights));
     if pilots_layout(settings, &plan, b.class()) {
         for layout in PILOT_LAYOUTS {
             let other = Plan { layout, ..plan.clone() };
@@ -166,6 +181,13 @@ impl<B: Backend> Prepared<B> {
             Some(sums) => b.upload("accumulation", sums)?,
             None => b.zeroed("accumulation", pixels * 16)?,
         };
+        if integrator == super::Integrator::Caustics && plan.method() == crate::runtime::kernels::Method::Classic {
+            bail!("--integrator caustics traces light paths through the scan and the bvh2 and cwbvh layouts, not the seed's classic layout");
+        }
+        let light_paths = match light_kernel(integrator, &plan, !table.is_empty()) {
+            Some(k) => Some((k, b.zeroed("light path landings", pixels * 16)?)),
+            None => None,
+        };
         Ok(Prepared {
             tree,
             buffers,
@@ -173,6 +195,7 @@ impl<B: Backend> Prepared<B> {
             lights,
             accum,
             kernel: Kernel::Render(plan.method(), plan.variant as u8),
+            light_paths,
             params,
             per_dispatch: samples_per_dispatch(pixels, b.class()),
             pixels,
@@ -191,6 +214,9 @@ impl<B: Backend> Prepared<B> {
             let params = RenderParams { samples, first_sample: first + done, ..self.params };
             let scene = (&self.materials, &self.lights, &params);
             dispatch_render(b, self.kernel, &self.tree, &self.buffers, scene, &self.accum)?;
+            if let Some((kernel, landings)) = &self.light_paths {
+                dispatch_render(b, *kernel, &self.tree, &self.buffers, scene, landings)?;
+            }
             done += samples;
         }
         Ok(())
@@ -203,7 +229,18 @@ impl<B: Backend> Prepared<B> {
 
     /// The per-pixel sums so far (waits for the dispatches).
     pub fn read_sums(&self, b: &mut B) -> Result<Vec<[f32; 4]>> {
-        b.read(&self.accum, self.pixels as usize)
+        let mut sums: Vec<[f32; 4]> = b.read(&self.accum, self.pixels as usize)?;
+        if let Some((_, landings)) = &self.light_paths {
+            // The light paths' landings: colour only (the squared
+            // luminance, for the noise estimate, is the camera paths').
+            let landed: Vec<[f32; 4]> = b.read(landings, self.pixels as usize)?;
+            for (s, l) in sums.iter_mut().zip(&landed) {
+                for k in 0..3 {
+                    s[k] += l[k];
+                }
+            }
+        }
+        Ok(sums)
     }
 }
 

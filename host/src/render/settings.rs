@@ -17,6 +17,10 @@ pub enum Integrator {
     /// Next-event estimation: a light sampled at every diffuse bounce, with
     /// multiple importance sampling (`treelet_core::render::lights`).
     Nee,
+    /// Next-event estimation, and light paths for the caustics it cannot
+    /// find (`treelet_core::render::caustics`): light through mirrors and
+    /// glass onto what the camera sees.
+    Caustics,
 }
 
 impl Integrator {
@@ -24,6 +28,7 @@ impl Integrator {
         match self {
             Integrator::Smallpt => treelet_core::geometry::buffers::SMALLPT,
             Integrator::Nee => treelet_core::geometry::buffers::NEE,
+            Integrator::Caustics => treelet_core::geometry::buffers::CAUSTICS,
         }
     }
 
@@ -32,6 +37,7 @@ impl Integrator {
         match self {
             Integrator::Smallpt => "smallpt",
             Integrator::Nee => "nee",
+            Integrator::Caustics => "caustics",
         }
     }
 
@@ -40,6 +46,7 @@ impl Integrator {
         match self {
             Integrator::Smallpt => "smallpt's estimator",
             Integrator::Nee => "next-event estimation",
+            Integrator::Caustics => "next-event estimation and light paths",
         }
     }
 }

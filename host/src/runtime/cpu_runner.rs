@@ -170,6 +170,53 @@ fn render_all<T: ClosestHit + Sync>(
         .for_each(|(id, acc)| accumulate(acc, render_variant(v, id as u32, p, scene, lights)));
 }
 
+/// Light paths' landings shared by the CPU runner's threads: each word an
+/// atomic, added to by compare-exchange (as the GPU does).
+struct SharedLandings<'a>(&'a [std::sync::atomic::AtomicU32]);
+
+impl treelet_core::render::caustics::Landings for SharedLandings<'_> {
+    fn add(&mut self, word: usize, value: f32) {
+        use std::sync::atomic::Ordering::Relaxed;
+        let slot = &self.0[word];
+        let mut old = slot.load(Relaxed);
+        while let Err(seen) = slot.compare_exchange_weak(old, (f32::from_bits(old) + value).to_bits(), Relaxed, Relaxed) {
+            old = seen;
+        }
+    }
+}
+
+/// The light paths of every pixel of a dispatch (`light_paths` compiled for
+/// `VARIANTS[v]`), in parallel: they land anywhere, so through atomics.
+fn light_all<T: ClosestHit + Sync>(
+    v: u8,
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    lights: &[Light],
+    splats: &mut [u32],
+    groups: u32,
+) {
+    use treelet_core::render::caustics::light_paths;
+    let pixels = (p.width * p.height).min(groups * WORKGROUP_SIZE);
+    let shared: &[std::sync::atomic::AtomicU32] = {
+        let words = splats.as_mut_ptr();
+        // SAFETY: `splats` is exclusively borrowed for this call, u32 and
+        // AtomicU32 have the same size and alignment, and every access below
+        // is atomic.
+        unsafe { std::slice::from_raw_parts(words as *const std::sync::atomic::AtomicU32, splats.len()) }
+    };
+    macro_rules! arms {
+        ([$v:ident] $($i:literal $name:ident [$($f:path),*];)*) => {
+            match $v {
+                $($i => (0..pixels).into_par_iter().for_each(|id| {
+                    light_paths::<T, { 0 $(| $f)* }, 1, _>(id, p, scene, lights, &mut SharedLandings(shared), &mut [0u32; 1], 0)
+                }),)*
+                _ => panic!("render variant {} of {}", $v, VARIANTS.len()),
+            }
+        };
+    }
+    treelet_core::for_each_render_variant!(arms, v)
+}
+
 /// The sort pass ranked by subgroups (`ITEMS` keys per lane), its
 /// workgroups one after another, each subgroup's operations emulated.
 fn multisplit_sort_pass<const ITEMS: u32>(
@@ -829,6 +876,27 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 Method::Cwbvh => {
                     let tree = WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
+                }
+            }
+        }
+        (Kernel::Light(method, v), [p, spheres, materials, nodes, prims, splats, triangles, lights]) => {
+            let p: treelet_core::RenderParams = params(p);
+            let lights: &[Light] = view(lights);
+            let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
+            let splats: &mut [u32] = view(splats);
+            match method {
+                Method::Scan => {
+                    let tree = Scan::new(&[], &[]);
+                    light_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, splats, groups)
+                }
+                Method::Classic => panic!("no light paths through the seed's layout"),
+                Method::Bvh2 => {
+                    let tree = Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
+                    light_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, splats, groups)
+                }
+                Method::Cwbvh => {
+                    let tree = WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
+                    light_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, splats, groups)
                 }
             }
         }

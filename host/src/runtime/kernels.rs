@@ -54,13 +54,24 @@ pub fn render_entry_point_name(method: Method, variant: usize) -> String {
     }
 }
 
-fn render_entry_point(method: Method, variant: u8) -> &'static str {
+/// The entry point of the light paths (`treelet_core::render::caustics`)
+/// for `method` and `VARIANTS[variant]`: beside the camera paths' (no
+/// seed layout).
+pub fn light_entry_point_name(method: Method, variant: usize) -> String {
+    format!("render::{}::light_{}_cs", VARIANTS[variant].1, method.name())
+}
+
+fn render_entry_point(method: Method, variant: u8, light: bool) -> &'static str {
     static NAMES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
     let names = NAMES.get_or_init(|| {
-        Method::ALL.iter().flat_map(|&m| (0..VARIANTS.len()).map(move |v| render_entry_point_name(m, v))).collect()
+        let name = |m: Method, v: usize, light: bool| if light { light_entry_point_name(m, v) } else { render_entry_point_name(m, v) };
+        [false, true]
+            .iter()
+            .flat_map(|&l| Method::ALL.iter().flat_map(move |&m| (0..VARIANTS.len()).map(move |v| name(m, v, l))))
+            .collect()
     });
     let m = Method::ALL.iter().position(|&x| x == method).unwrap();
-    &names[m * VARIANTS.len() + variant as usize]
+    &names[(light as usize * Method::ALL.len() + m) * VARIANTS.len() + variant as usize]
 }
 
 /// Every compute kernel of Treelet.
@@ -168,6 +179,9 @@ pub enum Kernel {
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
+    /// The light paths of [`Kernel::Render`]'s method and feature set, for
+    /// caustics (`treelet_core::render::caustics`; not for the seed layout).
+    Light(Method, u8),
     /// Ray-casting throughput (primary, bounce or diffuse passes) through a
     /// tree; `true`: compiled for triangles alone (meshes).
     Cast(Method, bool),
@@ -259,6 +273,9 @@ impl Kernel {
             for v in 0..VARIANTS.len() as u8 {
                 if method.specialized() || v == full {
                     all.push(Kernel::Render(method, v));
+                    if method != Method::Classic {
+                        all.push(Kernel::Light(method, v));
+                    }
                 }
             }
         }
@@ -322,7 +339,9 @@ impl Kernel {
             Kernel::WideCount => "cwbvh::wide_count_cs",
             Kernel::WidePlace => "cwbvh::wide_place_cs",
             Kernel::WideEmit => "cwbvh::wide_emit_cs",
-            Kernel::Render(method, v) => render_entry_point(method, v),
+            Kernel::Render(method, v) => render_entry_point(method, v, false),
+            Kernel::Light(Method::Classic, _) => panic!("no light paths through the seed's layout"),
+            Kernel::Light(method, v) => render_entry_point(method, v, true),
             Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
             Kernel::Cast(Method::Bvh2, false) => "render::cast_bvh2_cs",
             Kernel::Cast(Method::Cwbvh, false) => "render::cast_cwbvh_cs",
@@ -352,8 +371,8 @@ impl Kernel {
             Kernel::LeafPrims => &[3, 4],
             Kernel::WideEmit => &[9],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
-            Kernel::Render(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) => &[6, 3, 4],
-            Kernel::Render(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
+            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) => &[6, 3, 4],
+            Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
     }
@@ -417,7 +436,7 @@ impl Kernel {
             Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::Render(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
+            Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
             Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
         }
     }
