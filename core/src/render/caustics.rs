@@ -8,10 +8,13 @@
 //! the `s >= 1, t = 1` strategies of pbrt-v4's `bdpt`).
 //!
 //! The two estimators split path space instead of weighting each other:
-//! a light path counts only where it reaches, after one or more mirror or
-//! glass bounces, a diffuse point the camera sees, and camera paths drop
-//! exactly those paths (see [`crate::render::integrator::Path`]). Each
+//! from the lamp, one or more mirror or glass bounces, then one or more
+//! diffuse points, the last seen by the camera, are the light paths'; camera
+//! paths drop exactly those (see [`crate::render::integrator::Path`]). Each
 //! part of the image then comes from one estimator, unbiased either way.
+//! (Diffuse bounces after the caustic carry its light on: the room's walls
+//! lit by the glass ball's spot, which camera paths find only by a diffuse
+//! bounce that happens to reach the lamp through the glass.)
 //!
 //! One light path is traced per camera path (per pixel and sample), so that
 //! the light paths' estimate, `1 / (width x height x spp)` of their sum,
@@ -80,8 +83,11 @@ pub fn light_paths<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?S
 }
 
 /// One light path: from a point on a light chosen by power, a cosine-
-/// weighted direction, through mirror and glass bounces, to the first
-/// diffuse point, which it links to the camera if it bounced at least once.
+/// weighted direction, through one or more mirror and glass bounces, then
+/// diffuse bounces, each diffuse point linked to the camera; it ends at
+/// the first diffuse point if it met no mirror or glass before (next-event
+/// estimation finds that light), and at a mirror or glass after a diffuse
+/// point (camera paths find those).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>(
@@ -124,6 +130,8 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
     let outward = hit_normal_for::<F>(prims, light.prim, y, d);
     let mut from = Origin { prim: light.prim, into: d.dot(outward) < 0.0 };
     let mut bounces = 0;
+    // Past the caustic's mirror and glass bounces, at a diffuse point.
+    let mut diffuse = false;
     while bounces < MAX_BOUNCES {
         let hit = trace::<T, F, S>(o, d, from, Query::CLOSEST, scene, stack, lane);
         if !hit.is_hit() {
@@ -133,21 +141,29 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
         let x = o + d * hit.t;
         let n = hit_normal_for::<F>(prims, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
-        if m.kind == DIFFUSE {
-            if bounces > 0 {
-                let albedo = Vec3::from_array(m.color) * core::f32::consts::FRAC_1_PI;
-                to_camera::<T, F, S, L>(x, n, nl, hit.prim, power * albedo, sample, params, scene, splats, stack, lane);
-            }
-            return;
+        if m.kind == DIFFUSE && bounces == 0 {
+            return; // Not a caustic: next-event estimation's.
+        }
+        if m.kind != DIFFUSE && diffuse {
+            return; // A mirror or glass after the caustic: camera paths'.
         }
         bounces += 1;
         let rng = BounceRng::new(seed, id, sample, bounces);
-        power *= Vec3::from_array(m.color);
         let eps = surface_offset(x);
-        if has(F, features::MIRROR) && m.kind == MIRROR {
+        if m.kind == DIFFUSE {
+            // The caustic's light, and its diffuse bounces, seen by the camera.
+            let albedo = Vec3::from_array(m.color);
+            to_camera::<T, F, S, L>(x, n, nl, hit.prim, power * albedo * core::f32::consts::FRAC_1_PI, sample, params, scene, splats, stack, lane);
+            diffuse = true;
+            power *= albedo;
+            d = cosine_direction(nl, rng.uniform(2), rng.uniform(3));
+            o = x + nl * eps;
+        } else if has(F, features::MIRROR) && m.kind == MIRROR {
+            power *= Vec3::from_array(m.color);
             d = d - n * 2.0 * n.dot(d);
             o = x + nl * eps;
         } else {
+            power *= Vec3::from_array(m.color);
             let b = glass_bounce(d, n, nl, m.ior, rng.uniform(0));
             // Light crossing into a denser medium spreads its flux over
             // more solid angle: camera paths (smallpt's) carry radiance

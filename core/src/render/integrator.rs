@@ -178,15 +178,15 @@ pub struct Path {
     /// Roulette ended the path; a pending shadow ray is still traced.
     ended: bool,
     /// Where the path stands among those light paths find instead
-    /// ([`CAUSTICS`]): [`SEEN_DIFFUSE`] after a diffuse first hit,
+    /// ([`CAUSTICS`]): [`SEEN_DIFFUSE`] while every hit has been diffuse,
     /// [`THEN_SPECULAR`] after mirror or glass bounces since; else 0.
     caustic: u32,
 }
 
-/// [`Path::caustic`]: the camera's first hit was diffuse.
+/// [`Path::caustic`]: every hit so far was diffuse.
 const SEEN_DIFFUSE: u32 = 1;
 /// [`Path::caustic`]: then only mirror and glass bounces: the emitter such a
-/// path reaches is the light paths' to count.
+/// path reaches is the light paths' to count (see `crate::render::caustics`).
 const THEN_SPECULAR: u32 = 2;
 
 impl Path {
@@ -269,9 +269,9 @@ impl Path {
         let nl = if n.dot(self.d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         let emission = Vec3::from_array(m.emission);
-        // A light path ends on a diffuse point the camera sees after mirror
-        // or glass bounces from the side of an emitter it leaves from (any
-        // side of a flat one, the outside of a sphere): those paths are its
+        // Diffuse hits, then mirror or glass, then the side of an emitter
+        // that light paths leave from (any side of a flat one, the outside
+        // of a sphere): those paths are the light paths'
         // (`crate::render::caustics`), not counted twice.
         let theirs = has(F, features::MIRROR | features::GLASS)
             && params.integrator == CAUSTICS
@@ -308,7 +308,7 @@ impl Path {
         // Branches for materials outside `F` are not compiled (the host
         // never runs such a kernel on a scene that has them).
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
-            self.caustic = if self.depth == 1 { SEEN_DIFFUSE } else { 0 };
+            self.caustic = if self.depth == 1 || self.caustic == SEEN_DIFFUSE { SEEN_DIFFUSE } else { 0 };
             if nee {
                 let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
                 if s.light != NO_LIGHT && !T::OCCLUSION_STOPS_EARLY {
