@@ -34,7 +34,7 @@ pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
     let parameters = serde_json::json!({ "scenes": SCENES.map(|s| s.1), "width": w, "height": h, "spp": spp, "reference_spp": reference_spp });
     wall.parameters = parameters.clone();
     kernel.parameters = parameters;
-    let pb = bar(SCENES.len() * (1 + 2 * s.repeats), "renders");
+    let pb = bar(SCENES.len() * (1 + 3 * s.repeats), "renders");
     for (name, spec) in SCENES {
         let scene = Scene::from_spec(spec)?;
         let settings = |integrator, spp, seed, error_each_pass| RenderSettings {
@@ -55,7 +55,7 @@ pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
             let path = s.out.join(format!("error_reference_{name}.exr"));
             image_io::write(&path, &reference)?;
             pb.inc(1);
-            for integrator in [Integrator::Smallpt, Integrator::Nee] {
+            for integrator in [Integrator::Smallpt, Integrator::Nee, Integrator::Caustics] {
                 pb.set_message(format!("{name}: {}", integrator.name()));
                 // Warm-up: the first render compiles the kernel (Mitsuba's times also leave that out).
                 render(b, &scene, &settings(integrator, 4, 1, false), None, |_| {})?;
