@@ -105,7 +105,9 @@ fn every_variant_renders_what_the_full_kernel_renders() {
             eprintln!("{} ({accel:?}, {}): {:.2}% of GPU pixels differ from the full kernel", scene.name, g.plan.kernel, off * 100.0);
         }
     }
-    let specialized: BTreeSet<&str> = VARIANTS.iter().map(|v| v.1).filter(|&n| n != "full").collect();
+    // (The caustics variants are the light paths' tests': tests/render.rs.)
+    let specialized: BTreeSet<&str> =
+        VARIANTS.iter().filter(|v| v.0 & features::CAUSTICS == 0).map(|v| v.1).filter(|&n| n != "full").collect();
     assert_eq!(exercised, specialized, "every specialized variant is exercised");
 }
 
@@ -115,9 +117,16 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner);
+            let p = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, false);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
+            assert_eq!(compiled & features::CAUSTICS, 0, "{}: {} has light paths unasked", scene.name, p.kernel);
+            // Light paths asked for: where there are mirrors or glass, and lights.
+            let c = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, true);
+            let f = SceneFeatures::of(&scene);
+            let wants = f.mirror + f.glass > 0 && f.emissive > 0;
+            assert_eq!(VARIANTS[c.variant].0 & features::CAUSTICS != 0, wants, "{}: {} with --integrator caustics", scene.name, c.kernel);
+            assert_eq!(VARIANTS[c.variant].0 & bits, bits, "{}: {} lacks a feature", scene.name, c.kernel);
             if scene.materials.iter().any(|m| m.kind == treelet_core::geometry::buffers::GLASS) {
                 assert!(compiled & features::GLASS != 0, "{}: glass without refraction", scene.name);
             }
@@ -138,14 +147,14 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
         // On a GPU, a render long enough pays for the treelets, a short one does not.
         if scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len() > LINEAR_MAX_CPU {
             let gpu = treelet::runtime::backend::DeviceClass::Gpu;
-            assert_eq!(plan(&scene, 1, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu).accel, Accel::Lbvh);
-            let long = plan(&scene, 1 << 40, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu);
+            assert_eq!(plan(&scene, 1, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false).accel, Accel::Lbvh);
+            let long = plan(&scene, 1 << 40, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false);
             assert_eq!(long.accel, Accel::Trbvh, "{}", scene.name);
             assert!(long.accel_reason.contains("pays for"), "{}", long.accel_reason);
         }
         // Forced choices stay as asked.
         use treelet::runtime::backend::DeviceClass::Gpu;
-        assert_eq!(plan(&scene, 1 << 40, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu).accel, Accel::Sweep);
-        assert_eq!(plan(&scene, 1, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu).layout, Layout::Cwbvh);
+        assert_eq!(plan(&scene, 1 << 40, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu, false).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, 1, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu, false).layout, Layout::Cwbvh);
     }
 }

@@ -297,7 +297,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let memory = MemoryEstimate::of(&settings, (scene.spheres.len() + scene.triangles.len()) as u64, &classes);
     if args.explain {
         bar.suspend(|| {
-            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class()).explain());
+            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), args.integrator == Integrator::Caustics).explain());
             eprintln!(
                 "memory     about {} of host memory (image {}, scene and trees {}); {} available (TREELET_MAX_MEMORY caps it)",
                 human(memory.total_bytes),

@@ -20,8 +20,13 @@ pub const GLASS: u32 = 8;
 /// triangles are, see [`crate::geometry::flat`]): without it a kernel tests
 /// every flat primitive as a triangle.
 pub const SHAPES: u32 = 16;
-/// Everything: the general kernel.
+/// Everything a scene can have: the general kernel.
 pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES;
+/// Not of the scene but of the render: camera paths that leave caustics to
+/// light paths (`--integrator caustics`, [`crate::render::caustics`]), and
+/// the light paths' kernel. Outside [`ALL`], so that the kernels of every
+/// other render have none of that code (it cost cornell's NEE kernel 2%).
+pub const CAUSTICS: u32 = 32;
 
 /// Whether `features` includes `feature`.
 #[inline]

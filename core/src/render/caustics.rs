@@ -62,8 +62,8 @@ pub const SPLAT_WORDS: u32 = 4;
 /// Kernel body (one invocation per pixel, as [`crate::render::integrator::render_pixel`]):
 /// `params.samples` light paths, keyed by pixel `id` and sample, each
 /// adding what it carries to the camera into `splats` (f32 bits,
-/// [`SPLAT_WORDS`] a pixel). Nothing without mirrors or glass in `F`, or
-/// without lights.
+/// [`SPLAT_WORDS`] a pixel). Nothing without [`features::CAUSTICS`] in
+/// `F` (the host runs it on scenes with mirrors or glass), or without lights.
 #[inline]
 pub fn light_paths<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>(
     id: u32,
@@ -74,7 +74,7 @@ pub fn light_paths<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?S
     stack: &mut [u32; S],
     lane: u32,
 ) {
-    if !has(F, features::MIRROR | features::GLASS) || params.light_count == 0 {
+    if !has(F, features::CAUSTICS) || params.light_count == 0 {
         return;
     }
     for s in 0..params.samples {

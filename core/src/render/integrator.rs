@@ -275,7 +275,7 @@ impl Path {
         // that light paths leave from (any side of a flat one, the outside
         // of a sphere): those paths are the light paths'
         // (`crate::render::caustics`), not counted twice.
-        let caustics = has(F, features::MIRROR | features::GLASS) && params.integrator == CAUSTICS;
+        let caustics = has(F, features::CAUSTICS) && params.integrator == CAUSTICS;
         let theirs = caustics
             && self.flags & THEN_SPECULAR != 0
             && (!scene.prims.is_sphere::<F>(hit.prim) || self.d.dot(n) < 0.0);

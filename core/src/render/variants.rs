@@ -21,7 +21,9 @@ macro_rules! for_each_render_variant {
             2 spheres [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS];
             3 triangles_diffuse [$crate::geometry::features::TRIANGLES];
             4 mixed_diffuse [$crate::geometry::features::SPHERES, $crate::geometry::features::TRIANGLES];
-            5 full [$crate::geometry::features::ALL];
+            5 spheres_caustics [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::CAUSTICS];
+            6 full_caustics [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS];
+            7 full [$crate::geometry::features::ALL];
         }
     };
 }

@@ -7,7 +7,7 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::lights::{light_power, Light};
 
-use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
+use super::settings::{samples_per_dispatch, Integrator, MemoryEstimate, RenderSettings};
 use super::variant::{self, Plan, PILOT_MIN_SPP};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
@@ -77,23 +77,24 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
     k
 }
 
-/// The light paths' kernel of a render with `integrator` following `plan`,
-/// if it traces any: caustics asked for, and mirrors or glass, and lights.
-fn light_kernel(integrator: super::Integrator, plan: &Plan, lights: bool) -> Option<Kernel> {
-    use treelet_core::geometry::features::{GLASS, MIRROR};
-    let specular = treelet_core::render::variants::VARIANTS[plan.variant].0 & (MIRROR | GLASS) != 0;
-    (integrator == super::Integrator::Caustics && specular && lights).then(|| Kernel::Light(plan.method(), plan.variant as u8))
+/// The light paths' kernel of a render following `plan`, if it traces any:
+/// caustics asked for, and mirrors or glass, and lights (see
+/// [`variant::plan`], which then picks a variant with
+/// `treelet_core::geometry::features::CAUSTICS`).
+fn light_kernel(plan: &Plan, lights: bool) -> Option<Kernel> {
+    let caustics = treelet_core::render::variants::VARIANTS[plan.variant].0 & treelet_core::geometry::features::CAUSTICS != 0;
+    (caustics && lights).then(|| Kernel::Light(plan.method(), plan.variant as u8))
 }
 
 /// Builds the pipelines of a render of `scene` with `settings` on `b`
 /// before its timed work: a fresh machine's driver compiles each for
 /// seconds, so all at once ([`Backend::prepare_kernels`]).
 pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
-    let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class());
+    let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class(), settings.integrator == Integrator::Caustics);
     let mut kernels = kernels(b, &plan);
     let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
     let lights = scene.materials.len() == all.len() && !light_table(all, &scene.materials).is_empty();
-    kernels.extend(light_kernel(settings.integrator, &plan, lights));
+    kernels.extend(light_kernel(&plan, lights));
     if pilots_layout(settings, &plan, b.class()) {
         for layout in PILOT_LAYOUTS {
             let other = Plan { layout, ..plan.clone() };
@@ -155,7 +156,7 @@ impl<B: Backend> Prepared<B> {
         if let Some(sums) = base.filter(|sums| sums.len() as u64 != pixels) {
             bail!("the sums to resume from are of {} pixels, the image has {pixels}", sums.len());
         }
-        let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class());
+        let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class(), integrator == Integrator::Caustics);
         let materials = b.upload("materials", &scene.materials)?;
         let table = light_table(all, &scene.materials);
         let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;
@@ -181,10 +182,10 @@ impl<B: Backend> Prepared<B> {
             Some(sums) => b.upload("accumulation", sums)?,
             None => b.zeroed("accumulation", pixels * 16)?,
         };
-        if integrator == super::Integrator::Caustics && plan.method() == crate::runtime::kernels::Method::Classic {
+        if integrator == Integrator::Caustics && plan.method() == crate::runtime::kernels::Method::Classic {
             bail!("--integrator caustics traces light paths through the scan and the bvh2 and cwbvh layouts, not the seed's classic layout");
         }
-        let light_paths = match light_kernel(integrator, &plan, !table.is_empty()) {
+        let light_paths = match light_kernel(&plan, !table.is_empty()) {
             Some(k) => Some((k, b.zeroed("light path landings", pixels * 16)?)),
             None => None,
         };

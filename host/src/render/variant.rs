@@ -91,6 +91,7 @@ fn optional(bits: u32) -> String {
         (features::MIRROR, "mirror"),
         (features::GLASS, "glass"),
         (features::SHAPES, "disks and parallelograms"),
+        (features::CAUSTICS, "light paths for caustics"),
     ]
     .iter()
     .filter(|(bit, _)| bits & bit != 0)
@@ -192,7 +193,7 @@ pub struct Plan {
 /// treelet-optimized BVH, whichever gives the least build plus render time
 /// ([`cheaper_builder`]);
 /// `Layout::Auto` the fastest measured layout.
-pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass) -> Plan {
+pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass, light_paths: bool) -> Plan {
     let features = SceneFeatures::of(scene);
     let (n, cost) = (features.primitives(), features.scan_cost());
     let runs_on_cpu = class != DeviceClass::Gpu;
@@ -236,11 +237,15 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
         other => (other, "as asked (--layout)".to_string()),
     };
     let method = if accel == Accel::None { crate::runtime::kernels::Method::Scan } else { layout.method() };
-    let bits = features.bits();
+    // Light paths (`--integrator caustics`) where they can find caustics:
+    // mirrors or glass, and lights.
+    let caustics = light_paths && features.mirror + features.glass > 0 && features.emissive > 0;
+    let bits = features.bits() | if caustics { features::CAUSTICS } else { 0 };
+    let full = if caustics { smallest_variant(features::ALL | features::CAUSTICS) } else { full_variant() };
     let (variant, kernel_reason) = match kernel {
-        KernelChoice::Full => (full_variant(), "as asked (--kernel full)".to_string()),
+        KernelChoice::Full => (full, "as asked (--kernel full)".to_string()),
         KernelChoice::Auto if !method.specialized() => {
-            (full_variant(), format!("the {} layout has the general kernel only", layout.name()))
+            (full, format!("the {} layout has the general kernel only", layout.name()))
         }
         KernelChoice::Auto => {
             let v = smallest_variant(bits);
