@@ -437,8 +437,15 @@ fn nee_gpu_matches_cpu() {
         let same = 1.0 - mismatch_fraction(&g, &c, 1e-4);
         let name = integrator.name();
         eprintln!("{} {name}: {:.1}% of pixels agree within 1e-4; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}", scene.name, 100.0 * same);
-        assert!(same > 0.5, "{} {name}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
-        assert!(gpu_cpu < 0.25 * noise, "{} {name}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+        if integrator == Integrator::Caustics {
+            // Light paths land through atomics in any order, so the float
+            // sums differ in their last bits wherever they land (everywhere,
+            // for a light inside glass): far less than the noise, though.
+            assert!(gpu_cpu < 0.05 * noise, "{} {name}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+        } else {
+            assert!(same > 0.5, "{} {name}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
+            assert!(gpu_cpu < 0.25 * noise, "{} {name}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+        }
     }
 }
 
