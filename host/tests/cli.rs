@@ -826,6 +826,12 @@ fn renders_past_the_memory_are_refused_with_the_estimate() {
     let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "1", "--explain", "--out", out]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && e.contains("of host memory") && e.contains("available"), "{e}");
+    // Cornell has glass and a lamp: the explanation names the light paths,
+    // and asking for them picks the variant that traces them.
+    assert!(e.contains("`--integrator caustics` adds light paths"), "{e}");
+    let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "4", "--integrator", "caustics", "--explain", "--out", out]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && e.contains("spheres_caustics") && e.contains("light paths for caustics"), "{e}");
     let _ = std::fs::remove_file(out);
 }
 

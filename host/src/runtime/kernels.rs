@@ -273,7 +273,9 @@ impl Kernel {
             for v in 0..VARIANTS.len() as u8 {
                 if method.specialized() || v == full {
                     all.push(Kernel::Render(method, v));
-                    if method != Method::Classic && VARIANTS[v as usize].0 & treelet_core::geometry::features::CAUSTICS != 0 {
+                    // Every variant has one (the shader makes them all; only
+                    // the caustics variants' trace anything).
+                    if method != Method::Classic {
                         all.push(Kernel::Light(method, v));
                     }
                 }
