@@ -86,8 +86,18 @@ pub fn add_f32_device(slot: &mut u32, value: f32) {
         }
     }
     #[cfg(not(target_arch = "spirv"))]
-    {
-        *slot = (f32::from_bits(*slot) + value).to_bits();
+    add_f32_host(host_atomic(slot), value);
+}
+
+/// [`add_f32_device`] on the host, for words that threads share (the CPU
+/// runner's light paths): the same compare-exchange loop.
+#[cfg(not(target_arch = "spirv"))]
+#[inline]
+pub fn add_f32_host(slot: &core::sync::atomic::AtomicU32, value: f32) {
+    use core::sync::atomic::Ordering::Relaxed;
+    let mut old = slot.load(Relaxed);
+    while let Err(seen) = slot.compare_exchange_weak(old, (f32::from_bits(old) + value).to_bits(), Relaxed, Relaxed) {
+        old = seen;
     }
 }
 

@@ -176,12 +176,7 @@ struct SharedLandings<'a>(&'a [std::sync::atomic::AtomicU32]);
 
 impl treelet_core::render::caustics::Landings for SharedLandings<'_> {
     fn add(&mut self, word: usize, value: f32) {
-        use std::sync::atomic::Ordering::Relaxed;
-        let slot = &self.0[word];
-        let mut old = slot.load(Relaxed);
-        while let Err(seen) = slot.compare_exchange_weak(old, (f32::from_bits(old) + value).to_bits(), Relaxed, Relaxed) {
-            old = seen;
-        }
+        treelet_core::gpu::atomics::add_f32_host(&self.0[word], value);
     }
 }
 
