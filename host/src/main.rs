@@ -225,7 +225,11 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         println!("cpu: the CPU runner");
         return Ok(());
     }
+    // The devices open (Vulkan's instance and device: a tenth of a second
+    // each on an H100) while the scene and any parts load.
+    let opening = OpenDevices::start(args.devices.clone(), args.device);
     let scene = Scene::from_spec(&args.scene)?;
+    treelet::runtime::timeline::mark("scene");
     if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);
     }
@@ -274,14 +278,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         error_each_pass: args.report.is_some() || args.reference.is_some(),
         first_sample,
     };
-    // A single device is a list of one; by default a machine with several
-    // GPUs renders on all of them.
-    let gpus = if args.devices.is_none() && args.device == DeviceChoice::Auto { GpuContext::gpu_adapters() } else { Vec::new() };
-    let list = match &args.devices {
-        Some(spec) => treelet::render::devices::open(spec)?,
-        None if gpus.len() > 1 => gpus.into_iter().map(|i| Ok(Device::Gpu(GpuContext::with_adapter(i)?))).collect::<Result<Vec<_>>>()?,
-        None => vec![args.device.open()?],
-    };
+    let list = opening.finish()?;
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -317,7 +314,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             eprintln!("integrator {}", match (args.integrator, has_caustics) {
                 (Integrator::Smallpt, _) => "smallpt (emitters count where paths hit them; --integrator)",
                 (Integrator::Nee, false) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
-                (Integrator::Nee, true) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator).                     The scene has mirrors or glass, so caustics: `--integrator caustics` adds light paths for them                     (the disk-lit room: 0.89x nee's error at equal time on an H100; not the default, as a lamp mostly hidden, as cornell's, makes them noisy)",
+                (Integrator::Nee, true) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator).\n           The scene has mirrors or glass, so caustics: `--integrator caustics` adds light paths for them\n           (the disk-lit room: 0.89x nee's error at equal time on an H100; not the default, as a lamp mostly hidden, as cornell's, makes them noisy)",
                 (Integrator::Caustics, true) => "caustics (nee, and one light path per camera path, traced through mirrors and glass to the diffuse points the camera sees: the caustics nee cannot find; --integrator)",
                 (Integrator::Caustics, false) => "caustics: without mirrors or glass, or without lights, the scene has none, so this is nee (--integrator)",
             });
@@ -360,6 +357,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
     }
     let write_s = write_start.elapsed().as_secs_f64();
+    treelet::runtime::timeline::mark("image written");
     let startup = match &list[..] {
         [Device::Gpu(ctx)] => {
             let (pipelines, pipelines_s) = ctx.pipelines_built();
@@ -394,11 +392,14 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             eprintln!("           slowest pipelines: {}", slowest.join(", "));
         }
     }
+    if args.explain {
+        eprintln!("timeline   {} s (the stages of this process so far, each ending where named)", treelet::runtime::timeline::summary());
+    }
     if args.explain && args.layout == Layout::Auto && result.plan.accel != Accel::None {
         eprintln!("layout     {} (as rendered): {}", result.plan.layout.name(), result.plan.layout_reason);
     }
     // Wall time of the whole run so far: start-up, device, pipelines, render, image.
-    let process_s = PROCESS_START.get().map_or(0.0, |t| t.elapsed().as_secs_f64());
+    let process_s = treelet::runtime::timeline::now_s();
     let spp = done.end - done.start;
     // Only the samples this run rendered count toward its rate.
     let resumed = resume.as_ref().map_or(0, |(r, _)| r.end - r.start);
@@ -622,15 +623,55 @@ fn run(cli: Cli) -> Result<bool> {
     }
 }
 
-/// When the process started (as near as `main` knows), for wall times.
-static PROCESS_START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+/// The render's devices, opened on a thread of their own; joined when
+/// taken or dropped, so that no thread is inside a driver when the
+/// process ends.
+struct OpenDevices(Option<std::thread::JoinHandle<Result<(Vec<Device>, Option<String>)>>>);
+
+impl OpenDevices {
+    fn start(devices: Option<String>, device: DeviceChoice) -> Self {
+        OpenDevices(Some(std::thread::spawn(move || {
+            // A single device is a list of one; by default a machine with several
+            // GPUs renders on all of them.
+            let gpus = if devices.is_none() && device == DeviceChoice::Auto { GpuContext::gpu_adapters() } else { Vec::new() };
+            match &devices {
+                Some(spec) => Ok((treelet::render::devices::open(spec)?, None)),
+                None if gpus.len() > 1 => {
+                    Ok((gpus.into_iter().map(|i| Ok(Device::Gpu(GpuContext::with_adapter(i)?))).collect::<Result<_>>()?, None))
+                }
+                None => device.open_with_note().map(|(d, note)| (vec![d], note)),
+            }
+        })))
+    }
+
+    /// The devices, once open; prints the note of a fallback to the CPU runner.
+    fn finish(mut self) -> Result<Vec<Device>> {
+        let handle = self.0.take().expect("joined once");
+        let (list, note) = handle.join().map_err(|_| anyhow::anyhow!("opening the devices panicked"))??;
+        if let Some(note) = note {
+            eprintln!("{note}");
+        }
+        Ok(list)
+    }
+}
+
+impl Drop for OpenDevices {
+    fn drop(&mut self) {
+        if let Some(handle) = self.0.take() {
+            let _ = handle.join();
+        }
+    }
+}
 
 fn main() -> ExitCode {
-    PROCESS_START.get_or_init(std::time::Instant::now);
+    // The process's clock (as near as `main` knows), for wall times.
+    treelet::runtime::timeline::start();
     // Before any thread starts (the library also does it when it opens Vulkan).
     treelet::runtime::gpu::quiet_mesa_runtime_dir();
     bound_threads();
-    let outcome = run(Cli::parse());
+    let cli = Cli::parse();
+    treelet::runtime::timeline::mark("arguments");
+    let outcome = run(cli);
     // A render stopped by a signal exits as the shell expects of one (128 + SIGINT).
     if STOP.load(Ordering::SeqCst) {
         if let Err(e) = &outcome {

@@ -100,7 +100,8 @@ fn write_format(path: &Path, ext: &str, image: &HdrImage) -> Result<()> {
     match ext {
         "png" => {
             use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-            let bytes: Vec<u8> = image.pixels.iter().flat_map(|p| p.map(to_srgb8)).collect();
+            use rayon::prelude::*;
+            let bytes: Vec<u8> = image.pixels.par_iter().flat_map_iter(|p| p.map(to_srgb8)).collect();
             // Fast compression: a render's PNG is written on every run, and the
             // default level takes several times longer for a few percent of size.
             let file = std::fs::File::create(path)?;

@@ -21,6 +21,7 @@
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
+use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
@@ -154,6 +155,7 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         Ok(p) => p,
         Err(error) => return send(Event::Failed { device: job.device, error, lost: Vec::new() }),
     };
+    crate::runtime::timeline::mark("scene on the device");
     send(Event::Ready {
         device: job.device,
         plan: prepared.plan.clone(),
@@ -346,7 +348,10 @@ pub fn run(
         }
         Ok(())
     })?;
-    g.finish(start, first..end, interrupted, reference, &mut on_pass)
+    crate::runtime::timeline::mark("render (kernels, read-backs)");
+    let result = g.finish(start, first..end, interrupted, reference, &mut on_pass);
+    crate::runtime::timeline::mark("image made");
+    result
 }
 
 /// What this thread knows of the devices' work.
@@ -550,7 +555,7 @@ impl Gather {
     }
 
     fn sums_f32(&self) -> Vec<[f32; 4]> {
-        self.sums_f64().iter().map(|t| t.map(|v| v as f32)).collect()
+        self.sums_f64().par_iter().map(|t| t.map(|v| v as f32)).collect()
     }
 
     fn finish(
@@ -592,8 +597,17 @@ impl Gather {
         } else {
             Some(Stopped::Failed(failures))
         };
-        let total = self.sums_f64();
-        let sums: Vec<[f32; 4]> = total.iter().map(|t| t.map(|v| v as f32)).collect();
+        let samples = done.end - done.start;
+        let (sums, image) = if self.read.iter().flatten().count() == 1 {
+            // One device's sums are the total as they are (an f32 through f64
+            // and back is exact): no copy of the image's worth of sums.
+            let sums = self.read.iter_mut().find_map(Option::take).map(|r| r.0).unwrap_or_default();
+            let image = mean_image(self.width, self.height, &sums, samples);
+            (sums, image)
+        } else {
+            let total = self.sums_f64();
+            (total.par_iter().map(|t| t.map(|v| v as f32)).collect(), mean_image(self.width, self.height, &total, samples))
+        };
         let grid = Grid::new(asked.clone(), 1);
         if self.rows.last().is_none_or(|r| r.spp != done.end - self.first) {
             // The last row always measures the error (as far as it is defined).
@@ -601,7 +615,6 @@ impl Gather {
             on_pass(&row);
             self.rows.push(row);
         }
-        let image = mean_image(self.width, self.height, &total, done.end - done.start);
         Ok(RenderResult {
             image,
             sums,

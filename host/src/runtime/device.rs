@@ -22,39 +22,51 @@ pub enum DeviceChoice {
 
 impl DeviceChoice {
     /// Opens the device: `auto` falls back to the CPU runner with a note
-    /// that says why (no adapter, or only adapters on CPU cores).
+    /// (printed) that says why (no adapter, or only adapters on CPU cores).
     pub fn open(self) -> Result<Device> {
+        let (device, note) = self.open_with_note()?;
+        if let Some(note) = note {
+            eprintln!("{note}");
+        }
+        Ok(device)
+    }
+
+    /// [`DeviceChoice::open`], with the note returned instead of printed
+    /// (for a caller that opens devices on another thread and prints once
+    /// it knows the run goes on).
+    pub fn open_with_note(self) -> Result<(Device, Option<String>)> {
         match self {
-            DeviceChoice::Gpu => {
-                Ok(Device::Gpu(GpuContext::new().context("--device gpu (--device auto or cpu run on the CPU runner)")?))
-            }
-            DeviceChoice::Cpu => Ok(Device::Cpu),
+            DeviceChoice::Gpu => Ok((
+                Device::Gpu(GpuContext::new().context("--device gpu (--device auto or cpu run on the CPU runner)")?),
+                None,
+            )),
+            DeviceChoice::Cpu => Ok((Device::Cpu, None)),
             DeviceChoice::Auto => {
                 if let Some(&gpu) = GpuContext::gpu_adapters().first() {
-                    return match GpuContext::with_adapter(gpu) {
-                        Ok(ctx) => Ok(Device::Gpu(ctx)),
-                        Err(e) => {
-                            eprintln!("note: {e:#}: running on the CPU runner instead (--device cpu skips this note)");
-                            Ok(Device::Cpu)
-                        }
-                    };
+                    return Ok(match GpuContext::with_adapter(gpu) {
+                        Ok(ctx) => (Device::Gpu(ctx), None),
+                        Err(e) => (
+                            Device::Cpu,
+                            Some(format!("note: {e:#}: running on the CPU runner instead (--device cpu skips this note)")),
+                        ),
+                    });
                 }
                 let adapters = GpuContext::adapters();
-                if adapters.is_empty() {
+                let note = if adapters.is_empty() {
                     // GpuContext's own message: it says what is missing and how to get it.
                     let e = GpuContext::new().err().map_or_else(|| "no Vulkan adapter found".to_string(), |e| e.to_string());
-                    eprintln!("note: {e}: running on the CPU runner instead (--device cpu skips this note)");
+                    format!("note: {e}: running on the CPU runner instead (--device cpu skips this note)")
                 } else {
                     // On two cores the CPU runner rendered cornell 512x384 at
                     // 64 spp in 10.8 s where lavapipe took 14.9 to 17.1 s, the
                     // disk-lit room (256x192, 16 spp) in 1.0 s against 4.9 s,
                     // and built a 200 000-sphere TRBVH in 1.4 s against 16.7 s.
-                    eprintln!(
+                    format!(
                         "note: the only Vulkan adapter ({}) runs on CPU cores, where the CPU runner is faster: running on the CPU runner (--device gpu uses the adapter, --device cpu skips this note)",
                         adapters.join(", ")
-                    );
-                }
-                Ok(Device::Cpu)
+                    )
+                };
+                Ok((Device::Cpu, Some(note)))
             }
         }
     }

@@ -203,15 +203,23 @@ impl GpuBackend {
 
     /// Maps a MAP_READ buffer (after its copy was submitted) and returns its contents.
     fn map_read<T: Pod>(&self, staging: &wgpu::Buffer, bytes: u64) -> Result<Vec<T>> {
+        let mut out: Vec<T> = bytemuck::zeroed_vec(bytes as usize / std::mem::size_of::<T>());
+        self.map_into(staging, bytes, bytemuck::cast_slice_mut(&mut out))?;
+        Ok(out)
+    }
+
+    /// Maps a MAP_READ buffer of `bytes` (after its copy was submitted) and
+    /// copies its first `into.len()` bytes into `into`.
+    fn map_into(&self, staging: &wgpu::Buffer, bytes: u64, into: &mut [u8]) -> Result<()> {
         let (tx, rx) = std::sync::mpsc::channel();
         staging.map_async(wgpu::MapMode::Read, 0..bytes, move |r| {
             let _ = tx.send(r);
         });
         self.wait()?;
         rx.recv().context("readback callback lost")?.context("could not map a readback buffer")?;
-        let out = bytemuck::cast_slice::<u8, T>(&staging.get_mapped_range(0..bytes)?).to_vec();
+        into.copy_from_slice(&staging.get_mapped_range(0..bytes)?[..into.len()]);
         staging.unmap();
-        Ok(out)
+        Ok(())
     }
 }
 
@@ -369,7 +377,10 @@ impl Backend for GpuBackend {
     fn read<T: Pod>(&mut self, buffer: &wgpu::Buffer, count: usize) -> Result<Vec<T>> {
         self.flush()?;
         let total = (count * std::mem::size_of::<T>()) as u64;
-        let mut bytes = Vec::with_capacity(total as usize);
+        // Mapped bytes are copied once, straight into the result (a render's
+        // sums are tens of MB, and every copy is on the way to the image).
+        let mut out: Vec<T> = bytemuck::zeroed_vec(count);
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut out);
         let mut offset = 0;
         while offset < total {
             let len = (total - offset).min(READBACK_CHUNK);
@@ -383,11 +394,10 @@ impl Backend for GpuBackend {
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
             encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, padded);
             self.ctx.queue.submit([encoder.finish()]);
-            let chunk: Vec<u8> = self.map_read(&staging, padded)?;
-            bytes.extend_from_slice(&chunk[..len as usize]);
+            self.map_into(&staging, padded, &mut bytes[offset as usize..(offset + len) as usize])?;
             offset += len;
         }
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
+        Ok(out)
     }
 
     fn take_times(&mut self) -> Result<StageTimes> {

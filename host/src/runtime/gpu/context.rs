@@ -211,14 +211,19 @@ impl GpuContext {
         let start = Instant::now();
         let adapter = match index {
             Some(i) => vulkan().1.get(i).cloned(),
+            // High performance first, from the adapters the process listed
+            // already (`request_adapter` would list them again).
             None => vulkan()
-                .0
-                .request_adapter(&wgpu::RequestAdapterOptions {
-                    power_preference: wgpu::PowerPreference::HighPerformance,
-                    ..Default::default()
+                .1
+                .iter()
+                .min_by_key(|a| match a.get_info().device_type {
+                    wgpu::DeviceType::DiscreteGpu => 0,
+                    wgpu::DeviceType::IntegratedGpu => 1,
+                    wgpu::DeviceType::VirtualGpu => 2,
+                    wgpu::DeviceType::Other => 3,
+                    wgpu::DeviceType::Cpu => 4,
                 })
-                .await
-                .ok(),
+                .cloned(),
         };
         let adapter = adapter
             .context(
@@ -253,6 +258,7 @@ impl GpuContext {
         }
         .with_context(|| format!("could not open adapter `{}`", info.name))?;
         let device_s = start.elapsed().as_secs_f64();
+        crate::runtime::timeline::mark("device");
         // Unpacks the modules now, so that a damaged file fails here.
         let _ = shaders::module("");
         let module_s = start.elapsed().as_secs_f64() - device_s;
@@ -391,6 +397,7 @@ fn vulkan() -> &'static (wgpu::Instance, Vec<wgpu::Adapter>) {
         desc.backends = wgpu::Backends::VULKAN;
         let instance = wgpu::Instance::new(desc);
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+        crate::runtime::timeline::mark("Vulkan instance");
         (instance, adapters)
     })
 }

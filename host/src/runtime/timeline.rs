@@ -1,0 +1,52 @@
+//! Marks on the process's clock: what a short run spends besides its
+//! kernels (Vulkan's instance, the device, pipelines, uploads, the image
+//! file), so that `render --explain` can say where the time went.
+//!
+//! A mark costs a lock and a push; code marks once per stage, never per
+//! sample or chunk.
+
+use std::sync::{Mutex, OnceLock};
+use std::time::Instant;
+
+static START: OnceLock<Instant> = OnceLock::new();
+static MARKS: Mutex<Vec<(&'static str, f64)>> = Mutex::new(Vec::new());
+
+/// Starts the clock (the first call wins; `main` calls it first thing).
+pub fn start() -> Instant {
+    *START.get_or_init(Instant::now)
+}
+
+/// Seconds since [`start`].
+pub fn now_s() -> f64 {
+    start().elapsed().as_secs_f64()
+}
+
+/// Records that `what` ended now.
+pub fn mark(what: &'static str) {
+    let at = now_s();
+    MARKS.lock().unwrap_or_else(|e| e.into_inner()).push((what, at));
+}
+
+/// The marks so far, in time order: (what ended, seconds
+/// since the start).
+pub fn marks() -> Vec<(&'static str, f64)> {
+    let mut marks = MARKS.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    // Threads (the devices open beside the scene's loading) mark in any order.
+    marks.sort_by(|a, b| a.1.total_cmp(&b.1));
+    marks
+}
+
+/// The marks as one line of stages and their durations, each from the mark
+/// before: `arguments 0.001 s, Vulkan 0.102 s, ...`.
+pub fn summary() -> String {
+    let mut last = 0.0;
+    marks()
+        .into_iter()
+        .map(|(what, at)| {
+            let part = format!("{what} {:.3}", at - last);
+            last = at;
+            part
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
