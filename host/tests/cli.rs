@@ -829,6 +829,10 @@ fn renders_past_the_memory_are_refused_with_the_estimate() {
     // Cornell has glass and a lamp: the explanation names the light paths,
     // and asking for them picks the variant that traces them.
     assert!(e.contains("`--integrator caustics` adds light paths"), "{e}");
+    // The timeline names every stage of the process once, in order.
+    let timeline = e.lines().find(|l| l.starts_with("timeline")).unwrap_or_else(|| panic!("no timeline: {e}"));
+    let at = |what: &str| timeline.find(what).unwrap_or_else(|| panic!("no `{what}` in {timeline}"));
+    assert!(at("arguments") < at("scene on the device") && at("scene on the device") < at("render (kernels") && at("render (kernels") < at("image made") && at("image made") < at("image written"), "{timeline}");
     let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "4", "--integrator", "caustics", "--explain", "--out", out]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && e.contains("spheres_caustics") && e.contains("light paths for caustics"), "{e}");
