@@ -553,11 +553,18 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
+            if (builder, device) == (Builder::Sweep, DeviceChoice::Gpu) {
+                anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu");
+            }
+            // The device opens while the scene loads.
+            let opening = (builder != Builder::Sweep).then(|| OpenDevices::one(device));
             let scene = Scene::from_spec(&scene)?;
-            let (_, report) = match (builder, device) {
-                (Builder::Sweep, DeviceChoice::Gpu) => anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu"),
-                (Builder::Sweep, _) => run_build_sweep(&scene, max_leaf)?,
-                (_, _) => treelet::with_backend!(device.open()?, |b| run_build_with(b, &scene, builder, config)?),
+            let (_, report) = match opening {
+                None => run_build_sweep(&scene, max_leaf)?,
+                Some(opening) => {
+                    let device = opening.finish()?.pop().expect("one device opened");
+                    treelet::with_backend!(device, |b| run_build_with(b, &scene, builder, config)?)
+                }
             };
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
@@ -629,6 +636,7 @@ fn run(cli: Cli) -> Result<bool> {
 struct OpenDevices(Option<std::thread::JoinHandle<Result<(Vec<Device>, Option<String>)>>>);
 
 impl OpenDevices {
+    /// The devices a render asked for (`--devices`, else `--device`).
     fn start(devices: Option<String>, device: DeviceChoice) -> Self {
         OpenDevices(Some(std::thread::spawn(move || {
             // A single device is a list of one; by default a machine with several
@@ -642,6 +650,11 @@ impl OpenDevices {
                 None => device.open_with_note().map(|(d, note)| (vec![d], note)),
             }
         })))
+    }
+
+    /// One device, as `device` says.
+    fn one(device: DeviceChoice) -> Self {
+        OpenDevices(Some(std::thread::spawn(move || device.open_with_note().map(|(d, note)| (vec![d], note)))))
     }
 
     /// The devices, once open; prints the note of a fallback to the CPU runner.
