@@ -21,10 +21,17 @@ pub fn now_s() -> f64 {
     start().elapsed().as_secs_f64()
 }
 
+/// The most marks kept: a process that renders again and again (an
+/// engine, a benchmark) keeps its first stages, not a list without end.
+const MAX_MARKS: usize = 256;
+
 /// Records that `what` ended now.
 pub fn mark(what: &'static str) {
     let at = now_s();
-    MARKS.lock().unwrap_or_else(|e| e.into_inner()).push((what, at));
+    let mut marks = MARKS.lock().unwrap_or_else(|e| e.into_inner());
+    if marks.len() < MAX_MARKS {
+        marks.push((what, at));
+    }
 }
 
 /// The marks so far, in time order: (what ended, seconds
