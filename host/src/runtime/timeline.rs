@@ -57,3 +57,31 @@ pub fn summary() -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Marks from several threads come back in time order, each stage's
+    /// duration from the mark before, and the list stops at its cap.
+    #[test]
+    fn marks_are_in_time_order_and_capped() {
+        std::thread::scope(|s| {
+            for _ in 0..4 {
+                s.spawn(|| {
+                    for _ in 0..100 {
+                        mark("test stage");
+                    }
+                });
+            }
+        });
+        let marks = marks();
+        assert_eq!(marks.len(), MAX_MARKS);
+        assert!(marks.windows(2).all(|w| w[0].1 <= w[1].1));
+        let summary = summary();
+        // Other tests of this process may have marked too (a device opened).
+        let others = marks.iter().filter(|m| m.0 != "test stage").count();
+        assert_eq!(summary.matches("test stage").count(), MAX_MARKS - others);
+        assert!(summary.split(", ").all(|part| part.rsplit(' ').next().unwrap().parse::<f64>().unwrap() >= 0.0), "{summary}");
+    }
+}
