@@ -248,7 +248,12 @@ impl GpuContext {
             required_features: features,
             required_limits: limits.clone(),
             experimental_features: unsafe { wgpu::ExperimentalFeatures::enabled() },
-            memory_hints: wgpu::MemoryHints::Performance,
+            // Memory blocks from 8 MiB (host-visible ones from 4), growing to
+            // 256 MiB: the first read-back's block was 64 MiB of pinned host
+            // memory with `Performance`, 13-17 ms before a render's first
+            // dispatch (1.2 ms with small blocks; large buffers get blocks of
+            // their own either way).
+            memory_hints: wgpu::MemoryHints::Manual { suballocated_device_memory_block_size: (8 << 20)..(256 << 20) },
             trace: wgpu::Trace::Off,
         };
         let ((device, queue), partitioned) = if subgroup_partitioned_supported(&adapter) {
