@@ -118,13 +118,8 @@ struct RenderArgs {
     /// Print the scene's features and the accel and kernel chosen, and why.
     #[arg(long)]
     explain: bool,
-    /// nee: a light sampled at every diffuse bounce, with multiple
-    /// importance sampling (the default: on the H100, about as little error
-    /// as smallpt's estimator at equal time on cornell, 1.34 times less RMSE
-    /// on scenes/room_disk.json); smallpt: emitters count only where paths
-    /// hit them.
     #[arg(long, value_enum, default_value = "nee")]
-    integrator: Integrator,
+    integrator: IntegratorArg,
     #[arg(long, value_enum, default_value = "auto")]
     device: DeviceChoice,
     /// Render on several devices at once, each taking chunks of samples as
@@ -158,6 +153,37 @@ struct RenderArgs {
     /// runner the image is the uninterrupted render's, bit for bit.
     #[arg(long, value_name = "PART.exr")]
     resume: Option<std::path::PathBuf>,
+}
+
+/// How radiance is estimated (`--integrator`): one by name, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum IntegratorArg {
+    /// smallpt's: emitters count only where paths hit them.
+    Smallpt,
+    /// A light sampled at every diffuse bounce, with multiple importance
+    /// sampling (on the H100, about as little error as smallpt's estimator
+    /// at equal time on cornell, half of it on scenes/room_disk.json).
+    Nee,
+    /// nee, and one light path per camera path through mirrors and glass
+    /// to what the camera sees: the caustics nee cannot find (the disk-lit
+    /// room: 0.89x nee's error at equal time; cornell: 4x).
+    Caustics,
+    /// nee or caustics, whichever a pilot (4 spp, twice each) measures to
+    /// give less error in equal time; nee without mirrors or glass lit by
+    /// a lamp, or below 256 spp. `--explain` gives the measurements.
+    Auto,
+}
+
+impl IntegratorArg {
+    /// The integrator named; `None` for `auto`.
+    fn fixed(self) -> Option<Integrator> {
+        match self {
+            IntegratorArg::Smallpt => Some(Integrator::Smallpt),
+            IntegratorArg::Nee => Some(Integrator::Nee),
+            IntegratorArg::Caustics => Some(Integrator::Caustics),
+            IntegratorArg::Auto => None,
+        }
+    }
 }
 
 /// A whole number from 1 to 2^32 - 1 (sizes, sample counts).
@@ -215,6 +241,11 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     if let Some(report) = &args.report {
         image_io::check_output(report, "--report", &[])?;
     }
+    if args.integrator == IntegratorArg::Auto && part.is_some() {
+        anyhow::bail!(
+            "--integrator auto with --samples: parts rendered apart must share one integrator, and a pilot on each machine may choose another; name one (nee or caustics)"
+        );
+    }
     if args.checkpoint.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
         anyhow::bail!("--checkpoint {}: seconds between checkpoints must be a positive number", args.checkpoint.unwrap_or(0.0));
     }
@@ -234,19 +265,49 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);
     }
     let first_sample = part.as_ref().map_or(0, |r| r.start);
+    let resumed = args.resume.as_deref().map(|path| parts::read_part(path).map(|r| (path, r))).transpose()?;
+    let reference = args.reference.as_deref().map(|r| parts::read_scored_image(r, "--reference")).transpose()?;
+    let mut settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        seed: args.seed,
+        accel: args.accel,
+        layout: args.layout,
+        kernel: args.kernel,
+        integrator: Integrator::Nee,
+        error_each_pass: args.report.is_some() || args.reference.is_some(),
+        first_sample,
+    };
+    let list = opening.finish()?;
+    // The integrator: the one named; for `auto`, the one a resumed part was
+    // made with, else the pilot's choice.
+    let (integrator, choice) = match (args.integrator.fixed(), &resumed) {
+        (Some(i), _) => (i, None),
+        (None, Some((path, (info, _)))) => {
+            let i = Integrator::from_name(&info.integrator).with_context(|| {
+                format!("--resume {}: the part's integrator `{}` is not one this build knows", path.display(), info.integrator)
+            })?;
+            (i, Some(format!("the part resumed was rendered with {}", i.name())))
+        }
+        (None, None) => {
+            let c = treelet::render::integrator_choice::choose(&list, &scene, &settings)?;
+            (c.integrator, Some(c.reason))
+        }
+    };
+    settings.integrator = integrator;
     let part_info = |samples: std::ops::Range<u32>| PartInfo {
         scene: scene.name.clone(),
         scene_hash: format!("{:016x}", scene.content_hash()),
         width: args.width,
         height: args.height,
         seed: args.seed,
-        integrator: args.integrator.name().into(),
+        integrator: integrator.name().into(),
         samples,
         planned_end: first_sample.saturating_add(args.spp),
     };
-    let resume = match &args.resume {
-        Some(path) => {
-            let (info, sums) = parts::read_part(path)?;
+    let resume = match resumed {
+        Some((path, (info, sums))) => {
             let asked = part_info(first_sample..first_sample.saturating_add(args.spp));
             if let Some(why) = info.differs_from(&asked) {
                 anyhow::bail!("--resume {}: the part is of another render than this one: {why}", path.display());
@@ -265,20 +326,6 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
         None => None,
     };
-    let reference = args.reference.as_deref().map(|r| parts::read_scored_image(r, "--reference")).transpose()?;
-    let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        seed: args.seed,
-        accel: args.accel,
-        layout: args.layout,
-        kernel: args.kernel,
-        integrator: args.integrator,
-        error_each_pass: args.report.is_some() || args.reference.is_some(),
-        first_sample,
-    };
-    let list = opening.finish()?;
     let bar = ProgressBar::new(args.spp as u64);
     bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed_precise}  {msg}").unwrap());
     let on_pass = |row: &PassRow| {
@@ -294,7 +341,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let memory = MemoryEstimate::of(&settings, (scene.spheres.len() + scene.triangles.len()) as u64, &classes);
     if args.explain {
         bar.suspend(|| {
-            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), args.integrator == Integrator::Caustics).explain());
+            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), integrator == Integrator::Caustics).explain());
             eprintln!(
                 "memory     about {} of host memory (image {}, scene and trees {}); {} available (TREELET_MAX_MEMORY caps it)",
                 human(memory.total_bytes),
@@ -311,13 +358,15 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             }
             let features = variant::SceneFeatures::of(&scene);
             let has_caustics = features.mirror + features.glass > 0 && features.emissive > 0;
-            eprintln!("integrator {}", match (args.integrator, has_caustics) {
+            if let Some(why) = &choice {
+                eprintln!("integrator {} (auto: {why})", integrator.name());
+            } else { eprintln!("integrator {}", match (integrator, has_caustics) {
                 (Integrator::Smallpt, _) => "smallpt (emitters count where paths hit them; --integrator)",
                 (Integrator::Nee, false) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator)",
-                (Integrator::Nee, true) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator).\n           The scene has mirrors or glass, so caustics: `--integrator caustics` adds light paths for them\n           (the disk-lit room: 0.89x nee's error at equal time on an H100; not the default, as a lamp mostly hidden, as cornell's, makes them noisy)",
+                (Integrator::Nee, true) => "nee (a light sampled at every diffuse bounce, weighted by multiple importance sampling; --integrator).\n           The scene has mirrors or glass, so caustics: `--integrator caustics` adds light paths for them\n           (the disk-lit room: 0.89x nee's error at equal time on an H100; not the default, as a lamp mostly hidden, as cornell's, makes them noisy;\n           `--integrator auto` measures both first)",
                 (Integrator::Caustics, true) => "caustics (nee, and one light path per camera path, traced through mirrors and glass to the diffuse points the camera sees: the caustics nee cannot find; --integrator)",
                 (Integrator::Caustics, false) => "caustics: without mirrors or glass, or without lights, the scene has none, so this is nee (--integrator)",
-            });
+            }); }
         });
     }
     catch_stop_signals();
@@ -418,7 +467,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         result.plan.accel.name(),
         if result.plan.accel == Accel::None { "-" } else { result.plan.layout.name() },
         result.plan.kernel,
-        args.integrator.name(),
+        integrator.name(),
         result.total_s,
         paths / result.total_s / 1e6,
         (result.build_ms + result.render_ms) / 1e3,
@@ -458,7 +507,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             "stopped": result.stopped.as_ref().map(|s| format!("{s:?}")),
             "seed": args.seed,
             "accel": result.plan.accel,
-            "integrator": args.integrator,
+            "integrator": integrator,
             "plan": result.plan,
             "device": device,
             "adapter": adapter,

@@ -801,6 +801,38 @@ fn huge_thread_counts_are_bounded() {
     let _ = std::fs::remove_file(&out);
 }
 
+/// `--integrator auto`: NEE without a pilot where light paths have nothing
+/// to find or the pilot would cost too much; a pilot on cornell (whose lamp
+/// sits inside the ceiling, so light paths are noisy: 2 to 4x NEE's error
+/// measured) keeps NEE and says what it measured; refused for parts.
+#[test]
+fn integrator_auto_pilots_and_says_why() {
+    let out = std::env::temp_dir().join(format!("treelet-cli-auto-{}.png", std::process::id()));
+    let out = out.to_str().unwrap();
+    let render = |scene: &str, size: [&str; 2], spp: &str| {
+        let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", size[0], "--height", size[1], "--spp", spp, "--integrator", "auto", "--explain", "--out", out]);
+        let e = String::from_utf8_lossy(&o.stderr).to_string();
+        assert!(o.status.success(), "{e}");
+        let line = e.lines().find(|l| l.starts_with("integrator ")).unwrap_or_else(|| panic!("no integrator line: {e}")).to_string();
+        let summary = e.lines().find(|l| l.contains("M camera paths/s")).unwrap_or_else(|| panic!("no summary: {e}")).to_string();
+        (line, summary)
+    };
+    let (line, summary) = render(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell_diffuse.json"), ["16", "12"], "8");
+    assert!(line.starts_with("integrator nee (auto: the scene has no mirrors or glass"), "{line}");
+    assert!(summary.contains("integrator nee"), "{summary}");
+    let (line, _) = render("cornell", ["16", "12"], "64");
+    assert!(line.starts_with("integrator nee (auto: a pilot of both") && line.contains("over 1/8"), "{line}");
+    let (line, summary) = render("cornell", ["128", "96"], "352");
+    assert!(line.starts_with("integrator nee (auto: a pilot of 11 spp, twice each: light paths would give"), "{line}");
+    let ratio: f64 = line.split("would give ").nth(1).and_then(|r| r.split('x').next()).and_then(|r| r.parse().ok()).unwrap_or_else(|| panic!("{line}"));
+    assert!(ratio > 1.2, "cornell's light paths measured at {ratio}x NEE's error: {line}");
+    assert!(summary.contains("integrator nee"), "{summary}");
+    let o = treelet(&["render", "--device", "cpu", "--samples", "0..4", "--integrator", "auto", "--out", "part.exr"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && e.contains("--integrator auto with --samples"), "{e}");
+    let _ = std::fs::remove_file(out);
+}
+
 /// Sizes past the memory are refused before anything is allocated, with
 /// the estimate and the limit (no abort from a failed allocation):
 /// against the machine's memory, and against TREELET_MAX_MEMORY.

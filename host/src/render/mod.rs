@@ -7,6 +7,7 @@
 //! | file | what it holds |
 //! |---|---|
 //! | `settings.rs` | what a render is asked for; passes and dispatch sizes |
+//! | `integrator_choice.rs` | `--integrator auto`: a pilot of NEE against light paths |
 //! | `variant.rs` | the plan: tree, layout and kernel variant for a scene and device |
 //! | `prepared.rs` | one device's tree, buffers and accumulation |
 //! | `queue.rs` | the samples handed out to devices, cut on a fixed grid |
@@ -18,6 +19,7 @@
 //! | `image_io.rs` | reading and writing images |
 pub mod devices;
 pub mod image_io;
+pub mod integrator_choice;
 pub mod outcome;
 pub mod parts;
 pub mod prepared;

@@ -41,6 +41,11 @@ impl Integrator {
         }
     }
 
+    /// The integrator of a name [`Integrator::name`] gives.
+    pub fn from_name(name: &str) -> Option<Integrator> {
+        [Integrator::Smallpt, Integrator::Nee, Integrator::Caustics].into_iter().find(|i| i.name() == name)
+    }
+
     /// What it is, for figures.
     pub fn label(self) -> &'static str {
         match self {
