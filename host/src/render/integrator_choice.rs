@@ -31,7 +31,7 @@ pub const PILOT_MIN_SPP: u32 = 4;
 pub const PILOT_PATHS: u64 = 1 << 17;
 
 /// The pilot's four images take at most this share of the render's samples.
-const PILOT_SHARE: u32 = 8;
+pub const PILOT_SHARE: u32 = 8;
 
 /// Added to the render's seed for the two pilot images of each integrator.
 const PILOT_SEEDS: [u32; 2] = [0x5eed_0001, 0x5eed_0002];
