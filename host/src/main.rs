@@ -168,9 +168,10 @@ enum IntegratorArg {
     /// to what the camera sees: the caustics nee cannot find (the disk-lit
     /// room: 0.89x nee's error at equal time; cornell: 4x).
     Caustics,
-    /// nee or caustics, whichever a pilot (4 spp, twice each) measures to
-    /// give less error in equal time; nee without mirrors or glass lit by
-    /// a lamp, or below 256 spp. `--explain` gives the measurements.
+    /// nee or caustics, whichever a pilot (four short images, thrown away)
+    /// measures to give less error in equal time; nee without mirrors or
+    /// glass lit by a lamp, or where the pilot would take over an eighth of
+    /// the render's samples. `--explain` gives the measurements.
     Auto,
 }
 
