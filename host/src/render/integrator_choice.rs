@@ -136,13 +136,8 @@ pub fn pick(nee: &Measured, caustics: &Measured) -> Integrator {
 /// Half the mean squared difference of two images' channels: the variance
 /// of either, when they are independent estimates of the same image.
 fn half_mean_squared_difference(a: &HdrImage, b: &HdrImage) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(p, q)| (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum::<f64>())
-        .sum();
-    sum / (2.0 * 3.0 * a.pixels.len().max(1) as f64)
+    let (rmse, _) = super::sums::image_error(a.pixels.iter().map(|p| p.map(f64::from)), b);
+    rmse * rmse / 2.0
 }
 
 #[cfg(test)]
