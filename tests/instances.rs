@@ -310,3 +310,136 @@ fn stiff_transforms_hit_what_the_flattened_scene_hits() {
         assert!(exact as f64 >= 0.99 * cpu.len() as f64, "seed {seed}: GPU and CPU hit the same triangle for {exact} rays of {}", cpu.len());
     }
 }
+
+/// A glTF file placing `meshes` by `nodes` (each: a mesh, rotation
+/// quaternion, scale, translation, and the index of a parent node or
+/// none), the meshes' positions unindexed in one `.bin` beside it.
+fn write_gltf(dir: &std::path::Path, meshes: &[Vec<Triangle>], nodes: &[(usize, Quat, Vec3, Vec3, Option<usize>)]) -> std::path::PathBuf {
+    let mut bin = Vec::new();
+    let (mut views, mut accessors, mut gltf_meshes) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, m) in meshes.iter().enumerate() {
+        let offset = bin.len();
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for v in m.iter().flat_map(|t| [t.v0, t.v1, t.v2]) {
+            for a in 0..3 {
+                (lo[a], hi[a]) = (lo[a].min(v[a]), hi[a].max(v[a]));
+                bin.extend(v[a].to_le_bytes());
+            }
+        }
+        views.push(format!(r#"{{"buffer": 0, "byteOffset": {offset}, "byteLength": {}}}"#, bin.len() - offset));
+        accessors.push(format!(
+            r#"{{"bufferView": {k}, "componentType": 5126, "count": {}, "type": "VEC3", "min": {lo:?}, "max": {hi:?}}}"#,
+            3 * m.len()
+        ));
+        gltf_meshes.push(format!(r#"{{"primitives": [{{"attributes": {{"POSITION": {k}}}}}]}}"#));
+    }
+    let node_json: Vec<String> = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, (mesh, q, s, t, _))| {
+            let children: Vec<usize> = (0..nodes.len()).filter(|&c| nodes[c].4 == Some(i)).collect();
+            format!(
+                r#"{{"mesh": {mesh}, "rotation": {:?}, "scale": {:?}, "translation": {:?}, "children": {children:?}}}"#,
+                q.to_array(),
+                s.to_array(),
+                t.to_array()
+            )
+        })
+        .collect();
+    let roots: Vec<usize> = (0..nodes.len()).filter(|&i| nodes[i].4.is_none()).collect();
+    std::fs::write(dir.join("placed.bin"), &bin).unwrap();
+    let text = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": {roots:?}}}], "nodes": [{}], "meshes": [{}],
+  "buffers": [{{"uri": "placed.bin", "byteLength": {}}}], "bufferViews": [{}], "accessors": [{}]}}"#,
+        node_json.join(", "),
+        gltf_meshes.join(", "),
+        bin.len(),
+        views.join(", "),
+        accessors.join(", ")
+    );
+    let path = dir.join("placed.gltf");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A glTF file with two meshes placed by 60 nodes (random rotations,
+/// scales, translations; a third of them children of others), loaded with
+/// its instances kept and traced through them, against the same file
+/// loaded flattened (what `render` takes) and traced as one mesh; and a
+/// JSON scene file placing a mesh file by reference.
+fn scene_files<B: Backend>(b: &mut B, seed: u64) {
+    use treelet::scene::instanced;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let m = meshes(&mut rng, &[300, 40]);
+    let nodes: Vec<_> = (0..60)
+        .map(|i| {
+            let q = Quat::from_xyzw(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+            let s = Vec3::new(rng.random_range(1.0..3.0), rng.random_range(1.0..3.0), rng.random_range(1.0..3.0));
+            let t = Vec3::new(rng.random_range(0.0..30.0), rng.random_range(0.0..30.0), rng.random_range(0.0..30.0));
+            let parent = (i % 3 == 2).then(|| rng.random_range(0..i));
+            (rng.random_range(0..2usize), q, if parent.is_some() { s * 0.5 } else { s }, if parent.is_some() { t * 0.2 } else { t }, parent)
+        })
+        .collect();
+    let dir = std::env::temp_dir().join(format!("treelet-placed-{}-{seed}-{}", std::process::id(), b.adapter().len()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = write_gltf(&dir, &m, &nodes);
+    let what = format!("{} seed {seed}", b.adapter());
+    let scene = instanced::InstancedScene::load(&path).unwrap();
+    assert_eq!((scene.meshes.len(), scene.instances.len()), (2, 60), "{what}: each mesh once, a copy per node");
+    let flat = treelet::scene::Scene::from_spec(path.to_str().unwrap()).unwrap();
+    let from: Vec<(u32, u32)> = scene
+        .instances
+        .iter()
+        .enumerate()
+        .flat_map(|(k, i)| (0..scene.meshes[i.mesh as usize].triangles.len() as u32).map(move |p| (k as u32, p)))
+        .collect();
+    assert_eq!(flat.triangles.len(), from.len(), "{what}: the flattened file has every copy's triangles");
+    let rays = rays(&mut rng, 4000);
+    let placed = InstancedTracer::build_scene(b, &scene, Quality::High).unwrap();
+    let hits = placed.closest_hits(b, &rays).unwrap();
+    let flat_hits = Tracer::build(b, &[], &flat.triangles, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+    // 60 copies of small meshes: a few percent of random rays hit.
+    check(&format!("{what}, glTF"), &hits, &flat_hits, &(flat.triangles.clone(), from), &rays, rays.len() / 50);
+    std::fs::remove_dir_all(&dir).ok();
+
+    // A scene file: the repository's pyramid named once and placed twice
+    // more, beside a parallelogram (not instanced: refused by the tracer,
+    // by name).
+    let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes");
+    let text = r#"{"camera": {"origin": [0, 0, 60], "direction": [0, 0, -1]},
+      "materials": {"w": {"type": "diffuse", "color": [0.5, 0.5, 0.5]}, "g": {"type": "glass", "color": [1, 1, 1]}},
+      "meshes": [{"path": "pyramid.obj", "material": "w", "name": "p", "scale": [10, 10, 10]}],
+      "instances": [{"mesh": "p", "material": "g", "scale": [5, 5, 5], "rotate": [0, 45, 0], "translate": [20, 0, 0]},
+                    {"mesh": "p", "scale": [8, -8, 8], "translate": [-20, 5, 0]}]}"#;
+    let scene = treelet::scene::file::parse_instanced_in(text, "placed.json", std::path::Path::new(scenes)).unwrap();
+    assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 3), "{what}: the pyramid read once, placed three times");
+    let flat = scene.clone().flatten().unwrap();
+    let n = scene.meshes[0].triangles.len();
+    assert_eq!(flat.triangles.len(), 3 * n);
+    assert!(flat.materials[..n].iter().chain(&flat.materials[2 * n..]).all(|m| m.kind == treelet_core::geometry::buffers::DIFFUSE));
+    assert!(flat.materials[n..2 * n].iter().all(|m| m.kind == treelet_core::geometry::buffers::GLASS), "{what}: the instance's own material");
+    let from: Vec<(u32, u32)> = (0..3).flat_map(|k| (0..n as u32).map(move |p| (k, p))).collect();
+    let rays: Vec<Ray> = (0..2000)
+        .map(|_| {
+            let o = [rng.random_range(-30.0..30.0), rng.random_range(-10.0..15.0), 40.0];
+            Ray::new(o, [rng.random_range(-0.2..0.2), rng.random_range(-0.2..0.2), -1.0])
+        })
+        .collect();
+    let placed = InstancedTracer::build_scene(b, &scene, Quality::Fast).unwrap();
+    let hits = placed.closest_hits(b, &rays).unwrap();
+    let flat_hits = Tracer::build(b, &[], &flat.triangles, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+    check(&format!("{what}, scene file"), &hits, &flat_hits, &(flat.triangles.clone(), from), &rays, rays.len() / 20);
+    let with_shape = text.replace(r#""instances""#, r#""parallelograms": [{"corner": [0, 0, -5], "edges": [[1, 0, 0], [0, 1, 0]], "material": "w"}], "instances""#);
+    let scene = treelet::scene::file::parse_instanced_in(&with_shape, "shape.json", std::path::Path::new(scenes)).unwrap();
+    let e = format!("{:#}", InstancedTracer::build_scene(b, &scene, Quality::Fast).err().expect("refused"));
+    assert!(e.contains("shape.json") && e.contains("triangles only"), "{e}");
+}
+
+#[test]
+fn scene_files_place_meshes_as_instances() {
+    let seed = fresh_seed();
+    scene_files(&mut CpuBackend::new(), seed);
+    if let Some(ctx) = gpu() {
+        scene_files(&mut GpuBackend::new(ctx), seed);
+    }
+}

@@ -12,6 +12,9 @@
 //! ([`RayHit`]) of batches of [`Ray`]s. [`Quality`] trades build time for
 //! faster rays, or ([`Quality::ForRays`]) picks the builder that finishes a
 //! given number of rays per build first, by costs measured per device class.
+//! An [`InstancedTracer`] places meshes many times; [`scene::instanced::InstancedScene::load`]
+//! reads a glTF or scene file's meshes once each, with their copies as
+//! instances ([`InstancedTracer::build_scene`]).
 //!
 //! ```
 //! use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};

@@ -932,3 +932,39 @@ fn slurm_array_script_on_a_real_cluster() {
     drop(_stop);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scene file placing a mesh by reference: built (and rendered) flattened,
+/// with a note that says so; a flattening past the memory available is
+/// refused by name before anything is allocated.
+#[test]
+fn scene_file_instances_are_flattened_with_a_note() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
+    let out = treelet(&["build", "--scene", scene, "--device", "cpu", "--json"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("5 instances of 1 mesh, flattened into 37 triangles"), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["triangles"], 37, "five pyramids of six triangles, a disk and six walls");
+    assert_eq!(v["valid"], true);
+
+    let dir = std::env::temp_dir().join(format!("treelet-cli-instances-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramid.obj"), dir.join("pyramid.obj")).unwrap();
+    let copies: Vec<String> = (0..2000).map(|k| format!(r#"{{"mesh": "p", "translate": [{k}, 0, 0]}}"#)).collect();
+    let text = format!(
+        r#"{{"camera": {{"origin": [0, 0, 50], "direction": [0, 0, -1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1, 1, 1]}}}},
+  "meshes": [{{"path": "pyramid.obj", "material": "w", "name": "p"}}], "instances": [{}]}}"#,
+        copies.join(", ")
+    );
+    let file = dir.join("many.json");
+    std::fs::write(&file, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["build", "--device", "cpu", "--scene", file.to_str().unwrap()])
+        .env("TREELET_MAX_MEMORY", "100000")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && !err.contains("panicked"), "{err}");
+    assert!(err.contains("many.json") && err.contains("2001 instances of 1 mesh, flattened into 12006 triangles") && err.contains("memory"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

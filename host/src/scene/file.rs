@@ -12,8 +12,11 @@
 //!     { "center": [50, 1e5, 81.6], "radius": 1e5, "material": "white" }
 //!   ],
 //!   "meshes": [
-//!     { "path": "pyramid.obj", "material": "glass",
+//!     { "path": "pyramid.obj", "material": "glass", "name": "pyramid",
 //!       "scale": [20, 20, 20], "rotate": [0, 30, 0], "translate": [60, 0, 90] }
+//!   ],
+//!   "instances": [
+//!     { "mesh": "pyramid", "material": "white", "scale": [10, 10, 10], "translate": [20, 0, 60] }
 //!   ],
 //!   "disks": [
 //!     { "center": [50, 81.5, 81.6], "normal": [0, -1, 0], "radius": 18, "material": "lamp" }
@@ -31,7 +34,12 @@
 //! let walls overlap at their corners so that no ray slips between them.
 //! A mesh (`.obj` or `.ply`, its path relative to the scene file) is scaled,
 //! then rotated about x, y and z (degrees, in that order), then translated;
-//! all three are optional. `scenes/cornell.json` in the repository is
+//! all three are optional. An instance places another copy of a named mesh
+//! by its own transform (from the mesh file's space, not from the first
+//! copy's), in the mesh's material unless it names one; a file read by
+//! several meshes is read once. `render`, `build` and `bench` flatten the
+//! copies into one set of triangles; [`load_instanced`] keeps them (see
+//! [`super::instanced`]). `scenes/cornell.json` in the repository is
 //! smallpt's scene in this form, `scenes/cornell_mesh.json` adds a mesh.
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -40,8 +48,9 @@ use anyhow::{bail, Context as _, Result};
 use serde::Deserialize;
 use treelet_core::geometry::buffers::{DIFFUSE, GLASS, MIRROR, Material, Sphere};
 
+use super::instanced::{InstancedScene, SceneInstance, SceneMesh};
 use super::model::{CameraSpec, Scene};
-use super::primitives::{validate_spheres, Primitives};
+use super::primitives::validate_spheres;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -52,6 +61,8 @@ struct SceneFile {
     spheres: Vec<SphereSpec>,
     #[serde(default)]
     meshes: Vec<MeshSpec>,
+    #[serde(default)]
+    instances: Vec<InstanceSpec>,
     #[serde(default)]
     disks: Vec<DiskSpec>,
     #[serde(default)]
@@ -80,6 +91,26 @@ struct DiskSpec {
 struct MeshSpec {
     path: String,
     material: String,
+    /// What instances call it.
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(flatten)]
+    placement: Placement,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InstanceSpec {
+    mesh: String,
+    #[serde(default)]
+    material: Option<String>,
+    #[serde(flatten)]
+    placement: Placement,
+}
+
+/// Where a copy of a mesh goes: scaled, rotated, translated.
+#[derive(Deserialize)]
+struct Placement {
     #[serde(default = "unit_scale")]
     scale: [f32; 3],
     #[serde(default)]
@@ -92,12 +123,16 @@ fn unit_scale() -> [f32; 3] {
     [1.0; 3]
 }
 
-impl MeshSpec {
+impl Placement {
     /// Scale, rotate (x, then y, then z; degrees), translate.
     fn transform(&self) -> glam::Affine3A {
         let r = self.rotate.map(f32::to_radians);
         let rotation = glam::Quat::from_euler(glam::EulerRot::ZYX, r[2], r[1], r[0]);
         glam::Affine3A::from_scale_rotation_translation(self.scale.into(), rotation, self.translate.into())
+    }
+
+    fn is_finite(&self) -> bool {
+        self.scale.iter().chain(&self.rotate).chain(&self.translate).all(|v| v.is_finite())
     }
 }
 
@@ -137,11 +172,17 @@ struct SphereSpec {
 /// luminance over 2^16 samples of it stays far below `f32::MAX`.
 pub const MAX_EMISSION: f32 = 1e6;
 
-/// Reads a scene file; errors name the file and the line and column, or the
-/// sphere or material at fault.
+/// Reads a scene file, its instances flattened; errors name the file and
+/// the line and column, or the sphere or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
+    load_instanced(path)?.flatten()
+}
+
+/// Reads a scene file with its meshes once each and their copies as
+/// instances (see [`super::instanced`]).
+pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     let text = crate::input::read_text(path, "scene file")?;
-    parse_in(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
+    parse_instanced_in(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 
 /// Parses scene-file text; `name` labels errors and the scene; mesh paths
@@ -152,6 +193,11 @@ pub fn parse(text: &str, name: &str) -> Result<Scene> {
 
 /// Parses scene-file text whose mesh paths are relative to `dir`.
 pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
+    parse_instanced_in(text, name, dir)?.flatten()
+}
+
+/// [`parse_in`] with the instances kept.
+pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<InstancedScene> {
     let file: SceneFile = serde_json::from_str(text)
         .map_err(|e| anyhow::anyhow!("scene file {name}: line {}, column {}: {e}", e.line(), e.column()))?;
     let mut materials = BTreeMap::new();
@@ -199,24 +245,52 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
         sphere_materials.push(*m);
     }
     validate_spheres(&spheres).with_context(|| format!("scene file {name}"))?;
-    let mut triangles = Vec::new();
-    let mut triangle_materials = Vec::new();
+    let mut meshes: Vec<SceneMesh> = Vec::new();
+    let mut instances = Vec::new();
+    let mut names: BTreeMap<&str, (u32, Material)> = BTreeMap::new();
     for (i, mesh) in file.meshes.iter().enumerate() {
         let m = materials
             .get(&mesh.material)
             .with_context(|| format!("scene file {name}: mesh {i} uses unknown material `{}`", mesh.material))?;
-        if mesh.scale.iter().chain(&mesh.rotate).chain(&mesh.translate).any(|v| !v.is_finite()) {
+        if !mesh.placement.is_finite() {
             bail!("scene file {name}: mesh {i} has a non-finite transform");
         }
-        let loaded = super::mesh::load(&dir.join(&mesh.path)).with_context(|| format!("scene file {name}: mesh {i}"))?;
-        let xf = mesh.transform();
-        let place = |v: [f32; 3]| xf.transform_point3(v.into()).to_array();
-        triangle_materials.extend(std::iter::repeat_n(*m, loaded.len()));
-        triangles.extend(loaded.iter().map(|t| treelet_core::geometry::triangle::Triangle::new(place(t.v0), place(t.v1), place(t.v2))));
+        let path = dir.join(&mesh.path);
+        let label = path.display().to_string();
+        let slot = match meshes.iter().position(|s| s.name == label) {
+            Some(slot) => slot as u32,
+            None => {
+                let loaded = super::mesh::load(&path).with_context(|| format!("scene file {name}: mesh {i}"))?;
+                let materials = vec![*m; loaded.len()];
+                meshes.push(SceneMesh { name: label, triangles: loaded, materials });
+                meshes.len() as u32 - 1
+            }
+        };
+        if let Some(key) = &mesh.name {
+            if names.insert(key, (slot, *m)).is_some() {
+                bail!("scene file {name}: mesh {i}: a mesh is already named `{key}`");
+            }
+        }
+        instances.push(SceneInstance { mesh: slot, transform: mesh.placement.transform(), material: Some(*m) });
     }
-    Primitives::triangles(&triangles)
-        .check()
-        .with_context(|| format!("scene file {name}: after the mesh transforms"))?;
+    for (i, instance) in file.instances.iter().enumerate() {
+        let &(slot, named) = names.get(instance.mesh.as_str()).with_context(|| {
+            format!("scene file {name}: instance {i} places `{}`, which no mesh is named", instance.mesh)
+        })?;
+        if !instance.placement.is_finite() {
+            bail!("scene file {name}: instance {i} has a non-finite transform");
+        }
+        let material = match &instance.material {
+            Some(key) => *materials
+                .get(key)
+                .with_context(|| format!("scene file {name}: instance {i} uses unknown material `{key}`"))?,
+            None => named, // the material of the mesh entry that named it
+
+        };
+        instances.push(SceneInstance { mesh: slot, transform: instance.placement.transform(), material: Some(material) });
+    }
+    let mut triangles = Vec::new();
+    let mut triangle_materials = Vec::new();
     for (i, d) in file.disks.iter().enumerate() {
         let m = materials
             .get(&d.material)
@@ -265,7 +339,8 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
     }
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
-    Ok(Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles })
+    let loose = Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles };
+    Ok(InstancedScene { loose, meshes, instances })
 }
 
 #[cfg(test)]
@@ -375,5 +450,35 @@ mod tests {
         assert!(e.contains("after the mesh transforms"), "{e}");
         let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "w", "spin": 3}"#));
         assert!(e.contains("line 1") && e.contains("spin"), "{e}");
+    }
+
+    #[test]
+    fn instances_place_named_meshes_and_bad_ones_are_named() {
+        let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes"));
+        let file = |meshes: &str, instances: &str| {
+            format!(
+                r#"{{"camera": {{"origin": [0,0,0], "direction": [0,0,1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1,1,1]}}, "m": {{"type": "mirror", "color": [1,1,1]}}}}, "meshes": [{meshes}], "instances": [{instances}]}}"#
+            )
+        };
+        let named = r#"{"path": "pyramid.obj", "material": "w", "name": "p"}"#;
+        let err = |text: String| format!("{:#}", parse_instanced_in(&text, "i.json", dir).unwrap_err());
+        let e = err(file(named, r#"{"mesh": "q"}"#));
+        assert!(e.contains("i.json") && e.contains("instance 0 places `q`, which no mesh is named"), "{e}");
+        let e = err(file(named, r#"{"mesh": "p"}, {"mesh": "p", "material": "gold"}"#));
+        assert!(e.contains("instance 1 uses unknown material `gold`"), "{e}");
+        let e = err(file(&format!("{named}, {named}"), ""));
+        assert!(e.contains("mesh 1: a mesh is already named `p`"), "{e}");
+        let e = err(file(named, r#"{"mesh": "p", "turn": 3}"#));
+        assert!(e.contains("line 1") && e.contains("turn"), "{e}");
+        // The same file under two mesh entries is read once; copies keep
+        // their entry's material unless they name one.
+        let other = r#"{"path": "pyramid.obj", "material": "m", "translate": [5, 0, 0]}"#;
+        let scene = parse_instanced_in(&file(&format!("{named}, {other}"), r#"{"mesh": "p", "translate": [0, 9, 0]}"#), "ok.json", dir).unwrap();
+        assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 3));
+        let flat = scene.flatten().unwrap();
+        let n = flat.triangles.len() / 3;
+        let kinds: Vec<u32> = [0, n, 2 * n].iter().map(|&k| flat.materials[k].kind).collect();
+        assert_eq!(kinds, [DIFFUSE, MIRROR, DIFFUSE]);
+        assert_eq!(flat.triangles[2 * n].v0[1], flat.triangles[0].v0[1] + 9.0);
     }
 }

@@ -1,7 +1,9 @@
 //! glTF 2.0 scenes (`.gltf` with its buffers, or `.glb`), through the `gltf`
-//! crate: the triangle meshes of the default scene, placed by their nodes'
-//! transforms (flattened into one set of triangles), their materials mapped
-//! to the path tracer's, and the first perspective camera.
+//! crate: the triangle meshes of the default scene, each read once and
+//! placed by every node that names it (an instance: [`load_instanced`];
+//! [`load`] flattens them into one set of triangles), their materials
+//! mapped to the path tracer's, and the first perspective camera (else one
+//! framing the placed meshes' boxes).
 //!
 //! Materials (metallic-roughness, with the transmission, IOR and emissive
 //! strength extensions): transmission above one half is glass (colour: the
@@ -16,17 +18,25 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context as _, Result};
-use glam::{Mat4, Vec3};
+use glam::{Affine3A, Mat4, Vec3};
 use treelet_core::geometry::buffers::{Material, DIFFUSE, GLASS, MIRROR};
 use treelet_core::geometry::triangle::Triangle;
 
 use super::file::MAX_EMISSION;
+use super::instanced::{InstancedScene, SceneInstance, SceneMesh};
 use super::model::{CameraSpec, Scene};
-use super::primitives::Primitives;
 
-/// Loads a glTF 2.0 file as a scene; errors name the file and the mesh,
-/// primitive or material at fault.
+/// Loads a glTF 2.0 file as a scene, its instances flattened; errors name
+/// the file and the mesh, primitive or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
+    load_instanced(path)?.flatten()
+}
+
+/// Loads a glTF 2.0 file with each mesh once, in its own space, and an
+/// instance for every node that places it (see
+/// [`super::instanced`]); errors name the file and the mesh, primitive or
+/// material at fault.
+pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     let name = path.display().to_string();
     let bytes = crate::input::read(path, "glTF file")?;
     precheck(&bytes, &name)?;
@@ -36,14 +46,14 @@ pub fn load(path: &Path) -> Result<Scene> {
     let document = &gltf.document;
     let scene =
         document.default_scene().or_else(|| document.scenes().next()).with_context(|| format!("{name}: no scene"))?;
-    let mut out = Loaded::default();
+    let mut out = Loaded { mesh_slots: vec![None; document.meshes().len()], ..Default::default() };
     for node in scene.nodes() {
         walk(&node, Mat4::IDENTITY, &buffers, &name, &mut out)?;
     }
-    if out.triangles.is_empty() {
+    let placed = out.instances.iter().map(|i| out.meshes[i.mesh as usize].triangles.len() as u64).sum::<u64>();
+    if placed == 0 {
         bail!("{name}: the scene has no triangles");
     }
-    Primitives::triangles(&out.triangles).check().with_context(|| format!("{name}: after the node transforms"))?;
     if out.textured {
         eprintln!("note: {name}: textures are not read; textured materials render in their colour factors alone");
     }
@@ -52,8 +62,43 @@ pub fn load(path: &Path) -> Result<Scene> {
             "note: {name}: punctual lights (KHR_lights_punctual) are not supported; only emissive materials give light"
         );
     }
-    let camera = out.camera.unwrap_or_else(|| framing(&out.triangles));
-    Ok(Scene { name, spheres: Vec::new(), materials: out.materials, room: 0, camera, triangles: out.triangles })
+    let camera = match out.camera {
+        Some(c) => c,
+        None => framing(placed_bounds(&out.meshes, &out.instances)),
+    };
+    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new() };
+    Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
+}
+
+/// The box of every instance's mesh box, placed (each placed box's eight
+/// corners; the triangles' own box where the transforms keep axes).
+fn placed_bounds(meshes: &[SceneMesh], instances: &[SceneInstance]) -> (Vec3, Vec3) {
+    let boxes: Vec<(Vec3, Vec3)> = meshes
+        .iter()
+        .map(|m| {
+            m.triangles.iter().flat_map(|t| [t.v0, t.v1, t.v2]).fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), v| (lo.min(v.into()), hi.max(v.into())),
+            )
+        })
+        .collect();
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for i in instances {
+        let (a, b) = boxes[i.mesh as usize];
+        if a.x > b.x {
+            continue; // no triangles
+        }
+        for k in 0..8 {
+            let corner = Vec3::new(
+                if k & 1 == 0 { a.x } else { b.x },
+                if k & 2 == 0 { a.y } else { b.y },
+                if k & 4 == 0 { a.z } else { b.z },
+            );
+            let p = i.transform.transform_point3(corner);
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+    }
+    (lo, hi)
 }
 
 /// What the `gltf` crate indexes without checking (found by fuzzing: its
@@ -107,8 +152,10 @@ fn check_ranges(document: &gltf::Document, name: &str) -> Result<()> {
 
 #[derive(Default)]
 struct Loaded {
-    triangles: Vec<Triangle>,
-    materials: Vec<Material>,
+    meshes: Vec<SceneMesh>,
+    /// Per glTF mesh: its index in `meshes`, once a node has placed it.
+    mesh_slots: Vec<Option<u32>>,
+    instances: Vec<SceneInstance>,
     camera: Option<CameraSpec>,
     textured: bool,
 }
@@ -147,41 +194,29 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
     Ok(out)
 }
 
-/// Adds `node` and its children, placed by `parent` times their transforms.
+/// Adds `node` and its children, placed by `parent` times their
+/// transforms: an instance of its mesh (read the first time a node places
+/// it), and the first perspective camera.
 fn walk(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<()> {
     let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if !world.is_finite() {
         bail!("{name}: node {} has a non-finite transform", node.index());
     }
+    if world.row(3) != glam::Vec4::W {
+        bail!("{name}: node {} has a projective transform (its matrix's last row is not 0, 0, 0, 1)", node.index());
+    }
     if let Some(mesh) = node.mesh() {
-        for primitive in mesh.primitives() {
-            let at = format!("{name}: mesh {} primitive {}", mesh.index(), primitive.index());
-            if primitive.mode() != gltf::mesh::Mode::Triangles {
-                bail!("{at}: {:?} primitives are not supported (triangles only)", primitive.mode());
+        let slot = match out.mesh_slots[mesh.index()] {
+            Some(slot) => slot,
+            None => {
+                let loaded = read_mesh(&mesh, buffers, name, out)?;
+                out.meshes.push(loaded);
+                let slot = out.meshes.len() as u32 - 1;
+                out.mesh_slots[mesh.index()] = Some(slot);
+                slot
             }
-            let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .with_context(|| format!("{at}: no positions"))?
-                .map(|p| world.transform_point3(p.into()))
-                .collect();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            };
-            if indices.len() % 3 != 0 {
-                bail!("{at}: {} indices, not a multiple of three", indices.len());
-            }
-            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
-                bail!("{at}: index {bad} past its {} vertices", positions.len());
-            }
-            let material = material(&primitive.material(), &at, out)?;
-            for t in indices.chunks(3) {
-                let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize].to_array());
-                out.triangles.push(Triangle::new(a, b, c));
-                out.materials.push(material);
-            }
-        }
+        };
+        out.instances.push(SceneInstance { mesh: slot, transform: Affine3A::from_mat4(world), material: None });
     }
     if let (None, Some(camera)) = (&out.camera, node.camera()) {
         if let gltf::camera::Projection::Perspective(p) = camera.projection() {
@@ -199,6 +234,42 @@ fn walk(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &
         walk(&child, world, buffers, name, out)?;
     }
     Ok(())
+}
+
+/// A glTF mesh's triangles in its own space, every primitive's in order,
+/// with their materials.
+fn read_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<SceneMesh> {
+    let mut triangles = Vec::new();
+    let mut materials = Vec::new();
+    for primitive in mesh.primitives() {
+        let at = format!("{name}: mesh {} primitive {}", mesh.index(), primitive.index());
+        if primitive.mode() != gltf::mesh::Mode::Triangles {
+            bail!("{at}: {:?} primitives are not supported (triangles only)", primitive.mode());
+        }
+        let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        let positions: Vec<[f32; 3]> = reader.read_positions().with_context(|| format!("{at}: no positions"))?.collect();
+        if let Some(p) = positions.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+            bail!("{at}: position {p} is not finite: {:?}", positions[p]);
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        if indices.len() % 3 != 0 {
+            bail!("{at}: {} indices, not a multiple of three", indices.len());
+        }
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            bail!("{at}: index {bad} past its {} vertices", positions.len());
+        }
+        let material = material(&primitive.material(), &at, out)?;
+        for t in indices.chunks(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+            triangles.push(Triangle::new(a, b, c));
+            materials.push(material);
+        }
+    }
+    let label = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), |n| format!("mesh {} `{n}`", mesh.index()));
+    Ok(SceneMesh { name: format!("{name}: {label}"), triangles, materials })
 }
 
 /// The path tracer's material for a glTF material (see the module doc).
@@ -233,16 +304,9 @@ fn material(m: &gltf::Material, at: &str, out: &mut Loaded) -> Result<Material> 
     Ok(Material { emission, kind, color, ior })
 }
 
-/// A camera for a file without one: on the +z side of the triangles' box,
+/// A camera for a file without one: on the +z side of the box `lo..hi`,
 /// looking down -z at its centre, the box filling about the image.
-fn framing(triangles: &[Triangle]) -> CameraSpec {
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for t in triangles {
-        for v in [t.v0, t.v1, t.v2] {
-            lo = lo.min(v.into());
-            hi = hi.max(v.into());
-        }
-    }
+fn framing((lo, hi): (Vec3, Vec3)) -> CameraSpec {
     let (center, half) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
     let fov = 0.5;
     let distance = half.x.max(half.y) / fov + half.z;
@@ -400,6 +464,29 @@ mod tests {
             let e = format!("{:#}", load(&path).unwrap_err());
             assert!(e.contains(expected) && e.contains(file), "{file}: {e}");
         }
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn a_mesh_placed_by_two_nodes_is_one_mesh_and_two_instances() {
+        let d = dir();
+        // Node 2 (the camera's) also places mesh 0.
+        let text = document(&data_uri(), 4, 6).replace(r#""camera": 0}"#, r#""camera": 0, "mesh": 0}"#);
+        let path = d.join("twice.gltf");
+        std::fs::write(&path, &text).unwrap();
+        let scene = load_instanced(&path).unwrap();
+        assert_eq!((scene.meshes.len(), scene.instances.len()), (1, 2));
+        assert_eq!(scene.meshes[0].triangles.len(), 6);
+        assert_eq!(scene.instances[1].rows()[2][3], 9.0);
+        let flat = load(&path).unwrap();
+        assert_eq!(flat.triangles.len(), 12);
+        assert_eq!(flat.triangles[6], Triangle::new([0.0, 0.0, 9.0], [1.0, 0.0, 9.0], [1.0, 1.0, 9.0]));
+        // A matrix whose last row is not (0, 0, 0, 1) places nothing affinely.
+        let projective = text.replace(r#""translation": [0, 0, 9], "camera": 0, "mesh": 0"#, r#""matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0.5, 0,0,0,1], "camera": 0, "mesh": 0"#);
+        let path = d.join("projective.gltf");
+        std::fs::write(&path, projective).unwrap();
+        let e = format!("{:#}", load(&path).unwrap_err());
+        assert!(e.contains("projective.gltf") && e.contains("node 2") && e.contains("projective"), "{e}");
         std::fs::remove_dir_all(&d).ok();
     }
 }

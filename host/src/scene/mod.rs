@@ -3,10 +3,13 @@
 //!
 //! [`model`] is the scene itself and the built-in ones, [`primitives`] the
 //! spheres-then-triangles view a build takes (and its checks), [`mesh`]
-//! reads `.obj` / `.ply`, [`file`](mod@file) reads JSON scene files, and [`spec`]
+//! reads `.obj` / `.ply`, [`file`](mod@file) reads JSON scene files,
+//! [`gltf`](mod@gltf) glTF 2.0 ones, [`instanced`] keeps their meshes placed by
+//! reference (and flattens them), and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
 pub mod file;
 pub mod gltf;
+pub mod instanced;
 pub mod mesh;
 pub mod model;
 pub mod primitives;

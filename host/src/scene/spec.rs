@@ -2,6 +2,7 @@
 //! `terrain:N`, a JSON scene file, a glTF 2.0 scene, or an `.obj` / `.ply` mesh.
 use anyhow::{bail, Context as _, Result};
 
+use super::instanced::InstancedScene;
 use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
 use super::primitives::MAX_PRIMITIVES;
 use crate::runtime::memory;
@@ -61,6 +62,21 @@ impl Scene {
             _ => bail!(
                 "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh"
             ),
+        }
+    }
+}
+
+impl InstancedScene {
+    /// Loads a glTF 2.0 file or a JSON scene file with its instances kept
+    /// (see [`super::instanced`]).
+    pub fn load(path: &std::path::Path) -> Result<InstancedScene> {
+        let lower = path.to_string_lossy().to_ascii_lowercase();
+        if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            super::gltf::load_instanced(path)
+        } else if lower.ends_with(".json") {
+            super::file::load_instanced(path)
+        } else {
+            bail!("{}: expected a .gltf/.glb or a .json scene file", path.display())
         }
     }
 }

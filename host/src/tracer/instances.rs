@@ -154,6 +154,30 @@ impl<B: Backend> InstancedTracer<B> {
         Ok(scene)
     }
 
+    /// [`Self::build`] over a scene loaded with its instances kept
+    /// ([`crate::scene::instanced::InstancedScene::load`]: glTF nodes, a scene file's
+    /// copies): mesh `k` of the scene is mesh `k` here, and its instances
+    /// keep their order. The scene's loose triangles (in world space) are
+    /// one more mesh, placed once where it is, after the scene's; spheres,
+    /// disks and parallelograms are refused by name (the instanced walk
+    /// tests triangles only). Materials are the renderer's; hits carry
+    /// mesh and primitive, by which an engine finds its own.
+    pub fn build_scene(b: &mut B, scene: &crate::scene::instanced::InstancedScene, quality: Quality) -> Result<Self> {
+        let name = &scene.loose.name;
+        if !scene.loose.spheres.is_empty() {
+            bail!("{name}: {} spheres: instanced scenes take triangles only", scene.loose.spheres.len());
+        }
+        let mut meshes: Vec<&[Triangle]> = scene.meshes.iter().map(|m| m.triangles.as_slice()).collect();
+        let mut instances: Vec<Instance> =
+            scene.instances.iter().map(|i| Instance { mesh: i.mesh, transform: i.rows() }).collect();
+        if !scene.loose.triangles.is_empty() {
+            only_triangles(&scene.loose.triangles).with_context(|| format!("{name}: the scene's own (not instanced) primitives"))?;
+            instances.push(Instance { mesh: meshes.len() as u32, transform: Instance::IDENTITY });
+            meshes.push(&scene.loose.triangles);
+        }
+        Self::build(b, &meshes, &instances, quality).with_context(|| format!("{name}"))
+    }
+
     /// Places the meshes anew (any number of instances, any transforms):
     /// rebuilds the top-level tree only.
     pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> Result<()> {
