@@ -260,7 +260,7 @@ fn bench_dynamic_times_refit_rebuild_and_rays() {
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let row = &doc["row"];
     assert_eq!((row["triangles"].as_u64(), row["rays"].as_u64(), row["frames"].as_u64()), (Some(800), Some(192), Some(2)), "{doc}");
-    for key in ["refit_ms", "rebuild_lbvh_ms", "rebuild_trbvh_ms", "closest_refit_mrays", "occluded_rebuilt_mrays"] {
+    for key in ["refit_ms", "rebuild_lbvh_ms", "rebuild_trbvh_ms", "closest_refit_mrays", "occluded_rebuilt_mrays", "closest_diffuse_mrays", "occluded_diffuse_mrays", "closest_ao_mrays", "occluded_ao_mrays"] {
         assert!(row[key].as_f64().is_some_and(|v| v > 0.0 && v.is_finite()), "{key}: {doc}");
     }
     std::fs::remove_file(&json).ok();

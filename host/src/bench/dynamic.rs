@@ -1,7 +1,10 @@
 //! `bench dynamic`: an animated mesh through the engine API, frame by frame:
 //! refit the tree against rebuilding it with each builder, and one frame's
 //! rays (closest hits and occlusion queries) through the refit tree and the
-//! rebuilt one, whose difference is what refitting costs in ray speed.
+//! rebuilt one, whose difference is what refitting costs in ray speed; and
+//! through the rebuilt tree, a cosine bounce from each hit (an engine's
+//! diffuse rays, unbounded, and its ambient-occlusion rays, reaching 5% of
+//! the mesh's extent) as closest hits and as occlusion queries.
 use std::time::Instant;
 
 use anyhow::{bail, Result};
@@ -10,7 +13,9 @@ use treelet::runtime::backend::Backend;
 use treelet::scene::Scene;
 use treelet::{Quality, Ray, Tracer, Triangle};
 
-use super::measure::{median, traced_in_place_ms};
+use rand::SeedableRng;
+
+use super::measure::{cosine_bounces, median, traced_in_place_ms};
 
 /// Medians over the frames, in ms (device time: `Tracer::last_update_ms` and
 /// the trace stage's timestamps on a GPU, wall clock on the CPU runner;
@@ -31,7 +36,18 @@ pub(crate) struct DynamicRow {
     pub(crate) closest_rebuilt_mrays: f64,
     pub(crate) occluded_refit_mrays: f64,
     pub(crate) occluded_rebuilt_mrays: f64,
+    /// Bounce rays a frame (the hits' cosine bounces), and their rays per
+    /// second (millions) through the rebuilt tree: unbounded, and reaching
+    /// [`AO_REACH`] of the mesh's extent.
+    pub(crate) bounce_rays: usize,
+    pub(crate) closest_diffuse_mrays: f64,
+    pub(crate) occluded_diffuse_mrays: f64,
+    pub(crate) closest_ao_mrays: f64,
+    pub(crate) occluded_ao_mrays: f64,
 }
+
+/// How far ambient-occlusion rays reach, in the mesh's largest extent.
+pub(crate) const AO_REACH: f32 = 0.05;
 
 /// The mesh at `frame`: every vertex lifted by a travelling wave of 2% of
 /// the mesh's extent (the same vertex always moves the same way, so shared
@@ -89,6 +105,10 @@ pub(crate) fn bench_dynamic<B: Backend>(
     let rays = rays(lo, hi, size);
     let mut tracer = Tracer::build(b, &[], &scene.triangles, Quality::High)?;
     let mut m: [Vec<f64>; 10] = Default::default();
+    // Bounce rays: Mray/s each frame (their count changes with the mesh).
+    let mut bounce: [Vec<f64>; 4] = Default::default();
+    let mut bounce_rays = 0;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
     b.take_times()?;
     for frame in 0..=frames {
         let mesh = deform(&scene.triangles, frame, lo, extent);
@@ -107,8 +127,21 @@ pub(crate) fn bench_dynamic<B: Backend>(
         let rebuilt = Tracer::build(b, &[], &mesh, Quality::High)?;
         let trbvh = update_times(b, &rebuilt, start)?;
         let (closest_rebuilt, occluded_rebuilt) = trace(b, &rebuilt, &rays)?;
+        let hits = rebuilt.closest_hits(b, &rays)?;
+        let diffuse = cosine_bounces(&rays, &hits, extent, &mut rng);
+        let ao: Vec<Ray> = diffuse.iter().map(|r| Ray { t_max: AO_REACH * extent, ..*r }).collect();
+        let mut per_s = Vec::new();
+        for set in [&diffuse, &ao] {
+            warm_up(b, &rebuilt, set)?;
+            let (closest, occluded) = trace(b, &rebuilt, set)?;
+            per_s.extend([set.len() as f64 / closest / 1e3, set.len() as f64 / occluded / 1e3]);
+        }
         if frame == 0 {
             continue; // warm-up
+        }
+        bounce_rays = diffuse.len();
+        for (list, v) in bounce.iter_mut().zip(per_s) {
+            list.push(v);
         }
         let values = [
             refit.0,
@@ -129,6 +162,7 @@ pub(crate) fn bench_dynamic<B: Backend>(
     let [refit_ms, rebuild_lbvh_ms, rebuild_trbvh_ms, wall_refit_ms, wall_rebuild_lbvh_ms, wall_rebuild_trbvh_ms, c_refit, c_rebuilt, o_refit, o_rebuilt] =
         m.map(median);
     let mrays = |ms: f64| rays.len() as f64 / ms / 1e3;
+    let [closest_diffuse_mrays, occluded_diffuse_mrays, closest_ao_mrays, occluded_ao_mrays] = bounce.map(median);
     Ok(DynamicRow {
         triangles: scene.triangles.len(),
         rays: rays.len(),
@@ -143,6 +177,11 @@ pub(crate) fn bench_dynamic<B: Backend>(
         closest_rebuilt_mrays: mrays(c_rebuilt),
         occluded_refit_mrays: mrays(o_refit),
         occluded_rebuilt_mrays: mrays(o_rebuilt),
+        bounce_rays,
+        closest_diffuse_mrays,
+        occluded_diffuse_mrays,
+        closest_ao_mrays,
+        occluded_ao_mrays,
     })
 }
 

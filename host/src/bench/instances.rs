@@ -15,7 +15,7 @@ use treelet::runtime::backend::Backend;
 use treelet::scene::Scene;
 use treelet::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer, Triangle};
 
-use super::measure::{median, traced_in_place_ms};
+use super::measure::{cosine_bounces, median, traced_in_place_ms};
 
 /// Medians (ms: device time, `last_update_ms` and the trace stage's
 /// timestamps on a GPU; wall clock on the CPU runner).
@@ -95,28 +95,6 @@ fn camera_rays((lo, hi): (Vec3, Vec3), view: Vec3, (w, h): (u32, u32)) -> Vec<Ra
         .collect()
 }
 
-/// A cosine-distributed bounce from each hit, on the side the ray came from,
-/// starting a little off the surface.
-fn bounces(rays: &[Ray], hits: &[RayHit], extent: f32, rng: &mut impl Rng) -> Vec<Ray> {
-    rays.iter()
-        .zip(hits)
-        .filter(|(_, h)| h.is_hit())
-        .map(|(r, h)| {
-            let d = Vec3::from(r.dir).normalize();
-            let mut n = Vec3::from(h.normal);
-            if n.dot(d) > 0.0 {
-                n = -n;
-            }
-            let (u1, u2): (f32, f32) = (rng.random(), rng.random());
-            let (a, b) = n.any_orthonormal_pair();
-            let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-            let dir = a * s * phi.cos() + b * s * phi.sin() + n * (1.0 - u1).sqrt();
-            let x = Vec3::from(r.origin) + d * h.t;
-            Ray { t_min: 1e-4 * extent, ..Ray::new(x.into(), dir.into()) }
-        })
-        .collect()
-}
-
 /// A tracer as the benchmark drives it: closest hits from host rays (to
 /// make the bounce rays), and in place on the device (what is timed).
 struct Traced<'a, B: Backend> {
@@ -136,7 +114,7 @@ fn rays_per_second<B: Backend>(
 ) -> Result<(f64, f64, usize, usize)> {
     let primary = camera_rays(framing, view, size);
     let hits = (t.closest)(b, &primary)?;
-    let diffuse = bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
+    let diffuse = cosine_bounces(&primary, &hits, extent, &mut rand_pcg::Pcg64::seed_from_u64(7));
     let p = traced_in_place_ms(b, &primary, repeats, 0.5, t.on_device)?;
     let d = traced_in_place_ms(b, &diffuse, repeats, 0.5, t.on_device)?;
     let mrays = |n: usize, ms: f64| n as f64 / ms / 1e3;

@@ -497,3 +497,25 @@ pub(crate) fn traced_in_place_ms<B: Backend>(
     Ok(median(times))
 }
 
+/// A cosine-distributed bounce from each hit, on the side the ray came from,
+/// starting a little off the surface.
+pub(crate) fn cosine_bounces(rays: &[Ray], hits: &[treelet::RayHit], extent: f32, rng: &mut impl rand::Rng) -> Vec<Ray> {
+    rays.iter()
+        .zip(hits)
+        .filter(|(_, h)| h.is_hit())
+        .map(|(r, h)| {
+            use glam::Vec3;
+            let d = Vec3::from(r.dir).normalize();
+            let mut n = Vec3::from(h.normal);
+            if n.dot(d) > 0.0 {
+                n = -n;
+            }
+            let (u1, u2): (f32, f32) = (rng.random(), rng.random());
+            let (a, b) = n.any_orthonormal_pair();
+            let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+            let dir = a * s * phi.cos() + b * s * phi.sin() + n * (1.0 - u1).sqrt();
+            let x = Vec3::from(r.origin) + d * h.t;
+            Ray { t_min: 1e-4 * extent, ..Ray::new(x.into(), dir.into()) }
+        })
+        .collect()
+}

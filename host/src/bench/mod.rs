@@ -318,6 +318,17 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             println!("  rebuild, TRBVH   {:>9.3} ms  (wall {:.3})", row.rebuild_trbvh_ms, row.wall_rebuild_trbvh_ms);
             println!("  closest hits     {:>9.1} Mray/s refit, {:.1} rebuilt (TRBVH)", row.closest_refit_mrays, row.closest_rebuilt_mrays);
             println!("  occlusion        {:>9.1} Mray/s refit, {:.1} rebuilt (TRBVH)", row.occluded_refit_mrays, row.occluded_rebuilt_mrays);
+            println!(
+                "  bounce rays ({} a frame, rebuilt TRBVH): diffuse {:.1} Mray/s closest, {:.1} occlusion ({:.2}x); ambient occlusion (reach {}% of the extent) {:.1} closest, {:.1} occlusion ({:.2}x)",
+                row.bounce_rays,
+                row.closest_diffuse_mrays,
+                row.occluded_diffuse_mrays,
+                row.occluded_diffuse_mrays / row.closest_diffuse_mrays,
+                dynamic::AO_REACH * 100.0,
+                row.closest_ao_mrays,
+                row.occluded_ao_mrays,
+                row.occluded_ao_mrays / row.closest_ao_mrays
+            );
             if let Some(path) = json {
                 let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
                 let doc = serde_json::json!({ "adapter": adapter, "scene": scene.name, "clocks": clocks, "row": row });
