@@ -968,3 +968,40 @@ fn scene_file_instances_are_flattened_with_a_note() {
     assert!(err.contains("many.json") && err.contains("2001 instances of 1 mesh, flattened into 12006 triangles") && err.contains("memory"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `bench placed` traces a file's own instances against the same scene
+/// flattened, with the same hits; a file whose own shapes are not
+/// triangles is refused by name.
+#[test]
+fn bench_placed_traces_a_files_instances() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-placed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramid.obj"), dir.join("pyramid.obj")).unwrap();
+    let copies: Vec<String> =
+        (0..24).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}], "rotate": [0, {}, 0]}}"#, (k % 6) * 3, (k / 6) * 3, k * 7)).collect();
+    let text = format!(
+        r#"{{"camera": {{"origin": [8, 20, 40], "direction": [0, -0.3, -1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1, 1, 1]}}}},
+  "meshes": [{{"path": "pyramid.obj", "material": "w", "name": "p"}}], "instances": [{}]}}"#,
+        copies.join(", ")
+    );
+    let file = dir.join("grid.json");
+    std::fs::write(&file, text).unwrap();
+    let json = dir.join("out.json");
+    let args = ["bench", "placed", "--device", "cpu", "--repeats", "1", "--width", "32", "--height", "24"];
+    let out = treelet(&[&args[..], &["--scene", file.to_str().unwrap(), "--json", json.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let row = &doc["row"];
+    assert_eq!((row["meshes"].as_u64(), row["instances"].as_u64()), (Some(1), Some(25)), "{doc}");
+    assert_eq!((row["triangles_kept"].as_u64(), row["triangles_flattened"].as_u64()), (Some(6), Some(150)), "{doc}");
+    assert!(row["hits_differ"].as_u64().is_some_and(|d| d * 100 <= row["camera_rays"].as_u64().unwrap()), "{doc}");
+    for key in ["build_instanced_ms", "top_level_ms", "instanced_primary_mrays", "flattened_diffuse_mrays"] {
+        assert!(row[key].as_f64().is_some_and(|v| v > 0.0 && v.is_finite()), "{key}: {doc}");
+    }
+    let room = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
+    let e = stderr_of(&[&args[..], &["--scene", room]].concat());
+    assert!(e.contains("pyramids.json") && e.contains("triangles only"), "{e}");
+    let e = stderr_of(&[&args[..], &["--scene", "cornell"]].concat());
+    assert!(e.contains("expected a .gltf/.glb or a .json scene file"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

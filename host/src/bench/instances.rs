@@ -66,19 +66,19 @@ fn placed(angle: f32, at: Vec3) -> Instance {
 }
 
 /// The box of `points`.
-fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+pub(crate) fn bounds(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
 /// The eye of `bench rays --mesh-only`: from the side and above.
-const OBLIQUE: Vec3 = Vec3::new(0.0, 0.6, 0.8);
+pub(crate) const OBLIQUE: Vec3 = Vec3::new(0.0, 0.6, 0.8);
 /// An eye nearly straight above (a grid of copies seen from above: about
 /// one copy behind each pixel, as for the mesh alone).
 const ABOVE: Vec3 = Vec3::new(0.0, 1.0, 0.2);
 
 /// One camera ray a pixel, looking at the centre of `lo..hi` from the
 /// centre plus `view` times its largest extent (smallpt's lens).
-fn camera_rays((lo, hi): (Vec3, Vec3), view: Vec3, (w, h): (u32, u32)) -> Vec<Ray> {
+pub(crate) fn camera_rays((lo, hi): (Vec3, Vec3), view: Vec3, (w, h): (u32, u32)) -> Vec<Ray> {
     let centre = (lo + hi) * 0.5;
     let eye = centre + view * (hi - lo).max_element();
     let forward = (centre - eye).normalize();
@@ -97,14 +97,14 @@ fn camera_rays((lo, hi): (Vec3, Vec3), view: Vec3, (w, h): (u32, u32)) -> Vec<Ra
 
 /// A tracer as the benchmark drives it: closest hits from host rays (to
 /// make the bounce rays), and in place on the device (what is timed).
-struct Traced<'a, B: Backend> {
-    closest: &'a dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
-    on_device: &'a dyn Fn(&mut B, &B::Buffer, usize) -> Result<()>,
+pub(crate) struct Traced<'a, B: Backend> {
+    pub(crate) closest: &'a dyn Fn(&mut B, &[Ray]) -> Result<Vec<RayHit>>,
+    pub(crate) on_device: &'a dyn Fn(&mut B, &B::Buffer, usize) -> Result<()>,
 }
 
 /// Primary and diffuse M rays/s (medians of `repeats`) through `t`, and the
 /// numbers of rays.
-fn rays_per_second<B: Backend>(
+pub(crate) fn rays_per_second<B: Backend>(
     b: &mut B,
     (framing, view): ((Vec3, Vec3), Vec3),
     size: (u32, u32),

@@ -22,6 +22,7 @@ mod error_curves;
 mod figure;
 mod instances;
 mod measure;
+mod placed;
 pub mod results;
 mod suite;
 mod tradeoff;
@@ -196,6 +197,25 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+    /// A scene file's or glTF file's own instances (meshes placed by
+    /// reference) through the engine API, against the same scene
+    /// flattened: memory, build time, rays per second, top-level rebuild.
+    Placed {
+        /// A .gltf/.glb or .json scene that places meshes.
+        #[arg(long)]
+        scene: std::path::PathBuf,
+        #[arg(long, default_value_t = 1920)]
+        width: u32,
+        #[arg(long, default_value_t = 1080)]
+        height: u32,
+        #[arg(long, value_enum, default_value = "gpu")]
+        device: DeviceChoice,
+        /// Timed repeats (median reported), after one warm-up.
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
     /// Specialized render kernels against the general one (--kernel full):
     /// render-kernel time per scene, and each kernel's SPIR-V size.
     Variants {
@@ -299,6 +319,38 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             if let Some(path) = json {
                 let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
                 let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "row": row, "clocks": clocks });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Placed { scene, width, height, device, repeats, json } => {
+            let scene = treelet::scene::instanced::InstancedScene::load(&scene)?;
+            let device = device.open()?;
+            let before = clocks::read();
+            let (adapter, row) = treelet::with_backend!(&device, |b| (b.adapter(), placed::bench_placed(b, &scene, (width, height), repeats)?));
+            let clocks = matches!(device, Device::Gpu(_)).then(|| (before, clocks::read()));
+            println!(
+                "{}: {} mesh(es) placed {} times ({} triangles kept, {} flattened), {width}x{height}, {adapter}, median of {repeats}",
+                scene.loose.name, row.meshes, row.instances, row.triangles_kept, row.triangles_flattened
+            );
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
+            println!("  build            {:>9.3} ms instanced (every mesh and the top level), {:.3} flattened", row.build_instanced_ms, row.build_flattened_ms);
+            println!("  top level again  {:>9.3} ms  (wall {:.3})", row.top_level_ms, row.top_level_wall_ms);
+            let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+            println!(
+                "  instances        {:>9.1} M primary rays/s, {:.1} M diffuse ({:.2}x, {:.2}x the flattened scene's)",
+                row.instanced_primary_mrays,
+                row.instanced_diffuse_mrays,
+                ratio(row.instanced_primary_mrays, row.flattened_primary_mrays),
+                ratio(row.instanced_diffuse_mrays, row.flattened_diffuse_mrays)
+            );
+            println!("  flattened        {:>9.1} M primary rays/s, {:.1} M diffuse", row.flattened_primary_mrays, row.flattened_diffuse_mrays);
+            println!("  camera rays whose hit differs from the flattened scene's: {} of {}", row.hits_differ, row.camera_rays);
+            if let Some(path) = json {
+                let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
+                let doc = serde_json::json!({ "adapter": adapter, "scene": scene.loose.name, "width": width, "height": height, "repeats": repeats, "row": row, "clocks": clocks });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
             }
             Ok(())
