@@ -933,6 +933,23 @@ fn slurm_array_script_on_a_real_cluster() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A scene file `name` in a fresh temporary folder (`tag` names it) beside
+/// a copy of `scenes/pyramid.obj`, named `p` once and placed again by
+/// `copies` (scene-file instance entries); the folder and the file.
+fn pyramid_copies(tag: &str, name: &str, copies: &[String]) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramid.obj"), dir.join("pyramid.obj")).unwrap();
+    let text = format!(
+        r#"{{"camera": {{"origin": [8, 20, 40], "direction": [0, -0.3, -1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1, 1, 1]}}}},
+  "meshes": [{{"path": "pyramid.obj", "material": "w", "name": "p"}}], "instances": [{}]}}"#,
+        copies.join(", ")
+    );
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    (dir, file)
+}
+
 /// A scene file placing a mesh by reference: built (and rendered) flattened,
 /// with a note that says so; a flattening past the memory available is
 /// refused by name before anything is allocated.
@@ -947,17 +964,8 @@ fn scene_file_instances_are_flattened_with_a_note() {
     assert_eq!(v["triangles"], 37, "five pyramids of six triangles, a disk and six walls");
     assert_eq!(v["valid"], true);
 
-    let dir = std::env::temp_dir().join(format!("treelet-cli-instances-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramid.obj"), dir.join("pyramid.obj")).unwrap();
     let copies: Vec<String> = (0..2000).map(|k| format!(r#"{{"mesh": "p", "translate": [{k}, 0, 0]}}"#)).collect();
-    let text = format!(
-        r#"{{"camera": {{"origin": [0, 0, 50], "direction": [0, 0, -1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1, 1, 1]}}}},
-  "meshes": [{{"path": "pyramid.obj", "material": "w", "name": "p"}}], "instances": [{}]}}"#,
-        copies.join(", ")
-    );
-    let file = dir.join("many.json");
-    std::fs::write(&file, text).unwrap();
+    let (dir, file) = pyramid_copies("instances", "many.json", &copies);
     let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
         .args(["build", "--device", "cpu", "--scene", file.to_str().unwrap()])
         .env("TREELET_MAX_MEMORY", "100000")
@@ -974,18 +982,9 @@ fn scene_file_instances_are_flattened_with_a_note() {
 /// triangles is refused by name.
 #[test]
 fn bench_placed_traces_a_files_instances() {
-    let dir = std::env::temp_dir().join(format!("treelet-cli-placed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::copy(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramid.obj"), dir.join("pyramid.obj")).unwrap();
     let copies: Vec<String> =
         (0..24).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}], "rotate": [0, {}, 0]}}"#, (k % 6) * 3, (k / 6) * 3, k * 7)).collect();
-    let text = format!(
-        r#"{{"camera": {{"origin": [8, 20, 40], "direction": [0, -0.3, -1]}}, "materials": {{"w": {{"type": "diffuse", "color": [1, 1, 1]}}}},
-  "meshes": [{{"path": "pyramid.obj", "material": "w", "name": "p"}}], "instances": [{}]}}"#,
-        copies.join(", ")
-    );
-    let file = dir.join("grid.json");
-    std::fs::write(&file, text).unwrap();
+    let (dir, file) = pyramid_copies("placed", "grid.json", &copies);
     let json = dir.join("out.json");
     let args = ["bench", "placed", "--device", "cpu", "--repeats", "1", "--width", "32", "--height", "24"];
     let out = treelet(&[&args[..], &["--scene", file.to_str().unwrap(), "--json", json.to_str().unwrap()]].concat());
