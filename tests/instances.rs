@@ -443,3 +443,71 @@ fn scene_files_place_meshes_as_instances() {
         scene_files(&mut GpuBackend::new(ctx), seed);
     }
 }
+
+/// Mean over pixels and channels of `|a - b|`, and the share of pixels
+/// whose channels differ by more than `tol` (relative to 1 + value).
+fn image_difference(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> (f64, f64) {
+    let mean = a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>()).sum::<f64>() / (3 * a.len()) as f64;
+    let off = a.iter().zip(b).filter(|(x, y)| (0..3).any(|k| (x[k] - y[k]).abs() > tol * (1.0 + y[k].abs()))).count();
+    (mean, off as f64 / a.len() as f64)
+}
+
+/// `render` keeps the copies of `scenes/pyramids.json` (one pyramid placed
+/// five times, in glass, mirror and three diffuse materials, one upside
+/// down under the ceiling) placed, and renders what the same file
+/// flattened renders, on the CPU runner; the GPU renders it as the CPU
+/// runner does, within the rounding that sends a few paths elsewhere. A
+/// scene of copies alone (no primitives of its own) renders too.
+#[test]
+fn placed_copies_render_what_the_flattened_scene_renders() {
+    use treelet::render::{render, Integrator, RenderSettings};
+    let seed = fresh_seed() as u32;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
+    let placed = treelet::scene::Scene::for_render(path).unwrap();
+    let flat = treelet::scene::Scene::from_spec(path).unwrap();
+    let copies = placed.placed.as_ref().expect("the repeated pyramid is kept placed");
+    assert_eq!((copies.meshes.len(), copies.instances.len()), (1, 5));
+    assert_eq!(placed.triangles.len() as u64 + copies.triangles(), flat.triangles.len() as u64, "the flattened file has every copy's triangles");
+    let settings = RenderSettings {
+        width: 64,
+        height: 48,
+        spp: 16,
+        seed,
+        accel: treelet::bvh::tree::Accel::Auto,
+        layout: treelet::bvh::layout::Layout::Auto,
+        kernel: treelet::render::variant::KernelChoice::Auto,
+        integrator: Integrator::Nee,
+        error_each_pass: false,
+        first_sample: 0,
+    };
+    let mut cpu = CpuBackend::new();
+    let placed_cpu = render(&mut cpu, &placed, &settings, None, |_| {}).unwrap();
+    assert!(placed_cpu.plan.placed && placed_cpu.plan.kernel == "placed", "{:?}", placed_cpu.plan.kernel);
+    let flat_cpu = render(&mut cpu, &flat, &settings, None, |_| {}).unwrap();
+    let brightness = flat_cpu.image.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * flat_cpu.image.pixels.len()) as f64;
+    assert!(brightness > 0.05, "the room is lit: mean {brightness}");
+    // The same paths: a hit point rounds differently in a copy's own space
+    // (no face of a copy lies in another's plane: coplanar faces would
+    // tie by rounding).
+    let (mean, off) = image_difference(&placed_cpu.image.pixels, &flat_cpu.image.pixels, 1e-2);
+    assert!(mean < 1e-3 * brightness && off < 0.01, "seed {seed}: placed against flattened on the CPU runner: mean difference {mean} (brightness {brightness}), {off} of pixels off");
+    if let Some(ctx) = gpu() {
+        let mut b = GpuBackend::new(ctx);
+        let placed_gpu = render(&mut b, &placed, &settings, None, |_| {}).unwrap();
+        let (mean, off) = image_difference(&placed_gpu.image.pixels, &placed_cpu.image.pixels, 1e-2);
+        assert!(mean < 0.02 * brightness && off < 0.05, "seed {seed}: placed on {} against the CPU runner: mean difference {mean}, {off} of pixels off", b.adapter());
+    }
+    // Copies alone: nothing of the scene's own, no light: black, and no
+    // tree of its own built.
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed as u64);
+    let m = meshes(&mut rng, &[30]);
+    let nodes = vec![(0usize, Quat::IDENTITY, Vec3::ONE, Vec3::ZERO, None), (0, Quat::IDENTITY, Vec3::ONE, Vec3::new(3.0, 0.0, 0.0), None)];
+    let dir = std::env::temp_dir().join(format!("treelet-copies-alone-{}-{seed}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let gltf = write_gltf(&dir, &m, &nodes);
+    let alone = treelet::scene::Scene::for_render(gltf.to_str().unwrap()).unwrap();
+    assert!(alone.placed.is_some() && alone.spheres.is_empty() && alone.triangles.is_empty());
+    let black = render(&mut cpu, &alone, &RenderSettings { spp: 2, ..settings }, None, |_| {}).unwrap();
+    assert!(black.image.pixels.iter().all(|p| p.iter().all(|&c| c == 0.0)));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -92,6 +92,11 @@ struct RenderArgs {
     /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
+    /// Trace a scene file's or glTF file's copies of meshes flattened into
+    /// the scene's own triangles, as `build` does (by default a mesh placed
+    /// more than once keeps its copies placed: one tree per mesh).
+    #[arg(long)]
+    flatten: bool,
     #[arg(long, default_value_t = 512, value_parser = positive)]
     width: u32,
     #[arg(long, default_value_t = 384, value_parser = positive)]
@@ -260,7 +265,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     // The devices open (Vulkan's instance and device: a tenth of a second
     // each on an H100) while the scene and any parts load.
     let opening = OpenDevices::start(args.devices.clone(), args.device);
-    let scene = Scene::from_spec(&args.scene)?;
+    let scene = if args.flatten { Scene::from_spec(&args.scene)? } else { Scene::for_render(&args.scene)? };
     treelet::runtime::timeline::mark("scene");
     if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);

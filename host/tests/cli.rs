@@ -950,9 +950,9 @@ fn pyramid_copies(tag: &str, name: &str, copies: &[String]) -> (std::path::PathB
     (dir, file)
 }
 
-/// A scene file placing a mesh by reference: built (and rendered) flattened,
-/// with a note that says so; a flattening past the memory available is
-/// refused by name before anything is allocated.
+/// A scene file placing a mesh by reference: built flattened, with a note
+/// that says so; a flattening past the memory available is refused by name
+/// before anything is allocated.
 #[test]
 fn scene_file_instances_are_flattened_with_a_note() {
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
@@ -974,6 +974,41 @@ fn scene_file_instances_are_flattened_with_a_note() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && !err.contains("panicked"), "{err}");
     assert!(err.contains("many.json") && err.contains("2001 instances of 1 mesh, flattened into 12006 triangles") && err.contains("memory"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `render` keeps a file's copies placed (`--explain` says so, with the
+/// counts), so that copies whose flattening `build` refuses for memory
+/// render; `--integrator caustics` on them is refused by name.
+#[test]
+fn render_keeps_copies_placed() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-render-placed-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("pyramids.png");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
+    let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", "16", "--height", "12", "--spp", "2", "--explain", "--out", out.to_str().unwrap()]);
+    let (stdout, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("5 copies of 1 mesh kept placed (30 triangles"), "{err}");
+    let text = format!("{stdout}{err}");
+    assert!(text.contains("kernel     placed") && text.contains("5 placed copies of meshes (30 triangles)"), "{text}");
+    assert!(out.exists());
+    let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", "8", "--height", "8", "--spp", "1", "--integrator", "caustics", "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && !err.contains("panicked") && err.contains("placed copies") && err.contains("--integrator nee"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+
+    let copies: Vec<String> = (0..2000).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}]}}"#, (k % 50) * 2, (k / 50) * 2)).collect();
+    let (dir, file) = pyramid_copies("render-many", "many.json", &copies);
+    let out = dir.join("many.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["render", "--device", "cpu", "--scene", file.to_str().unwrap(), "--width", "16", "--height", "12", "--spp", "1", "--out", out.to_str().unwrap()])
+        .env("TREELET_MAX_MEMORY", "100000")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("2001 copies of 1 mesh kept placed (12006 triangles"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

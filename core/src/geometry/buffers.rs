@@ -220,9 +220,13 @@ pub struct RenderParams {
     /// Entries of the light table ([`crate::render::lights::Light`]).
     pub light_count: u32,
     /// Instances of an instanced scene's cast
-    /// ([`crate::render::rays::cast_instances_kernel`]).
+    /// ([`crate::render::rays::cast_instances_kernel`]), or of the placed
+    /// copies a render traces beside the scene's own primitives
+    /// ([`crate::trace::placed`]).
     pub instances: u32,
-    pub _pad: u32,
+    /// Triangles of every placed mesh, one mesh after another (a render
+    /// with copies).
+    pub placed_triangles: u32,
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
 
@@ -329,6 +333,24 @@ impl InstanceRecord {
         if row(0).dot(row(1).cross(row(2))) < 0.0 { -w } else { w }
     }
 }
+
+/// What the renderer knows of a placed copy of a mesh beside its
+/// [`InstanceRecord`] ([`crate::trace::placed`]): the index its first
+/// triangle has among the render's primitives, counted from the scene's
+/// own, and its material ([`NO_MATERIAL`]: its mesh's, per triangle).
+/// repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct PlacedInfo {
+    pub first: u32,
+    pub material: u32,
+    pub _pad: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<PlacedInfo>() == 16);
+
+/// [`PlacedInfo::material`] of a copy that keeps its mesh's materials.
+pub const NO_MATERIAL: u32 = u32::MAX;
 
 /// A placed copy of a mesh as an engine gives it, before the top level is
 /// built ([`crate::construct::instances`]): the rows of the 3x4 matrix that

@@ -265,9 +265,8 @@ impl Path {
         if !hit.is_hit() {
             return false;
         }
-        let m = scene.materials[hit.prim as usize];
         let x = self.o + self.d * hit.t;
-        let n = hit_normal_for::<F>(&scene.prims, hit.prim, x, self.d);
+        let (m, n) = surface::<T, F>(scene, hit.prim, x, self.d);
         let nl = if n.dot(self.d) < 0.0 { n } else { -n };
         let mut f = Vec3::from_array(m.color);
         let emission = Vec3::from_array(m.emission);
@@ -498,6 +497,19 @@ fn sample_direct<T: ClosestHit>(
     let emission = Vec3::from_array(scene.materials[light.prim as usize].emission);
     let value = emission * (bsdf_pdf / light_pdf * power_heuristic(light_pdf, bsdf_pdf));
     DirectSample { light: light.prim, dir: s.dir, value }
+}
+
+/// The material and outward normal of primitive `prim` at its point `x`
+/// (hit along `d`): the scene's own ([`hit_normal_for`]), or, where `F`
+/// has [`features::INSTANCES`], a placed copy's past them
+/// ([`ClosestHit::placed_surface`]).
+#[inline]
+fn surface<T: ClosestHit, const F: u32>(scene: &SceneRefs<T>, prim: u32, x: Vec3, d: Vec3) -> (Material, Vec3) {
+    if has(F, features::INSTANCES) && prim >= scene.prims.count() {
+        scene.tree.placed_surface(prim - scene.prims.count(), d)
+    } else {
+        (scene.materials[prim as usize], hit_normal_for::<F>(&scene.prims, prim, x, d))
+    }
 }
 
 /// The outward normal of primitive `prim` at its point `x` (hit along `d`):

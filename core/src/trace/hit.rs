@@ -3,6 +3,7 @@
 //! casts are generic over it.
 use glam::Vec3;
 
+use crate::geometry::buffers::Material;
 use crate::geometry::intersect::MISS;
 use crate::geometry::prims::{Origin, Prims};
 
@@ -35,6 +36,15 @@ pub trait ClosestHit {
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit;
+
+    /// The material and outward normal (unit length) of the `k`-th
+    /// primitive past the scene's own, hit along `d`: a placed copy's
+    /// triangle ([`crate::trace::placed`]). Only a tree over copies finds
+    /// such primitives; the others never are asked.
+    #[inline]
+    fn placed_surface(&self, _k: u32, d: Vec3) -> (Material, Vec3) {
+        (Material::default(), -d)
+    }
 }
 
 /// What a traversal looks for: the closest hit up to `t_max`, or, for an

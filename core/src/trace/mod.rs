@@ -9,6 +9,11 @@
 //! - [`cwbvh`]: compressed 8-wide nodes with node and primitive groups
 //!   (Ylitie, Karras & Laine 2017).
 //!
+//! Two more walk placed copies of meshes: [`instances`] (a top-level tree
+//! over copies, each entered with the ray in its mesh's space: the engine
+//! API's), and [`placed`] (a scene's own tree, then its copies: the
+//! renderer's).
+//!
 //! Every layout finds exactly the scan's closest hit: ties go to the lower
 //! primitive index ([`hit::Hit::is_beaten_by`]).
 pub mod bvh2;
@@ -16,3 +21,4 @@ pub mod classic;
 pub mod cwbvh;
 pub mod hit;
 pub mod instances;
+pub mod placed;

@@ -60,6 +60,9 @@ pub struct Prepared<B: Backend> {
     /// lights: the light paths' kernel and the buffer they land in (its
     /// sums are added to `accum`'s when read).
     light_paths: Option<(Kernel, B::Buffer)>,
+    /// The scene's copies of meshes kept placed, if it has any (the kernel
+    /// is then [`Kernel::RenderPlaced`]).
+    placed: Option<super::placed::PlacedPart<B>>,
     /// Render parameters but for the samples of a dispatch.
     params: RenderParams,
     per_dispatch: u32,
@@ -73,8 +76,13 @@ pub struct Prepared<B: Backend> {
 /// ([`Backend::prepare_kernels`]).
 pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
     let mut k = crate::bvh::tree::kernels_of(b, plan.accel, plan.layout);
-    k.extend([Kernel::Fill, Kernel::Render(plan.method(), plan.variant as u8)]);
+    k.extend([Kernel::Fill, render_kernel(plan)]);
     k
+}
+
+/// The render kernel of `plan`.
+fn render_kernel(plan: &Plan) -> Kernel {
+    if plan.placed { Kernel::RenderPlaced } else { Kernel::Render(plan.method(), plan.variant as u8) }
 }
 
 /// The light paths' kernel of a render following `plan`, if it traces any:
@@ -112,6 +120,7 @@ const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
 /// `class` times both layouts before it starts (see [`PILOT_MIN_SPP`]).
 pub fn pilots_layout(settings: &RenderSettings, plan: &Plan, class: DeviceClass) -> bool {
     settings.layout == Layout::Auto
+        && !plan.placed
         && class != DeviceClass::CpuRunner
         && plan.accel != crate::bvh::tree::Accel::None
         && plan.method().specialized()
@@ -171,11 +180,36 @@ impl<B: Backend> Prepared<B> {
             light_count: table.len() as u32,
             ..Default::default()
         };
-        let (tree, buffers, build_ms) = if pilots_layout(settings, &plan, b.class()) {
+        let (tree, buffers, mut build_ms) = if pilots_layout(settings, &plan, b.class()) {
             let scene_buffers = (&materials, &lights, &params);
             faster_layout(b, all, &mut plan, scene_buffers, pixels)?
+        } else if plan.placed && all.is_empty() {
+            // No primitives of its own: placeholders the kernel never reads.
+            traced_tree(b, all, crate::bvh::tree::Accel::None, plan.layout)?
         } else {
             traced_tree(b, all, plan.accel, plan.layout)?
+        };
+        let placed = match &scene.placed {
+            Some(copies) => {
+                if integrator == Integrator::Caustics {
+                    bail!(
+                        "{}: --integrator caustics traces light paths through a scene's own primitives, not its placed copies of meshes; use --integrator nee, or --flatten",
+                        scene.name
+                    );
+                }
+                if plan.layout != Layout::Bvh2 || (plan.accel == crate::bvh::tree::Accel::None && !all.is_empty()) {
+                    bail!(
+                        "{}: the scene keeps copies of meshes placed, and their kernel traces the scene's own primitives through a bvh2 tree (not --accel none, nor --layout {})",
+                        scene.name,
+                        plan.layout.name()
+                    );
+                }
+                let quality = super::placed::mesh_quality(accel, settings.paths());
+                let part = super::placed::PlacedPart::build(b, copies, all.len() as u32, quality)?;
+                build_ms += part.build_ms;
+                Some(part)
+            }
+            None => None,
         };
         // After the pilot, whose scratch sums (as large) are released by then.
         let accum = match base {
@@ -195,9 +229,10 @@ impl<B: Backend> Prepared<B> {
             materials,
             lights,
             accum,
-            kernel: Kernel::Render(plan.method(), plan.variant as u8),
+            kernel: render_kernel(&plan),
             light_paths,
-            params,
+            params: placed.as_ref().map_or(params, |p| p.params(params)),
+            placed,
             per_dispatch: samples_per_dispatch(pixels, b.class()),
             pixels,
             build_ms,
@@ -214,6 +249,11 @@ impl<B: Backend> Prepared<B> {
             let samples = (count - done).min(self.per_dispatch);
             let params = RenderParams { samples, first_sample: first + done, ..self.params };
             let scene = (&self.materials, &self.lights, &params);
+            if let Some(placed) = &self.placed {
+                dispatch_placed(b, &self.tree, &self.buffers, scene, placed, &self.accum)?;
+                done += samples;
+                continue;
+            }
             dispatch_render(b, self.kernel, &self.tree, &self.buffers, scene, &self.accum)?;
             if let Some((kernel, landings)) = &self.light_paths {
                 dispatch_render(b, *kernel, &self.tree, &self.buffers, scene, landings)?;
@@ -259,6 +299,41 @@ fn dispatch_render<B: Backend>(
     b.dispatch(
         kernel,
         &[&p, &buffers.spheres, materials, &tree.nodes, &tree.prims, accum, &buffers.triangles, lights],
+        groups_for(tiled_invocations(params.width, params.height), WORKGROUP_SIZE),
+    );
+    Ok(())
+}
+
+/// [`dispatch_render`] of [`Kernel::RenderPlaced`]: the scene's own
+/// bindings, then the copies'.
+fn dispatch_placed<B: Backend>(
+    b: &mut B,
+    tree: &TracedTree<B>,
+    buffers: &PrimBuffers<B>,
+    (materials, lights, params): (&B::Buffer, &B::Buffer, &RenderParams),
+    placed: &super::placed::PlacedPart<B>,
+    accum: &B::Buffer,
+) -> Result<()> {
+    let p = b.upload("render params", &[*params])?;
+    let [records, info, nodes, leaves, triangles, placed_materials] = placed.bindings();
+    b.dispatch(
+        Kernel::RenderPlaced,
+        &[
+            &p,
+            &buffers.spheres,
+            materials,
+            &tree.nodes,
+            &tree.prims,
+            accum,
+            &buffers.triangles,
+            lights,
+            records,
+            info,
+            nodes,
+            leaves,
+            triangles,
+            placed_materials,
+        ],
         groups_for(tiled_invocations(params.width, params.height), WORKGROUP_SIZE),
     );
     Ok(())

@@ -29,6 +29,9 @@ pub struct SceneFeatures {
     pub glass: usize,
     /// Primitives that emit light (of any kind).
     pub emissive: usize,
+    /// Copies of meshes kept placed (`Scene::placed`), and their triangles.
+    pub copies: usize,
+    pub copied_triangles: u64,
 }
 
 impl SceneFeatures {
@@ -42,7 +45,7 @@ impl SceneFeatures {
             parallelograms: count(SHAPE_PARALLELOGRAM),
             ..Default::default()
         };
-        for m in &scene.materials {
+        let mut count_material = |m: &treelet_core::geometry::buffers::Material| {
             match m.kind {
                 DIFFUSE => f.diffuse += 1,
                 MIRROR => f.mirror += 1,
@@ -52,6 +55,19 @@ impl SceneFeatures {
             if m.emission.iter().any(|&e| e > 0.0) {
                 f.emissive += 1;
             }
+        };
+        scene.materials.iter().for_each(&mut count_material);
+        if let Some(placed) = &scene.placed {
+            // A copy's triangles, each in its material (none emits).
+            for instance in &placed.instances {
+                let mesh = &placed.meshes[instance.mesh as usize];
+                match &instance.material {
+                    Some(m) => (0..mesh.triangles.len()).for_each(|_| count_material(m)),
+                    None => mesh.materials.iter().for_each(&mut count_material),
+                }
+            }
+            f.copies = placed.instances.len();
+            f.copied_triangles = placed.triangles();
         }
         f
     }
@@ -182,6 +198,10 @@ pub struct Plan {
     pub variant: usize,
     /// Name of the variant (entry points `render::<name>::<method>_cs`).
     pub kernel: &'static str,
+    /// The scene keeps copies of meshes placed: the kernel is
+    /// `render::render_placed_cs` (every feature, and the copies' walk),
+    /// over the scene's own primitives in `bvh2`.
+    pub placed: bool,
     pub kernel_features: String,
     pub kernel_reason: String,
 }
@@ -259,7 +279,7 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
         }
     };
     let name = VARIANTS[variant].1;
-    Plan {
+    let plan = Plan {
         features,
         accel,
         accel_reason,
@@ -267,9 +287,38 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
         layout_reason,
         variant,
         kernel: name,
+        placed: false,
         kernel_features: describe(VARIANTS[variant].0),
         kernel_reason,
+    };
+    if features.copies > 0 { placed_plan(plan) } else { plan }
+}
+
+/// [`plan`] for a scene with copies kept placed: one kernel traces them
+/// (`render::render_placed_cs`), with the scene's own primitives in a
+/// `bvh2` tree (an LBVH where a scan would do: the room's few primitives
+/// cost nothing to build). What was asked explicitly is kept, and refused
+/// by the render if that kernel cannot run it.
+fn placed_plan(mut plan: Plan) -> Plan {
+    let why = "the kernel of placed copies traces the scene's own primitives through a bvh2 tree";
+    if plan.accel_reason.starts_with("as asked") {
+    } else if plan.accel == Accel::None {
+        plan.accel = Accel::Lbvh;
+        plan.accel_reason = format!("{} primitives of the scene's own, besides its copies: {why}", plan.features.primitives());
     }
+    if plan.layout_reason != "as asked (--layout)" {
+        plan.layout = Layout::Bvh2;
+        plan.layout_reason = why.to_string();
+    }
+    plan.placed = true;
+    plan.variant = full_variant();
+    plan.kernel = "placed";
+    plan.kernel_features = format!("{}, placed copies of meshes", describe(features::ALL));
+    plan.kernel_reason = format!(
+        "{} copies of meshes ({} triangles) kept placed, traced through their meshes' own trees",
+        plan.features.copies, plan.features.copied_triangles
+    );
+    plan
 }
 
 impl Plan {
@@ -289,6 +338,7 @@ impl Plan {
                 .iter()
                 .filter(|(n, _)| *n > 0)
                 .map(|(n, what)| format!(", {n} {what}{}", if *n == 1 { "" } else { "s" }))
+                .chain((f.copies > 0).then(|| format!(", {} placed copies of meshes ({} triangles)", f.copies, f.copied_triangles)))
                 .collect::<String>(),
             f.diffuse,
             f.mirror,

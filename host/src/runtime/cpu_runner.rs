@@ -19,7 +19,8 @@ use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE};
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
 use treelet_core::render::lights::Light;
 use treelet_core::render::variants::VARIANTS;
-use treelet_core::trace::bvh2::Bvh2Tree;
+use treelet_core::trace::bvh2::{Bvh2Tree, Level};
+use treelet_core::trace::placed::PlacedScene;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
@@ -585,10 +586,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
-        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out]) => {
+        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out, records, layout]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (prim_indices, spheres, triangles, nodes) = (view(prim_indices), view(spheres), view(triangles), view(nodes));
             let (parents, flags, out) = (view(parents), view(flags), view::<treelet_core::LeafPrim>(out));
+            let (records, layout) = (view(records), view::<treelet_core::Bvh2Node>(layout));
             let prims = treelet_core::geometry::prims::Prims {
                 spheres,
                 sphere_count: p.spheres,
@@ -596,7 +598,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 triangle_count: p.n - p.spheres,
             };
             for id in ids(groups) {
-                bvh2::refit_kernel::<true, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out);
+                bvh2::refit_kernel::<true, _, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out, records, layout);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
@@ -739,11 +741,12 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);
             }
         }
-        (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
+        (Kernel::Bvh2Nodes, [p, nodes, parents, out, records]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, parents, out) = (view::<treelet_core::Node>(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
+            let records = view(records);
             for id in ids(groups) {
-                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
+                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out, records);
             }
         }
         (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {
@@ -873,6 +876,39 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
             }
+        }
+        (
+            Kernel::RenderPlaced,
+            [p, spheres, materials, nodes, prims, accum, triangles, lights, records, info, placed_nodes, placed_leaves, placed_triangles, placed_materials],
+        ) => {
+            use treelet_core::geometry::features::{ALL, INSTANCES};
+            use treelet_core::{Bvh2Node, InstanceRecord, LeafPrim};
+            let p: treelet_core::RenderParams = params(p);
+            let lights: &[Light] = view(lights);
+            let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
+            let accum: &mut [[f32; 4]] = view(accum);
+            let own = Bvh2Tree::new(view::<Bvh2Node>(nodes) as &[_], view::<LeafPrim>(prims) as &[_]);
+            let (placed_nodes, placed_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(placed_nodes), view(placed_leaves));
+            let meshes = treelet_core::geometry::prims::Prims {
+                spheres: &[],
+                sphere_count: 0,
+                triangles: Split::whole(view(placed_triangles)),
+                triangle_count: p.placed_triangles,
+            };
+            let tree = PlacedScene {
+                own,
+                instances: view::<InstanceRecord>(records) as &[_],
+                info: view(info),
+                count: p.instances,
+                trees: Level { nodes: placed_nodes, leaves: placed_leaves },
+                meshes,
+                materials: view(placed_materials),
+            };
+            let scene = SceneRefs::new(&p, spheres, triangles, materials, tree);
+            let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
+            accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
+                accumulate(acc, render_pixel::<_, { ALL | INSTANCES }, 1>(id as u32, &p, &scene, lights, &mut [0u32; 1], 0))
+            });
         }
         (Kernel::Light(method, v), [p, spheres, materials, nodes, prims, splats, triangles, lights]) => {
             let p: treelet_core::RenderParams = params(p);

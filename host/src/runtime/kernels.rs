@@ -179,6 +179,10 @@ pub enum Kernel {
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
+    /// Path tracing of a scene with copies of meshes kept placed
+    /// (`treelet_core::trace::placed`): its own primitives in `bvh2`, the
+    /// copies through the instanced walk; every feature.
+    RenderPlaced,
     /// The light paths of [`Kernel::Render`]'s method and feature set, for
     /// caustics (`treelet_core::render::caustics`; not for the seed layout).
     Light(Method, u8),
@@ -269,6 +273,7 @@ impl Kernel {
         let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::geometry::features::ALL).unwrap() as u8;
         let mut all = Self::FIXED.to_vec();
         all.push(Kernel::CastWideWorkgroupStack);
+        all.push(Kernel::RenderPlaced);
         for method in Method::ALL {
             for v in 0..VARIANTS.len() as u8 {
                 if method.specialized() || v == full {
@@ -342,6 +347,7 @@ impl Kernel {
             Kernel::WidePlace => "cwbvh::wide_place_cs",
             Kernel::WideEmit => "cwbvh::wide_emit_cs",
             Kernel::Render(method, v) => render_entry_point(method, v, false),
+            Kernel::RenderPlaced => "render::render_placed_cs",
             Kernel::Light(Method::Classic, _) => panic!("no light paths through the seed's layout"),
             Kernel::Light(method, v) => render_entry_point(method, v, true),
             Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
@@ -363,7 +369,7 @@ impl Kernel {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
             Kernel::Fit | Kernel::FitRelaxed => &[3],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7, 9],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
@@ -373,7 +379,7 @@ impl Kernel {
             Kernel::LeafPrims => &[3, 4],
             Kernel::WideEmit => &[9],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
-            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) => &[6, 3, 4],
+            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
@@ -409,7 +415,9 @@ impl Kernel {
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => {
+                &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite, Read, ReadWrite]
+            }
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }
@@ -431,7 +439,7 @@ impl Kernel {
                 &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
+            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
             Kernel::TreeDepth => &[Read, Read, Read, ReadWrite],
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
@@ -439,6 +447,8 @@ impl Kernel {
             Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
+            // The render's, then the copies' (`render::render_placed_cs`).
+            Kernel::RenderPlaced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
             Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
         }
     }

@@ -339,7 +339,7 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     }
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
-    let loose = Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles };
+    let loose = Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles, placed: None };
     Ok(InstancedScene { loose, meshes, instances })
 }
 

@@ -66,7 +66,7 @@ pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
         Some(c) => c,
         None => framing(placed_bounds(&out.meshes, &out.instances)),
     };
-    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new() };
+    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new(), placed: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
 }
 

@@ -5,13 +5,15 @@
 //! spheres-then-triangles view a build takes (and its checks), [`mesh`]
 //! reads `.obj` / `.ply`, [`file`](mod@file) reads JSON scene files,
 //! [`gltf`](mod@gltf) glTF 2.0 ones, [`instanced`] keeps their meshes placed by
-//! reference (and flattens them), and [`spec`]
+//! reference (and flattens them), [`placed`] the copies a render keeps
+//! placed, and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
 pub mod file;
 pub mod gltf;
 pub mod instanced;
 pub mod mesh;
 pub mod model;
+pub mod placed;
 pub mod primitives;
 pub mod spec;
 

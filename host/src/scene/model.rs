@@ -7,6 +7,7 @@ use treelet_core::geometry::buffers::{Camera, DIFFUSE, GLASS, MIRROR, Material, 
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::render::integrator::SMALLPT_FOV;
 
+use crate::scene::placed::PlacedCopies;
 use crate::scene::primitives::Primitives;
 
 /// Where random scenes place sphere centres: smallpt's room, short of the
@@ -30,6 +31,12 @@ pub struct Scene {
     /// Triangles of a mesh scene (`treelet build` builds over them; they
     /// are not rendered yet).
     pub triangles: Vec<Triangle>,
+    /// Copies of meshes beside the primitives above, kept placed by
+    /// reference: only `render` takes a scene with them
+    /// ([`crate::scene::instanced::InstancedScene::for_render`]); every
+    /// other command loads scenes flattened ([`Scene::from_spec`]), with
+    /// none.
+    pub placed: Option<std::sync::Arc<PlacedCopies>>,
 }
 
 /// Where the camera is; the image size comes from the render.
@@ -87,7 +94,7 @@ pub fn cornell() -> Scene {
             light,
         ])
         .unzip();
-    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
+    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new(), placed: None }
 }
 
 /// `terrain:N`: a height field of about N triangles (a square grid, two per
@@ -123,7 +130,7 @@ pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
     let (spheres, mut materials): (Vec<_>, Vec<_>) = cornell_room().into_iter().unzip();
     let room = spheres.len();
     materials.extend(std::iter::repeat_n(diffuse([0.8, 0.78, 0.72]), triangles.len()));
-    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, triangles }
+    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, triangles, placed: None }
 }
 
 /// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
@@ -156,6 +163,19 @@ impl Scene {
         field(bytemuck::cast_slice(&self.materials));
         field(bytemuck::cast_slice(&self.triangles));
         field(serde_json::to_string(&self.camera).unwrap_or_default().as_bytes());
+        // Copies kept placed: each mesh, then each copy's mesh, transform
+        // and material.
+        if let Some(placed) = &self.placed {
+            for mesh in &placed.meshes {
+                field(bytemuck::cast_slice(&mesh.triangles));
+                field(bytemuck::cast_slice(&mesh.materials));
+            }
+            for instance in &placed.instances {
+                field(&instance.mesh.to_le_bytes());
+                field(bytemuck::cast_slice(&instance.rows()));
+                field(instance.material.as_ref().map_or(&[][..], bytemuck::bytes_of));
+            }
+        }
         h.finish()
     }
 
@@ -187,6 +207,7 @@ impl Scene {
             room: 0,
             camera,
             triangles: self.triangles.clone(),
+            placed: None,
         })
     }
 
@@ -222,7 +243,7 @@ pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
         spheres.push(s);
         materials.push(m);
     }
-    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, triangles: Vec::new() }
+    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, triangles: Vec::new(), placed: None }
 }
 
 /// `n` spheres with uniform random centres inside the Cornell box and random

@@ -66,6 +66,21 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// [`Scene::from_spec`] for `render`: a glTF or scene file keeps the
+    /// copies of meshes it places more than once placed
+    /// ([`InstancedScene::for_render`]); every other scene as `from_spec`
+    /// gives it.
+    pub fn for_render(spec: &str) -> Result<Scene> {
+        let lower = spec.to_ascii_lowercase();
+        if [".json", ".gltf", ".glb"].iter().any(|e| lower.ends_with(e)) {
+            InstancedScene::load(std::path::Path::new(spec))?.for_render()
+        } else {
+            Scene::from_spec(spec)
+        }
+    }
+}
+
 impl InstancedScene {
     /// Loads a glTF 2.0 file or a JSON scene file with its instances kept
     /// (see [`super::instanced`]).

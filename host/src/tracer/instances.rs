@@ -86,6 +86,21 @@ struct TopLevel<B: Backend> {
     count: u32,
 }
 
+/// The buffers a render binds for its placed copies
+/// ([`InstancedTracer::placed_bindings`]): the instances' records (a
+/// placeholder without any), every node (the top level, then each mesh's
+/// tree), leaf primitive and triangle, and where each mesh's triangles
+/// start.
+pub(crate) struct PlacedBindings<'a, B: Backend> {
+    pub records: &'a B::Buffer,
+    pub nodes: &'a B::Buffer,
+    pub leaves: &'a B::Buffer,
+    pub triangles: &'a B::Buffer,
+    pub triangle_count: u32,
+    pub instances: u32,
+    pub mesh_triangle_bases: Vec<u32>,
+}
+
 /// Meshes placed many times, on one device, for closest hits and occlusion
 /// queries: see the module doc.
 ///
@@ -301,6 +316,21 @@ impl<B: Backend> InstancedTracer<B> {
             groups_for(tiled_invocations(p.width, p.height), WORKGROUP_SIZE),
         );
         Ok(())
+    }
+
+    /// What a render kernel binds of these copies
+    /// (`treelet_core::trace::placed`).
+    pub(crate) fn placed_bindings(&self) -> PlacedBindings<'_, B> {
+        let g = &self.gathered;
+        PlacedBindings {
+            records: self.top.as_ref().map_or(&self.no_instances, |t| &t.records),
+            nodes: &g.nodes,
+            leaves: &g.leaves,
+            triangles: &g.triangles,
+            triangle_count: g.triangle_count,
+            instances: self.top.as_ref().map_or(0, |t| t.count),
+            mesh_triangle_bases: g.bases.iter().map(|b| b[2]).collect(),
+        }
     }
 
     /// `instances` as the top level's build reads them, after checking them.
