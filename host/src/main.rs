@@ -344,7 +344,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         bar.set_message(err);
     };
     let classes: Vec<_> = list.iter().map(Device::class).collect();
-    let memory = MemoryEstimate::of(&settings, (scene.spheres.len() + scene.triangles.len()) as u64, &classes);
+    let memory = MemoryEstimate::of(&settings, scene.traced_primitives(), &classes);
     if args.explain {
         bar.suspend(|| {
             eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), integrator == Integrator::Caustics).explain());
@@ -357,7 +357,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             );
             for d in &list {
                 if let Device::Gpu(ctx) = d {
-                    let needed = MemoryEstimate::device_bytes(&settings, (scene.spheres.len() + scene.triangles.len()) as u64);
+                    let needed = MemoryEstimate::device_bytes(&settings, scene.traced_primitives());
                     let has = ctx.device_memory.map_or("an unknown amount".into(), human);
                     eprintln!("           about {} of device memory on {}, which has {has}", human(needed), ctx.info.name);
                 }

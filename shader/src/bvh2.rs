@@ -15,14 +15,13 @@ pub fn bvh2_nodes_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] out: &mut [Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] records: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] nodes_hi: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_hi: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes_hi: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] out_hi: &mut [Vec4],
 ) {
     let id = linear_id(gid.x, gid.y, groups.x);
     let nodes = Split::new(nodes, nodes_hi);
     let out = &mut SplitMut::new(out, out_hi);
-    treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, &nodes, parents, out, records);
+    treelet_core::layouts::bvh2::bvh2_node_kernel(id, params.nodes, &nodes, parents, out);
 }
 
 /// One node of an instanced scene's top level (its LBVH as built): an
@@ -62,9 +61,8 @@ pub fn leaf_prims_cs(
 }
 
 /// A layout's refit in place: each leaf of the collapsed tree writes its
-/// primitives and box, then climbs, writing the two-box nodes it finishes
-/// (`treelet_core::layouts::bvh2::refit_kernel`); `$ordered` as for the
-/// build's fit kernels.
+/// primitives and box, then climbs (`treelet_core::layouts::bvh2::refit_kernel`);
+/// `$ordered` as for the build's fit kernels.
 macro_rules! refit_kernel {
     ($name:ident, $ordered:literal) => {
         #[spirv(compute(threads(256)))]
@@ -79,12 +77,9 @@ macro_rules! refit_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &[u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] flags: &mut [u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out: &mut [Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] records: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] layout: &mut [Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] triangles_hi: &[Triangle],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] nodes_hi: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] out_hi: &mut [Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] layout_hi: &mut [Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &mut [Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_hi: &mut [Vec4],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let prims = Prims {
@@ -93,7 +88,7 @@ macro_rules! refit_kernel {
                 triangles: Split::new(triangles, triangles_hi),
                 triangle_count: params.n - params.spheres,
             };
-            treelet_core::layouts::bvh2::refit_kernel::<$ordered, _, _>(
+            treelet_core::layouts::bvh2::refit_kernel::<$ordered, _>(
                 id,
                 params.nodes,
                 &prims,
@@ -102,8 +97,6 @@ macro_rules! refit_kernel {
                 parents,
                 flags,
                 &mut SplitMut::new(out, out_hi),
-                records,
-                &mut SplitMut::new(layout, layout_hi),
             );
         }
     };

@@ -87,39 +87,22 @@ pub fn fit_kernel<const ORDERED: bool>(
     climb_boxes::<ORDERED>(leaf_node(n, i), b, nodes, parents, flags);
 }
 
-/// The climb of [`fit_kernel`] from node `start`, whose box `own` is
-/// written: each internal node it arrives at second gets the union of its
-/// children's boxes.
+/// The climb of [`fit_kernel`] (and of the `bvh2` layout's refit,
+/// `crate::layouts::bvh2::refit_kernel`) from node `start`, whose box `own`
+/// is written: each internal node it arrives at second gets the union of
+/// its children's boxes.
 #[inline]
 pub(crate) fn climb_boxes<const ORDERED: bool>(start: u32, own: Aabb, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
-    climb_boxes_with::<ORDERED>(start, own, nodes, parents, flags, |_, _, _, _, _, _| {});
-}
-
-/// [`climb_boxes`], calling `at_parent(parent, left, left_box, right,
-/// right_box, nodes)` after each internal node's box is written (the `bvh2`
-/// layout's refit, `crate::layouts::bvh2::refit_kernel`, writes the
-/// parent's two-box node there: both children are final then).
-#[inline]
-pub(crate) fn climb_boxes_with<const ORDERED: bool>(
-    start: u32,
-    own: Aabb,
-    nodes: &mut SplitMut<Node>,
-    parents: &[u32],
-    flags: &mut [u32],
-    mut at_parent: impl FnMut(u32, u32, &Aabb, u32, &Aabb, &SplitMut<Node>),
-) {
     // The climber keeps its subtree's box and reads only the sibling's.
     let mut own = own;
     let mut climb = Climb::<ORDERED>::new(start);
     while let Some(parent) = climb.next(parents, flags) {
         let (left, right) = nodes.with(parent as usize, |node| (node.left, node.right));
-        let (left_box, right_box) = if left == climb.child() {
-            (own, nodes.with(right as usize, load_box))
+        own = if left == climb.child() {
+            own.union(&nodes.with(right as usize, load_box))
         } else {
-            (nodes.with(left as usize, load_box), own)
+            nodes.with(left as usize, load_box).union(&own)
         };
-        own = left_box.union(&right_box);
         nodes.with_mut(parent as usize, |node| store_box(node, &own));
-        at_parent(parent, left, &left_box, right, &right_box, nodes);
     }
 }

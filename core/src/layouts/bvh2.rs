@@ -11,10 +11,8 @@
 //! in leaf order) by two kernels without atomics: [`bvh2_node_kernel`]
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
-//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order). The
-//! map `f` is kept, so that a refit ([`refit_kernel`]) writes each node as
-//! its bottom-up climb finishes it, in one dispatch.
-use crate::construct::fit::{climb_boxes_with, store_box};
+//! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
+use crate::construct::fit::{climb_boxes, store_box};
 use crate::construct::primitive_boxes::primitive_box;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::records::{RecordLoad, RecordStore};
@@ -27,8 +25,7 @@ use crate::gpu::unchecked::at;
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
 /// nodes, root 0, depth-first order: a left child follows its parent, a
 /// right child `right = i + 2 L` where `L` is its left sibling's leaf
-/// count): each internal node writes its [`Bvh2Node`], and the index it
-/// has there in `records[i]` (for [`refit_kernel`]). A tree of one leaf
+/// count): each internal node writes its [`Bvh2Node`]. A tree of one leaf
 /// gets a root whose second child is an empty box.
 pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> + ?Sized>(
     i: u32,
@@ -36,7 +33,6 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
     nodes: &N,
     parents: &[u32],
     out: &mut O,
-    records: &mut [u32],
 ) {
     if i >= node_count {
         return;
@@ -61,19 +57,16 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
     let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
     let record = two_boxes(&l, &r, child_ref(&l, index + 1), child_ref(&r, index + (node.right - i) / 2));
     out.store(index as usize, &record);
-    records[i as usize] = index;
 }
 
 /// Kernel: the refit of a layout in place, over the collapsed tree it was
 /// made from (its shape kept; `prims` moved): one invocation per node `i` of
 /// `node_count`; a leaf writes its primitives' [`LeafPrim`]s again (slots
 /// `first..first + count` of `out`) and its box, the union of theirs, then
-/// climbs as the build's fit does ([`crate::construct::fit`]), writing each
-/// internal node's [`Bvh2Node`] again (at `records[i]`, as
-/// [`bvh2_node_kernel`] left them) once both its children are done. `flags`
-/// holds one zeroed counter per node.
+/// climbs as the build's fit does ([`crate::construct::fit`]). `flags` holds
+/// one zeroed counter per node. [`bvh2_node_kernel`] then writes the nodes.
 #[allow(clippy::too_many_arguments)]
-pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized, L: RecordStore<Bvh2Node> + ?Sized>(
+pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized>(
     i: u32,
     node_count: u32,
     prims: &Prims,
@@ -82,8 +75,6 @@ pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized, L: R
     parents: &[u32],
     flags: &mut [u32],
     out: &mut O,
-    records: &[u32],
-    layout: &mut L,
 ) {
     if i >= node_count {
         return;
@@ -99,36 +90,13 @@ pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized, L: R
         own = own.union(&primitive_box(prim, prims.sphere_count, prims.spheres, &prims.triangles));
     }
     nodes.with_mut(i as usize, |node| store_box(node, &own));
-    if node_count == 1 {
-        let leaf = Node { min: own.min, left: first, max: own.max, right };
-        layout.store(0, &single_leaf_root(&leaf, first, right & !LEAF_BIT));
-        return;
-    }
-    climb_boxes_with::<ORDERED>(i, own, nodes, parents, flags, |parent, l, l_box, r, r_box, nodes| {
-        // The children's shapes are the build's: only their boxes are new.
-        let reference = |c: u32| {
-            let (left, right) = nodes.with(c as usize, |node| (node.left, node.right));
-            if right & LEAF_BIT != 0 {
-                (left, right & !LEAF_BIT)
-            } else {
-                (records[c as usize], 0)
-            }
-        };
-        let record = boxes_node(l_box, r_box, reference(l), reference(r));
-        layout.store(records[parent as usize] as usize, &record);
-    });
+    climb_boxes::<ORDERED>(i, own, nodes, parents, flags);
 }
 
 /// The node of children `l` and `r`, referred to as given (a leaf by its
 /// first primitive and count, an internal node by its index and 0).
 #[inline]
-fn two_boxes(l: &Node, r: &Node, left: (u32, u32), right: (u32, u32)) -> Bvh2Node {
-    boxes_node(&Aabb { min: l.min, max: l.max, ..Aabb::EMPTY }, &Aabb { min: r.min, max: r.max, ..Aabb::EMPTY }, left, right)
-}
-
-/// The node of children boxed by `l` and `r`, referred to as given.
-#[inline]
-fn boxes_node(l: &Aabb, r: &Aabb, (left, left_count): (u32, u32), (right, right_count): (u32, u32)) -> Bvh2Node {
+fn two_boxes(l: &Node, r: &Node, (left, left_count): (u32, u32), (right, right_count): (u32, u32)) -> Bvh2Node {
     Bvh2Node { left_min: l.min, left, left_max: l.max, right, right_min: r.min, left_count, right_max: r.max, right_count }
 }
 

@@ -116,10 +116,6 @@ pub struct TracedTree<B: Backend> {
     /// ([`crate::bvh::refit::refit_bvh2`]) rewrites the layout's boxes and
     /// primitives without collapsing again.
     pub collapsed: Option<DeviceBvh<B>>,
-    /// For `bvh2`: the two-box node each internal node of `collapsed`
-    /// became (a `u32` per node), so that the refit writes each node as it
-    /// finishes it.
-    pub records: Option<B::Buffer>,
 }
 
 /// Lays out `bvh`, a tree of one primitive per leaf in the LBVH layout (as
@@ -152,7 +148,7 @@ pub fn lay_out<B: Backend>(
         }
         _ if max_leaf <= 1 && layout == Layout::Classic => {
             check_depth(b, &bvh)?;
-            Ok(TracedTree { layout, node_count: bvh.node_count, nodes: bvh.nodes, prims: bvh.prim_indices, collapsed: None, records: None })
+            Ok(TracedTree { layout, node_count: bvh.node_count, nodes: bvh.nodes, prims: bvh.prim_indices, collapsed: None })
         }
         _ => {
             b.stage("collapse");
@@ -165,7 +161,6 @@ pub fn lay_out<B: Backend>(
                     nodes: collapsed.nodes,
                     prims: collapsed.prim_indices,
                     collapsed: None,
-                    records: None,
                 });
             }
             b.stage("layout");
@@ -245,34 +240,20 @@ fn bvh2<B: Backend>(b: &mut B, collapsed: &DeviceBvh<B>, prims: &PrimBuffers<B>)
     check_fits(b, "leaf primitives", collapsed.n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
     let nodes = b.scratch("two-box nodes", internal as u64 * std::mem::size_of::<Bvh2Node>() as u64)?;
     let leaf_prims = b.scratch("leaf primitives", collapsed.n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
-    let records = b.scratch("two-box node of each node", collapsed.node_count as u64 * 4)?;
-    write_bvh2(b, collapsed, prims, &nodes, &leaf_prims, &records)?;
-    Ok(TracedTree {
-        layout: Layout::Bvh2,
-        nodes,
-        prims: leaf_prims,
-        node_count: internal,
-        collapsed: Some(collapsed.clone()),
-        records: Some(records),
-    })
+    write_bvh2(b, collapsed, prims, &nodes, &leaf_prims)?;
+    Ok(TracedTree { layout: Layout::Bvh2, nodes, prims: leaf_prims, node_count: internal, collapsed: Some(collapsed.clone()) })
 }
 
-/// Writes the two-box nodes of `collapsed` into `nodes` (and where each
-/// went into `records`) and its primitives in leaf order into `leaf_prims`.
+/// Writes the two-box nodes of `collapsed` into `nodes` and its primitives
+/// in leaf order into `leaf_prims`.
 fn write_bvh2<B: Backend>(
     b: &mut B,
     collapsed: &DeviceBvh<B>,
     prims: &PrimBuffers<B>,
     nodes: &B::Buffer,
     leaf_prims: &B::Buffer,
-    records: &B::Buffer,
 ) -> Result<()> {
-    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
-    b.dispatch(
-        Kernel::Bvh2Nodes,
-        &[&p, &collapsed.nodes, &collapsed.parents, nodes, records],
-        groups_for(collapsed.node_count, WORKGROUP_SIZE),
-    );
+    let p = write_bvh2_nodes(b, collapsed, prims, nodes)?;
     let n = collapsed.n;
     b.dispatch(
         Kernel::LeafPrims,
@@ -280,6 +261,23 @@ fn write_bvh2<B: Backend>(
         groups_for(n, WORKGROUP_SIZE),
     );
     Ok(())
+}
+
+/// Writes the two-box nodes of `collapsed` into `nodes`; returns the
+/// layout's parameters.
+pub(crate) fn write_bvh2_nodes<B: Backend>(
+    b: &mut B,
+    collapsed: &DeviceBvh<B>,
+    prims: &PrimBuffers<B>,
+    nodes: &B::Buffer,
+) -> Result<B::Buffer> {
+    let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
+    b.dispatch(
+        Kernel::Bvh2Nodes,
+        &[&p, &collapsed.nodes, &collapsed.parents, nodes],
+        groups_for(collapsed.node_count, WORKGROUP_SIZE),
+    );
+    Ok(p)
 }
 
 /// The compressed wide BVH of a tree of one primitive per leaf (see
@@ -346,7 +344,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
         ],
         groups,
     );
-    Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal, collapsed: None, records: None })
+    Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal, collapsed: None })
 }
 
 /// The nodes of a wide tree that are in use: those reachable from the root

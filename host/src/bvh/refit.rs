@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::{BuildParams, LayoutParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::bvh::layout::{PrimBuffers, TracedTree};
+use crate::bvh::layout::{PrimBuffers, TracedTree, write_bvh2_nodes};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -50,12 +50,12 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
 /// made from ([`TracedTree::collapsed`]), for `prims`, the primitives it was
 /// built over (same count and order), moved: each leaf of the collapsed
 /// tree writes its primitives again and its box (their union), then the
-/// boxes climb as the build's fit does, and each two-box node is written
-/// again as the climb finishes it ([`TracedTree::records`] says where;
-/// `treelet_core::layouts::bvh2::refit_kernel`): one dispatch. No collapse
-/// and no depth check: the shape is the one laid out.
+/// boxes climb as the build's fit does
+/// (`treelet_core::layouts::bvh2::refit_kernel`), then the two-box nodes are
+/// written again. No collapse and no depth check: the shape is the one
+/// laid out.
 pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
-    let (Some(collapsed), Some(records)) = (&tree.collapsed, &tree.records) else {
+    let Some(collapsed) = &tree.collapsed else {
         bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
     };
     let n = collapsed.n;
@@ -69,19 +69,10 @@ pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffe
     let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
     b.dispatch(
         refit,
-        &[
-            &lp,
-            &collapsed.prim_indices,
-            &prims.spheres,
-            &prims.triangles,
-            &collapsed.nodes,
-            &collapsed.parents,
-            &flags,
-            &tree.prims,
-            records,
-            &tree.nodes,
-        ],
+        &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &flags, &tree.prims],
         groups_for(nodes, WORKGROUP_SIZE),
     );
+    b.stage("layout");
+    write_bvh2_nodes(b, collapsed, prims, &tree.nodes)?;
     b.take_times()
 }

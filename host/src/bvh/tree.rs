@@ -109,7 +109,6 @@ pub fn traced_tree<B: Backend>(
             prims: b.upload("no indices", &[0u32])?,
             node_count: 0,
             collapsed: None,
-            records: None,
         };
         return Ok((tree, buffers, 0.0));
     };

@@ -66,7 +66,7 @@ pub fn render_on_devices(
     on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
     let classes: Vec<_> = devices.iter().map(Device::class).collect();
-    let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
+    let prims = scene.traced_primitives();
     MemoryEstimate::of(settings, prims, &classes).check(settings, prims)?;
     // Before the clock starts (see `prepare_pipelines`).
     for d in devices {

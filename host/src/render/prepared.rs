@@ -151,12 +151,12 @@ impl<B: Backend> Prepared<B> {
             bail!("{}: {} materials for {} primitives", scene.name, scene.materials.len(), all.len());
         }
         if let Some(memory) = b.device_memory_bytes() {
-            let needed = MemoryEstimate::device_bytes(settings, all.len() as u64);
+            let needed = MemoryEstimate::device_bytes(settings, scene.traced_primitives());
             if needed > memory {
                 bail!(
-                    "this render needs about {} of device memory ({width}x{height} image and a tree of {} primitives), and `{}` has {}",
+                    "this render needs about {} of device memory ({width}x{height} image and trees of {} primitives), and `{}` has {}",
                     human(needed),
-                    all.len(),
+                    scene.traced_primitives(),
                     b.adapter(),
                     human(memory)
                 );

@@ -91,7 +91,7 @@ pub fn render_with<B: Backend>(
     control: Control<'_>,
     on_pass: impl FnMut(&PassRow),
 ) -> Result<RenderResult> {
-    let prims = (scene.spheres.len() + scene.triangles.len()) as u64;
+    let prims = scene.traced_primitives();
     MemoryEstimate::of(settings, prims, &[b.class()]).check(settings, prims)?;
     super::prepared::prepare_pipelines(b, scene, settings);
     let step = samples_per_dispatch(settings.width as u64 * settings.height as u64, b.class());

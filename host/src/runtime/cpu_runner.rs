@@ -586,11 +586,10 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
-        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out, records, layout]) => {
+        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (prim_indices, spheres, triangles, nodes) = (view(prim_indices), view(spheres), view(triangles), view(nodes));
             let (parents, flags, out) = (view(parents), view(flags), view::<treelet_core::LeafPrim>(out));
-            let (records, layout) = (view(records), view::<treelet_core::Bvh2Node>(layout));
             let prims = treelet_core::geometry::prims::Prims {
                 spheres,
                 sphere_count: p.spheres,
@@ -598,7 +597,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 triangle_count: p.n - p.spheres,
             };
             for id in ids(groups) {
-                bvh2::refit_kernel::<true, _, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out, records, layout);
+                bvh2::refit_kernel::<true, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
@@ -741,12 +740,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);
             }
         }
-        (Kernel::Bvh2Nodes, [p, nodes, parents, out, records]) => {
+        (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, parents, out) = (view::<treelet_core::Node>(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
-            let records = view(records);
             for id in ids(groups) {
-                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out, records);
+                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
         }
         (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {

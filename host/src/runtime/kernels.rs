@@ -369,7 +369,7 @@ impl Kernel {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
             Kernel::Fit | Kernel::FitRelaxed => &[3],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7, 9],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
@@ -415,9 +415,7 @@ impl Kernel {
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => {
-                &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite, Read, ReadWrite]
-            }
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }
@@ -439,7 +437,7 @@ impl Kernel {
                 &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite, ReadWrite],
+            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
             Kernel::TreeDepth => &[Read, Read, Read, ReadWrite],
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],

@@ -179,6 +179,17 @@ impl Scene {
         h.finish()
     }
 
+    /// Primitives a render builds trees over: the scene's own, each placed
+    /// mesh's triangles once, and a top-level leaf per copy (what memory
+    /// estimates count).
+    pub fn traced_primitives(&self) -> u64 {
+        let own = (self.spheres.len() + self.triangles.len()) as u64;
+        let placed = self.placed.as_ref().map_or(0, |p| {
+            p.meshes.iter().map(|m| m.triangles.len() as u64).sum::<u64>() + p.instances.len() as u64
+        });
+        own + placed
+    }
+
     /// The spheres `treelet build` builds over: all but the room.
     pub fn objects(&self) -> &[Sphere] {
         &self.spheres[..self.spheres.len() - self.room]

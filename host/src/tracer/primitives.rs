@@ -133,7 +133,6 @@ impl<B: Backend> Tracer<B> {
             if let Some(c) = &tree.collapsed {
                 kept.extend([&c.nodes, &c.parents, &c.prim_indices]);
             }
-            kept.extend(&tree.records);
         }
         b.keep(&kept);
     }
