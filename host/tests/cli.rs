@@ -1001,11 +1001,13 @@ fn render_keeps_copies_placed() {
     let copies: Vec<String> = (0..2000).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}]}}"#, (k % 50) * 2, (k / 50) * 2)).collect();
     let (dir, file) = pyramid_copies("render-many", "many.json", &copies);
     let out = dir.join("many.png");
-    let o = Command::new(env!("CARGO_BIN_EXE_treelet"))
-        .args(["render", "--device", "cpu", "--scene", file.to_str().unwrap(), "--width", "16", "--height", "12", "--spp", "1", "--out", out.to_str().unwrap()])
-        .env("TREELET_MAX_MEMORY", "100000")
-        .output()
-        .unwrap();
+    // 1 MB: the copies flattened need about 1.9 MB, placed about 0.8 MB.
+    let with_cap = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_treelet")).args(args).env("TREELET_MAX_MEMORY", "1000000").output().unwrap();
+    let scene = file.to_str().unwrap();
+    let o = with_cap(&["build", "--device", "cpu", "--scene", scene]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("flattened into 12006 triangles") && err.contains("memory"), "{err}");
+    let o = with_cap(&["render", "--device", "cpu", "--scene", scene, "--width", "16", "--height", "12", "--spp", "1", "--out", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("2001 copies of 1 mesh kept placed (12006 triangles"), "{err}");
