@@ -23,8 +23,10 @@ const CORE_FLOORS: &[(&str, u32)] =
     &[("gpu", 0), ("geometry", 1), ("construct", 2), ("layouts", 3), ("trace", 4), ("render", 5)];
 
 /// Floors of the host library's top-level folders; a top-level file (`tracer.rs`) is a folder named by its stem.
+/// The engine API (`tracer`) sits below the renderer, which traces a scene's
+/// placed copies of meshes through its `InstancedTracer`.
 const HOST_LIB_FLOORS: &[(&str, u32)] =
-    &[("runtime", 0), ("plot", 0), ("input", 0), ("scene", 1), ("bvh", 2), ("render", 3), ("tracer", 4)];
+    &[("runtime", 0), ("plot", 0), ("input", 0), ("scene", 1), ("bvh", 2), ("tracer", 3), ("render", 4)];
 
 /// The crate roots checked, relative to the workspace root.
 const CRATES: &[CrateSpec] = &[
