@@ -19,7 +19,8 @@ pub struct SceneMesh {
 /// A placed copy of a mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneInstance {
-    /// Index into [`InstancedScene::meshes`].
+    /// Index into the meshes it places ([`PlacedCopies::meshes`],
+    /// [`crate::scene::instanced::InstancedScene::meshes`]).
     pub mesh: u32,
     /// Mesh space to world space (affine).
     pub transform: Affine3A,
