@@ -49,10 +49,15 @@ use crate::gpu::atomics;
 /// second of the two children, which then knows both subtrees are done.
 /// `ORDERED` releases this subtree's writes and acquires the sibling's
 /// (see [`atomics::add_device_acq_rel`] for the device that needs it relaxed).
+///
+/// The second arrival is the one that finds the counter odd: a climb adds
+/// two to every counter it passes, so counters that start even (zeroed)
+/// are even again after it, and a tree climbed again and again (a refit
+/// every frame) keeps its counters without zeroing them each time.
 #[inline]
 pub fn second_arrival<const ORDERED: bool>(counter: &mut u32) -> bool {
     let previous = if ORDERED { atomics::add_device_acq_rel(counter, 1) } else { atomics::add_device(counter, 1) };
-    previous != 0
+    previous & 1 != 0
 }
 
 /// [`second_arrival`] that also hands over a value: leaves `mine` (below
@@ -187,6 +192,30 @@ mod tests {
         fn check(&self, what: &str) {
             assert!(self.processed.iter().all(|&c| c == 1), "{what}: processed {:?}", self.processed);
             assert!(self.counters.iter().all(|&c| c == 2), "{what}: counters {:?}", self.counters);
+        }
+    }
+
+    /// Climbs again and again on the same counters, never zeroed between
+    /// (as a tree refit every frame keeps them): each climb still processes
+    /// every internal node once, after its children.
+    #[test]
+    fn counters_serve_the_next_climb_without_zeroing() {
+        let children: &[(u32, u32)] = &[(6, 1), (2, 3), (7, 8), (4, 5), (9, 10), (11, 12)];
+        let n = children.len() as u32 + 1;
+        let mut run = Run::new(children);
+        for round in 1..=4u32 {
+            run.processed.iter_mut().for_each(|p| *p = 0);
+            let order: Vec<u32> = if round % 2 == 0 { (0..n).collect() } else { (0..n).rev().collect() };
+            let mut climbs: Vec<(Climb<true>, bool)> = order.iter().map(|&j| (Climb::new(n - 1 + j), true)).collect();
+            while climbs.iter().any(|c| c.1) {
+                for (climb, going) in climbs.iter_mut() {
+                    if *going {
+                        *going = run.step(climb);
+                    }
+                }
+            }
+            assert!(run.processed.iter().all(|&c| c == 1), "round {round}: processed {:?}", run.processed);
+            assert!(run.counters.iter().all(|&c| c == 2 * round), "round {round}: counters {:?}", run.counters);
         }
     }
 

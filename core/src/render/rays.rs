@@ -151,7 +151,9 @@ pub fn cast_instances_kernel(
     };
     let found = hit.is_hit() && hit.t <= query.t_max;
     let record = if found && params.cast_mode == CAST_RAYS {
-        // The barycentrics by the traversal's own test, in the mesh's space.
+        // The barycentrics by the traversal's own test, in the mesh's space;
+        // the ray read again, so that it is not held through the walk.
+        let EngineRay { o, d, .. } = engine_ray(params, rays, id);
         let instance = instances.load(hit.instance as usize);
         let tri = prims.triangle(instance.triangle_base + hit.prim);
         let (o2, d2) = instance.to_object(o, d);

@@ -155,7 +155,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     trees: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized>,
 ) -> (Hit, u32) {
     let mut hit = query.start();
-    let (mut found_in, mut current) = (u32::MAX, u32::MAX);
+    let mut found_in = u32::MAX;
     // Where the walk is: in a mesh (`inside`; the bases of its nodes and
     // leaf primitives, the ray in its space), or in the top level.
     let mut inside = !INSTANCED;
@@ -163,18 +163,33 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     let (mut slabs, mut ray, mut at_ray) = (SlabRay::new(o, d), WatertightRay::new(o, d), (o, d, from));
     // Entries: node index and the entry distance it was pushed with; below
     // `floor`, the top level's. `STACK` words: two a level of depth, for
-    // both levels when instanced.
+    // both levels when instanced, and then the world ray and the instance
+    // entered in the last `WORLD` words: read only on entering and leaving
+    // a mesh, they stay out of the registers the walk's loop keeps (the
+    // driver gave the instanced walk 80 registers against the plain one's
+    // 64, so three workgroups an SM instead of four).
     let mut stack = [0u32; STACK];
+    let entries = if INSTANCED { (STACK - WORLD) / 2 } else { STACK / 2 };
+    if INSTANCED {
+        let w = [o.x, o.y, o.z, d.x, d.y, d.z];
+        let mut k = 0;
+        while k < 6 {
+            set(&mut stack, STACK - WORLD + k, w[k].to_bits());
+            k += 1;
+        }
+    }
     let (mut top_len, mut floor) = (0usize, 0usize);
     let mut node = 0u32;
     loop {
         if INSTANCED && !inside && node & ENTER != 0 {
             // The top level's leaves refer to their instances directly
             // (`crate::layouts::bvh2::top_level_node_kernel`).
-            current = node & !ENTER;
+            let current = node & !ENTER;
+            set(&mut stack, STACK - 1, current);
             let record = instances.load(current as usize);
             (node_base, leaf_base) = (record.node_base, record.leaf_base);
-            let (o2, d2) = record.to_object(o, d);
+            let (wo, wd) = world_ray::<STACK>(&stack);
+            let (o2, d2) = record.to_object(wo, wd);
             (slabs, ray, at_ray) = (SlabRay::new(o2, d2), WatertightRay::new(o2, d2), (o2, d2, Origin::NONE));
             inside = true;
             floor = top_len;
@@ -198,7 +213,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
                 go_right = false;
             }
             if INSTANCED && (hit.t != before.t || hit.prim != before.prim) {
-                found_in = current;
+                found_in = get(&stack, STACK - 1);
             }
             if query.done(&hit) {
                 return (hit, found_in);
@@ -214,7 +229,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
         }
         if go_left && go_right {
             let (near, far, far_t) = if ln <= rn { (left, right, rn) } else { (right, left, ln) };
-            if top_len < stack.len() / 2 {
+            if top_len < entries {
                 set(&mut stack, 2 * top_len, far);
                 set(&mut stack, 2 * top_len + 1, far_t.to_bits());
                 top_len += 1;
@@ -232,7 +247,8 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
                 if INSTANCED && inside && top_len == floor {
                     inside = false;
                     node_base = 0;
-                    slabs = SlabRay::new(o, d);
+                    let (wo, wd) = world_ray::<STACK>(&stack);
+                    slabs = SlabRay::new(wo, wd);
                 }
                 if top_len == 0 {
                     break;
@@ -248,6 +264,22 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             node = next;
         }
     }
+}
+
+/// Words at the end of an instanced walk's stack: the world ray (origin,
+/// direction) and the instance the walk is in.
+const WORLD: usize = 7;
+
+/// The stack of an instanced walk: [`STACK_DEPTH`] entries of two words
+/// for each level, and the world ray and instance (seven words, rounded up
+/// to an entry) at its end.
+pub const INSTANCED_STACK_WORDS: usize = 4 * STACK_DEPTH + WORLD + 1;
+
+/// The world ray an instanced walk keeps at the end of its stack.
+#[inline]
+fn world_ray<const STACK: usize>(stack: &[u32; STACK]) -> (Vec3, Vec3) {
+    let w = |k: usize| f32::from_bits(get(stack, STACK - WORLD + k));
+    (Vec3::new(w(0), w(1), w(2)), Vec3::new(w(3), w(4), w(5)))
 }
 
 /// [`closest_hit_bvh2`] with every primitive kind compiled in.

@@ -18,8 +18,8 @@ use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim};
 use crate::geometry::features;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::records::RecordLoad;
-use crate::trace::bvh2::{walk, Level};
-use crate::trace::hit::{Query, STACK_DEPTH};
+use crate::trace::bvh2::{walk, Level, INSTANCED_STACK_WORDS};
+use crate::trace::hit::Query;
 
 /// The closest (or, for an occlusion query, the first found) hit in an
 /// instanced scene: distance, the primitive within its mesh and the
@@ -58,7 +58,7 @@ pub fn trace_instances(
 ) -> InstanceHit {
     let trees = Level { nodes, leaves };
     let (hit, instance) =
-        walk::<{ features::TRIANGLES }, true, { 4 * STACK_DEPTH }>(o, d, Origin::NONE, &query, prims, instances, &trees);
+        walk::<{ features::TRIANGLES }, true, INSTANCED_STACK_WORDS>(o, d, Origin::NONE, &query, prims, instances, &trees);
     if hit.is_hit() {
         InstanceHit { t: hit.t, prim: hit.prim, instance }
     } else {

@@ -54,7 +54,18 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
 /// (`treelet_core::layouts::bvh2::refit_kernel`), then the two-box nodes are
 /// written again. No collapse and no depth check: the shape is the one
 /// laid out.
-pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
+///
+/// `counters`: the climb's arrival counters, one per node of the collapsed
+/// tree, zeroed when `None` and kept there for the next refit of the same
+/// tree (a climb leaves them as it found them:
+/// `treelet_core::construct::climb::second_arrival`), so that a refit every
+/// frame does not zero them every frame.
+pub fn refit_bvh2<B: Backend>(
+    b: &mut B,
+    tree: &TracedTree<B>,
+    prims: &PrimBuffers<B>,
+    counters: &mut Option<B::Buffer>,
+) -> Result<StageTimes> {
     let Some(collapsed) = &tree.collapsed else {
         bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
     };
@@ -65,13 +76,17 @@ pub fn refit_bvh2<B: Backend>(b: &mut B, tree: &TracedTree<B>, prims: &PrimBuffe
     b.stage("fit");
     let nodes = collapsed.node_count;
     let lp = b.upload("refit params", &[LayoutParams { n, nodes, spheres: prims.sphere_count, ..Default::default() }])?;
-    let flags = b.zeroed("fit flags", nodes as u64 * 4)?;
+    let flags = match counters.take() {
+        Some(kept) => kept,
+        None => b.zeroed("refit counters", nodes as u64 * 4)?,
+    };
     let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
     b.dispatch(
         refit,
         &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &flags, &tree.prims],
         groups_for(nodes, WORKGROUP_SIZE),
     );
+    *counters = Some(flags);
     b.stage("layout");
     write_bvh2_nodes(b, collapsed, prims, &tree.nodes)?;
     b.take_times()
