@@ -455,7 +455,10 @@ fn image_difference(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> (f64, f64) {
 /// `render` keeps the copies of `scenes/pyramids.json` (one pyramid placed
 /// five times, in glass, mirror and three diffuse materials, one upside
 /// down under the ceiling) placed, and renders what the same file
-/// flattened renders, on the CPU runner; the GPU renders it as the CPU
+/// flattened renders, on the CPU runner, with next-event estimation and
+/// with light paths for caustics (traced from the lamp through the glass
+/// and mirror copies: a copy whose light paths went missing would leave
+/// its caustics out of the placed image only); the GPU renders it as the CPU
 /// runner does, within the rounding that sends a few paths elsewhere. A
 /// scene of copies alone (no primitives of its own) renders too.
 #[test]
@@ -481,21 +484,27 @@ fn placed_copies_render_what_the_flattened_scene_renders() {
         first_sample: 0,
     };
     let mut cpu = CpuBackend::new();
-    let placed_cpu = render(&mut cpu, &placed, &settings, None, |_| {}).unwrap();
-    assert!(placed_cpu.plan.placed && placed_cpu.plan.kernel == "placed", "{:?}", placed_cpu.plan.kernel);
-    let flat_cpu = render(&mut cpu, &flat, &settings, None, |_| {}).unwrap();
-    let brightness = flat_cpu.image.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * flat_cpu.image.pixels.len()) as f64;
-    assert!(brightness > 0.05, "the room is lit: mean {brightness}");
-    // The same paths: a hit point rounds differently in a copy's own space
-    // (no face of a copy lies in another's plane: coplanar faces would
-    // tie by rounding).
-    let (mean, off) = image_difference(&placed_cpu.image.pixels, &flat_cpu.image.pixels, 1e-2);
-    assert!(mean < 1e-3 * brightness && off < 0.01, "seed {seed}: placed against flattened on the CPU runner: mean difference {mean} (brightness {brightness}), {off} of pixels off");
-    if let Some(ctx) = gpu() {
-        let mut b = GpuBackend::new(ctx);
-        let placed_gpu = render(&mut b, &placed, &settings, None, |_| {}).unwrap();
-        let (mean, off) = image_difference(&placed_gpu.image.pixels, &placed_cpu.image.pixels, 1e-2);
-        assert!(mean < 0.02 * brightness && off < 0.05, "seed {seed}: placed on {} against the CPU runner: mean difference {mean}, {off} of pixels off", b.adapter());
+    // Next-event estimation, and with light paths (the glass and mirror
+    // copies' caustics, traced from the lamp through the copies).
+    for integrator in [Integrator::Nee, Integrator::Caustics] {
+        let settings = RenderSettings { integrator, ..settings };
+        let placed_cpu = render(&mut cpu, &placed, &settings, None, |_| {}).unwrap();
+        assert!(placed_cpu.plan.placed && placed_cpu.plan.kernel == "placed", "{:?}", placed_cpu.plan.kernel);
+        let flat_cpu = render(&mut cpu, &flat, &settings, None, |_| {}).unwrap();
+        let brightness = flat_cpu.image.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * flat_cpu.image.pixels.len()) as f64;
+        assert!(brightness > 0.05, "the room is lit: mean {brightness}");
+        // The same paths: a hit point rounds differently in a copy's own
+        // space (no face of a copy lies in another's plane: coplanar faces
+        // would tie by rounding).
+        let (mean, off) = image_difference(&placed_cpu.image.pixels, &flat_cpu.image.pixels, 1e-2);
+        let name = integrator.name();
+        assert!(mean < 1e-3 * brightness && off < 0.01, "seed {seed}, {name}: placed against flattened on the CPU runner: mean difference {mean} (brightness {brightness}), {off} of pixels off");
+        if let Some(ctx) = gpu() {
+            let mut b = GpuBackend::new(ctx);
+            let placed_gpu = render(&mut b, &placed, &settings, None, |_| {}).unwrap();
+            let (mean, off) = image_difference(&placed_gpu.image.pixels, &placed_cpu.image.pixels, 1e-2);
+            assert!(mean < 0.02 * brightness && off < 0.05, "seed {seed}, {name}: placed on {} against the CPU runner: mean difference {mean}, {off} of pixels off", b.adapter());
+        }
     }
     // Copies alone: nothing of the scene's own, no light: black, and no
     // tree of its own built.

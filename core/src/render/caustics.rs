@@ -32,7 +32,7 @@ use crate::geometry::intersect::surface_offset;
 use crate::geometry::prims::Origin;
 use crate::gpu::atomics;
 use crate::gpu::rng::BounceRng;
-use crate::render::integrator::{MAX_BOUNCES, SceneRefs, glass_bounce, hit_normal_for, trace};
+use crate::render::integrator::{MAX_BOUNCES, SceneRefs, glass_bounce, hit_normal_for, surface, trace};
 use crate::render::lights::{Light, select_light};
 use crate::render::sampling::{cosine_direction, sin_cos_turns};
 use crate::trace::hit::{ClosestHit, Query};
@@ -137,9 +137,9 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
         if !hit.is_hit() {
             return;
         }
-        let m = scene.materials[hit.prim as usize];
         let x = o + d * hit.t;
-        let n = hit_normal_for::<F>(prims, hit.prim, x, d);
+        // A placed copy's triangle too (`crate::trace::placed`).
+        let (m, n) = surface::<T, F>(scene, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         if m.kind == DIFFUSE && bounces == 0 {
             return; // Not a caustic: next-event estimation's.

@@ -504,7 +504,7 @@ fn sample_direct<T: ClosestHit>(
 /// has [`features::INSTANCES`], a placed copy's past them
 /// ([`ClosestHit::placed_surface`]).
 #[inline]
-fn surface<T: ClosestHit, const F: u32>(scene: &SceneRefs<T>, prim: u32, x: Vec3, d: Vec3) -> (Material, Vec3) {
+pub(crate) fn surface<T: ClosestHit, const F: u32>(scene: &SceneRefs<T>, prim: u32, x: Vec3, d: Vec3) -> (Material, Vec3) {
     if has(F, features::INSTANCES) && prim >= scene.prims.count() {
         scene.tree.placed_surface(prim - scene.prims.count(), d)
     } else {

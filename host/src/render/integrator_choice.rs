@@ -77,10 +77,6 @@ pub fn pilot_spp(settings: &RenderSettings) -> Option<u32> {
 /// one; else by the pilot (see the module doc).
 pub fn choose(devices: &[Device], scene: &Scene, settings: &RenderSettings) -> Result<Choice> {
     let f = SceneFeatures::of(scene);
-    if f.copies > 0 {
-        let reason = "light paths do not trace placed copies of meshes, which this scene keeps".to_string();
-        return Ok(Choice { integrator: Integrator::Nee, reason, measured: Vec::new() });
-    }
     if f.mirror + f.glass == 0 || f.emissive == 0 {
         let reason = "the scene has no mirrors or glass with lights, so no caustics for light paths".to_string();
         return Ok(Choice { integrator: Integrator::Nee, reason, measured: Vec::new() });

@@ -82,7 +82,12 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
 
 /// The render kernel of `plan`.
 fn render_kernel(plan: &Plan) -> Kernel {
-    if plan.placed { Kernel::RenderPlaced } else { Kernel::Render(plan.method(), plan.variant as u8) }
+    let caustics = treelet_core::render::variants::VARIANTS[plan.variant].0 & treelet_core::geometry::features::CAUSTICS != 0;
+    match (plan.placed, caustics) {
+        (true, true) => Kernel::RenderPlacedCaustics,
+        (true, false) => Kernel::RenderPlaced,
+        _ => Kernel::Render(plan.method(), plan.variant as u8),
+    }
 }
 
 /// The light paths' kernel of a render following `plan`, if it traces any:
@@ -91,7 +96,8 @@ fn render_kernel(plan: &Plan) -> Kernel {
 /// `treelet_core::geometry::features::CAUSTICS`).
 fn light_kernel(plan: &Plan, lights: bool) -> Option<Kernel> {
     let caustics = treelet_core::render::variants::VARIANTS[plan.variant].0 & treelet_core::geometry::features::CAUSTICS != 0;
-    (caustics && lights).then(|| Kernel::Light(plan.method(), plan.variant as u8))
+    let kernel = if plan.placed { Kernel::LightPlaced } else { Kernel::Light(plan.method(), plan.variant as u8) };
+    (caustics && lights).then_some(kernel)
 }
 
 /// Builds the pipelines of a render of `scene` with `settings` on `b`
@@ -191,12 +197,6 @@ impl<B: Backend> Prepared<B> {
         };
         let placed = match &scene.placed {
             Some(copies) => {
-                if integrator == Integrator::Caustics {
-                    bail!(
-                        "{}: --integrator caustics traces light paths through a scene's own primitives, not its placed copies of meshes; use --integrator nee, or --flatten",
-                        scene.name
-                    );
-                }
                 if plan.layout != Layout::Bvh2 || (plan.accel == crate::bvh::tree::Accel::None && !all.is_empty()) {
                     bail!(
                         "{}: the scene keeps copies of meshes placed, and their kernel traces the scene's own primitives through a bvh2 tree (not --accel none, nor --layout {})",
@@ -250,7 +250,10 @@ impl<B: Backend> Prepared<B> {
             let params = RenderParams { samples, first_sample: first + done, ..self.params };
             let scene = (&self.materials, &self.lights, &params);
             if let Some(placed) = &self.placed {
-                dispatch_placed(b, &self.tree, &self.buffers, scene, placed, &self.accum)?;
+                dispatch_placed(b, self.kernel, &self.tree, &self.buffers, scene, placed, &self.accum)?;
+                if let Some((kernel, landings)) = &self.light_paths {
+                    dispatch_placed(b, *kernel, &self.tree, &self.buffers, scene, placed, landings)?;
+                }
                 done += samples;
                 continue;
             }
@@ -304,10 +307,11 @@ fn dispatch_render<B: Backend>(
     Ok(())
 }
 
-/// [`dispatch_render`] of [`Kernel::RenderPlaced`]: the scene's own
-/// bindings, then the copies'.
+/// [`dispatch_render`] of [`Kernel::RenderPlaced`] (or its caustics
+/// kernels): the scene's own bindings, then the copies'.
 fn dispatch_placed<B: Backend>(
     b: &mut B,
+    kernel: Kernel,
     tree: &TracedTree<B>,
     buffers: &PrimBuffers<B>,
     (materials, lights, params): (&B::Buffer, &B::Buffer, &RenderParams),
@@ -317,7 +321,7 @@ fn dispatch_placed<B: Backend>(
     let p = b.upload("render params", &[*params])?;
     let [records, info, nodes, leaves, triangles, placed_materials] = placed.bindings();
     b.dispatch(
-        Kernel::RenderPlaced,
+        kernel,
         &[
             &p,
             &buffers.spheres,

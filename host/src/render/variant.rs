@@ -295,7 +295,8 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
 }
 
 /// [`plan`] for a scene with copies kept placed: one kernel traces them
-/// (`render::render_placed_cs`), with the scene's own primitives in a
+/// (`render::render_placed_cs`, or `render_placed_caustics_cs` and `render::light_placed_cs` for light
+/// paths), with the scene's own primitives in a
 /// `bvh2` tree (an LBVH where a scan would do: the room's few primitives
 /// cost nothing to build). What was asked explicitly is kept, and refused
 /// by the render if that kernel cannot run it.
@@ -311,9 +312,13 @@ fn placed_plan(mut plan: Plan) -> Plan {
         plan.layout_reason = why.to_string();
     }
     plan.placed = true;
-    plan.variant = full_variant();
+    // Light paths, where the plan has them, run through the copies too
+    // (`render::light_placed_cs`).
+    let caustics = VARIANTS[plan.variant].0 & features::CAUSTICS != 0;
+    let bits = features::ALL | if caustics { features::CAUSTICS } else { 0 };
+    plan.variant = if caustics { smallest_variant(bits) } else { full_variant() };
     plan.kernel = "placed";
-    plan.kernel_features = format!("{}, placed copies of meshes", describe(features::ALL));
+    plan.kernel_features = format!("{}, placed copies of meshes", describe(bits));
     plan.kernel_reason = format!(
         "{} copies of meshes ({} triangles) kept placed, traced through their meshes' own trees",
         plan.features.copies, plan.features.copied_triangles

@@ -182,9 +182,29 @@ impl treelet_core::render::caustics::Landings for SharedLandings<'_> {
 }
 
 /// The light paths of every pixel of a dispatch (`light_paths` compiled for
-/// `VARIANTS[v]`), in parallel: they land anywhere, so through atomics.
+/// `VARIANTS[v]`), in parallel (see [`light_with`]).
 fn light_all<T: ClosestHit + Sync>(
     v: u8,
+    p: &treelet_core::RenderParams,
+    scene: &SceneRefs<T>,
+    lights: &[Light],
+    splats: &mut [u32],
+    groups: u32,
+) {
+    macro_rules! arms {
+        ([$v:ident] $($i:literal $name:ident [$($f:path),*];)*) => {
+            match $v {
+                $($i => light_with::<T, { 0 $(| $f)* }>(p, scene, lights, splats, groups),)*
+                _ => panic!("render variant {} of {}", $v, VARIANTS.len()),
+            }
+        };
+    }
+    treelet_core::for_each_render_variant!(arms, v)
+}
+
+/// The light paths of every pixel of a dispatch, compiled for features
+/// `F`, in parallel: they land anywhere, so through atomics.
+fn light_with<T: ClosestHit + Sync, const F: u32>(
     p: &treelet_core::RenderParams,
     scene: &SceneRefs<T>,
     lights: &[Light],
@@ -200,17 +220,9 @@ fn light_all<T: ClosestHit + Sync>(
         // is atomic.
         unsafe { std::slice::from_raw_parts(words as *const std::sync::atomic::AtomicU32, splats.len()) }
     };
-    macro_rules! arms {
-        ([$v:ident] $($i:literal $name:ident [$($f:path),*];)*) => {
-            match $v {
-                $($i => (0..pixels).into_par_iter().for_each(|id| {
-                    light_paths::<T, { 0 $(| $f)* }, 1, _>(id, p, scene, lights, &mut SharedLandings(shared), &mut [0u32; 1], 0)
-                }),)*
-                _ => panic!("render variant {} of {}", $v, VARIANTS.len()),
-            }
-        };
-    }
-    treelet_core::for_each_render_variant!(arms, v)
+    (0..pixels).into_par_iter().for_each(|id| {
+        light_paths::<T, F, 1, _>(id, p, scene, lights, &mut SharedLandings(shared), &mut [0u32; 1], 0)
+    });
 }
 
 /// The sort pass ranked by subgroups (`ITEMS` keys per lane), its
@@ -876,7 +888,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             }
         }
         (
-            Kernel::RenderPlaced,
+            Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced,
             [p, spheres, materials, nodes, prims, accum, triangles, lights, records, info, placed_nodes, placed_leaves, placed_triangles, placed_materials],
         ) => {
             use treelet_core::geometry::features::{ALL, INSTANCES};
@@ -884,7 +896,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let p: treelet_core::RenderParams = params(p);
             let lights: &[Light] = view(lights);
             let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
-            let accum: &mut [[f32; 4]] = view(accum);
             let own = Bvh2Tree::new(view::<Bvh2Node>(nodes) as &[_], view::<LeafPrim>(prims) as &[_]);
             let (placed_nodes, placed_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(placed_nodes), view(placed_leaves));
             let meshes = treelet_core::geometry::prims::Prims {
@@ -903,10 +914,24 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 materials: view(placed_materials),
             };
             let scene = SceneRefs::new(&p, spheres, triangles, materials, tree);
-            let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
-            accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
-                accumulate(acc, render_pixel::<_, { ALL | INSTANCES }, 1>(id as u32, &p, &scene, lights, &mut [0u32; 1], 0))
-            });
+            // As the shader's entry points: light paths' split of path space only beside them.
+            const F: u32 = ALL | INSTANCES;
+            const C: u32 = F | treelet_core::geometry::features::CAUSTICS;
+            if kernel == Kernel::LightPlaced {
+                light_with::<_, C>(&p, &scene, lights, view(accum), groups);
+            } else {
+                let accum: &mut [[f32; 4]] = view(accum);
+                let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
+                let caustics = kernel == Kernel::RenderPlacedCaustics;
+                accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
+                    let sums = if caustics {
+                        render_pixel::<_, C, 1>(id as u32, &p, &scene, lights, &mut [0u32; 1], 0)
+                    } else {
+                        render_pixel::<_, F, 1>(id as u32, &p, &scene, lights, &mut [0u32; 1], 0)
+                    };
+                    accumulate(acc, sums)
+                });
+            }
         }
         (Kernel::Light(method, v), [p, spheres, materials, nodes, prims, splats, triangles, lights]) => {
             let p: treelet_core::RenderParams = params(p);

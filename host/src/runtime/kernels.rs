@@ -183,6 +183,11 @@ pub enum Kernel {
     /// (`treelet_core::trace::placed`): its own primitives in `bvh2`, the
     /// copies through the instanced walk; every feature.
     RenderPlaced,
+    /// [`Kernel::RenderPlaced`] beside light paths for caustics
+    /// ([`Kernel::LightPlaced`]): camera paths leave theirs to them.
+    RenderPlacedCaustics,
+    /// The light paths of [`Kernel::RenderPlaced`]'s scenes, for caustics.
+    LightPlaced,
     /// The light paths of [`Kernel::Render`]'s method and feature set, for
     /// caustics (`treelet_core::render::caustics`; not for the seed layout).
     Light(Method, u8),
@@ -274,6 +279,8 @@ impl Kernel {
         let mut all = Self::FIXED.to_vec();
         all.push(Kernel::CastWideWorkgroupStack);
         all.push(Kernel::RenderPlaced);
+        all.push(Kernel::RenderPlacedCaustics);
+        all.push(Kernel::LightPlaced);
         for method in Method::ALL {
             for v in 0..VARIANTS.len() as u8 {
                 if method.specialized() || v == full {
@@ -348,6 +355,8 @@ impl Kernel {
             Kernel::WideEmit => "cwbvh::wide_emit_cs",
             Kernel::Render(method, v) => render_entry_point(method, v, false),
             Kernel::RenderPlaced => "render::render_placed_cs",
+            Kernel::RenderPlacedCaustics => "render::render_placed_caustics_cs",
+            Kernel::LightPlaced => "render::light_placed_cs",
             Kernel::Light(Method::Classic, _) => panic!("no light paths through the seed's layout"),
             Kernel::Light(method, v) => render_entry_point(method, v, true),
             Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
@@ -379,7 +388,7 @@ impl Kernel {
             Kernel::LeafPrims => &[3, 4],
             Kernel::WideEmit => &[9],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
-            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced => &[6, 3, 4],
+            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
@@ -446,7 +455,7 @@ impl Kernel {
             Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
             // The render's, then the copies' (`render::render_placed_cs`).
-            Kernel::RenderPlaced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
+            Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
             Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
         }
     }
