@@ -165,9 +165,10 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     // `floor`, the top level's. `STACK` words: two a level of depth, for
     // both levels when instanced, and then the world ray and the instance
     // entered in the last `WORLD` words: read only on entering and leaving
-    // a mesh, they stay out of the registers the walk's loop keeps (the
-    // driver gave the instanced walk 80 registers against the plain one's
-    // 64, so three workgroups an SM instead of four).
+    // a mesh, they stay out of the registers the walk's loop keeps (held
+    // there, the driver gave the engine's instanced kernel 80 registers
+    // against the plain walk's 64, so three workgroups an SM instead of
+    // four; now 64 as well).
     let mut stack = [0u32; STACK];
     let entries = if INSTANCED { (STACK - WORLD) / 2 } else { STACK / 2 };
     if INSTANCED {
