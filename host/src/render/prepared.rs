@@ -82,8 +82,7 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
 
 /// The render kernel of `plan`.
 fn render_kernel(plan: &Plan) -> Kernel {
-    let caustics = treelet_core::render::variants::VARIANTS[plan.variant].0 & treelet_core::geometry::features::CAUSTICS != 0;
-    match (plan.placed, caustics) {
+    match (plan.placed, plan.light_paths()) {
         (true, true) => Kernel::RenderPlacedCaustics,
         (true, false) => Kernel::RenderPlaced,
         _ => Kernel::Render(plan.method(), plan.variant as u8),
@@ -95,9 +94,8 @@ fn render_kernel(plan: &Plan) -> Kernel {
 /// [`variant::plan`], which then picks a variant with
 /// `treelet_core::geometry::features::CAUSTICS`).
 fn light_kernel(plan: &Plan, lights: bool) -> Option<Kernel> {
-    let caustics = treelet_core::render::variants::VARIANTS[plan.variant].0 & treelet_core::geometry::features::CAUSTICS != 0;
     let kernel = if plan.placed { Kernel::LightPlaced } else { Kernel::Light(plan.method(), plan.variant as u8) };
-    (caustics && lights).then_some(kernel)
+    (plan.light_paths() && lights).then_some(kernel)
 }
 
 /// Builds the pipelines of a render of `scene` with `settings` on `b`

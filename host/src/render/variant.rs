@@ -314,7 +314,7 @@ fn placed_plan(mut plan: Plan) -> Plan {
     plan.placed = true;
     // Light paths, where the plan has them, run through the copies too
     // (`render::light_placed_cs`).
-    let caustics = VARIANTS[plan.variant].0 & features::CAUSTICS != 0;
+    let caustics = plan.light_paths();
     let bits = features::ALL | if caustics { features::CAUSTICS } else { 0 };
     plan.variant = if caustics { smallest_variant(bits) } else { full_variant() };
     plan.kernel = "placed";
@@ -394,5 +394,12 @@ impl Plan {
         } else {
             self.layout.method()
         }
+    }
+
+    /// Whether the render kernel leaves caustics to light paths
+    /// (`--integrator caustics` where the scene has mirrors or glass and
+    /// lights): its variant has `features::CAUSTICS`.
+    pub fn light_paths(&self) -> bool {
+        VARIANTS[self.variant].0 & features::CAUSTICS != 0
     }
 }
