@@ -60,9 +60,28 @@ pub fn leaf_prims_cs(
     treelet_core::layouts::bvh2::leaf_prims_kernel(id, params.n, params.spheres, prim_indices, spheres, triangles, out);
 }
 
+/// The state a layout's refit climbs on, one collapsed node each: its
+/// counter zeroed and its index in the layout
+/// (`treelet_core::layouts::bvh2::refit_state_kernel`).
+#[spirv(compute(threads(256)))]
+pub fn refit_state_cs(
+    #[spirv(global_invocation_id)] gid: UVec3,
+    #[spirv(num_workgroups)] groups: UVec3,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &LayoutParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] state: &mut [u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes_hi: &[Node],
+) {
+    let id = linear_id(gid.x, gid.y, groups.x);
+    let nodes = Split::new(nodes, nodes_hi);
+    treelet_core::layouts::bvh2::refit_state_kernel(id, params.nodes, &nodes, parents, state);
+}
+
 /// A layout's refit in place: each leaf of the collapsed tree writes its
-/// primitives and box, then climbs (`treelet_core::layouts::bvh2::refit_kernel`);
-/// `$ordered` as for the build's fit kernels.
+/// primitives, then climbs, writing each box into the layout's node above
+/// it (`treelet_core::layouts::bvh2::refit_kernel`); `$ordered` as for the
+/// build's fit kernels.
 macro_rules! refit_kernel {
     ($name:ident, $ordered:literal) => {
         #[spirv(compute(threads(256)))]
@@ -73,13 +92,15 @@ macro_rules! refit_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] prim_indices: &[u32],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] spheres: &[Sphere],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] triangles: &[Triangle],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &mut [Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &[Node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] flags: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out: &mut [Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_hi: &mut [Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] state: &mut [u32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out_prims: &mut [Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] out_nodes: &mut [f32],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] triangles_hi: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] nodes_hi: &[Node],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] out_prims_hi: &mut [Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] out_nodes_hi: &mut [f32],
         ) {
             let id = linear_id(gid.x, gid.y, groups.x);
             let prims = Prims {
@@ -88,15 +109,16 @@ macro_rules! refit_kernel {
                 triangles: Split::new(triangles, triangles_hi),
                 triangle_count: params.n - params.spheres,
             };
-            treelet_core::layouts::bvh2::refit_kernel::<$ordered, _>(
+            treelet_core::layouts::bvh2::refit_kernel::<$ordered, _, _>(
                 id,
                 params.nodes,
                 &prims,
                 prim_indices,
-                &mut SplitMut::new(nodes, nodes_hi),
+                &Split::new(nodes, nodes_hi),
                 parents,
-                flags,
-                &mut SplitMut::new(out, out_hi),
+                state,
+                &mut SplitMut::new(out_prims, out_prims_hi),
+                &mut SplitMut::new(out_nodes, out_nodes_hi),
             );
         }
     };

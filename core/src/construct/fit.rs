@@ -87,12 +87,12 @@ pub fn fit_kernel<const ORDERED: bool>(
     climb_boxes::<ORDERED>(leaf_node(n, i), b, nodes, parents, flags);
 }
 
-/// The climb of [`fit_kernel`] (and of the `bvh2` layout's refit,
-/// `crate::layouts::bvh2::refit_kernel`) from node `start`, whose box `own`
-/// is written: each internal node it arrives at second gets the union of
-/// its children's boxes.
+/// The climb of [`fit_kernel`] from node `start`, whose box `own` is
+/// written: each internal node it arrives at second gets the union of its
+/// children's boxes. (The `bvh2` layout's refit climbs the same way but
+/// keeps its boxes in the layout's nodes: `crate::layouts::bvh2::refit_kernel`.)
 #[inline]
-pub(crate) fn climb_boxes<const ORDERED: bool>(start: u32, own: Aabb, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
+fn climb_boxes<const ORDERED: bool>(start: u32, own: Aabb, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
     // The climber keeps its subtree's box and reads only the sibling's.
     let mut own = own;
     let mut climb = Climb::<ORDERED>::new(start);

@@ -12,14 +12,15 @@
 //! (internal node `i` of the input becomes node `f(i)` of the output, the
 //! number of internal nodes before it in depth-first order, found by
 //! climbing) and [`leaf_prims_kernel`] (the primitives in leaf order).
-use crate::construct::fit::{climb_boxes, store_box};
+use crate::construct::climb::second_arrival;
 use crate::construct::primitive_boxes::primitive_box;
 use crate::geometry::aabb::Aabb;
 use crate::geometry::records::{RecordLoad, RecordStore};
-use crate::geometry::buffers::{Bvh2Node, LEAF_BIT, LeafPrim, Node, Sphere};
+use crate::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere};
 use crate::geometry::prims::Prims;
 use crate::geometry::split::{Split, SplitMut};
 use crate::geometry::triangle::Triangle;
+use crate::gpu::atomics;
 use crate::gpu::unchecked::at;
 
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
@@ -44,9 +45,19 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
         }
         return;
     }
-    // f(i): internal nodes before i in depth-first order. A left child is
-    // its parent's next; a right child comes after its left sibling's L - 1
-    // internal nodes.
+    let index = output_index(i, parents);
+    let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
+    let record = two_boxes(&l, &r, child_ref(&l, index + 1), child_ref(&r, index + (node.right - i) / 2));
+    out.store(index as usize, &record);
+}
+
+/// Internal node `i` of a collapsed tree (depth-first order, as
+/// [`bvh2_node_kernel`] takes it) is node `f(i)` of the layout: the number
+/// of internal nodes before it in depth-first order. A left child is its
+/// parent's next; a right child comes after its left sibling's `L - 1`
+/// internal nodes (`right = parent + 2 L`).
+#[inline]
+fn output_index(i: u32, parents: &[u32]) -> u32 {
     let mut index = 0u32;
     let mut x = i;
     while x != 0 {
@@ -54,43 +65,119 @@ pub fn bvh2_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> +
         index += if x == p + 1 { 1 } else { (x - p) / 2 };
         x = p;
     }
-    let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
-    let record = two_boxes(&l, &r, child_ref(&l, index + 1), child_ref(&r, index + (node.right - i) / 2));
-    out.store(index as usize, &record);
+    index
 }
 
-/// Kernel: the refit of a layout in place, over the collapsed tree it was
-/// made from (its shape kept; `prims` moved): one invocation per node `i` of
-/// `node_count`; a leaf writes its primitives' [`LeafPrim`]s again (slots
-/// `first..first + count` of `out`) and its box, the union of theirs, then
-/// climbs as the build's fit does ([`crate::construct::fit`]). `flags` holds
-/// one zeroed counter per node. [`bvh2_node_kernel`] then writes the nodes.
+/// Kernel, one invocation per node `i` of the collapsed tree a layout was
+/// made from: the state [`refit_kernel`] climbs on, two words per node,
+/// made once per tree and kept from one refit to the next. `state[2 i]` is
+/// node `i`'s arrival counter (zeroed; a climb leaves it even, as it found
+/// it: [`crate::construct::climb::second_arrival`]), `state[2 i + 1]` the
+/// index of its [`Bvh2Node`] in the layout (internal nodes; `u32::MAX` for
+/// a leaf). The two words side by side: the climber that counts at a node
+/// reads where to write from the same cache line.
+pub fn refit_state_kernel<N: RecordLoad<Node> + ?Sized>(i: u32, node_count: u32, nodes: &N, parents: &[u32], state: &mut [u32]) {
+    if i >= node_count {
+        return;
+    }
+    let slot = if nodes.load(i as usize).is_leaf() { u32::MAX } else { output_index(i, parents) };
+    state[2 * i as usize] = 0;
+    state[2 * i as usize + 1] = slot;
+}
+
+/// Kernel: the refit of a `bvh2` layout in place, over the collapsed tree it
+/// was made from (its shape kept; `prims` moved), one invocation per node
+/// `i` of `node_count`. A leaf writes its primitives' [`LeafPrim`]s again
+/// (slots `first..first + count` of `out_prims`) and its box, the union of
+/// theirs, into its parent's [`Bvh2Node`] (`out_nodes`, as 16 words a
+/// node), then climbs as the build's fit does ([`crate::construct::fit`]):
+/// the second child to arrive at a node reads its sibling's box from the
+/// same node and writes the union into the node above. So the layout's
+/// boxes are written where the climb makes them: no pass over the nodes
+/// after it, and the collapsed tree is only read (its boxes stay those of
+/// the build; its shape and parent links are what the refit uses). `state`
+/// is [`refit_state_kernel`]'s.
 #[allow(clippy::too_many_arguments)]
-pub fn refit_kernel<const ORDERED: bool, O: RecordStore<LeafPrim> + ?Sized>(
+pub fn refit_kernel<const ORDERED: bool, N: RecordLoad<Node> + ?Sized, O: RecordStore<LeafPrim> + ?Sized>(
     i: u32,
     node_count: u32,
     prims: &Prims,
     prim_indices: &[u32],
-    nodes: &mut SplitMut<Node>,
+    nodes: &N,
     parents: &[u32],
-    flags: &mut [u32],
-    out: &mut O,
+    state: &mut [u32],
+    out_prims: &mut O,
+    out_nodes: &mut SplitMut<f32>,
 ) {
     if i >= node_count {
         return;
     }
-    let (first, right) = nodes.with(i as usize, |node| (node.left, node.right));
-    if right & LEAF_BIT == 0 {
+    let node = nodes.load(i as usize);
+    if !node.is_leaf() {
         return;
     }
     let mut own = Aabb::EMPTY;
-    for slot in first..first + (right & !LEAF_BIT) {
+    for slot in node.left..node.left + node.prim_count() {
         let prim = prim_indices[slot as usize];
-        out.store(slot as usize, &prims.leaf_prim(prim));
+        out_prims.store(slot as usize, &prims.leaf_prim(prim));
         own = own.union(&primitive_box(prim, prims.sphere_count, prims.spheres, &prims.triangles));
     }
-    nodes.with_mut(i as usize, |node| store_box(node, &own));
-    climb_boxes::<ORDERED>(i, own, nodes, parents, flags);
+    if node_count == 1 {
+        // A tree of one leaf: the root's first child.
+        store_child_box(out_nodes, 0, true, &own);
+        return;
+    }
+    // The climber keeps its subtree's box and reads only the sibling's.
+    let mut child = i;
+    loop {
+        let parent = parents[child as usize];
+        let slot = state[2 * parent as usize + 1];
+        let left = child == parent + 1;
+        store_child_box(out_nodes, slot, left, &own);
+        if !second_arrival::<ORDERED>(&mut state[2 * parent as usize]) {
+            return;
+        }
+        let sibling = load_child_box(out_nodes, slot, !left);
+        own = if left { own.union(&sibling) } else { sibling.union(&own) };
+        if parent == 0 {
+            return;
+        }
+        child = parent;
+    }
+}
+
+/// The first word of a child's box in node `slot` of a layout read as
+/// words: [`Bvh2Node`] holds `left_min, left, left_max, right, right_min,
+/// left_count, right_max, right_count`, a box's minimum three words and its
+/// maximum four further on.
+#[inline]
+fn child_box_word(slot: u32, left: bool) -> usize {
+    16 * slot as usize + if left { 0 } else { 8 }
+}
+
+/// Writes a child's box into its parent's node, with device-scope stores:
+/// the sibling's climber reads it after the arrival that orders them (see
+/// [`crate::construct::climb`]).
+#[inline]
+fn store_child_box(out_nodes: &mut SplitMut<f32>, slot: u32, left: bool, b: &Aabb) {
+    let w = child_box_word(slot, left);
+    for k in 0..3 {
+        out_nodes.with_mut(w + k, |x| atomics::store_f32(x, b.min[k]));
+        out_nodes.with_mut(w + 4 + k, |x| atomics::store_f32(x, b.max[k]));
+    }
+}
+
+/// Reads a child's box from its parent's node, written by
+/// [`store_child_box`] in another invocation.
+#[inline]
+fn load_child_box(out_nodes: &SplitMut<f32>, slot: u32, left: bool) -> Aabb {
+    let w = child_box_word(slot, left);
+    let mut b = Aabb::EMPTY;
+    for k in 0..3 {
+        b.min[k] = out_nodes.with(w + k, atomics::load_f32);
+        b.max[k] = out_nodes.with(w + 4 + k, atomics::load_f32);
+    }
+    b
 }
 
 /// The node of children `l` and `r`, referred to as given (a leaf by its

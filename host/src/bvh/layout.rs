@@ -265,7 +265,7 @@ fn write_bvh2<B: Backend>(
 
 /// Writes the two-box nodes of `collapsed` into `nodes`; returns the
 /// layout's parameters.
-pub(crate) fn write_bvh2_nodes<B: Backend>(
+fn write_bvh2_nodes<B: Backend>(
     b: &mut B,
     collapsed: &DeviceBvh<B>,
     prims: &PrimBuffers<B>,

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::{BuildParams, LayoutParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::bvh::layout::{PrimBuffers, TracedTree, write_bvh2_nodes};
+use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -48,23 +48,23 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
 
 /// Refits a tree laid out in `bvh2` in place, from the collapsed tree it was
 /// made from ([`TracedTree::collapsed`]), for `prims`, the primitives it was
-/// built over (same count and order), moved: each leaf of the collapsed
-/// tree writes its primitives again and its box (their union), then the
-/// boxes climb as the build's fit does
-/// (`treelet_core::layouts::bvh2::refit_kernel`), then the two-box nodes are
-/// written again. No collapse and no depth check: the shape is the one
-/// laid out.
+/// built over (same count and order), moved, in one dispatch: each leaf of
+/// the collapsed tree writes its primitives again, and the boxes climb as
+/// the build's fit does, each written straight into the two-box node above
+/// it (`treelet_core::layouts::bvh2::refit_kernel`). No collapse, no depth
+/// check and no pass over the nodes: the shape is the one laid out.
 ///
-/// `counters`: the climb's arrival counters, one per node of the collapsed
-/// tree, zeroed when `None` and kept there for the next refit of the same
-/// tree (a climb leaves them as it found them:
+/// `state`: what the climb needs besides the tree, two words per node of
+/// the collapsed tree (its arrival counter, and where its node is in the
+/// layout): made when `None` (one more dispatch) and kept there for the next
+/// refit of the same tree (a climb leaves the counters as it found them:
 /// `treelet_core::construct::climb::second_arrival`), so that a refit every
-/// frame does not zero them every frame.
+/// frame makes it once.
 pub fn refit_bvh2<B: Backend>(
     b: &mut B,
     tree: &TracedTree<B>,
     prims: &PrimBuffers<B>,
-    counters: &mut Option<B::Buffer>,
+    state: &mut Option<B::Buffer>,
 ) -> Result<StageTimes> {
     let Some(collapsed) = &tree.collapsed else {
         bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
@@ -76,18 +76,21 @@ pub fn refit_bvh2<B: Backend>(
     b.stage("fit");
     let nodes = collapsed.node_count;
     let lp = b.upload("refit params", &[LayoutParams { n, nodes, spheres: prims.sphere_count, ..Default::default() }])?;
-    let flags = match counters.take() {
+    let groups = groups_for(nodes, WORKGROUP_SIZE);
+    let climb = match state.take() {
         Some(kept) => kept,
-        None => b.zeroed("refit counters", nodes as u64 * 4)?,
+        None => {
+            let made = b.scratch("refit state", nodes as u64 * 8)?;
+            b.dispatch(Kernel::RefitState, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups);
+            made
+        }
     };
     let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
     b.dispatch(
         refit,
-        &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &flags, &tree.prims],
-        groups_for(nodes, WORKGROUP_SIZE),
+        &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &climb, &tree.prims, &tree.nodes],
+        groups,
     );
-    *counters = Some(flags);
-    b.stage("layout");
-    write_bvh2_nodes(b, collapsed, prims, &tree.nodes)?;
+    *state = Some(climb);
     b.take_times()
 }

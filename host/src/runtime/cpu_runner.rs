@@ -598,18 +598,27 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
             }
         }
-        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, flags, out]) => {
+        (Kernel::RefitState, [p, nodes, parents, state]) => {
             let p: treelet_core::LayoutParams = params(p);
-            let (prim_indices, spheres, triangles, nodes) = (view(prim_indices), view(spheres), view(triangles), view(nodes));
-            let (parents, flags, out) = (view(parents), view(flags), view::<treelet_core::LeafPrim>(out));
+            let (nodes, parents, state) = (view::<treelet_core::Node>(nodes), view(parents), view(state));
+            for id in ids(groups) {
+                bvh2::refit_state_kernel(id, p.nodes, nodes, parents, state);
+            }
+        }
+        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, state, out_prims, out_nodes]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
+            let (nodes, parents, state) = (view::<treelet_core::Node>(nodes), view(parents), view(state));
+            let (out_prims, out_nodes) = (view::<treelet_core::LeafPrim>(out_prims), view::<f32>(out_nodes));
             let prims = treelet_core::geometry::prims::Prims {
                 spheres,
                 sphere_count: p.spheres,
                 triangles: Split::whole(triangles),
                 triangle_count: p.n - p.spheres,
             };
+            let mut out_nodes = SplitMut::whole(out_nodes);
             for id in ids(groups) {
-                bvh2::refit_kernel::<true, _>(id, p.nodes, &prims, prim_indices, &mut SplitMut::whole(nodes), parents, flags, out);
+                bvh2::refit_kernel::<true, _, _>(id, p.nodes, &prims, prim_indices, nodes, parents, state, out_prims, &mut out_nodes);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {

@@ -122,7 +122,11 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
-    /// A `bvh2` layout's refit in place: its collapsed tree's leaf primitives and boxes, bottom-up.
+    /// The state a `bvh2` layout's refit climbs on (counters and node
+    /// indices), made once per tree.
+    RefitState,
+    /// A `bvh2` layout's refit in place: its leaf primitives, and its boxes
+    /// bottom-up over its collapsed tree.
     RefitLeaves,
     /// [`Kernel::RefitLeaves`] with relaxed counters, for CPU adapters.
     RefitLeavesRelaxed,
@@ -210,7 +214,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 60] = [
+    const FIXED: [Kernel; 61] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -239,6 +243,7 @@ impl Kernel {
         Kernel::RadixTree,
         Kernel::Fit,
         Kernel::FitRelaxed,
+        Kernel::RefitState,
         Kernel::RefitLeaves,
         Kernel::RefitLeavesRelaxed,
         Kernel::Agglomerate,
@@ -327,6 +332,7 @@ impl Kernel {
             Kernel::RadixTree => "radix_tree::radix_tree_cs",
             Kernel::Fit => "fit::fit_cs",
             Kernel::FitRelaxed => "fit::fit_relaxed_cs",
+            Kernel::RefitState => "bvh2::refit_state_cs",
             Kernel::RefitLeaves => "bvh2::refit_cs",
             Kernel::RefitLeavesRelaxed => "bvh2::refit_relaxed_cs",
             Kernel::Agglomerate => "fit::agglomerate_cs",
@@ -378,7 +384,8 @@ impl Kernel {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
             Kernel::Fit | Kernel::FitRelaxed => &[3],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7],
+            Kernel::RefitState => &[1],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7, 8],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
@@ -424,7 +431,8 @@ impl Kernel {
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
             Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, ReadWrite, Read, ReadWrite, ReadWrite],
+            Kernel::RefitState => &[Read, Read, Read, ReadWrite],
+            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
                 &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
             }

@@ -60,9 +60,9 @@ pub struct Tracer<B: Backend> {
     pub(super) counts: (usize, usize),
     /// Device time of the last build or refit, layout included (ms).
     update_ms: f64,
-    /// The `bvh2` refit's arrival counters, kept from one refit to the next
+    /// The `bvh2` refit's climb state (arrival counters, node indices), kept from one refit to the next
     /// ([`refit_bvh2`]).
-    refit_counters: Option<B::Buffer>,
+    refit_state: Option<B::Buffer>,
 }
 
 impl<B: Backend> Tracer<B> {
@@ -82,7 +82,7 @@ impl<B: Backend> Tracer<B> {
             tree: None,
             counts: (spheres.len(), triangles.len()),
             update_ms: 0.0,
-            refit_counters: None,
+            refit_state: None,
         };
         let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
         tracer.update_ms = build_ms + tracer.lay_out(b)?;
@@ -116,7 +116,7 @@ impl<B: Backend> Tracer<B> {
         self.prims = PrimBuffers::upload(b, all)?;
         self.update_ms = match (&self.tree, &self.built) {
             // The layout's boxes and primitives rewritten in place.
-            (Some(tree), _) if tree.collapsed.is_some() => refit_bvh2(b, tree, &self.prims, &mut self.refit_counters)?.total(),
+            (Some(tree), _) if tree.collapsed.is_some() => refit_bvh2(b, tree, &self.prims, &mut self.refit_state)?.total(),
             (_, Some(built)) => refit_uploaded(b, &built.bvh, &self.prims)?.total() + self.lay_out(b)?,
             _ => 0.0,
         };
@@ -132,7 +132,7 @@ impl<B: Backend> Tracer<B> {
             let bvh = &built.bvh;
             kept.extend([&bvh.nodes, &bvh.parents, &bvh.prim_indices, &bvh.sorted_keys]);
         }
-        kept.extend(&self.refit_counters);
+        kept.extend(&self.refit_state);
         if let Some(tree) = &self.tree {
             kept.extend([&tree.nodes, &tree.prims]);
             if let Some(c) = &tree.collapsed {
