@@ -282,8 +282,8 @@ fn gpu_layouts_equal_cpu() {
 }
 
 /// A `bvh2` tree refit in place after its primitives moved
-/// (`treelet::bvh::refit::refit_bvh2`: the collapsed tree's boxes bottom-up,
-/// then its nodes and leaf primitives written again, no new collapse): valid
+/// (`treelet::bvh::refit::refit_bvh2`: its leaf primitives written again
+/// and its boxes bottom-up over the collapsed tree, no new collapse): valid
 /// for the moved primitives, every child box exactly its subtree's, each
 /// ray hitting what the scan of the moved primitives hits; the GPU writes
 /// what the CPU runner writes.
@@ -335,9 +335,10 @@ fn bvh2_refit_in_place_fits_the_moved_primitives() {
 }
 
 /// Builds over `prims` in `bvh2`, then refits in place for `moved`, back
-/// for `prims` and for `moved` again, the climb's counters kept from one
-/// refit to the next as an engine's tracer keeps them (a climb that left
-/// them otherwise than it found them would misplace the last refit's boxes).
+/// for `prims` and for `moved` again, the climb's state kept from one
+/// refit to the next as an engine's tracer keeps it (a climb that left its
+/// counters otherwise than it found them would misplace the last refit's
+/// boxes).
 fn refit_in_place<B: Backend>(b: &mut B, prims: Primitives, moved: Primitives, accel: Accel) -> HostTree {
     let (tree, _, _) = traced_tree(b, prims, accel, Layout::Bvh2).unwrap();
     assert!(tree.collapsed.is_some(), "a bvh2 layout keeps its collapsed tree");

@@ -157,6 +157,31 @@ fn tracer_finds_the_scans_hits_before_and_after_a_refit() {
     }
 }
 
+/// A tree of one leaf refits too (the climb has no parent to go to; the
+/// refit writes the root's one child box): a triangle moved three times is
+/// hit where it went and missed where it was, on the CPU runner and the GPU.
+#[test]
+fn a_tree_of_one_leaf_refits() {
+    fn moves<B: Backend>(b: &mut B, what: &str) {
+        let at = |z: f32, x: f32| [Triangle::new([x, 0.0, z], [x + 1.0, 0.0, z], [x, 1.0, z])];
+        let probe = |x: f32| Ray::new([x + 0.2, 0.2, 0.0], [0.0, 0.0, 1.0]);
+        let mut t = Tracer::build(b, &[], &at(5.0, 0.0), Quality::High).unwrap();
+        let mut was = 0.0;
+        for (z, x) in [(7.0, 10.0), (3.0, -4.0), (6.0, 0.0)] {
+            t.refit(b, &[], &at(z, x)).unwrap();
+            let hits = t.closest_hits(b, &[probe(x), probe(was)]).unwrap();
+            // Within rounding: the GPU fuses the watertight test's products.
+            assert!(hits[0].prim == 0 && (hits[0].t - z).abs() <= 1e-6 * z, "{what}: the triangle moved to x {x}, z {z}: {:?}", hits[0]);
+            assert!(!hits[1].is_hit(), "{what}: a hit where the triangle was: {:?}", hits[1]);
+            was = x;
+        }
+    }
+    moves(&mut CpuBackend::new(), "CPU runner");
+    if let Some(ctx) = gpu() {
+        moves(&mut GpuBackend::new(ctx), "GPU");
+    }
+}
+
 #[test]
 fn tracer_small_and_empty_scenes() {
     let b = &mut CpuBackend::new();
