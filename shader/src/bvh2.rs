@@ -78,8 +78,8 @@ pub fn refit_state_cs(
     treelet_core::layouts::bvh2::refit_state_kernel(id, params.nodes, &nodes, parents, state);
 }
 
-/// A layout's refit in place: each leaf of the collapsed tree writes its
-/// primitives, then climbs, writing each box into the layout's node above
+/// A layout's refit in place: each primitive slot writes its leaf primitive,
+/// each leaf's first then climbs, writing each box into the layout's node above
 /// it (`treelet_core::layouts::bvh2::refit_kernel`); `$ordered` as for the
 /// build's fit kernels.
 macro_rules! refit_kernel {
@@ -111,6 +111,7 @@ macro_rules! refit_kernel {
             };
             treelet_core::layouts::bvh2::refit_kernel::<$ordered, _, _>(
                 id,
+                params.n,
                 params.nodes,
                 &prims,
                 prim_indices,

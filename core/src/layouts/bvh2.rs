@@ -69,37 +69,51 @@ fn output_index(i: u32, parents: &[u32]) -> u32 {
 }
 
 /// Kernel, one invocation per node `i` of the collapsed tree a layout was
-/// made from: the state [`refit_kernel`] climbs on, two words per node,
-/// made once per tree and kept from one refit to the next. `state[2 i]` is
+/// made from: the state [`refit_kernel`] climbs on, made once per tree and
+/// kept from one refit to the next. Two words per node: `state[2 i]` is
 /// node `i`'s arrival counter (zeroed; a climb leaves it even, as it found
 /// it: [`crate::construct::climb::second_arrival`]), `state[2 i + 1]` the
 /// index of its [`Bvh2Node`] in the layout (internal nodes; `u32::MAX` for
-/// a leaf). The two words side by side: the climber that counts at a node
-/// reads where to write from the same cache line.
+/// a leaf), side by side so that the climber that counts at a node reads
+/// where to write from the same cache line. Then a word per primitive slot
+/// (`state[2 node_count + j]`): the leaf whose first slot `j` is, else
+/// `u32::MAX`.
 pub fn refit_state_kernel<N: RecordLoad<Node> + ?Sized>(i: u32, node_count: u32, nodes: &N, parents: &[u32], state: &mut [u32]) {
     if i >= node_count {
         return;
     }
-    let slot = if nodes.load(i as usize).is_leaf() { u32::MAX } else { output_index(i, parents) };
+    let node = nodes.load(i as usize);
+    let slot = if node.is_leaf() { u32::MAX } else { output_index(i, parents) };
     state[2 * i as usize] = 0;
     state[2 * i as usize + 1] = slot;
+    if node.is_leaf() {
+        let slots = 2 * node_count as usize + node.left as usize;
+        state[slots] = i;
+        let mut k = 1;
+        while k < node.prim_count() as usize {
+            state[slots + k] = u32::MAX;
+            k += 1;
+        }
+    }
 }
 
 /// Kernel: the refit of a `bvh2` layout in place, over the collapsed tree it
-/// was made from (its shape kept; `prims` moved), one invocation per node
-/// `i` of `node_count`. A leaf writes its primitives' [`LeafPrim`]s again
-/// (slots `first..first + count` of `out_prims`) and its box, the union of
-/// theirs, into its parent's [`Bvh2Node`] (`out_nodes`, as 16 words a
-/// node), then climbs as the build's fit does ([`crate::construct::fit`]):
-/// the second child to arrive at a node reads its sibling's box from the
-/// same node and writes the union into the node above. So the layout's
-/// boxes are written where the climb makes them: no pass over the nodes
-/// after it, and the collapsed tree is only read (its boxes stay those of
-/// the build; its shape and parent links are what the refit uses). `state`
-/// is [`refit_state_kernel`]'s.
+/// was made from (its shape kept; `prims` moved), one invocation per
+/// primitive slot `j` of `n`. Each writes its slot's [`LeafPrim`] again
+/// (slots side by side in neighbouring invocations); the first slot of a
+/// leaf then makes the leaf's box, the union of its primitives' (read again,
+/// from the cache its neighbours just filled), writes it into its parent's
+/// [`Bvh2Node`] (`out_nodes`, as 16 words a node), and climbs as the
+/// build's fit does ([`crate::construct::fit`]): the second child to arrive
+/// at a node reads its sibling's box from the same node and writes the
+/// union into the node above. So the layout's boxes are written where the
+/// climb makes them: no pass over the nodes after it, and the collapsed tree
+/// is only read (its boxes stay those of the build; its shape and parent
+/// links are what the refit uses). `state` is [`refit_state_kernel`]'s.
 #[allow(clippy::too_many_arguments)]
 pub fn refit_kernel<const ORDERED: bool, N: RecordLoad<Node> + ?Sized, O: RecordStore<LeafPrim> + ?Sized>(
-    i: u32,
+    j: u32,
+    n: u32,
     node_count: u32,
     prims: &Prims,
     prim_indices: &[u32],
@@ -109,17 +123,18 @@ pub fn refit_kernel<const ORDERED: bool, N: RecordLoad<Node> + ?Sized, O: Record
     out_prims: &mut O,
     out_nodes: &mut SplitMut<f32>,
 ) {
-    if i >= node_count {
+    if j >= n {
+        return;
+    }
+    out_prims.store(j as usize, &prims.leaf_prim(prim_indices[j as usize]));
+    let i = state[2 * node_count as usize + j as usize];
+    if i == u32::MAX {
         return;
     }
     let node = nodes.load(i as usize);
-    if !node.is_leaf() {
-        return;
-    }
     let mut own = Aabb::EMPTY;
     for slot in node.left..node.left + node.prim_count() {
         let prim = prim_indices[slot as usize];
-        out_prims.store(slot as usize, &prims.leaf_prim(prim));
         own = own.union(&primitive_box(prim, prims.sphere_count, prims.spheres, &prims.triangles));
     }
     if node_count == 1 {

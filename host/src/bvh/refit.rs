@@ -48,16 +48,17 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
 
 /// Refits a tree laid out in `bvh2` in place, from the collapsed tree it was
 /// made from ([`TracedTree::collapsed`]), for `prims`, the primitives it was
-/// built over (same count and order), moved, in one dispatch: each leaf of
-/// the collapsed tree writes its primitives again, and the boxes climb as
-/// the build's fit does, each written straight into the two-box node above
-/// it (`treelet_core::layouts::bvh2::refit_kernel`). No collapse, no depth
+/// built over (same count and order), moved, in one dispatch: each primitive
+/// slot is written again, and the boxes climb from the leaves as the
+/// build's fit does, each written straight into the two-box node above it
+/// (`treelet_core::layouts::bvh2::refit_kernel`). No collapse, no depth
 /// check and no pass over the nodes: the shape is the one laid out.
 ///
 /// `state`: what the climb needs besides the tree, two words per node of
 /// the collapsed tree (its arrival counter, and where its node is in the
-/// layout): made when `None` (one more dispatch) and kept there for the next
-/// refit of the same tree (a climb leaves the counters as it found them:
+/// layout) and one per primitive slot (the leaf it starts, if any): made
+/// when `None` (one more dispatch) and kept there for the next refit of the
+/// same tree (a climb leaves the counters as it found them:
 /// `treelet_core::construct::climb::second_arrival`), so that a refit every
 /// frame makes it once.
 pub fn refit_bvh2<B: Backend>(
@@ -76,12 +77,11 @@ pub fn refit_bvh2<B: Backend>(
     b.stage("fit");
     let nodes = collapsed.node_count;
     let lp = b.upload("refit params", &[LayoutParams { n, nodes, spheres: prims.sphere_count, ..Default::default() }])?;
-    let groups = groups_for(nodes, WORKGROUP_SIZE);
     let climb = match state.take() {
         Some(kept) => kept,
         None => {
-            let made = b.scratch("refit state", nodes as u64 * 8)?;
-            b.dispatch(Kernel::RefitState, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups);
+            let made = b.scratch("refit state", nodes as u64 * 8 + n as u64 * 4)?;
+            b.dispatch(Kernel::RefitState, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups_for(nodes, WORKGROUP_SIZE));
             made
         }
     };
@@ -89,7 +89,7 @@ pub fn refit_bvh2<B: Backend>(
     b.dispatch(
         refit,
         &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &climb, &tree.prims, &tree.nodes],
-        groups,
+        groups_for(n, WORKGROUP_SIZE),
     );
     *state = Some(climb);
     b.take_times()

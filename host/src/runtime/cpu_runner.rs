@@ -618,7 +618,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             };
             let mut out_nodes = SplitMut::whole(out_nodes);
             for id in ids(groups) {
-                bvh2::refit_kernel::<true, _, _>(id, p.nodes, &prims, prim_indices, nodes, parents, state, out_prims, &mut out_nodes);
+                bvh2::refit_kernel::<true, _, _>(id, p.n, p.nodes, &prims, prim_indices, nodes, parents, state, out_prims, &mut out_nodes);
             }
         }
         (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
