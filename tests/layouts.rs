@@ -451,8 +451,9 @@ fn tree_depth_on_the_device_is_the_trees_depth() {
 /// past one binding's 2 GiB build and trace) give exactly the trees and
 /// hits of the same buffers bound whole, on the same device: every buffer
 /// the split kernels bind (triangles, nodes, through the treelet rounds
-/// too, collapsed nodes, `bvh2` and leaf primitives) is split after a few hundred records here, so each
-/// kernel reads and writes both parts; the hits are also the scan's.
+/// too, collapsed nodes, `bvh2` and leaf primitives, and the refit's writes
+/// into them) is split after a few hundred records here, so each kernel
+/// reads and writes both parts; the hits are also the scan's.
 #[test]
 fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
     use treelet::{Quality, Ray, Tracer};
@@ -479,11 +480,22 @@ fn gpu_buffers_in_two_parts_build_and_trace_as_whole() {
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 400);
         let rays: Vec<Ray> = probes.iter().map(|(o, d, _, _)| Ray::new(o.to_array(), d.to_array())).collect();
+        // And refit in place (boxes written into both parts of the nodes):
+        // every primitive moved by a wave.
+        let wave = |v: [f32; 3]| [v[0], v[1] + 2.0 * (v[0] * 0.05).sin() * (v[2] * 0.07).cos() + 0.5, v[2]];
+        let moved_tris: Vec<Triangle> = prims.triangles.iter().map(|t| Triangle::new(wave(t.v0), wave(t.v1), wave(t.v2))).collect();
+        let moved_spheres: Vec<Sphere> = prims.spheres.iter().map(|s| Sphere { center: wave(s.center), ..*s }).collect();
         let mut hits = Vec::new();
+        let mut refit_hits = Vec::new();
         for mut b in [GpuBackend::new(ctx.clone()), GpuBackend::new(ctx.clone()).with_split_bytes(split)] {
-            let t = Tracer::build(&mut b, prims.spheres, prims.triangles, Quality::Fast).unwrap();
+            let mut t = Tracer::build(&mut b, prims.spheres, prims.triangles, Quality::Fast).unwrap();
             hits.push((t.closest_hits(&mut b, &rays).unwrap(), t.occluded(&mut b, &rays).unwrap()));
+            t.refit(&mut b, &moved_spheres, &moved_tris).unwrap();
+            refit_hits.push(t.closest_hits(&mut b, &rays).unwrap());
         }
+        let found = refit_hits[1].iter().filter(|h| h.is_hit()).count();
+        assert!(found > rays.len() / 4, "{what}: {found} of {} probes hit the moved primitives", rays.len());
+        assert_eq!(refit_hits[0], refit_hits[1], "{what}: closest hits through split buffers differ after a refit");
         // The probes aim at primitives: most hit, and the scan agrees (to
         // rounding: the tracer takes unnormalized directions and `t_min`).
         let found = hits[1].0.iter().filter(|h| h.is_hit()).count();

@@ -61,8 +61,8 @@ pub fn leaf_prims_cs(
 }
 
 /// The state a layout's refit climbs on, one collapsed node each: its
-/// counter zeroed and its index in the layout
-/// (`treelet_core::layouts::bvh2::refit_state_kernel`).
+/// counter zeroed, its index in the layout, and for a leaf, which primitive
+/// slot starts it (`treelet_core::layouts::bvh2::refit_state_kernel`).
 #[spirv(compute(threads(256)))]
 pub fn refit_state_cs(
     #[spirv(global_invocation_id)] gid: UVec3,

@@ -3,18 +3,21 @@
 //! HPG 2012, section 4 (the bounding boxes).
 //!
 //! One invocation per leaf starts at its leaf and climbs towards the root.
-//! At each internal node it adds one to that node's counter (zeroed before
-//! the dispatch): the first of the two children's invocations to arrive
-//! stops, the second, which then knows both subtrees are done, processes
-//! the node and goes on to its parent. Every internal node is thus
-//! processed exactly once, by the last of its children, after both of them:
-//! a node is finished by exactly one invocation (by induction from the
-//! leaves), so its parent's counter is incremented exactly twice, and
-//! exactly one of the two increments sees a previous value other than 0.
+//! At each internal node it adds one to that node's counter (even before
+//! the dispatch: zeroed, or left so by an earlier climb): the first of the
+//! two children's invocations to arrive stops, the second, which then knows
+//! both subtrees are done, processes the node and goes on to its parent.
+//! Every internal node is thus processed exactly once, by the last of its
+//! children, after both of them: a node is finished by exactly one
+//! invocation (by induction from the leaves), so its parent's counter is
+//! incremented exactly twice, and exactly one of the two increments sees
+//! an odd previous value ([`second_arrival`]).
 //!
 //! Users: the bounds fit ([`crate::construct::fit`]), the treelet rounds'
 //! counts, costs and heights ([`crate::construct::treelet_kernels`]) and the
 //! wide layout's DP (`crate::layouts::cwbvh_build`) climb with [`Climb`];
+//! the `bvh2` layout's refit (`crate::layouts::bvh2::refit_kernel`) with
+//! [`second_arrival`], its boxes kept in the layout's nodes;
 //! the agglomerative build ([`crate::construct::agglomerate`], after
 //! C. Apetrei, "Fast and Simple Agglomerative LBVH Construction", CGVC 2014)
 //! uses only the arrival, [`second_arrival_exchange`]: there no parent

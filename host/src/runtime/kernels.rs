@@ -122,8 +122,8 @@ pub enum Kernel {
     Fit,
     /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
     FitRelaxed,
-    /// The state a `bvh2` layout's refit climbs on (counters and node
-    /// indices), made once per tree.
+    /// The state a `bvh2` layout's refit climbs on (counters, node indices,
+    /// the leaf each primitive slot starts), made once per tree.
     RefitState,
     /// A `bvh2` layout's refit in place: its leaf primitives, and its boxes
     /// bottom-up over its collapsed tree.

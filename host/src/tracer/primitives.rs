@@ -60,7 +60,8 @@ pub struct Tracer<B: Backend> {
     pub(super) counts: (usize, usize),
     /// Device time of the last build or refit, layout included (ms).
     update_ms: f64,
-    /// The `bvh2` refit's climb state (arrival counters, node indices), kept from one refit to the next
+    /// The `bvh2` refit's state (arrival counters, layout node indices, the
+    /// leaf each primitive slot starts), kept from one refit to the next
     /// ([`refit_bvh2`]).
     refit_state: Option<B::Buffer>,
 }
@@ -161,6 +162,8 @@ impl<B: Backend> Tracer<B> {
             None => (None, 0.0),
         };
         self.tree = tree;
+        // The refit's state names nodes of the tree it was made for.
+        self.refit_state = None;
         Ok(ms)
     }
 
