@@ -25,6 +25,7 @@ fn settings(spp: u32, seed: u32) -> RenderSettings {
         layout: Layout::Auto,
         kernel: KernelChoice::Auto,
         integrator: Integrator::Nee,
+        sampler: treelet::render::Sampler::Sobol,
         error_each_pass: false,
         first_sample: 0,
     }

@@ -46,6 +46,7 @@ fn write_seeds() -> Vec<(String, Vec<u8>)> {
         height: h,
         seed: 7,
         integrator: "nee".into(),
+        sampler: "sobol".into(),
         samples: 4..12,
         planned_end: 16,
     };

@@ -480,6 +480,7 @@ fn placed_copies_render_what_the_flattened_scene_renders() {
         layout: treelet::bvh::layout::Layout::Auto,
         kernel: treelet::render::variant::KernelChoice::Auto,
         integrator: Integrator::Nee,
+        sampler: treelet::render::Sampler::Sobol,
         error_each_pass: false,
         first_sample: 0,
     };

@@ -395,6 +395,7 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
                     layout,
                     kernel: KernelChoice::Auto,
                     integrator: Integrator::Nee,
+                    sampler: treelet::render::Sampler::Sobol,
                     error_each_pass: false,
                     first_sample: 0,
                 };

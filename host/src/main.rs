@@ -14,7 +14,7 @@ use treelet::plot::Series;
 use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::parts::{self, PartInfo};
 use treelet::render::settings::MemoryEstimate;
-use treelet::render::{Control, Integrator, PassRow, RenderSettings, Stopped};
+use treelet::render::{Control, Integrator, PassRow, RenderSettings, Sampler, Stopped};
 use treelet::runtime::memory::{available_bytes, human};
 use treelet::bvh::report::{run_build_with, run_build_sweep, BuildReport};
 use treelet::scene::Scene;
@@ -125,6 +125,9 @@ struct RenderArgs {
     explain: bool,
     #[arg(long, value_enum, default_value = "nee")]
     integrator: IntegratorArg,
+    /// Where camera paths draw their sample points.
+    #[arg(long, value_enum, default_value = "sobol")]
+    sampler: Sampler,
     #[arg(long, value_enum, default_value = "auto")]
     device: DeviceChoice,
     /// Render on several devices at once, each taking chunks of samples as
@@ -153,8 +156,8 @@ struct RenderArgs {
     #[arg(long, value_name = "SECONDS")]
     checkpoint: Option<f64>,
     /// Continue the render that PART.exr (a checkpoint, or a render stopped
-    /// with Ctrl-C) holds the start of: same scene, size, seed and
-    /// integrator; --spp (or --samples) names where it ends. On the CPU
+    /// with Ctrl-C) holds the start of: same scene, size, seed,
+    /// integrator and sampler; --spp (or --samples) names where it ends. On the CPU
     /// runner the image is the uninterrupted render's, bit for bit.
     #[arg(long, value_name = "PART.exr")]
     resume: Option<std::path::PathBuf>,
@@ -282,6 +285,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         layout: args.layout,
         kernel: args.kernel,
         integrator: Integrator::Nee,
+        sampler: args.sampler,
         error_each_pass: args.report.is_some() || args.reference.is_some(),
         first_sample,
     };
@@ -309,6 +313,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         height: args.height,
         seed: args.seed,
         integrator: integrator.name().into(),
+        sampler: args.sampler.name().into(),
         samples,
         planned_end: first_sample.saturating_add(args.spp),
     };

@@ -7,7 +7,10 @@ estimation with MIS). Kernel times from Dr.Jit's kernel history (GPU time of the
 usage: room_disk.py OUTDIR [SPP,SPP,..]   prints one JSON line per sample count.
 RFILTER=box renders with Mitsuba's box pixel filter (each sample counts in its own pixel only, as in
 Treelet) instead of its tent (the default here), which splats each sample into the pixels within
-one pixel of it: less noise per pixel, a blurrier image, not like for like with Treelet."""
+one pixel of it: less noise per pixel, a blurrier image, not like for like with Treelet.
+SAMPLER=ldsampler (or any of Mitsuba's samplers) draws the samples from Mitsuba's low-discrepancy
+sampler (scrambled (0,2)-sequences, Kollig & Keller 2002) instead of independent numbers (the
+default here and Mitsuba's), to set beside Treelet's Owen-scrambled Sobol points."""
 import sys, json, time, math, os
 import drjit as dr
 import mitsuba as mi
@@ -32,12 +35,13 @@ def wall(c, n, rgb):
     return {'type': 'rectangle', 'bsdf': diff_(rgb),
             'to_world': T().look_at(origin=c, target=[c[k] + n[k] for k in range(3)], up=up) @ T().scale([200, 200, 1])}
 RFILTER = os.environ.get('RFILTER', 'tent')
+SAMPLER = os.environ.get('SAMPLER', 'independent')
 cam_o = [50, 52, 295.6]; d = [0, -0.042612, -1]; norm = math.sqrt(sum(x * x for x in d)); d = [x / norm for x in d]
 scene = mi.load_dict({'type': 'scene', 'integrator': {'type': 'path', 'max_depth': -1, 'rr_depth': 5},
   'sensor': {'type': 'perspective', 'fov': FOV, 'fov_axis': 'y', 'near_clip': 140.0,
              'to_world': T().look_at(origin=cam_o, target=[cam_o[k] + d[k] for k in range(3)], up=[0, 1, 0]),
              'film': {'type': 'hdrfilm', 'width': 1024, 'height': 768, 'rfilter': {'type': RFILTER}},
-             'sampler': {'type': 'independent', 'sample_count': 1024}},
+             'sampler': {'type': SAMPLER, 'sample_count': 1024}},
   'left': wall([1, 40.8, 81.6], [1, 0, 0], [.75, .25, .25]),
   'right': wall([99, 40.8, 81.6], [-1, 0, 0], [.25, .25, .75]),
   'back': wall([50, 40.8, 0], [0, 0, 1], [.75, .75, .75]),
@@ -61,7 +65,7 @@ for spp in counts:
         acc = last['img'] if acc is None else acc + last['img']
     acc = acc / passes; dr.eval(acc); dr.sync_thread()
     wall_s = time.perf_counter() - t0
-    path = f'{out}/mitsuba_room_disk_{RFILTER}_{spp}spp.exr'
+    path = f'{out}/mitsuba_room_disk_{RFILTER}_{SAMPLER}_{spp}spp.exr'
     mi.util.write_bitmap(path, acc)
     print(json.dumps({'peer': 'Mitsuba 3.9.1 path (cuda_ad_rgb, OptiX)', 'scene': 'room_disk', 'width': 1024,
-                      'height': 768, 'spp': spp, 'rfilter': RFILTER, 'passes': passes, 'kernel_ms': ks, 'wall_s': wall_s, 'image': path}), flush=True)
+                      'height': 768, 'spp': spp, 'rfilter': RFILTER, 'sampler': SAMPLER, 'passes': passes, 'kernel_ms': ks, 'wall_s': wall_s, 'image': path}), flush=True)

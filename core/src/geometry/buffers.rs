@@ -196,7 +196,7 @@ pub struct Camera {
 }
 const _: () = assert!(core::mem::size_of::<Camera>() == 64);
 
-/// Parameters of one render dispatch. repr(C), Pod, 112 bytes.
+/// Parameters of one render dispatch. repr(C), Pod, 128 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
@@ -227,8 +227,20 @@ pub struct RenderParams {
     /// Triangles of every placed mesh, one mesh after another (a render
     /// with copies).
     pub placed_triangles: u32,
+    /// [`INDEPENDENT`] or [`SOBOL`]: where camera paths draw their sample
+    /// points ([`crate::render::sampler`]).
+    pub sampler: u32,
+    pub _pad: [u32; 3],
 }
-const _: () = assert!(core::mem::size_of::<RenderParams>() == 112);
+const _: () = assert!(core::mem::size_of::<RenderParams>() == 128);
+
+/// [`RenderParams::sampler`]: every number of a path an independent hash
+/// ([`crate::gpu::rng`]), sample `s` of a pixel in subpixel `s % 4`.
+pub const INDEPENDENT: u32 = 0;
+/// [`RenderParams::sampler`]: the pixel position, the diffuse direction and
+/// the point on a light from Owen-scrambled Sobol pairs
+/// ([`crate::render::sampler`]); the other numbers as [`INDEPENDENT`].
+pub const SOBOL: u32 = 1;
 
 /// smallpt's estimator: emitters are found only by paths that hit them.
 pub const SMALLPT: u32 = 0;

@@ -37,6 +37,18 @@ impl BounceRng {
         Self { key: hash(key ^ bounce.wrapping_mul(0xc2b2_ae35)) }
     }
 
+    /// The word the stream is keyed by (to keep a stream in one word).
+    #[inline]
+    pub fn key(&self) -> u32 {
+        self.key
+    }
+
+    /// The stream [`Self::key`] gave.
+    #[inline]
+    pub fn from_key(key: u32) -> Self {
+        Self { key }
+    }
+
     /// Uniform in `[0, 1)`, 24 bits, for dimension `dim` of this bounce.
     #[inline]
     pub fn uniform(&self, dim: u32) -> f32 {

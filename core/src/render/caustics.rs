@@ -31,9 +31,9 @@ use crate::geometry::features::{self, has};
 use crate::geometry::intersect::surface_offset;
 use crate::geometry::prims::Origin;
 use crate::gpu::atomics;
-use crate::gpu::rng::BounceRng;
 use crate::render::integrator::{MAX_BOUNCES, SceneRefs, glass_bounce, hit_normal_for, surface, trace};
 use crate::render::lights::{Light, select_light};
+use crate::render::sampler::BounceSamples;
 use crate::render::sampling::{cosine_direction, sin_cos_turns};
 use crate::trace::hit::{ClosestHit, Query};
 
@@ -101,31 +101,34 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
     lane: u32,
 ) {
     let seed = params.seed ^ LIGHT_STREAM;
-    let rng = BounceRng::new(seed, id, sample, 0);
-    let light = lights[select_light(lights, params.light_count, rng.uniform(0)) as usize];
+    let rng = BounceSamples::new(params, seed, id, sample, 0);
+    let light = lights[select_light(lights, params.light_count, rng.single(0)) as usize];
     let prims = &scene.prims;
     // A point uniformly on the emitter, and the normal it emits along. A
     // flat emitter lights both sides (as camera paths see it): one is drawn.
     let (y, n, area_over_pdf) = if prims.is_sphere::<F>(light.prim) {
         let s = prims.spheres[light.prim as usize];
-        let z = 1.0 - 2.0 * rng.uniform(1);
+        let (u1, u2) = rng.pair(1);
+        let z = 1.0 - 2.0 * u1;
         let r = libm::sqrtf((1.0 - z * z).max(0.0));
-        let (sp, cp) = sin_cos_turns(rng.uniform(2));
+        let (sp, cp) = sin_cos_turns(u2);
         let n = Vec3::new(r * cp, r * sp, z);
         let area = 4.0 * core::f32::consts::PI * s.radius * s.radius;
         (Vec3::from_array(s.center) + n * s.radius, n, area)
     } else {
         let t = prims.triangle(light.prim - prims.sphere_count);
-        let y = crate::geometry::flat::flat_point(&t, rng.uniform(1), rng.uniform(2), sin_cos_turns);
+        let (u1, u2) = rng.pair(1);
+        let y = crate::geometry::flat::flat_point(&t, u1, u2, sin_cos_turns);
         let n = hit_normal_for::<F>(prims, light.prim, y, Vec3::Z);
-        let n = if rng.uniform(3) < 0.5 { n } else { -n };
+        let n = if rng.single(3) < 0.5 { n } else { -n };
         (y, n, 2.0 * t.area())
     };
     // Emitted radiance times cos / (density of the point and direction):
     // the cosine-weighted direction's density cos/π leaves π.
     let emission = Vec3::from_array(scene.materials[light.prim as usize].emission);
     let mut power = emission * (core::f32::consts::PI * area_over_pdf / light.pmf);
-    let mut d = cosine_direction(n, rng.uniform(4), rng.uniform(5));
+    let (u4, u5) = rng.pair(4);
+    let mut d = cosine_direction(n, u4, u5);
     let mut o = y + n * surface_offset(y);
     let outward = hit_normal_for::<F>(prims, light.prim, y, d);
     let mut from = Origin { prim: light.prim, into: d.dot(outward) < 0.0 };
@@ -148,7 +151,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
             return; // A mirror or glass after the caustic: camera paths'.
         }
         bounces += 1;
-        let rng = BounceRng::new(seed, id, sample, bounces);
+        let rng = BounceSamples::new(params, seed, id, sample, bounces);
         let eps = surface_offset(x);
         if m.kind == DIFFUSE {
             // The caustic's light, and its diffuse bounces, seen by the camera.
@@ -156,7 +159,8 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
             to_camera::<T, F, S, L>(x, n, nl, hit.prim, power * albedo * core::f32::consts::FRAC_1_PI, sample, params, scene, splats, stack, lane);
             diffuse = true;
             power *= albedo;
-            d = cosine_direction(nl, rng.uniform(2), rng.uniform(3));
+            let (u2, u3) = rng.pair(2);
+            d = cosine_direction(nl, u2, u3);
             o = x + nl * eps;
         } else if has(F, features::MIRROR) && m.kind == MIRROR {
             power *= Vec3::from_array(m.color);
@@ -164,7 +168,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
             o = x + nl * eps;
         } else {
             power *= Vec3::from_array(m.color);
-            let b = glass_bounce(d, n, nl, m.ior, rng.uniform(0));
+            let b = glass_bounce(d, n, nl, m.ior, rng.single(0));
             // Light crossing into a denser medium spreads its flux over
             // more solid angle: camera paths (smallpt's) carry radiance
             // unscaled through a refraction, so the light's flux takes the
@@ -179,7 +183,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
         if bounces >= 3 {
             let p = power.max_element() / (emission.max_element() * core::f32::consts::PI * area_over_pdf / light.pmf);
             if p < 1.0 {
-                if rng.uniform(1) < p {
+                if rng.single(1) < p {
                     power /= p;
                 } else {
                     return;
@@ -295,7 +299,7 @@ mod tests {
             for sample in 0..8 {
                 let (x, y) = (pixel % w, h - 1 - pixel / w);
                 let rng = BounceRng::new(3, pixel, sample, 0);
-                let (_, d) = cam.primary_ray(x, y, sample % 4, w, h, &rng);
+                let (_, d) = cam.primary_ray(x, y, sample % 4, w, h, (rng.uniform(0), rng.uniform(1)));
                 let l = landing(&cam, d, sample, w, h).expect("lands");
                 assert_eq!(l.pixel, pixel, "sample {sample}");
                 assert!(l.weight > 0.0 && l.weight <= 4.0);

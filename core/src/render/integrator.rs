@@ -1,8 +1,10 @@
 //! The path tracer of smallpt (Kevin Beason, "smallpt: Global Illumination
 //! in 99 lines of C++"), iterative so that it runs on a GPU:
 //!
-//! * 2x2 subpixels per pixel with a tent filter; sample `s` of a pixel falls
-//!   in subpixel `s % 4`, so `spp` counts all samples of the pixel;
+//! * 2x2 subpixels per pixel with a tent filter; with independent numbers
+//!   sample `s` of a pixel falls in subpixel `s % 4`, with Sobol points
+//!   ([`crate::render::sampler`], the default) each run of four samples
+//!   covers the four; `spp` counts all samples of the pixel;
 //! * diffuse (cosine-weighted), mirror, and glass with Schlick's Fresnel;
 //! * Russian roulette after depth 5 with the surface's largest reflectance
 //!   (smallpt's estimator; next-event estimation uses pbrt-v4's rule, see
@@ -21,14 +23,16 @@
 //! has shown: Russian roulette ends them long before).
 //! A path also ends where its throughput becomes zero (a black surface such
 //! as smallpt's lamp or front wall), which changes no pixel's value.
-//! Random numbers are counter-based ([`crate::gpu::rng`]).
+//! Random numbers are counter-based ([`crate::gpu::rng`]), or Owen-scrambled
+//! Sobol points keyed the same way ([`crate::render::sampler`]):
+//! [`RenderParams::sampler`].
 //!
 //! `RenderParams::integrator` selects smallpt's estimator or next-event
 //! estimation with multiple importance sampling (see [`radiance`] and
 //! [`crate::render::lights`]); both converge to the same image.
 use glam::Vec3;
 
-use crate::geometry::buffers::{CAUSTICS, Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
+use crate::geometry::buffers::{CAUSTICS, Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, SOBOL, Sphere};
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::split::Split;
@@ -36,6 +40,7 @@ use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{Triangle, WatertightRay};
 use crate::gpu::rng::BounceRng;
 use crate::render::lights::{Light, light_pdf, light_pmf, power_heuristic, sample_light, select_light};
+use crate::render::sampler::{BounceSamples, PathSampler};
 use crate::render::sampling::{cosine_direction, luminance};
 use crate::trace::hit::{ClosestHit, Hit, Query};
 
@@ -63,9 +68,10 @@ impl Camera {
     }
 
     /// Ray through pixel (`x`, `y`; y up from the bottom row, as smallpt),
-    /// subpixel `sub` (0..4), with the tent-filter offsets drawn from `rng`.
+    /// subpixel `sub` (0..4), with the tent-filter offsets drawn from the
+    /// uniform numbers `u`.
     #[inline]
-    pub fn primary_ray(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, rng: &BounceRng) -> (Vec3, Vec3) {
+    pub fn primary_ray(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, u: (f32, f32)) -> (Vec3, Vec3) {
         let tent = |u: f32| {
             let r = 2.0 * u;
             if r < 1.0 {
@@ -75,7 +81,7 @@ impl Camera {
             }
         };
         let (sx, sy) = ((sub % 2) as f32, (sub / 2) as f32);
-        let (dx, dy) = (tent(rng.uniform(0)), tent(rng.uniform(1)));
+        let (dx, dy) = (tent(u.0), tent(u.1));
         let fx = ((sx + 0.5 + dx) / 2.0 + x as f32) / width as f32 - 0.5;
         let fy = ((sy + 0.5 + dy) / 2.0 + y as f32) / height as f32 - 0.5;
         let d = Vec3::from_array(self.cx) * fx + Vec3::from_array(self.cy) * fy + Vec3::from_array(self.dir);
@@ -222,8 +228,8 @@ impl Path {
     pub fn camera(params: &RenderParams, pixel: u32, sample: u32) -> Path {
         let (w, h) = (params.width, params.height);
         let (x, y) = (pixel % w, h - 1 - pixel / w);
-        let rng = BounceRng::new(params.seed, pixel, sample, 0);
-        let (o, d) = params.camera.primary_ray(x, y, sample % 4, w, h, &rng);
+        let (sub, u) = camera_sample(params, pixel, sample);
+        let (o, d) = params.camera.primary_ray(x, y, sub, w, h, u);
         Path::new(o, d, sample)
     }
 
@@ -289,10 +295,10 @@ impl Path {
         self.bsdf_pdf = 0.0;
         self.depth += 1;
         // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
-        let rng = BounceRng::new(params.seed, pixel, self.sample, self.depth);
+        let rng = BounceSamples::new(params, params.seed, pixel, self.sample, self.depth);
         if self.depth > 5 && !nee {
             let p = f.max_element();
-            if rng.uniform(0) < p {
+            if rng.single(0) < p {
                 f /= p;
             } else {
                 return false;
@@ -329,7 +335,8 @@ impl Path {
                     }
                 }
             }
-            self.d = cosine_direction(nl, rng.uniform(1), rng.uniform(2));
+            let (u1, u2) = rng.pair(1);
+            self.d = cosine_direction(nl, u1, u2);
             self.o = x + nl * eps;
             self.bsdf_pdf = nl.dot(self.d).max(0.0) * core::f32::consts::FRAC_1_PI;
             self.last_x = x;
@@ -343,7 +350,7 @@ impl Path {
             if caustics && self.flags & CAUSTIC_STATE != 0 {
                 self.flags = (self.flags & !CAUSTIC_STATE) | THEN_SPECULAR;
             }
-            let b = glass_bounce(self.d, n, nl, m.ior, rng.uniform(3));
+            let b = glass_bounce(self.d, n, nl, m.ior, rng.single(3));
             self.throughput *= b.weight;
             self.d = b.d;
             self.o = if b.refracted { x - nl * eps } else { x + nl * eps };
@@ -356,7 +363,7 @@ impl Path {
         if nee && self.depth >= NEE_ROULETTE_DEPTH {
             let p = self.throughput.max_element();
             if p < 1.0 {
-                if rng.uniform(0) < p {
+                if rng.single(0) < p {
                     self.throughput /= p;
                 } else if self.shadow_light == NO_LIGHT {
                     return false;
@@ -459,6 +466,23 @@ pub const NEE_ROULETTE_DEPTH: u32 = 3;
 /// No light: no shadow ray pending.
 const NO_LIGHT: u32 = u32::MAX;
 
+/// The subpixel and tent-filter numbers of sample `sample` of `pixel`:
+/// with [`SOBOL`], one Owen-scrambled Sobol point over the pixel's 2x2
+/// subpixels (its top bits pick the subpixel, so each run of four samples
+/// covers all four; the rest are uniform within it); else sample `s` in
+/// subpixel `s % 4` with two independent numbers, as smallpt.
+#[inline]
+pub fn camera_sample(params: &RenderParams, pixel: u32, sample: u32) -> (u32, (f32, f32)) {
+    if params.sampler == SOBOL {
+        let (u, v) = PathSampler::new(params.seed, pixel, sample, 0).pair(0);
+        let (sx, sy) = ((u >= 0.5) as u32, (v >= 0.5) as u32);
+        (sx + 2 * sy, (2.0 * u - sx as f32, 2.0 * v - sy as f32))
+    } else {
+        let rng = BounceRng::new(params.seed, pixel, sample, 0);
+        (sample % 4, (rng.uniform(0), rng.uniform(1)))
+    }
+}
+
 /// A light sample at a diffuse point: the light, the shadow ray's
 /// direction, and the radiance the light adds (per unit throughput) if that
 /// ray reaches it first; `light == NO_LIGHT` where there is nothing to trace.
@@ -477,17 +501,18 @@ fn sample_direct<T: ClosestHit>(
     x: Vec3,
     nl: Vec3,
     prim: u32,
-    rng: &BounceRng,
+    rng: &BounceSamples,
     params: &RenderParams,
     scene: &SceneRefs<T>,
     lights: &[Light],
 ) -> DirectSample {
     let none = DirectSample { light: NO_LIGHT, dir: Vec3::Z, value: Vec3::ZERO };
-    let light = lights[select_light(lights, params.light_count, rng.uniform(4)) as usize];
+    let light = lights[select_light(lights, params.light_count, rng.single(4)) as usize];
     if light.prim == prim {
         return none; // A surface does not light itself.
     }
-    let s = sample_light(&scene.prims, light.prim, x, rng.uniform(5), rng.uniform(6));
+    let (u5, u6) = rng.pair(5);
+    let s = sample_light(&scene.prims, light.prim, x, u5, u6);
     let cos = nl.dot(s.dir);
     if !(s.pdf > 0.0) || !(cos > 0.0) {
         return none;
@@ -605,6 +630,7 @@ pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::buffers::INDEPENDENT;
     use crate::gpu::rng::BounceRng;
     use crate::render::sampling::sin_cos_turns;
 
@@ -659,7 +685,7 @@ mod tests {
         let (w, h) = (8u32, 6u32);
         let camera = Camera::look(Vec3::new(50.0, 52.0, 295.6), Vec3::new(0.0, -0.042612, -1.0), 140.0, SMALLPT_FOV, w, h);
         let mut total = 0.0;
-        for integrator in [SMALLPT, NEE] {
+        for (integrator, sampler) in [(SMALLPT, INDEPENDENT), (NEE, INDEPENDENT), (NEE, SOBOL)] {
             let params = RenderParams {
                 width: w,
                 height: h,
@@ -670,6 +696,7 @@ mod tests {
                 camera,
                 integrator,
                 light_count: 1,
+                sampler,
                 ..Default::default()
             };
             let scene = SceneRefs::new(&params, &spheres, Split::whole(&[]), &materials, Scan::new(&[], &[]));
@@ -678,13 +705,13 @@ mod tests {
                 let (x, y) = (pixel % w, h - 1 - pixel / w);
                 let (mut sum, mut sum_sq) = (Vec3::ZERO, 0.0f32);
                 for sample in params.first_sample..params.first_sample + params.samples {
-                    let rng = BounceRng::new(params.seed, pixel, sample, 0);
-                    let (o, d) = camera.primary_ray(x, y, sample % 4, w, h, &rng);
+                    let (sub, u) = camera_sample(&params, pixel, sample);
+                    let (o, d) = camera.primary_ray(x, y, sub, w, h, u);
                     let l = radiance::<_, { features::ALL }, 1>(o, d, &params, pixel, sample, &scene, &lights, &mut [0; 1], 0);
                     sum += l;
                     sum_sq += luminance(l) * luminance(l);
                 }
-                assert_eq!(got, [sum.x, sum.y, sum.z, sum_sq], "integrator {integrator}, pixel {pixel}");
+                assert_eq!(got, [sum.x, sum.y, sum.z, sum_sq], "integrator {integrator}, sampler {sampler}, pixel {pixel}");
                 total += sum_sq;
             }
         }

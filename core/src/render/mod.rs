@@ -10,6 +10,8 @@
 //!   area (Veach 1997, chapter 9; pbrt-v4's path integrator);
 //! - [`sampling`]: directions from uniform numbers, the same bits on both
 //!   targets (random numbers: [`crate::gpu::rng`]);
+//! - [`sampler`]: the camera paths' low-discrepancy points (Owen-scrambled
+//!   Sobol pairs);
 //! - [`rays`]: the ray-casting kernels (primary, diffuse, bounce rays, and
 //!   rays given by an engine);
 //! - [`variants`]: the feature sets render kernels are compiled for.
@@ -17,5 +19,6 @@ pub mod caustics;
 pub mod integrator;
 pub mod lights;
 pub mod rays;
+pub mod sampler;
 pub mod sampling;
 pub mod variants;

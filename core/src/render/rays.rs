@@ -249,5 +249,5 @@ fn barycentrics<const F: u32>(prims: &Prims, prim: u32, o: Vec3, d: Vec3) -> (f3
 fn camera_ray(params: &RenderParams, id: u32) -> (Vec3, Vec3) {
     let (w, h) = (params.width, params.height);
     let rng = BounceRng::new(params.seed, id, params.first_sample, 0);
-    params.camera.primary_ray(id % w, h - 1 - id / w, 0, w, h, &rng)
+    params.camera.primary_ray(id % w, h - 1 - id / w, 0, w, h, (rng.uniform(0), rng.uniform(1)))
 }

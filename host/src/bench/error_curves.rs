@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use treelet::bvh::layout::Layout;
 use treelet::render::variant::KernelChoice;
 use treelet::bvh::tree::Accel;
-use treelet::render::{render, Integrator, RenderSettings};
+use treelet::render::{render, Integrator, RenderSettings, Sampler};
 use treelet::scene::Scene;
 
 use super::figure::{bar, doc, Figure, FigureDoc, Point, Suite, ERROR_KERNEL};
@@ -34,10 +34,10 @@ pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
     let parameters = serde_json::json!({ "scenes": SCENES.map(|s| s.1), "width": w, "height": h, "spp": spp, "reference_spp": reference_spp });
     wall.parameters = parameters.clone();
     kernel.parameters = parameters;
-    let pb = bar(SCENES.len() * (1 + 3 * s.repeats), "renders");
+    let pb = bar(SCENES.len() * (1 + 4 * s.repeats), "renders");
     for (name, spec) in SCENES {
         let scene = Scene::from_spec(spec)?;
-        let settings = |integrator, spp, seed, error_each_pass| RenderSettings {
+        let settings = |integrator, sampler, spp, seed, error_each_pass| RenderSettings {
             width: w,
             height: h,
             spp,
@@ -46,25 +46,37 @@ pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
             layout: Layout::Auto,
             kernel: KernelChoice::Auto,
             integrator,
+            sampler,
             error_each_pass,
             first_sample: 0,
         };
         treelet::with_backend!(runner, |b| {
             pb.set_message(format!("{name}: reference, {reference_spp} spp"));
-            let reference = render(b, &scene, &settings(Integrator::Nee, reference_spp, 99, false), None, |_| {})?.image;
+            let reference = render(b, &scene, &settings(Integrator::Nee, Sampler::Sobol, reference_spp, 99, false), None, |_| {})?.image;
             let path = s.out.join(format!("error_reference_{name}.exr"));
             image_io::write(&path, &reference)?;
             pb.inc(1);
-            for integrator in [Integrator::Smallpt, Integrator::Nee, Integrator::Caustics] {
-                pb.set_message(format!("{name}: {}", integrator.name()));
+            // Every integrator with the default sampler, and next-event
+            // estimation with independent numbers beside it.
+            let runs_of = [
+                (Integrator::Smallpt, Sampler::Sobol),
+                (Integrator::Nee, Sampler::Sobol),
+                (Integrator::Caustics, Sampler::Sobol),
+                (Integrator::Nee, Sampler::Independent),
+            ];
+            for (integrator, sampler) in runs_of {
+                pb.set_message(format!("{name}: {} ({})", integrator.name(), sampler.name()));
                 // Warm-up: the first render compiles the kernel (Mitsuba's times also leave that out).
-                render(b, &scene, &settings(integrator, 4, 1, false), None, |_| {})?;
+                render(b, &scene, &settings(integrator, sampler, 4, 1, false), None, |_| {})?;
                 let mut runs = Vec::new();
                 for _ in 0..s.repeats {
-                    runs.push(render(b, &scene, &settings(integrator, spp, 1, true), Some(&reference), |_| {})?.rows);
+                    runs.push(render(b, &scene, &settings(integrator, sampler, spp, 1, true), Some(&reference), |_| {})?.rows);
                     pb.inc(1);
                 }
-                let series = format!("{name}: Treelet, {}", integrator.label());
+                let series = match sampler {
+                    Sampler::Sobol => format!("{name}: Treelet, {}", integrator.label()),
+                    Sampler::Independent => format!("{name}: Treelet, {}, independent numbers", integrator.label()),
+                };
                 for (i, row) in runs[0].iter().enumerate() {
                     let rmse = row.rmse.context("a render against a reference has an RMSE")?;
                     let at = |time: fn(&PassRow) -> f64| median(runs.iter().map(|r| time(&r[i])).collect());
@@ -110,15 +122,23 @@ pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
              one pixel of it, which lowers per-pixel noise and blurs the image: only its box series is like for like"
                 .into(),
         );
+        wall.notes.push(
+            "Samplers: Treelet's series draw Owen-scrambled Sobol points (`--sampler sobol`, its default) unless they say \
+             independent numbers; Mitsuba 3's draw independent numbers (its default) unless they name its ldsampler \
+             (`SAMPLER=ldsampler`: scrambled (0,2)-sequences)"
+                .into(),
+        );
     }
     Ok(vec![wall, kernel])
 }
 
 /// Mitsuba's images listed in `dir/mitsuba.jsonl` (one JSON object a line:
 /// `spp`, `wall_s`, `kernel_ms`, `image`, and `rfilter`, its pixel filter,
-/// `tent` where a line has none), each scored against the largest sample
-/// count of its filter and against Treelet's `reference`: (series label,
-/// which names the filter, (wall s, kernel s), RMSE).
+/// `tent` where a line has none, and `sampler`, `independent` where a line
+/// has none), each scored against the largest sample count of its filter
+/// and sampler and against Treelet's `reference`: (series label, which
+/// names the filter and any sampler but the independent one, (wall s,
+/// kernel s), RMSE).
 fn mitsuba_points(dir: &Path, reference: &HdrImage) -> Result<Vec<(String, (f64, f64), f64)>> {
     let list = dir.join("mitsuba.jsonl");
     let text = std::fs::read_to_string(&list).with_context(|| format!("reading {}", list.display()))?;
@@ -142,7 +162,11 @@ fn mitsuba_points(dir: &Path, reference: &HdrImage) -> Result<Vec<(String, (f64,
                 reference.height
             );
         }
-        let filter = v["rfilter"].as_str().unwrap_or("tent").to_string();
+        // Series by filter and, past Mitsuba's default, sampler.
+        let filter = match (v["rfilter"].as_str().unwrap_or("tent"), v["sampler"].as_str().unwrap_or("independent")) {
+            (filter, "independent") => format!("{filter} filter"),
+            (filter, sampler) => format!("{filter} filter, {sampler} sampler"),
+        };
         runs.push((filter, field("spp")?, (field("wall_s")?, field("kernel_ms")? / 1e3), hdr));
     }
     if runs.is_empty() {
@@ -155,9 +179,9 @@ fn mitsuba_points(dir: &Path, reference: &HdrImage) -> Result<Vec<(String, (f64,
         let top = same().map(|r| r.1).fold(0.0, f64::max);
         let own = &same().find(|r| r.1 == top).expect("the largest is in the list").3;
         if *spp < top {
-            points.push((format!("{filter} filter, against its own {top} spp"), *time, image_error(pixels(image), own).0));
+            points.push((format!("{filter}, against its own {top} spp"), *time, image_error(pixels(image), own).0));
         }
-        points.push((format!("{filter} filter, against Treelet's reference"), *time, image_error(pixels(image), reference).0));
+        points.push((format!("{filter}, against Treelet's reference"), *time, image_error(pixels(image), reference).0));
     }
     points.sort_by(|a, b| a.0.cmp(&b.0).then(a.1 .0.total_cmp(&b.1 .0)));
     Ok(points)
@@ -236,6 +260,13 @@ mod tests {
         let points = mitsuba_points(&dir, &image(1.0)).unwrap();
         assert_eq!(points.len(), 6);
         assert!(points.iter().any(|p| p.0 == "box filter, against its own 32 spp" && (p.2 - 0.25).abs() < 1e-6), "{points:?}");
+        // And each sampler.
+        let ld = |spp: u32, file: &str| line(spp, file).replace("\"spp\"", "\"sampler\": \"ldsampler\", \"spp\"");
+        std::fs::write(&list, line(16, "a_16spp.pfm") + &line(64, "a_64spp.pfm") + &ld(16, "a_64spp.pfm") + &ld(32, "a_16spp.pfm")).unwrap();
+        let points = mitsuba_points(&dir, &image(1.0)).unwrap();
+        assert_eq!(points.len(), 6);
+        assert!(points.iter().any(|p| p.0 == "tent filter, ldsampler sampler, against its own 32 spp" && (p.2 - 0.25).abs() < 1e-6), "{points:?}");
+        assert!(points.iter().any(|p| p.0 == "tent filter, against its own 64 spp" && (p.2 - 0.25).abs() < 1e-6), "{points:?}");
         std::fs::write(&list, line(16, "a_16spp.pfm") + "{\"spp\": 64}\n").unwrap();
         let e = format!("{:#}", mitsuba_points(&dir, &image(1.0)).unwrap_err());
         assert!(e.contains("mitsuba.jsonl:2") && e.contains("no string `image`"), "{e}");

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use treelet::runtime::backend::{Backend, StageTimes};
 use treelet::bvh::layout::Layout;
 use treelet::bvh::tree::{Accel, Builder};
-use treelet::render::{render, Integrator, RenderSettings};
+use treelet::render::{render, Integrator, RenderSettings, Sampler};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::KernelChoice;
@@ -68,7 +68,7 @@ pub(crate) fn bench_render_kernel<B: Backend>(
     layout: Layout,
     kernel: KernelChoice,
 ) -> Result<RenderRow> {
-    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt, error_each_pass: true, first_sample: 0 };
+    let settings = RenderSettings { width, height, spp, seed: 1, accel, layout, kernel, integrator: Integrator::Smallpt, sampler: Sampler::Sobol, error_each_pass: true, first_sample: 0 };
     let r = render(b, scene, &settings, None, |_| {})?;
     let kernel_s = r.render_ms / 1e3;
     Ok(RenderRow {

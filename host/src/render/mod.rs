@@ -34,5 +34,5 @@ pub mod variant;
 pub use outcome::{PassRow, RenderResult, Share, Stopped};
 pub use prepared::{light_table, Prepared};
 pub use run::{render, render_with, Control, InjectedFailure};
-pub use settings::{max_samples_per_dispatch, pass_schedule, Integrator, RenderSettings, MAX_PATHS_PER_DISPATCH};
+pub use settings::{max_samples_per_dispatch, pass_schedule, Integrator, RenderSettings, Sampler, MAX_PATHS_PER_DISPATCH};
 pub use sums::{add_sums, image_error, mean_image};

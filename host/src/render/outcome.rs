@@ -29,7 +29,9 @@ pub struct PassRow {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rel_mse: Option<f64>,
     /// Without a reference: mean over pixels of the standard error of the
-    /// pixel's mean luminance, from its sample variance.
+    /// pixel's mean luminance, from its sample variance. That treats the
+    /// samples as independent: with `--sampler sobol`, whose points are
+    /// not, the true error is smaller (an upper estimate).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_std_error: Option<f64>,
 }

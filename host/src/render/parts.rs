@@ -1,6 +1,6 @@
 //! Parts of a render made apart (other processes, other machines): each is a
 //! linear EXR of per-pixel sums (radiance in r, g, b; squared luminance in
-//! a) whose header names the scene, seed, integrator and sample range.
+//! a) whose header names the scene, seed, integrator, sampler and sample range.
 //! Because Treelet's random numbers are counted from (seed, pixel, sample),
 //! parts whose ranges tile `first..last` add up to the render of that range
 //! in one go, up to float rounding. `treelet render --samples` writes a
@@ -23,6 +23,9 @@ pub struct PartInfo {
     pub height: u32,
     pub seed: u32,
     pub integrator: String,
+    /// `--sampler`'s name (parts written before it was recorded are
+    /// `independent`, the only sampler then).
+    pub sampler: String,
     /// The samples rendered: `first..last`.
     pub samples: Range<u32>,
     /// Where the render that wrote it was to end (past `samples.end` when
@@ -33,7 +36,7 @@ pub struct PartInfo {
 
 impl PartInfo {
     /// How `self` is of another render than `other` (scene contents, size,
-    /// seed, integrator), if it is: parts add up only when none differs.
+    /// seed, integrator, sampler), if it is: parts add up only when none differs.
     /// The scene is compared by its contents, not its name: one file named
     /// by two paths is one scene, and a file edited between parts is not.
     pub fn differs_from(&self, other: &PartInfo) -> Option<String> {
@@ -47,6 +50,7 @@ impl PartInfo {
             ("size", format!("{}x{}", self.width, self.height), format!("{}x{}", other.width, other.height)),
             ("seed", self.seed.to_string(), other.seed.to_string()),
             ("integrator", self.integrator.clone(), other.integrator.clone()),
+            ("sampler", self.sampler.clone(), other.sampler.clone()),
         ];
         pairs.into_iter().find(|(_, a, b)| a != b).map(|(what, a, b)| format!("one is of {what} {a}, the other of {b}"))
     }
@@ -70,6 +74,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
     put("scene", text("scene name", &info.scene)?);
     put("scene_hash", text("scene hash", &info.scene_hash)?);
     put("integrator", text("integrator", &info.integrator)?);
+    put("sampler", text("sampler", &info.sampler)?);
     put("seed", AttributeValue::Text(Text::from(info.seed.to_string().as_str())));
     put("first_sample", AttributeValue::Text(Text::from(info.samples.start.to_string().as_str())));
     put("last_sample", AttributeValue::Text(Text::from(info.samples.end.to_string().as_str())));
@@ -135,6 +140,7 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
         height: size.height() as u32,
         seed: number("seed")?,
         integrator: field("integrator")?,
+        sampler: if other.contains_key(&Text::from(format!("{PREFIX}sampler").as_str())) { field("sampler")? } else { "independent".into() },
         samples: number("first_sample")?..number("last_sample")?,
         planned_end: 0,
     };
@@ -246,6 +252,7 @@ mod tests {
             height: 2,
             seed: 1,
             integrator: "nee".into(),
+            sampler: "sobol".into(),
             samples: 0..4,
             planned_end: 4,
         };

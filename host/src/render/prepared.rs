@@ -136,7 +136,7 @@ impl<B: Backend> Prepared<B> {
     /// the scene. `base`: per-pixel sums the accumulation starts from (a
     /// resumed render's part), else zeros.
     pub fn new(b: &mut B, scene: &Scene, settings: &RenderSettings, base: Option<&[[f32; 4]]>) -> Result<Self> {
-        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, first_sample, .. } =
+        let RenderSettings { width, height, spp, seed, accel, layout, kernel, integrator, sampler, first_sample, .. } =
             *settings;
         if width == 0 || height == 0 || spp == 0 {
             bail!("image size {width}x{height} at {spp} samples per pixel: all three must be positive");
@@ -182,6 +182,7 @@ impl<B: Backend> Prepared<B> {
             camera: scene.camera.camera(width, height),
             integrator: integrator.code(),
             light_count: table.len() as u32,
+            sampler: sampler.code(),
             ..Default::default()
         };
         let (tree, buffers, mut build_ms) = if pilots_layout(settings, &plan, b.class()) {

@@ -56,6 +56,36 @@ impl Integrator {
     }
 }
 
+/// Where camera paths draw their sample points (`--sampler`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Sampler {
+    /// Every number an independent hash of (seed, pixel, sample, bounce,
+    /// dimension); sample `s` of a pixel in subpixel `s % 4` (smallpt's).
+    Independent,
+    /// The pixel position, the diffuse direction and the point on a light
+    /// from Owen-scrambled Sobol pairs (`treelet_core::render::sampler`):
+    /// less error at equal samples, as unbiased.
+    Sobol,
+}
+
+impl Sampler {
+    pub(super) fn code(self) -> u32 {
+        match self {
+            Sampler::Independent => treelet_core::geometry::buffers::INDEPENDENT,
+            Sampler::Sobol => treelet_core::geometry::buffers::SOBOL,
+        }
+    }
+
+    /// The word the command line takes (`--sampler`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampler::Independent => "independent",
+            Sampler::Sobol => "sobol",
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct RenderSettings {
     pub width: u32,
@@ -69,6 +99,7 @@ pub struct RenderSettings {
     /// The render kernel: the smallest variant for the scene, or the general one.
     pub kernel: KernelChoice,
     pub integrator: Integrator,
+    pub sampler: Sampler,
     /// Read the image back and measure its error after every pass (for a
     /// report or a reference); else only after the last, which saves a
     /// readback of the whole image per pass.
