@@ -173,6 +173,7 @@ mod tests {
             layout: crate::bvh::layout::Layout::Auto,
             kernel: super::super::variant::KernelChoice::Auto,
             integrator: Integrator::Nee,
+            sampler: super::super::settings::Sampler::Sobol,
             error_each_pass: false,
             first_sample: 0,
         };
