@@ -400,7 +400,7 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
                     first_sample: 0,
                 };
                 let mut b = CpuBackend::new();
-                let p = plan(&scene, settings.paths(), accel, layout, KernelChoice::Auto, treelet::runtime::backend::Backend::class(&b), settings.integrator == treelet::render::Integrator::Caustics);
+                let p = plan(&scene, settings.paths(), accel, layout, KernelChoice::Auto, treelet::runtime::backend::Backend::class(&b), settings.integrator == treelet::render::Integrator::Caustics, settings.sampler == treelet::render::Sampler::Independent);
                 let ahead: std::collections::BTreeSet<_> = treelet::render::prepared::kernels(&b, &p).into_iter().collect();
                 render(&mut b, &scene, &settings, None, |_| {}).unwrap();
                 let missing: Vec<_> = b.kernels_dispatched().difference(&ahead).collect();

@@ -67,6 +67,7 @@ fn run<B: Backend>(b: &mut B, scene: &Scene, kernel: KernelChoice, accel: Accel,
         layout: Layout::Auto,
         kernel,
         integrator: treelet::render::Integrator::Smallpt,
+        sampler: treelet::render::Sampler::Sobol,
         error_each_pass: true,
         first_sample: 0,
     };
@@ -105,9 +106,14 @@ fn every_variant_renders_what_the_full_kernel_renders() {
             eprintln!("{} ({accel:?}, {}): {:.2}% of GPU pixels differ from the full kernel", scene.name, g.plan.kernel, off * 100.0);
         }
     }
-    // (The caustics variants are the light paths' tests': tests/render.rs.)
-    let specialized: BTreeSet<&str> =
-        VARIANTS.iter().filter(|v| v.0 & features::CAUSTICS == 0).map(|v| v.1).filter(|&n| n != "full").collect();
+    // (The caustics variants are the light paths' tests': tests/render.rs;
+    // the general kernels with independent numbers, the samplers' there.)
+    let specialized: BTreeSet<&str> = VARIANTS
+        .iter()
+        .filter(|v| v.0 & (features::CAUSTICS | features::INDEPENDENT_NUMBERS) == 0)
+        .map(|v| v.1)
+        .filter(|&n| n != "full")
+        .collect();
     assert_eq!(exercised, specialized, "every specialized variant is exercised");
 }
 
@@ -117,16 +123,25 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
     for (scene, _) in scenes(seed) {
         let bits = SceneFeatures::of(&scene).bits();
         for kernel in [KernelChoice::Auto, KernelChoice::Full] {
-            let p = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, false);
+            let p = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, false, false);
             let compiled = VARIANTS[p.variant].0;
             assert_eq!(compiled & bits, bits, "{}: {} lacks a feature", scene.name, p.kernel);
             assert_eq!(compiled & features::CAUSTICS, 0, "{}: {} has light paths unasked", scene.name, p.kernel);
             // Light paths asked for: where there are mirrors or glass, and lights.
-            let c = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, true);
+            let c = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, true, false);
             let f = SceneFeatures::of(&scene);
             let wants = f.mirror + f.glass > 0 && f.emissive > 0;
             assert_eq!(VARIANTS[c.variant].0 & features::CAUSTICS != 0, wants, "{}: {} with --integrator caustics", scene.name, c.kernel);
             assert_eq!(VARIANTS[c.variant].0 & bits, bits, "{}: {} lacks a feature", scene.name, c.kernel);
+            // Independent numbers: only a kernel that has them, and none
+            // that has them unasked.
+            assert_eq!(compiled & features::INDEPENDENT_NUMBERS, 0, "{}: {} carries independent numbers unasked", scene.name, p.kernel);
+            for light_paths in [false, true] {
+                let i = plan(&scene, 1 << 20, Accel::Auto, Layout::Auto, kernel, treelet::runtime::backend::DeviceClass::CpuRunner, light_paths, true);
+                let v = VARIANTS[i.variant].0;
+                assert!(v & features::INDEPENDENT_NUMBERS != 0 && v & bits == bits, "{}: {} for --sampler independent", scene.name, i.kernel);
+                assert_eq!(v & features::CAUSTICS != 0, light_paths && wants, "{}: {} for --sampler independent", scene.name, i.kernel);
+            }
             if scene.materials.iter().any(|m| m.kind == treelet_core::geometry::buffers::GLASS) {
                 assert!(compiled & features::GLASS != 0, "{}: glass without refraction", scene.name);
             }
@@ -147,14 +162,14 @@ fn choices_keep_every_feature_and_follow_the_crossover() {
         // On a GPU, a render long enough pays for the treelets, a short one does not.
         if scene.spheres.len() + TRIANGLE_SCAN_WEIGHT * scene.triangles.len() > LINEAR_MAX_CPU {
             let gpu = treelet::runtime::backend::DeviceClass::Gpu;
-            assert_eq!(plan(&scene, 1, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false).accel, Accel::Lbvh);
-            let long = plan(&scene, 1 << 40, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false);
+            assert_eq!(plan(&scene, 1, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false, false).accel, Accel::Lbvh);
+            let long = plan(&scene, 1 << 40, Accel::Auto, Layout::Auto, KernelChoice::Auto, gpu, false, false);
             assert_eq!(long.accel, Accel::Trbvh, "{}", scene.name);
             assert!(long.accel_reason.contains("pays for"), "{}", long.accel_reason);
         }
         // Forced choices stay as asked.
         use treelet::runtime::backend::DeviceClass::Gpu;
-        assert_eq!(plan(&scene, 1 << 40, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu, false).accel, Accel::Sweep);
-        assert_eq!(plan(&scene, 1, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu, false).layout, Layout::Cwbvh);
+        assert_eq!(plan(&scene, 1 << 40, Accel::Sweep, Layout::Auto, KernelChoice::Auto, Gpu, false, false).accel, Accel::Sweep);
+        assert_eq!(plan(&scene, 1, Accel::Sweep, Layout::Cwbvh, KernelChoice::Auto, Gpu, false, false).layout, Layout::Cwbvh);
     }
 }

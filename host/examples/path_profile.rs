@@ -90,7 +90,7 @@ fn main() -> Result<()> {
     for pixel in 0..width * height {
         for sample in 0..spp {
             let before = refs.tree.closest.get();
-            let mut path = Path::camera(&params, pixel, sample);
+            let mut path = Path::camera::<ALL>(&params, pixel, sample);
             while path.step::<_, ALL, 1>(&params, pixel, &refs, &lights, &mut [0; 1], 0) {}
             let length = (refs.tree.closest.get() - before) as usize;
             lengths[length.min(lengths.len() - 1)] += 1;

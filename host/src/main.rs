@@ -352,7 +352,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let memory = MemoryEstimate::of(&settings, scene.traced_primitives(), &classes);
     if args.explain {
         bar.suspend(|| {
-            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), integrator == Integrator::Caustics).explain());
+            eprintln!("{}", variant::plan(&scene, settings.paths(), args.accel, args.layout, args.kernel, list[0].class(), integrator == Integrator::Caustics, args.sampler == Sampler::Independent).explain());
             eprintln!(
                 "memory     about {} of host memory (image {}, scene and trees {}); {} available (TREELET_MAX_MEMORY caps it)",
                 human(memory.total_bytes),

@@ -2,7 +2,7 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{Material, Node, PlacedInfo, RenderParams, Sphere};
 use treelet_core::geometry::prims::Prims;
-use treelet_core::geometry::features::{ALL, CAUSTICS, INSTANCES, TRIANGLES};
+use treelet_core::geometry::features::{ALL, CAUSTICS, INDEPENDENT_NUMBERS, INSTANCES, TRIANGLES};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::linear_id;
@@ -280,6 +280,7 @@ macro_rules! placed_kernel {
 // Camera paths without the light paths' split of path space
 // (`treelet_core::render::caustics`) where none are traced: compiled in,
 // it made the placed render 1.7% slower with NEE (H100).
-placed_kernel!(camera render_placed_cs, ALL | INSTANCES);
-placed_kernel!(camera render_placed_caustics_cs, ALL | INSTANCES | CAUSTICS);
-placed_kernel!(light light_placed_cs, ALL | INSTANCES | CAUSTICS);
+// Placed copies' kernels draw either sampler's numbers, as the render asks.
+placed_kernel!(camera render_placed_cs, ALL | INSTANCES | INDEPENDENT_NUMBERS);
+placed_kernel!(camera render_placed_caustics_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);
+placed_kernel!(light light_placed_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);

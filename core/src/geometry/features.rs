@@ -32,6 +32,11 @@ pub const CAUSTICS: u32 = 32;
 /// through the instanced walk. Outside [`ALL`]: only the kernel of scenes
 /// with copies has that walk.
 pub const INSTANCES: u32 = 64;
+/// Not of the scene but of the render: `--sampler independent`'s numbers
+/// ([`crate::render::sampler`]). Outside [`ALL`]: the other kernels draw
+/// Sobol points only (carrying both behind a branch cost the H100's render
+/// kernels 6 to 12% whichever ran, `docs/results/h100-sampler-2026-11-28`).
+pub const INDEPENDENT_NUMBERS: u32 = 128;
 
 /// Whether `features` includes `feature`.
 #[inline]

@@ -101,7 +101,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
     lane: u32,
 ) {
     let seed = params.seed ^ LIGHT_STREAM;
-    let rng = BounceSamples::new(params, seed, id, sample, 0);
+    let rng = BounceSamples::new::<F>(params, seed, id, sample, 0);
     let light = lights[select_light(lights, params.light_count, rng.single(0)) as usize];
     let prims = &scene.prims;
     // A point uniformly on the emitter, and the normal it emits along. A
@@ -151,7 +151,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
             return; // A mirror or glass after the caustic: camera paths'.
         }
         bounces += 1;
-        let rng = BounceSamples::new(params, seed, id, sample, bounces);
+        let rng = BounceSamples::new::<F>(params, seed, id, sample, bounces);
         let eps = surface_offset(x);
         if m.kind == DIFFUSE {
             // The caustic's light, and its diffuse bounces, seen by the camera.

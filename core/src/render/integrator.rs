@@ -32,7 +32,7 @@
 //! [`crate::render::lights`]); both converge to the same image.
 use glam::Vec3;
 
-use crate::geometry::buffers::{CAUSTICS, Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, SOBOL, Sphere};
+use crate::geometry::buffers::{CAUSTICS, Camera, DIFFUSE, MIRROR, Material, NEE, RenderParams, Sphere};
 use crate::geometry::features::{self, has};
 use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::split::Split;
@@ -40,7 +40,7 @@ use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{Triangle, WatertightRay};
 use crate::gpu::rng::BounceRng;
 use crate::render::lights::{Light, light_pdf, light_pmf, power_heuristic, sample_light, select_light};
-use crate::render::sampler::{BounceSamples, PathSampler};
+use crate::render::sampler::{BounceSamples, PathSampler, uses_sobol};
 use crate::render::sampling::{cosine_direction, luminance};
 use crate::trace::hit::{ClosestHit, Hit, Query};
 
@@ -223,12 +223,13 @@ impl Path {
         }
     }
 
-    /// The camera path of sample `sample` of pixel `pixel`.
+    /// The camera path of sample `sample` of pixel `pixel`, in a kernel of
+    /// features `F` (see [`crate::render::sampler::uses_sobol`]).
     #[inline]
-    pub fn camera(params: &RenderParams, pixel: u32, sample: u32) -> Path {
+    pub fn camera<const F: u32>(params: &RenderParams, pixel: u32, sample: u32) -> Path {
         let (w, h) = (params.width, params.height);
         let (x, y) = (pixel % w, h - 1 - pixel / w);
-        let (sub, u) = camera_sample(params, pixel, sample);
+        let (sub, u) = camera_sample::<F>(params, pixel, sample);
         let (o, d) = params.camera.primary_ray(x, y, sub, w, h, u);
         Path::new(o, d, sample)
     }
@@ -295,7 +296,7 @@ impl Path {
         self.bsdf_pdf = 0.0;
         self.depth += 1;
         // Bounce 0's dimensions 0 and 1 are the camera's tent filter.
-        let rng = BounceSamples::new(params, params.seed, pixel, self.sample, self.depth);
+        let rng = BounceSamples::new::<F>(params, params.seed, pixel, self.sample, self.depth);
         if self.depth > 5 && !nee {
             let p = f.max_element();
             if rng.single(0) < p {
@@ -467,13 +468,13 @@ pub const NEE_ROULETTE_DEPTH: u32 = 3;
 const NO_LIGHT: u32 = u32::MAX;
 
 /// The subpixel and tent-filter numbers of sample `sample` of `pixel`:
-/// with [`SOBOL`], one Owen-scrambled Sobol point over the pixel's 2x2
+/// with [`SOBOL`](crate::geometry::buffers::SOBOL), one Owen-scrambled Sobol point over the pixel's 2x2
 /// subpixels (its top bits pick the subpixel, so each run of four samples
 /// covers all four; the rest are uniform within it); else sample `s` in
 /// subpixel `s % 4` with two independent numbers, as smallpt.
 #[inline]
-pub fn camera_sample(params: &RenderParams, pixel: u32, sample: u32) -> (u32, (f32, f32)) {
-    if params.sampler == SOBOL {
+pub fn camera_sample<const F: u32>(params: &RenderParams, pixel: u32, sample: u32) -> (u32, (f32, f32)) {
+    if uses_sobol::<F>(params) {
         let (u, v) = PathSampler::new(params.seed, pixel, sample, 0).pair(0);
         let (sx, sy) = ((u >= 0.5) as u32, (v >= 0.5) as u32);
         (sx + 2 * sy, (2.0 * u - sx as f32, 2.0 * v - sy as f32))
@@ -603,7 +604,7 @@ pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
     let mut sum_sq = 0.0;
     let mut s = 0;
     // One loop over every ray of the pixel's paths (see [`Path`]).
-    let mut path = Path::camera(params, id, params.first_sample);
+    let mut path = Path::camera::<F>(params, id, params.first_sample);
     while s < params.samples {
         if !path.step::<T, F, S>(params, id, scene, lights, stack, lane) {
             let l = path.result;
@@ -612,7 +613,7 @@ pub fn render_pixel<T: ClosestHit, const F: u32, const S: usize>(
             sum_sq += lum * lum;
             s += 1;
             if s < params.samples {
-                path = Path::camera(params, id, params.first_sample + s);
+                path = Path::camera::<F>(params, id, params.first_sample + s);
             }
         }
     }
@@ -630,7 +631,7 @@ pub fn accumulate(acc: &mut [f32; 4], add: [f32; 4]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::buffers::INDEPENDENT;
+    use crate::geometry::buffers::{INDEPENDENT, SOBOL};
     use crate::gpu::rng::BounceRng;
     use crate::render::sampling::sin_cos_turns;
 
@@ -685,6 +686,8 @@ mod tests {
         let (w, h) = (8u32, 6u32);
         let camera = Camera::look(Vec3::new(50.0, 52.0, 295.6), Vec3::new(0.0, -0.042612, -1.0), 140.0, SMALLPT_FOV, w, h);
         let mut total = 0.0;
+        // The general kernel with both samplers.
+        const G: u32 = features::ALL | features::INDEPENDENT_NUMBERS;
         for (integrator, sampler) in [(SMALLPT, INDEPENDENT), (NEE, INDEPENDENT), (NEE, SOBOL)] {
             let params = RenderParams {
                 width: w,
@@ -701,13 +704,13 @@ mod tests {
             };
             let scene = SceneRefs::new(&params, &spheres, Split::whole(&[]), &materials, Scan::new(&[], &[]));
             for pixel in 0..w * h {
-                let got = render_pixel::<_, { features::ALL }, 1>(pixel, &params, &scene, &lights, &mut [0; 1], 0);
+                let got = render_pixel::<_, G, 1>(pixel, &params, &scene, &lights, &mut [0; 1], 0);
                 let (x, y) = (pixel % w, h - 1 - pixel / w);
                 let (mut sum, mut sum_sq) = (Vec3::ZERO, 0.0f32);
                 for sample in params.first_sample..params.first_sample + params.samples {
-                    let (sub, u) = camera_sample(&params, pixel, sample);
+                    let (sub, u) = camera_sample::<G>(&params, pixel, sample);
                     let (o, d) = camera.primary_ray(x, y, sub, w, h, u);
-                    let l = radiance::<_, { features::ALL }, 1>(o, d, &params, pixel, sample, &scene, &lights, &mut [0; 1], 0);
+                    let l = radiance::<_, G, 1>(o, d, &params, pixel, sample, &scene, &lights, &mut [0; 1], 0);
                     sum += l;
                     sum_sq += luminance(l) * luminance(l);
                 }

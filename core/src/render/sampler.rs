@@ -22,6 +22,7 @@
 //! ranges (`treelet render --samples`) continues the same sequence in each
 //! part.
 use crate::geometry::buffers::{RenderParams, SOBOL};
+use crate::geometry::features::{INDEPENDENT_NUMBERS, has};
 use crate::gpu::rng::{BounceRng, hash};
 
 /// The numbers one bounce of one path draws, by the render's sampler
@@ -38,10 +39,12 @@ pub struct BounceSamples {
 
 impl BounceSamples {
     /// Bounce `bounce` of sample `sample` of `pixel` (or of whatever a
-    /// stream keys by those numbers), with the render's seed or `seed`.
+    /// stream keys by those numbers), with the render's seed or `seed`, in
+    /// a kernel of features `F`: Sobol points unless `F` has
+    /// [`INDEPENDENT_NUMBERS`] and the render asks for them.
     #[inline]
-    pub fn new(params: &RenderParams, seed: u32, pixel: u32, sample: u32, bounce: u32) -> Self {
-        let sobol = params.sampler == SOBOL;
+    pub fn new<const F: u32>(params: &RenderParams, seed: u32, pixel: u32, sample: u32, bounce: u32) -> Self {
+        let sobol = uses_sobol::<F>(params);
         let points = if sobol {
             PathSampler::new(seed, pixel, sample, bounce)
         } else {
@@ -124,6 +127,14 @@ impl PathSampler {
         let index = self.shuffled(seed);
         to_unit(laine_karras(index, hash(seed ^ 0x68e3_1da4)).reverse_bits())
     }
+}
+
+/// Whether a kernel of features `F` draws Sobol points for `params`: always
+/// without [`INDEPENDENT_NUMBERS`] (the host runs such kernels only for
+/// [`SOBOL`] renders), else as the render asks.
+#[inline]
+pub fn uses_sobol<const F: u32>(params: &RenderParams) -> bool {
+    !has(F, INDEPENDENT_NUMBERS) || params.sampler == SOBOL
 }
 
 /// The first dimension of Sobol's sequence (van der Corput's), as 32

@@ -8,6 +8,8 @@
 /// [`VARIANTS`]; the features are paths to the bits of
 /// [`crate::geometry::features`]. A scene runs the smallest set that
 /// contains its features; the general kernel (every feature) is last.
+/// Renders with independent numbers (`--sampler independent`) run the
+/// general kernels that have them, every other kernel Sobol points only.
 ///
 /// Entry points are named after the variant: the shader crate makes
 /// `render::<name>::{linear,bvh2,cwbvh}_cs` (and `render::full::classic_cs`).
@@ -23,7 +25,9 @@ macro_rules! for_each_render_variant {
             4 mixed_diffuse [$crate::geometry::features::SPHERES, $crate::geometry::features::TRIANGLES];
             5 spheres_caustics [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::CAUSTICS];
             6 full_caustics [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS];
-            7 full [$crate::geometry::features::ALL];
+            7 full_independent [$crate::geometry::features::ALL, $crate::geometry::features::INDEPENDENT_NUMBERS];
+            8 full_caustics_independent [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS, $crate::geometry::features::INDEPENDENT_NUMBERS];
+            9 full [$crate::geometry::features::ALL];
         }
     };
 }

@@ -7,7 +7,7 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::lights::{light_power, Light};
 
-use super::settings::{samples_per_dispatch, Integrator, MemoryEstimate, RenderSettings};
+use super::settings::{samples_per_dispatch, Integrator, MemoryEstimate, RenderSettings, Sampler};
 use super::variant::{self, Plan, PILOT_MIN_SPP};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
@@ -102,7 +102,7 @@ fn light_kernel(plan: &Plan, lights: bool) -> Option<Kernel> {
 /// before its timed work: a fresh machine's driver compiles each for
 /// seconds, so all at once ([`Backend::prepare_kernels`]).
 pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &RenderSettings) {
-    let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class(), settings.integrator == Integrator::Caustics);
+    let plan = variant::plan(scene, settings.paths(), settings.accel, settings.layout, settings.kernel, b.class(), settings.integrator == Integrator::Caustics, settings.sampler == Sampler::Independent);
     let mut kernels = kernels(b, &plan);
     let all = Primitives { spheres: &scene.spheres, triangles: &scene.triangles };
     let lights = scene.materials.len() == all.len() && !light_table(all, &scene.materials).is_empty();
@@ -169,7 +169,7 @@ impl<B: Backend> Prepared<B> {
         if let Some(sums) = base.filter(|sums| sums.len() as u64 != pixels) {
             bail!("the sums to resume from are of {} pixels, the image has {pixels}", sums.len());
         }
-        let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class(), integrator == Integrator::Caustics);
+        let mut plan = variant::plan(scene, settings.paths(), accel, layout, kernel, b.class(), integrator == Integrator::Caustics, sampler == Sampler::Independent);
         let materials = b.upload("materials", &scene.materials)?;
         let table = light_table(all, &scene.materials);
         let lights = lbvh::upload_or_placeholder(b, "lights", &table)?;

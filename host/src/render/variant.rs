@@ -108,6 +108,7 @@ fn optional(bits: u32) -> String {
         (features::GLASS, "glass"),
         (features::SHAPES, "disks and parallelograms"),
         (features::CAUSTICS, "light paths for caustics"),
+        (features::INDEPENDENT_NUMBERS, "independent numbers"),
     ]
     .iter()
     .filter(|(bit, _)| bits & bit != 0)
@@ -213,7 +214,10 @@ pub struct Plan {
 /// treelet-optimized BVH, whichever gives the least build plus render time
 /// ([`cheaper_builder`]);
 /// `Layout::Auto` the fastest measured layout.
-pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass, light_paths: bool) -> Plan {
+/// `independent`: the render draws independent numbers (`--sampler
+/// independent`), which only the general kernels have.
+#[allow(clippy::too_many_arguments)]
+pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: KernelChoice, class: DeviceClass, light_paths: bool, independent: bool) -> Plan {
     let features = SceneFeatures::of(scene);
     let (n, cost) = (features.primitives(), features.scan_cost());
     let runs_on_cpu = class != DeviceClass::Gpu;
@@ -260,8 +264,9 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
     // Light paths (`--integrator caustics`) where they can find caustics:
     // mirrors or glass, and lights.
     let caustics = light_paths && features.mirror + features.glass > 0 && features.emissive > 0;
-    let bits = features.bits() | if caustics { features::CAUSTICS } else { 0 };
-    let full = if caustics { smallest_variant(features::ALL | features::CAUSTICS) } else { full_variant() };
+    let render_bits = if caustics { features::CAUSTICS } else { 0 } | if independent { features::INDEPENDENT_NUMBERS } else { 0 };
+    let bits = features.bits() | render_bits;
+    let full = if render_bits != 0 { smallest_variant(features::ALL | render_bits) } else { full_variant() };
     let (variant, kernel_reason) = match kernel {
         KernelChoice::Full => (full, "as asked (--kernel full)".to_string()),
         KernelChoice::Auto if !method.specialized() => {

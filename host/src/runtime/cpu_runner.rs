@@ -924,7 +924,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             };
             let scene = SceneRefs::new(&p, spheres, triangles, materials, tree);
             // As the shader's entry points: light paths' split of path space only beside them.
-            const F: u32 = ALL | INSTANCES;
+            const F: u32 = ALL | INSTANCES | treelet_core::geometry::features::INDEPENDENT_NUMBERS;
             const C: u32 = F | treelet_core::geometry::features::CAUSTICS;
             if kernel == Kernel::LightPlaced {
                 light_with::<_, C>(&p, &scene, lights, view(accum), groups);
