@@ -125,7 +125,8 @@ struct RenderArgs {
     explain: bool,
     #[arg(long, value_enum, default_value = "nee")]
     integrator: IntegratorArg,
-    /// Where camera paths draw their sample points.
+    /// Where paths draw their sample points (independent numbers run the
+    /// general kernel: the smaller variants draw Sobol points only).
     #[arg(long, value_enum, default_value = "sobol")]
     sampler: Sampler,
     #[arg(long, value_enum, default_value = "auto")]
