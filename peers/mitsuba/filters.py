@@ -1,6 +1,7 @@
-"""Mitsuba 3's noise on the disk-lit room by pixel filter and sampler: runs room_disk.py (same
-folder) with RFILTER=tent and RFILTER=box (independent numbers), and RFILTER=tent with
-SAMPLER=ldsampler, and scores each render against the same filter and sampler's largest sample count
+"""Mitsuba 3's noise on the disk-lit room by pixel filter: runs room_disk.py (same folder) with
+RFILTER=tent and RFILTER=box (independent numbers; SAMPLERS=ldsampler adds a tent-filtered series
+with Mitsuba's low-discrepancy sampler, which on the H100 returned only its 16 and 64 spp renders,
+2026-11-28), and scores each render against the same filter and sampler's largest sample count
 (RMSE over all pixels and channels, as `treelet compare` computes it), so that the filters' noise
 at equal time can be compared, and Treelet's (whose samples count in their own pixel only, as with
 box) set beside the like-for-like one.
@@ -13,7 +14,8 @@ mi.set_variant('scalar_rgb')
 out = sys.argv[1]
 counts = sys.argv[2] if len(sys.argv) > 2 else '16,64,256,1024'
 here = os.path.dirname(os.path.abspath(__file__))
-for rfilter, sampler in (('tent', 'independent'), ('box', 'independent'), ('tent', 'ldsampler')):
+extra = [('tent', s) for s in os.environ.get('SAMPLERS', '').split(',') if s]
+for rfilter, sampler in [('tent', 'independent'), ('box', 'independent')] + extra:
     env = dict(os.environ, RFILTER=rfilter, SAMPLER=sampler)
     lines = subprocess.run([sys.executable, os.path.join(here, 'room_disk.py'), out, counts], env=env,
                            check=True, capture_output=True, text=True).stdout.splitlines()
