@@ -238,6 +238,33 @@ mod tests {
         assert!(pixels_or_none(usize::MAX, 2).is_empty());
     }
 
+    /// A part records its sampler, reads it back, and parts of two samplers
+    /// are not parts of one render (their sample points differ).
+    #[test]
+    fn parts_record_their_sampler() {
+        let dir = std::env::temp_dir().join(format!("treelet-part-sampler-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("part.exr");
+        let info = PartInfo {
+            scene: "cornell".into(),
+            scene_hash: "0".into(),
+            width: 3,
+            height: 2,
+            seed: 1,
+            integrator: "nee".into(),
+            sampler: "sobol".into(),
+            samples: 0..4,
+            planned_end: 4,
+        };
+        write_part(&path, &info, &[[1.0; 4]; 6]).unwrap();
+        let (back, _) = read_part(&path).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(back.sampler, "sobol");
+        assert!(back.differs_from(&info).is_none());
+        let why = back.differs_from(&PartInfo { sampler: "independent".into(), ..info }).expect("two samplers differ");
+        assert!(why.contains("sampler sobol") && why.contains("independent"), "{why}");
+    }
+
     /// A header whose data window asks for more pixels than the file holds:
     /// an error that names the file.
     #[test]
