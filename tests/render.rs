@@ -528,6 +528,37 @@ fn many_samples_per_pixel_on_a_small_image() {
     }
 }
 
+/// On a GPU a render's dispatches grow from their first size to the
+/// device's measured rate (`treelet::render::dispatch_size`): here to
+/// hundreds of samples of a pixel in one invocation's loop. CPU adapters
+/// keep their 16 (lavapipe gets longer loops wrong). Either way the image
+/// is the CPU runner's within noise.
+#[test]
+fn dispatches_grow_to_the_gpu_rate_and_keep_the_image() {
+    use treelet::runtime::backend::DeviceClass;
+    let Some(ctx) = gpu() else { return };
+    let class = GpuBackend::new(ctx.clone()).class();
+    let room = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/room_disk.json");
+    for scene in [cornell(), Scene::from_spec(room).expect(room)] {
+        let s = RenderSettings { error_each_pass: false, ..with_integrator(settings(24, 16, 1024, 5, Accel::None), Integrator::Nee) };
+        let r = render(&mut GpuBackend::new(ctx.clone()), &scene, &s, None, |_| {}).unwrap();
+        let largest = r.shares[0].dispatch_samples;
+        eprintln!("{} on {class:?}: dispatches of up to {largest} spp", scene.name);
+        match class {
+            DeviceClass::Gpu => assert!(largest >= 256, "{}: dispatches of at most {largest} spp on a GPU", scene.name),
+            _ => assert!((1..=16).contains(&largest), "{}: dispatches of {largest} spp on {class:?}", scene.name),
+        }
+        let g = r.image.pixels;
+        let c = pixels(&mut CpuBackend::new(), &scene, &s);
+        let other = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { seed: 6, ..s });
+        let (gpu_cpu, noise) = (mean_abs(&g, &c), mean_abs(&c, &other));
+        let same = 1.0 - mismatch_fraction(&g, &c, 1e-3);
+        eprintln!("{}: {:.1}% of pixels agree within 1e-3; mean |gpu - cpu| {gpu_cpu:.2e}, noise {noise:.2e}", scene.name, 100.0 * same);
+        assert!(same > 0.25, "{}: only {:.1}% of pixels agree", scene.name, 100.0 * same);
+        assert!(gpu_cpu < 0.25 * noise, "{}: GPU and CPU differ by {gpu_cpu}, noise is {noise}", scene.name);
+    }
+}
+
 /// With `--layout auto`, a render on a Vulkan device (here: the GPU, or
 /// lavapipe) of at least `PILOT_MIN_SPP` samples
 /// through a tree first times one sample of every pixel through each

@@ -455,6 +455,12 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     }
     if args.explain {
         eprintln!("timeline   {} s (the stages of this process so far, each ending where named)", treelet::runtime::timeline::summary());
+        let sizes: Vec<String> = result.shares.iter().map(|s| format!("{}: up to {} spp each", s.device, s.dispatch_samples)).collect();
+        eprintln!(
+            "dispatches {} (a GPU's are sized to its rate, about {} s each)",
+            sizes.join(", "),
+            treelet::render::dispatch_size::DISPATCH_S
+        );
     }
     if args.explain && args.layout == Layout::Auto && result.plan.accel != Accel::None {
         eprintln!("layout     {} (as rendered): {}", result.plan.layout.name(), result.plan.layout_reason);
@@ -489,11 +495,12 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     if list.len() > 1 {
         for s in &result.shares {
             eprintln!(
-                "  {}: {} spp ({:.1}%) in {} chunks, {:.1} M paths/s{}",
+                "  {}: {} spp ({:.1}%) in {} chunks (dispatches of up to {} spp), {:.1} M paths/s{}",
                 s.device,
                 s.samples,
                 100.0 * s.samples as f64 / spp.max(1) as f64,
                 s.chunks,
+                s.dispatch_samples,
                 s.paths_per_s / 1e6,
                 s.failed.as_ref().map(|f| format!(", stopped: {f}")).unwrap_or_default()
             );

@@ -6,7 +6,8 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `settings.rs` | what a render is asked for; passes and dispatch sizes |
+//! | `settings.rs` | what a render is asked for; passes and the first dispatch size |
+//! | `dispatch_size.rs` | samples per dispatch, grown on a GPU to its measured rate |
 //! | `integrator_choice.rs` | `--integrator auto`: a pilot of NEE against light paths |
 //! | `variant.rs` | the plan: tree, layout and kernel variant for a scene and device |
 //! | `prepared.rs` | one device's tree, buffers and accumulation |
@@ -19,6 +20,7 @@
 //! | `parts.rs` | parts of a render as EXR files, and merging them |
 //! | `image_io.rs` | reading and writing images |
 pub mod devices;
+pub mod dispatch_size;
 pub mod image_io;
 pub mod integrator_choice;
 pub mod outcome;

@@ -76,6 +76,9 @@ pub struct Share {
     /// Samples per pixel it rendered (and that were read back).
     pub samples: u32,
     pub chunks: u32,
+    /// Samples per pixel in its largest dispatch (see
+    /// [`super::dispatch_size`]).
+    pub dispatch_samples: u32,
     /// Wall seconds from its start to its last chunk.
     pub seconds: f64,
     /// Its rate: camera paths per second.

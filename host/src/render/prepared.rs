@@ -7,7 +7,8 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::lights::{light_power, Light};
 
-use super::settings::{samples_per_dispatch, Integrator, MemoryEstimate, RenderSettings, Sampler};
+use super::dispatch_size::DispatchSize;
+use super::settings::{Integrator, MemoryEstimate, RenderSettings, Sampler};
 use super::variant::{self, Plan, PILOT_MIN_SPP};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh;
@@ -65,7 +66,6 @@ pub struct Prepared<B: Backend> {
     placed: Option<super::placed::PlacedPart<B>>,
     /// Render parameters but for the samples of a dispatch.
     params: RenderParams,
-    per_dispatch: u32,
     pixels: u64,
     pub build_ms: f64,
     pub plan: Plan,
@@ -232,7 +232,6 @@ impl<B: Backend> Prepared<B> {
             light_paths,
             params: placed.as_ref().map_or(params, |p| p.params(params)),
             placed,
-            per_dispatch: samples_per_dispatch(pixels, b.class()),
             pixels,
             build_ms,
             plan,
@@ -240,12 +239,14 @@ impl<B: Backend> Prepared<B> {
     }
 
     /// Dispatches samples `first .. first + count` of every pixel, adding
-    /// to the accumulation (recorded, not waited for).
-    pub fn dispatch_samples(&self, b: &mut B, first: u32, count: u32) -> Result<()> {
+    /// to the accumulation (recorded, not waited for), in dispatches of at
+    /// most `size`'s samples; gives the samples of the largest.
+    pub fn dispatch_samples(&self, b: &mut B, first: u32, count: u32, size: &DispatchSize) -> Result<u32> {
         b.stage("render");
         let mut done = 0;
-        while done < count {
-            let samples = (count - done).min(self.per_dispatch);
+        let mut largest = 0;
+        for samples in size.cuts(count) {
+            largest = largest.max(samples);
             let params = RenderParams { samples, first_sample: first + done, ..self.params };
             let scene = (&self.materials, &self.lights, &params);
             if let Some(placed) = &self.placed {
@@ -262,7 +263,7 @@ impl<B: Backend> Prepared<B> {
             }
             done += samples;
         }
-        Ok(())
+        Ok(largest)
     }
 
     /// The layout this render traces (`auto` resolved, by a pilot or not).

@@ -26,6 +26,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
 
+use super::dispatch_size::DispatchSize;
 use super::image_io::HdrImage;
 use super::outcome::{PassRow, RenderResult, Share, Stopped};
 use super::prepared::Prepared;
@@ -127,6 +128,8 @@ enum Event {
         device: usize,
         range: Range<u32>,
         kernel_ms: f64,
+        /// Samples per pixel of its largest dispatch.
+        dispatch_samples: u32,
     },
     /// A device's sums so far, which hold the samples of `covers`.
     ReadBack {
@@ -184,6 +187,8 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
     };
     // The first chunk, a few samples, measures the device's rate.
     let (mut want, mut chunks) = (1u32, 0u32);
+    let pixels = job.settings.width as u64 * job.settings.height as u64;
+    let mut size = DispatchSize::new(pixels, b.class());
     let outcome: Result<()> = loop {
         // A render scored after every pass takes no range past a pass end.
         let taken = if job.rows { job.queue.take_in_pass(want) } else { job.queue.take(want) };
@@ -209,18 +214,19 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         }
         let chunk_start = Instant::now();
         let len = range.end - range.start;
-        // Dispatched pass by pass (each cut every `step` from its start, as
-        // the grid is), so that every render's dispatches are the same.
-        let dispatched = (|| -> Result<f64> {
-            let mut at = range.start;
+        // Dispatched pass by pass, each cut by the dispatch size (on a CPU
+        // device fixed, every `step` from the pass's start as the grid is,
+        // so that every render's dispatches are the same).
+        let dispatched = (|| -> Result<(f64, u32)> {
+            let (mut at, mut largest) = (range.start, 0);
             while at < range.end {
                 let to = job.queue.grid().pass_end_after(at).min(range.end);
-                prepared.dispatch_samples(b, at, to - at)?;
+                largest = largest.max(prepared.dispatch_samples(b, at, to - at, &size)?);
                 at = to;
             }
-            Ok(b.take_times()?.get("render"))
+            Ok((b.take_times()?.get("render"), largest))
         })();
-        let kernel_ms = match dispatched {
+        let (kernel_ms, dispatch_samples) = match dispatched {
             Ok(ms) => ms,
             Err(e) => {
                 job.queue.give_back(range);
@@ -228,9 +234,10 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
             }
         };
         chunks += 1;
+        size.measured(len, kernel_ms / 1e3);
         covers.push(range.clone());
         unread.push(range.clone());
-        send(Event::Chunk { device: job.device, range: range.clone(), kernel_ms });
+        send(Event::Chunk { device: job.device, range: range.clone(), kernel_ms, dispatch_samples });
         // Chunks are sized by the device's own rate, to take about CHUNK_S
         // each: a slow device never holds a large chunk at the end, and a
         // fast one waits seldom.
@@ -396,6 +403,7 @@ impl Gather {
                 device: name.clone(),
                 samples: 0,
                 chunks: 0,
+                dispatch_samples: 0,
                 seconds: 0.0,
                 paths_per_s: 0.0,
                 failed: None,
@@ -442,8 +450,9 @@ impl Gather {
                     self.build_ms = build_ms;
                 }
             }
-            Event::Chunk { device, range, kernel_ms } => {
+            Event::Chunk { device, range, kernel_ms, dispatch_samples } => {
                 let share = &mut self.shares[device];
+                share.dispatch_samples = share.dispatch_samples.max(dispatch_samples);
                 share.samples += range.end - range.start;
                 share.chunks += 1;
                 share.kernel_s += kernel_ms / 1e3;

@@ -118,8 +118,10 @@ impl RenderSettings {
     }
 }
 
-/// Camera paths per dispatch at most, so that no dispatch runs long enough
-/// for a driver to time it out, whatever the sample count.
+/// Camera paths per dispatch at most until a GPU's rate is known (and
+/// always on CPU devices), so that no dispatch runs long enough for a
+/// driver to time it out, whatever the sample count; a GPU's later
+/// dispatches are sized to its rate ([`super::dispatch_size`]).
 pub const MAX_PATHS_PER_DISPATCH: u64 = 1 << 22;
 
 /// Samples per pixel per dispatch at most: each invocation loops over
@@ -141,8 +143,9 @@ pub fn max_samples_per_dispatch(class: DeviceClass) -> u32 {
 }
 
 /// Samples per pixel in one dispatch for an image of `pixels` on a device
-/// of `class`: as many as [`MAX_PATHS_PER_DISPATCH`] and
-/// [`max_samples_per_dispatch`] allow, at least one.
+/// of `class` (a GPU's first dispatches): as many as
+/// [`MAX_PATHS_PER_DISPATCH`] and [`max_samples_per_dispatch`] allow, at
+/// least one.
 pub fn samples_per_dispatch(pixels: u64, class: DeviceClass) -> u32 {
     (MAX_PATHS_PER_DISPATCH / pixels.max(1)).clamp(1, max_samples_per_dispatch(class) as u64) as u32
 }
