@@ -446,8 +446,12 @@ fn nee_converges_to_the_smallpt_estimate() {
 /// The Sobol sampler's images have less error than independent numbers'
 /// at equal samples: the mean squared difference between two seeds' images
 /// (twice the variance of one) on cornell and the disk-lit room, CPU
-/// runner (here 1.95x and 1.57x less at 48x36 and 256 spp). A scramble
+/// runner (48x36, 256 spp). A scramble
 /// that lost the points' strata (or correlated two pairs) fails this.
+/// The mean leaves out the 0.3% of pixels that differ most (5 of 1 728): a
+/// few fireflies (light through cornell's glass ball, found by chance)
+/// otherwise decide it (one seed's Sobol pair came out 0.64x with them;
+/// without them six seeds gave cornell 1.9-2.2x, the room 1.4-1.8x).
 #[test]
 fn sobol_points_lower_the_error_at_equal_samples() {
     let seed = treelet_tests::fresh_seed() as u32;
@@ -457,7 +461,10 @@ fn sobol_points_lower_the_error_at_equal_samples() {
             let s = RenderSettings { sampler, ..with_integrator(settings(48, 36, 256, seed, Accel::None), Integrator::Nee) };
             let a = pixels(&mut CpuBackend::new(), &scene, &s);
             let b = pixels(&mut CpuBackend::new(), &scene, &RenderSettings { seed: seed ^ 0x9e37, ..s });
-            a.iter().zip(&b).map(|(x, y)| (0..3).map(|k| ((x[k] - y[k]) as f64).powi(2)).sum::<f64>()).sum::<f64>() / (3 * a.len()) as f64
+            let mut d: Vec<f64> = a.iter().zip(&b).map(|(x, y)| (0..3).map(|k| ((x[k] - y[k]) as f64).powi(2)).sum::<f64>() / 3.0).collect();
+            d.sort_by(f64::total_cmp);
+            let kept = &d[..d.len() - d.len() / 300];
+            kept.iter().sum::<f64>() / kept.len() as f64
         };
         let (sobol, plain) = (variance(Sampler::Sobol), variance(Sampler::Independent));
         eprintln!("{}: mean squared difference of two seeds, sobol {sobol:.3e}, independent {plain:.3e} ({:.2}x)", scene.name, plain / sobol);
