@@ -39,6 +39,8 @@ fn scenes(seed: u64) -> Vec<(Scene, &'static str)> {
     let mirrors = Scene::from_spec("scenes/cornell_mirrors.json")
         .or_else(|_| Scene::from_spec("../scenes/cornell_mirrors.json"))
         .unwrap();
+    // Spheres, a disk lamp and parallelogram walls: flat shapes, no triangles.
+    let shapes = Scene::from_spec("scenes/room_disk.json").or_else(|_| Scene::from_spec("../scenes/room_disk.json")).unwrap();
     let mixed = mesh_scene("triangles in the room", &triangles(150, seed));
     // Triangles alone, half of them lights.
     let mut only = mixed.mesh_only().unwrap();
@@ -52,6 +54,7 @@ fn scenes(seed: u64) -> Vec<(Scene, &'static str)> {
         (diffuse, "spheres_diffuse"),
         (mirrors, "spheres_mirror"),
         (random_scene("random:60", 60, seed), "spheres"),
+        (shapes, "spheres_shapes"),
         (mixed, "mixed_diffuse"),
         (only, "triangles_diffuse"),
     ]

@@ -18,7 +18,8 @@ pub const MIRROR: u32 = 4;
 pub const GLASS: u32 = 8;
 /// The scene has disks or parallelograms (flat primitives stored as
 /// triangles are, see [`crate::geometry::flat`]): without it a kernel tests
-/// every flat primitive as a triangle.
+/// every flat primitive as a triangle, without [`TRIANGLES`] as a disk or
+/// parallelogram.
 pub const SHAPES: u32 = 16;
 /// Everything a scene can have: the general kernel.
 pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES;

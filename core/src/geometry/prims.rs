@@ -49,7 +49,7 @@ impl<'a> Prims<'a> {
     /// `F` (see [`crate::geometry::features`]) has only one primitive kind.
     #[inline]
     pub fn is_sphere<const F: u32>(&self, prim: u32) -> bool {
-        if !has(F, features::TRIANGLES) {
+        if !has(F, features::TRIANGLES) && !has(F, features::SHAPES) {
             true
         } else if !has(F, features::SPHERES) {
             false
@@ -81,11 +81,18 @@ impl<'a> Prims<'a> {
     }
 }
 
+/// Whether flat primitive `tri` is a disk or parallelogram (else a
+/// triangle), decided at compile time when `F` has only one of the kinds.
+#[inline]
+pub fn is_shape<const F: u32>(tri: &Triangle) -> bool {
+    has(F, features::SHAPES) && (!has(F, features::TRIANGLES) || !tri.is_triangle())
+}
+
 /// Distance to a flat primitive: the watertight triangle test, or the
 /// disk's or parallelogram's where `F` has them and `tri` is one.
 #[inline]
 fn flat_distance<const F: u32>(o: Vec3, d: Vec3, ray: &WatertightRay, tri: &Triangle, t_max: f32) -> f32 {
-    if has(F, features::SHAPES) && !tri.is_triangle() {
+    if is_shape::<F>(tri) {
         ray_shape(o, d, tri, t_max)
     } else {
         ray_triangle(ray, tri, t_max)

@@ -74,7 +74,14 @@ pub fn light_paths<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?S
     stack: &mut [u32; S],
     lane: u32,
 ) {
-    if !has(F, features::CAUSTICS) || params.light_count == 0 {
+    // A constant of the instance, not a call: rustc's collector then leaves
+    // the light path out of every kernel without light paths (the shader
+    // crate makes a light entry point for every variant), which saves the
+    // shader build memory.
+    if const { !has(F, features::CAUSTICS) } {
+        return;
+    }
+    if params.light_count == 0 {
         return;
     }
     for s in 0..params.samples {

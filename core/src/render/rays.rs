@@ -14,7 +14,6 @@ use crate::geometry::intersect::{MISS, surface_offset};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{WatertightRay, ray_triangle_barycentrics};
 use crate::geometry::flat::ray_plane_coordinates;
-use crate::geometry::features::{self, has};
 use crate::gpu::rng::BounceRng;
 use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel, trace};
 use crate::render::sampling::cosine_direction;
@@ -236,7 +235,7 @@ fn barycentrics<const F: u32>(prims: &Prims, prim: u32, o: Vec3, d: Vec3) -> (f3
         return (0.0, 0.0);
     }
     let tri = &prims.triangle(prim - prims.sphere_count);
-    if has(F, features::SHAPES) && !tri.is_triangle() {
+    if crate::geometry::prims::is_shape::<F>(tri) {
         let (_, x, y) = ray_plane_coordinates(o, d, tri, MISS);
         return (x, y);
     }

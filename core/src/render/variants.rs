@@ -8,6 +8,8 @@
 /// [`VARIANTS`]; the features are paths to the bits of
 /// [`crate::geometry::features`]. A scene runs the smallest set that
 /// contains its features; the general kernel (every feature) is last.
+/// Each variant adds three camera kernels to the shader crate, whose build
+/// (one rustc process) needs memory for each (21.9 GB with these).
 /// Renders with independent numbers (`--sampler independent`) run the
 /// general kernels that have them, every other kernel Sobol points only.
 ///
@@ -23,11 +25,13 @@ macro_rules! for_each_render_variant {
             2 spheres [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS];
             3 triangles_diffuse [$crate::geometry::features::TRIANGLES];
             4 mixed_diffuse [$crate::geometry::features::SPHERES, $crate::geometry::features::TRIANGLES];
-            5 spheres_caustics [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::CAUSTICS];
-            6 full_caustics [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS];
-            7 full_independent [$crate::geometry::features::ALL, $crate::geometry::features::INDEPENDENT_NUMBERS];
-            8 full_caustics_independent [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS, $crate::geometry::features::INDEPENDENT_NUMBERS];
-            9 full [$crate::geometry::features::ALL];
+            5 spheres_shapes [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::SHAPES];
+            6 spheres_caustics [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::CAUSTICS];
+            7 spheres_shapes_caustics [$crate::geometry::features::SPHERES, $crate::geometry::features::MIRROR, $crate::geometry::features::GLASS, $crate::geometry::features::SHAPES, $crate::geometry::features::CAUSTICS];
+            8 full_caustics [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS];
+            9 full_independent [$crate::geometry::features::ALL, $crate::geometry::features::INDEPENDENT_NUMBERS];
+            10 full_caustics_independent [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS, $crate::geometry::features::INDEPENDENT_NUMBERS];
+            11 full [$crate::geometry::features::ALL];
         }
     };
 }

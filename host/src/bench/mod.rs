@@ -266,9 +266,16 @@ fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) ->
 
 /// Scenes `bench variants` compares by default: each exercises a different
 /// specialized kernel (cornell: no triangles; diffuse and mirror-only
-/// variants; many spheres through a BVH; a mesh in smallpt's room).
-const VARIANT_SCENES: [&str; 5] =
-    ["cornell", "scenes/cornell_diffuse.json", "scenes/cornell_mirrors.json", "random:1000", "terrain:100000"];
+/// variants; spheres and flat shapes, no triangles; many spheres through a
+/// BVH; a mesh in smallpt's room).
+const VARIANT_SCENES: [&str; 6] = [
+    "cornell",
+    "scenes/cornell_diffuse.json",
+    "scenes/cornell_mirrors.json",
+    "scenes/room_disk.json",
+    "random:1000",
+    "terrain:100000",
+];
 
 
 pub fn run(cmd: BenchCommand) -> Result<()> {

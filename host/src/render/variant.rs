@@ -86,7 +86,7 @@ impl SceneFeatures {
         let mut bits = 0;
         for (count, bit) in [
             (self.spheres, features::SPHERES),
-            (self.triangles, features::TRIANGLES),
+            (self.triangles - self.disks - self.parallelograms, features::TRIANGLES),
             (self.mirror, features::MIRROR),
             (self.glass, features::GLASS),
             (self.disks + self.parallelograms, features::SHAPES),
