@@ -359,14 +359,10 @@ fn with_integrator(s: RenderSettings, integrator: Integrator) -> RenderSettings 
     RenderSettings { integrator, ..s }
 }
 
-fn independent(s: RenderSettings) -> RenderSettings {
-    RenderSettings { sampler: Sampler::Independent, ..s }
-}
-
-/// Mean of each 8x6-pixel block's luminance.
+/// Mean of each 4x4-pixel block's luminance.
 fn block_means(p: &[[f32; 3]], w: usize, h: usize) -> Vec<f64> {
     let lum = |c: &[f32; 3]| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
-    let (bw, bh) = (8, 6);
+    let (bw, bh) = (4, 4);
     let mut out = Vec::new();
     for by in 0..h / bh {
         for bx in 0..w / bw {
@@ -382,65 +378,83 @@ fn block_means(p: &[[f32; 3]], w: usize, h: usize) -> Vec<f64> {
     out
 }
 
+/// Several seeds' block means: their mean per block, and the variance of
+/// that mean (each block's sample variance over the seeds, pooled over the
+/// blocks, over the number of seeds).
+fn mean_and_variance(images: &[Vec<f64>]) -> (Vec<f64>, f64) {
+    let k = images.len() as f64;
+    let n = images[0].len();
+    let mean: Vec<f64> = (0..n).map(|i| images.iter().map(|b| b[i]).sum::<f64>() / k).collect();
+    let pooled = (0..n).map(|i| images.iter().map(|b| (b[i] - mean[i]).powi(2)).sum::<f64>() / (k - 1.0)).sum::<f64>() / n as f64;
+    (mean, pooled / k)
+}
+
 /// Next-event estimation, alone and with light paths for caustics, is
 /// unbiased: on every light scene its image matches smallpt's estimator's
-/// with independent numbers (whole-image mean within 3%, 8x6-pixel blocks
-/// within their noise) and has no NaN, infinite or negative pixel, with
-/// the Sobol sampler (the default) and with independent numbers.
+/// with independent numbers (whole-image mean within 3%, 4x4-pixel blocks
+/// within the noise of the two) and has no NaN, infinite or negative
+/// pixel, with the Sobol sampler (the default) and with independent numbers.
 /// A lost MIS weight (light counted twice), a wrong density (a factor of π
 /// or 2), a light behind glass left dark, or sample points that are not
 /// uniform all fail this.
+///
+/// Each side's noise is measured from its own seeds (two for next-event
+/// estimation; four for smallpt and for light paths, whose noise is
+/// heavy-tailed where a light is small), and the blocks may differ by up to
+/// twice the noise of the difference. The bound was 1.5x smallpt's noise
+/// alone, which failed by chance in CI (the light in glass, where shadow
+/// rays cannot help and next-event estimation is as noisy as smallpt:
+/// 1.57x); with two smallpt seeds the small octahedron lamp's reference
+/// came out 1.73x in one of five seeds (two seeds that both missed its rare
+/// paths agree with each other and understate their noise).
 #[test]
 fn nee_converges_to_the_smallpt_estimate() {
     let seed = treelet_tests::fresh_seed() as u32;
     let (w, h, spp) = (32usize, 24usize, 1024);
+    let blocks_of = |scene: &Scene, integrator, sampler, seeds: &[u32], name: &str| -> Vec<Vec<f64>> {
+        seeds
+            .iter()
+            .map(|&k| {
+                let s = RenderSettings { sampler, ..with_integrator(settings(w as u32, h as u32, spp, seed ^ k, Accel::None), integrator) };
+                let image = pixels(&mut CpuBackend::new(), scene, &s);
+                assert!(image.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{} {name}: NaN, infinite or negative pixels", scene.name);
+                block_means(&image, w, h)
+            })
+            .collect()
+    };
+    let mut failures = Vec::new();
     for scene in light_scenes() {
-        let s = settings(w as u32, h as u32, spp, seed, Accel::None);
-        let plain = pixels(&mut CpuBackend::new(), &scene, &independent(with_integrator(s, Integrator::Smallpt)));
-        let bp = block_means(&plain, w, h);
+        let (bp, var_p) = mean_and_variance(&blocks_of(&scene, Integrator::Smallpt, Sampler::Independent, &[0x1111, 0x2222, 0x4444, 0x8888], "smallpt"));
         let mp = bp.iter().sum::<f64>() / bp.len() as f64;
-        // Blocks: the smallpt estimate's noise, from a second seed.
-        let again = pixels(&mut CpuBackend::new(), &scene, &independent(with_integrator(settings(w as u32, h as u32, spp, seed ^ 0x5555, Accel::None), Integrator::Smallpt)));
-        let ba = block_means(&again, w, h);
-        let noise = (bp.iter().zip(&ba).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
         for (integrator, sampler) in [(Integrator::Nee, Sampler::Sobol), (Integrator::Nee, Sampler::Independent), (Integrator::Caustics, Sampler::Sobol)] {
             let name = format!("{} ({})", integrator.name(), sampler.name());
-            // Light paths from a lamp mostly hidden in the ceiling (as
-            // cornell's) are far noisier than smallpt's estimator, and their
-            // noise is heavy-tailed (a few heavy paths): their image is the
-            // mean of four seeds, and their noise is measured from the four.
-            let seeds: &[u32] = if integrator == Integrator::Caustics { &[0, 0x5555, 0xaaaa, 0x3333] } else { &[0] };
-            let blocks: Vec<Vec<f64>> = seeds
-                .iter()
-                .map(|&k| {
-                    let s = RenderSettings { sampler, ..with_integrator(settings(w as u32, h as u32, spp, seed ^ k, Accel::None), integrator) };
-                    let image = pixels(&mut CpuBackend::new(), &scene, &s);
-                    assert!(image.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{} {name}: NaN, infinite or negative pixels", scene.name);
-                    block_means(&image, w, h)
-                })
-                .collect();
-            let k = blocks.len() as f64;
-            let bn: Vec<f64> = (0..bp.len()).map(|i| blocks.iter().map(|b| b[i]).sum::<f64>() / k).collect();
+            let seeds: &[u32] = if integrator == Integrator::Caustics { &[0, 0x5555, 0xaaaa, 0x3333] } else { &[0, 0x5555] };
+            let (bn, var_n) = mean_and_variance(&blocks_of(&scene, integrator, sampler, seeds, &name));
             let mn = bn.iter().sum::<f64>() / bn.len() as f64;
             let diff = (bp.iter().zip(&bn).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
-            eprintln!("{}: mean luminance {name} {mn:.4}, smallpt {mp:.4}; blocks differ by {diff:.4} (rms), smallpt's own noise {noise:.4}", scene.name);
+            let noise = (var_p + var_n).sqrt();
+            eprintln!(
+                "{}: mean luminance {name} {mn:.4}, smallpt {mp:.4}; blocks differ by {diff:.4} (rms), {:.2}x the noise ({noise:.4}: smallpt's {:.4}, its own {:.4})",
+                scene.name,
+                diff / noise.max(1e-30),
+                var_p.sqrt(),
+                var_n.sqrt()
+            );
             if scene.name == "no light" {
-                assert!(mn == 0.0 && mp == 0.0, "no light: the image must be black ({name} {mn}, smallpt {mp})");
+                if !(mn == 0.0 && mp == 0.0) {
+                    failures.push(format!("no light: the image must be black ({name} {mn}, smallpt {mp})"));
+                }
                 continue;
             }
-            assert!((mn / mp - 1.0).abs() < 0.03, "{} {name}: mean luminance {mn}, smallpt {mp}", scene.name);
-            // Against the noise of the difference: smallpt's (its two seeds
-            // differ by sqrt(2) of one's) and, for light paths, their mean's
-            // (the variance of the four seeds, pooled over the blocks, over four).
-            let noise = if blocks.len() > 1 {
-                let pooled = (0..bp.len()).map(|i| blocks.iter().map(|b| (b[i] - bn[i]).powi(2)).sum::<f64>() / (k - 1.0)).sum::<f64>() / bp.len() as f64;
-                (noise * noise / 2.0 + pooled / k).sqrt() * std::f64::consts::SQRT_2
-            } else {
-                noise
-            };
-            assert!(diff < 1.5 * noise + 1e-3 * mp, "{} {name}: blocks differ by {diff} (rms), the noise {noise}", scene.name);
+            if (mn / mp - 1.0).abs() >= 0.03 {
+                failures.push(format!("{} {name}: mean luminance {mn}, smallpt {mp}", scene.name));
+            }
+            if diff >= 2.0 * noise + 1e-3 * mp {
+                failures.push(format!("{} {name}: blocks differ by {diff} (rms), the noise {noise}", scene.name));
+            }
         }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// The Sobol sampler's images have less error than independent numbers'
