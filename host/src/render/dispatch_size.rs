@@ -18,6 +18,8 @@
 //! adapters keep the fixed size: the runner's resumed renders repeat its
 //! dispatches bit for bit, and lavapipe gets long loops wrong
 //! (see [`max_samples_per_dispatch`](super::settings::max_samples_per_dispatch)).
+//! A GPU's chunk is cut across the ends of passes unless each pass is
+//! scored (`run::device_loop`): cornell 0.543 -> 0.530 s on the H200.
 use super::settings::samples_per_dispatch;
 use crate::runtime::backend::DeviceClass;
 

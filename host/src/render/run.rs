@@ -34,7 +34,7 @@ use super::queue::{Grid, SampleQueue, Take};
 use super::settings::{samples_per_dispatch, MemoryEstimate, RenderSettings};
 use super::sums::{add_sums, error_row, mean_image};
 use super::variant::Plan;
-use crate::runtime::backend::Backend;
+use crate::runtime::backend::{Backend, DeviceClass};
 
 /// Seconds of work a device takes at a time. (On two H100s, chunks of 0.5
 /// and 1 s rendered the same images within 1% of the time of 0.25 s ones.)
@@ -216,11 +216,16 @@ pub fn device_loop<B: Backend>(b: &mut B, job: &DeviceJob<'_>) {
         let len = range.end - range.start;
         // Dispatched pass by pass, each cut by the dispatch size (on a CPU
         // device fixed, every `step` from the pass's start as the grid is,
-        // so that every render's dispatches are the same).
+        // so that every render's dispatches are the same). A GPU's sizes
+        // follow its timing anyway, so unless passes are scored one by one
+        // its chunk is cut evenly across pass ends: the passes of 4, 8, 16
+        // and 32 samples early in a render otherwise make short dispatches,
+        // whose lanes wait on their longest paths (see `DispatchSize`).
+        let by_pass = job.rows || b.class() != DeviceClass::Gpu;
         let dispatched = (|| -> Result<(f64, u32)> {
             let (mut at, mut largest) = (range.start, 0);
             while at < range.end {
-                let to = job.queue.grid().pass_end_after(at).min(range.end);
+                let to = if by_pass { job.queue.grid().pass_end_after(at).min(range.end) } else { range.end };
                 largest = largest.max(prepared.dispatch_samples(b, at, to - at, &size)?);
                 at = to;
             }
