@@ -191,6 +191,51 @@ fn instanced_scenes_hit_what_the_flattened_scene_hits() {
     }
 }
 
+/// Copies an engine places in the same place (here 40 of each of three
+/// placements: more than a sort's tie run, more than a subgroup) hit what
+/// one copy of each hits: the same triangle of the mesh at the same
+/// distance (which of the coincident copies is reported is the walk's
+/// tie-break), and every other ray misses.
+fn coincident<B: Backend>(b: &mut B, seed: u64) {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let m = meshes(&mut rng, &[300]);
+    let once = instances(&mut rng, 3, 1);
+    let repeated: Vec<Instance> = once.iter().flat_map(|i| std::iter::repeat_n(*i, 40)).collect();
+    // Rays at the copies (random ones mostly miss three of them).
+    let rays: Vec<Ray> = rays(&mut rng, 3000)
+        .into_iter()
+        .map(|r| {
+            let at = once[rng.random_range(0..3)].transform.map(|row| row[3] + rng.random_range(-1.5..1.5));
+            Ray { dir: [0, 1, 2].map(|k| at[k] - r.origin[k]), ..r }
+        })
+        .collect();
+    let refs: Vec<&[Triangle]> = m.iter().map(|m| m.as_slice()).collect();
+    let what = format!("{} seed {seed}", b.adapter());
+    let single = InstancedTracer::build(b, &refs, &once, Quality::Fast).unwrap().closest_hits(b, &rays).unwrap();
+    let scene = InstancedTracer::build(b, &refs, &repeated, Quality::Fast).unwrap();
+    let hits = scene.closest_hits(b, &rays).unwrap();
+    let occluded = scene.occluded(b, &rays).unwrap();
+    let mut hit = 0;
+    for (k, ((h, s), o)) in hits.iter().zip(&single).zip(&occluded).enumerate() {
+        assert_eq!(h.is_hit(), s.is_hit(), "{what}: ray {k} {:?}: coincident copies {h:?}, one copy {s:?}", rays[k]);
+        assert_eq!(*o, s.is_hit(), "{what}: ray {k}: occluded {o}, one copy {s:?}");
+        if h.is_hit() {
+            hit += 1;
+            assert_eq!((h.prim, h.t, h.instance / 40), (s.prim, s.t, s.instance), "{what}: ray {k}: {h:?} against one copy's {s:?}");
+        }
+    }
+    assert!(hit >= rays.len() / 20, "{what}: only {hit} rays hit");
+}
+
+#[test]
+fn coincident_copies_hit_what_one_copy_hits() {
+    let seed = fresh_seed();
+    coincident(&mut CpuBackend::new(), seed);
+    if let Some(ctx) = gpu() {
+        coincident(&mut GpuBackend::new(ctx), seed);
+    }
+}
+
 /// One copy in place (the identity) traces exactly as the mesh's own tracer:
 /// the ray is taken into the mesh's space without rounding.
 fn in_place<B: Backend>(b: &mut B, seed: u64) {
