@@ -234,7 +234,7 @@ fn cast_kernels_match_cpu() {
         for mode in [CAST_PRIMARY, CAST_BOUNCE, CAST_DIFFUSE] {
             let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, ..base }]).unwrap();
             let bindings = [&p, &prims.spheres, &materials, &tree.nodes, &tree.prims, &rays, &prims.triangles];
-            b.dispatch(kernel, &bindings, treelet_core::render::integrator::tiled_invocations(w, h).div_ceil(256));
+            b.dispatch(kernel, &bindings, treelet_core::render::integrator::tiled_invocations(w, h).div_ceil(kernel.workgroup_size()));
         }
         b.read(&rays, (2 * w * h) as usize).unwrap()
     }

@@ -39,5 +39,7 @@ pub mod scene;
 pub mod sort;
 pub mod treelet;
 
-// `#[spirv(compute(threads(256)))]` takes a literal: keep it in step.
+// `#[spirv(compute(threads(256)))]` takes a literal: keep it in step
+// (`threads(64)` for the ray kernels of `render`).
 const _: () = assert!(treelet_core::WORKGROUP_SIZE == 256);
+const _: () = assert!(treelet_core::gpu::workgroup::RAY_WORKGROUP_SIZE == 64);

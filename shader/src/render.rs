@@ -5,7 +5,7 @@ use treelet_core::geometry::prims::Prims;
 use treelet_core::geometry::features::{ALL, CAUSTICS, INDEPENDENT_NUMBERS, INSTANCES, TRIANGLES};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
-use treelet_core::gpu::workgroup::linear_id;
+use treelet_core::gpu::workgroup::{RAY_WORKGROUP_SIZE, linear_id, linear_id_in};
 use treelet_core::render::caustics::light_paths;
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
 use treelet_core::render::lights::Light;
@@ -44,7 +44,7 @@ macro_rules! render_kernel {
     // layout is not built past one binding yet, and its traversal lost 4%
     // of its diffuse rays/s to the split's branch (H100): it binds whole.
     ($pass:ident $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
-        #[spirv(compute(threads(256)))]
+        #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
             #[spirv(num_workgroups)] groups: UVec3,
@@ -60,7 +60,7 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &[$node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] prims_hi: &[$prim],
         ) {
-            let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
+            let pixel = tiled_pixel(linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE), params.width, params.height);
             if pixel != u32::MAX {
                 let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
                 let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
@@ -71,7 +71,7 @@ macro_rules! render_kernel {
     // The scan, the seed's layout and `cwbvh`: their buffers in one
     // binding each, triangles still in one or two parts.
     ($pass:ident whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
-        #[spirv(compute(threads(256)))]
+        #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
             #[spirv(num_workgroups)] groups: UVec3,
@@ -85,7 +85,7 @@ macro_rules! render_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] triangles_hi: &[Triangle],
         ) {
-            let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
+            let pixel = tiled_pixel(linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE), params.width, params.height);
             if pixel != u32::MAX {
                 let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
                 pass_body!($pass, pixel, params, scene, lights, accum, $features);
@@ -124,7 +124,7 @@ render_kernel!(camera whole classic_cs, Node, u32, ClassicTree::new, ALL);
 macro_rules! cast_kernel {
     // As `render_kernel!`: the `bvh2` layout's buffers in one or two parts.
     ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
-        #[spirv(compute(threads(256)))]
+        #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
             #[spirv(num_workgroups)] groups: UVec3,
@@ -139,14 +139,14 @@ macro_rules! cast_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &[$node],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] prims_hi: &[$prim],
         ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
+            let id = linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE);
             let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
             let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
             treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
     (whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
-        #[spirv(compute(threads(256)))]
+        #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
             #[spirv(num_workgroups)] groups: UVec3,
@@ -159,7 +159,7 @@ macro_rules! cast_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
         ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
+            let id = linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE);
             let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
             treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
@@ -199,7 +199,7 @@ pub fn cast_cwbvh_workgroup_cs(
 /// An engine's rays through an instanced scene: the top-level tree over
 /// the instances, then each instance's mesh tree (bindings: see
 /// `treelet_core::render::rays::cast_instances_kernel`).
-#[spirv(compute(threads(256)))]
+#[spirv(compute(threads(64)))]
 pub fn cast_instances_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
@@ -211,7 +211,7 @@ pub fn cast_instances_cs(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] triangles: &[Triangle],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] rays: &mut [[f32; 4]],
 ) {
-    let id = linear_id(gid.x, gid.y, groups.x);
+    let id = linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE);
     // Bound whole: the part past the split (the same slice) is never read.
     let prims = Prims { spheres, sphere_count: 0, triangles: Split::new(triangles, triangles), triangle_count: params.triangles };
     treelet_core::render::rays::cast_instances_kernel(
@@ -230,7 +230,7 @@ pub fn cast_instances_cs(
 /// of mesh triangles and copies.
 macro_rules! placed_kernel {
     ($pass:ident $name:ident, $features:expr) => {
-        #[spirv(compute(threads(256)))]
+        #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
             #[spirv(num_workgroups)] groups: UVec3,
@@ -252,7 +252,7 @@ macro_rules! placed_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 15)] nodes_hi: &[Vec4],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 16)] prims_hi: &[Vec4],
         ) {
-            let pixel = tiled_pixel(linear_id(gid.x, gid.y, groups.x), params.width, params.height);
+            let pixel = tiled_pixel(linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE), params.width, params.height);
             if pixel != u32::MAX {
                 let own = Bvh2Tree::new(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
                 // Bound whole: the part past the split (the same slice) is never read.

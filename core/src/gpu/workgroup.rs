@@ -12,8 +12,21 @@
 //! yet lower closures that capture references: they become structs of
 //! pointers, which logical SPIR-V forbids.)
 
-/// Invocations per workgroup, for every kernel of Treelet.
+/// Invocations per workgroup, for every kernel of Treelet but the ray
+/// kernels ([`RAY_WORKGROUP_SIZE`]).
 pub const WORKGROUP_SIZE: u32 = 256;
+/// Invocations per workgroup of the kernels that trace rays, one
+/// invocation a pixel or ray (the render's camera and light paths, the
+/// casts of `bench rays` and of the engine API; not the cast that keeps
+/// its stack in workgroup memory). Their lanes end at different times (a
+/// pixel's paths are as long as roulette makes them), and a workgroup's
+/// registers come back only when its last lane is done: in workgroups of
+/// two warps the SM starts new work sooner than in workgroups of eight. On
+/// an H200, 1024x768 renders took 0.530 -> 0.521 s of kernels (cornell,
+/// 1024 spp), 0.798 -> 0.758 s (`scenes/room_disk.json`), 0.574 -> 0.519 s
+/// (the bunny through `bvh2`, 256 spp) against 256; 32 was no better
+/// (`docs/results/h200-ray-workgroups-2026-11-28/`).
+pub const RAY_WORKGROUP_SIZE: u32 = 64;
 /// `WORKGROUP_SIZE` as a `usize`, for array lengths of workgroup memory.
 pub const WG: usize = WORKGROUP_SIZE as usize;
 /// log2(WORKGROUP_SIZE): steps of a tree reduction or a Hillis-Steele scan.
@@ -90,7 +103,13 @@ pub fn reduction_stride(step: u32) -> u32 {
 /// 65535 workgroups of work can be dispatched: see [`dispatch_grid`].
 #[inline]
 pub fn linear_id(global_x: u32, global_y: u32, num_groups_x: u32) -> u32 {
-    global_y * num_groups_x * WORKGROUP_SIZE + global_x
+    linear_id_in(global_x, global_y, num_groups_x, WORKGROUP_SIZE)
+}
+
+/// [`linear_id`] for workgroups of `size` invocations.
+#[inline]
+pub fn linear_id_in(global_x: u32, global_y: u32, num_groups_x: u32, size: u32) -> u32 {
+    global_y * num_groups_x * size + global_x
 }
 
 /// Linear workgroup id of a 2D dispatch.

@@ -399,7 +399,7 @@ pub(crate) fn time_casts<B: Backend>(
     (width, height): (u32, u32),
     repeats: usize,
 ) -> Result<(f64, f64, f64, u64)> {
-    use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+    use treelet_core::gpu::workgroup::groups_for;
     use treelet_core::render::rays::{CAST_BOUNCE, CAST_DIFFUSE, CAST_DIFFUSE_OCCLUDED, CAST_PRIMARY};
     let pixels = width * height;
     let base = treelet_core::RenderParams {
@@ -411,7 +411,7 @@ pub(crate) fn time_casts<B: Backend>(
         camera: scene.camera.camera(width, height),
         ..Default::default()
     };
-    let groups = groups_for(treelet_core::render::integrator::tiled_invocations(width, height), WORKGROUP_SIZE);
+    let groups = groups_for(treelet_core::render::integrator::tiled_invocations(width, height), kernel.workgroup_size());
     let (mut primary, mut diffuse, mut occlusion) = (Vec::new(), Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,

@@ -3,7 +3,7 @@
 //! the accumulation buffer of per-pixel sums that its dispatches add to.
 use anyhow::{bail, Context, Result};
 use treelet_core::geometry::buffers::RenderParams;
-use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
+use treelet_core::gpu::workgroup::groups_for;
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::lights::{light_power, Light};
 
@@ -302,7 +302,7 @@ fn dispatch_render<B: Backend>(
     b.dispatch(
         kernel,
         &[&p, &buffers.spheres, materials, &tree.nodes, &tree.prims, accum, &buffers.triangles, lights],
-        groups_for(tiled_invocations(params.width, params.height), WORKGROUP_SIZE),
+        groups_for(tiled_invocations(params.width, params.height), kernel.workgroup_size()),
     );
     Ok(())
 }
@@ -338,7 +338,7 @@ fn dispatch_placed<B: Backend>(
             triangles,
             placed_materials,
         ],
-        groups_for(tiled_invocations(params.width, params.height), WORKGROUP_SIZE),
+        groups_for(tiled_invocations(params.width, params.height), kernel.workgroup_size()),
     );
     Ok(())
 }

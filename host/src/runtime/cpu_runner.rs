@@ -15,7 +15,7 @@ use treelet_core::geometry::split::{Split, SplitMut};
 use treelet_core::geometry::aabb::Aabb;
 use treelet_core::construct::multisplit::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
 use treelet_core::gpu::subgroup::{self, Lane};
-use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE};
+use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE, groups_for};
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
 use treelet_core::render::lights::Light;
 use treelet_core::render::variants::VARIANTS;
@@ -379,6 +379,10 @@ impl Backend for CpuBackend {
         assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
         let mut guards: Vec<_> = bindings.iter().map(|b| b.borrow_mut()).collect();
         let mut b: Vec<&mut [u64]> = guards.iter_mut().map(|g| g.as_mut_slice()).collect();
+        // The runner counts invocations in workgroups of `WORKGROUP_SIZE`;
+        // the ray kernels' smaller ones are rounded up to those (their
+        // invocations past the last pixel return at once, as on the GPU).
+        let groups = groups_for(groups * kernel.workgroup_size(), WORKGROUP_SIZE);
         run_kernel(kernel, &mut b, groups, self.subgroup_size);
         self.dispatched.insert(kernel);
     }

@@ -401,6 +401,24 @@ impl Kernel {
         }
     }
 
+    /// Invocations per workgroup of the kernel's entry point (the number a
+    /// dispatch's workgroups are counted in): the ray kernels' own size
+    /// (`treelet_core::gpu::workgroup::RAY_WORKGROUP_SIZE`), else
+    /// `WORKGROUP_SIZE`.
+    pub fn workgroup_size(self) -> u32 {
+        use treelet_core::gpu::workgroup::{RAY_WORKGROUP_SIZE, WORKGROUP_SIZE};
+        match self {
+            Kernel::Render(..)
+            | Kernel::Light(..)
+            | Kernel::RenderPlaced
+            | Kernel::RenderPlacedCaustics
+            | Kernel::LightPlaced
+            | Kernel::Cast(..)
+            | Kernel::CastInstances => RAY_WORKGROUP_SIZE,
+            _ => WORKGROUP_SIZE,
+        }
+    }
+
     /// Bindings in order; binding 0 is always the parameter struct.
     pub fn bindings(self) -> &'static [Access] {
         match self {

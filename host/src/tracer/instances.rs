@@ -313,7 +313,7 @@ impl<B: Backend> InstancedTracer<B> {
         b.dispatch(
             Kernel::CastInstances,
             &[&params, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
-            groups_for(tiled_invocations(p.width, p.height), WORKGROUP_SIZE),
+            groups_for(tiled_invocations(p.width, p.height), Kernel::CastInstances.workgroup_size()),
         );
         Ok(())
     }

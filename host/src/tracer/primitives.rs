@@ -2,7 +2,7 @@
 use anyhow::{bail, Result};
 use treelet_core::geometry::buffers::{RenderParams, Sphere};
 use treelet_core::geometry::triangle::Triangle;
-use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::gpu::workgroup::groups_for;
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
@@ -231,7 +231,7 @@ impl<B: Backend> Tracer<B> {
         b.dispatch(
             kernel,
             &[&p, &self.prims.spheres, &materials, &tree.nodes, &tree.prims, rays, &self.prims.triangles],
-            groups_for(tiled_invocations(width, height), WORKGROUP_SIZE),
+            groups_for(tiled_invocations(width, height), kernel.workgroup_size()),
         );
         Ok(())
     }

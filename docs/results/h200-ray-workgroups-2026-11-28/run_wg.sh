@@ -1,0 +1,15 @@
+for f in tb t64 t32; do xz -dkf $f.xz; chmod +x $f; done
+nvidia-smi --query-gpu=name,driver_version,clocks.sm --format=csv,noheader
+R="--width 1024 --height 768 --device gpu --spp 1024"
+ROOM=../scenes/room_disk.json
+./tb render $R --spp 4 --out /tmp/w.png 2>&1 | tail -1
+for i in 1 2 3; do
+ for b in tb t64 t32; do
+  echo "== $b round $i"
+  timeout -s KILL 60 ./$b render $R --out /tmp/c_$b.pfm 2>&1 | tail -1
+  timeout -s KILL 60 ./$b render --scene $ROOM $R --out /tmp/r_$b.pfm 2>&1 | tail -1
+  timeout -s KILL 60 ./$b render --scene bunny.obj --width 1024 --height 768 --device gpu --spp 256 --out /tmp/b_$b.pfm 2>&1 | tail -1
+ done
+done
+for b in t64 t32; do for s in c r b; do ./tb compare --reference /tmp/${s}_tb.pfm /tmp/${s}_$b.pfm 2>&1 | tail -1; done; done
+nvidia-smi --query-gpu=clocks.sm --format=csv,noheader
