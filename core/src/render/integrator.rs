@@ -168,7 +168,9 @@ pub struct Path {
     /// not two (with two, NEE through the treelet BVH ran 6.7 times as long
     /// as smallpt's estimator on the H100; with one, 3 times; with pbrt-v4's
     /// roulette as well, 1.8 times). While one is pending, `(o, d, from)` is
-    /// the shadow ray, `next_*` the path's bounce, and `shadow_value` what
+    /// the shadow ray, `next_d` and [`NEXT_INTO`] the path's bounce (which
+    /// leaves from the same point and primitive, so only its direction and
+    /// side are kept: three registers fewer), and `shadow_value` what
     /// the light adds if the ray reaches `shadow_light` first: if an
     /// occlusion query finds nothing else up to `shadow_t`, where the ray
     /// meets the light (it stops at the first occluder, and the light is
@@ -177,10 +179,7 @@ pub struct Path {
     shadow_light: u32,
     shadow_t: f32,
     shadow_value: Vec3,
-    shadow_d: Vec3,
-    next_o: Vec3,
     next_d: Vec3,
-    next_from: Origin,
     /// [`ENDED`], and where the path stands among those light paths find
     /// instead ([`CAUSTICS`]): [`SEEN_DIFFUSE`] while every hit has been
     /// diffuse, [`THEN_SPECULAR`] after mirror or glass bounces since. One
@@ -197,6 +196,9 @@ const SEEN_DIFFUSE: u32 = 2;
 const THEN_SPECULAR: u32 = 4;
 /// [`Path::flags`]: the caustic states.
 const CAUSTIC_STATE: u32 = SEEN_DIFFUSE | THEN_SPECULAR;
+/// [`Path::flags`]: while a shadow ray is pending, the path's bounce heads
+/// into the sphere it leaves (its [`Origin::into`]).
+const NEXT_INTO: u32 = 8;
 
 impl Path {
     /// A path starting with the ray `(o, d)`, as sample `sample` of its pixel.
@@ -215,10 +217,7 @@ impl Path {
             shadow_light: NO_LIGHT,
             shadow_t: 0.0,
             shadow_value: Vec3::ZERO,
-            shadow_d: Vec3::Z,
-            next_o: o,
             next_d: d,
-            next_from: Origin::NONE,
             flags: 0,
         }
     }
@@ -266,7 +265,8 @@ impl Path {
                 self.result += self.shadow_value;
             }
             self.shadow_light = NO_LIGHT;
-            (self.o, self.d, self.from) = (self.next_o, self.next_d, self.next_from);
+            // The bounce leaves from where the shadow ray did.
+            (self.d, self.from.into) = (self.next_d, self.flags & NEXT_INTO != 0);
             return true;
         }
         if !hit.is_hit() {
@@ -313,6 +313,8 @@ impl Path {
             return false;
         }
         let eps = surface_offset(x);
+        // The light sample's direction, where one is taken (a diffuse hit).
+        let mut shadow_d = Vec3::Z;
         // Branches for materials outside `F` are not compiled (the host
         // never runs such a kernel on a scene that has them).
         if !has(F, features::MIRROR | features::GLASS) || m.kind == DIFFUSE {
@@ -323,7 +325,7 @@ impl Path {
             if nee {
                 let s = sample_direct(x, nl, hit.prim, &rng, params, scene, lights);
                 if s.light != NO_LIGHT && !T::OCCLUSION_STOPS_EARLY {
-                    (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                    (self.shadow_light, shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
                 } else if s.light != NO_LIGHT {
                     // Where the shadow ray (as traced below) meets the light,
                     // by the test the traversal itself would make; a ray
@@ -331,7 +333,7 @@ impl Path {
                     let (so, from) = (x + nl * eps, Origin { prim: hit.prim, into: s.dir.dot(n) < 0.0 });
                     let t = scene.prims.distance::<F>(so, s.dir, &WatertightRay::new(so, s.dir), from, s.light, MISS);
                     if t < MISS {
-                        (self.shadow_light, self.shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
+                        (self.shadow_light, shadow_d, self.shadow_value) = (s.light, s.dir, self.throughput * s.value);
                         self.shadow_t = t;
                     }
                 }
@@ -375,8 +377,11 @@ impl Path {
         }
         if self.shadow_light != NO_LIGHT {
             // The shadow ray first, from the same point (see above).
-            (self.next_o, self.next_d, self.next_from) = (self.o, self.d, self.from);
-            (self.o, self.d, self.from) = (x + nl * eps, self.shadow_d, Origin { prim: hit.prim, into: self.shadow_d.dot(n) < 0.0 });
+            // Only a diffuse bounce samples a light: its ray leaves from
+            // `x + nl * eps` too, and from the same primitive.
+            self.next_d = self.d;
+            self.flags = (self.flags & !NEXT_INTO) | if self.from.into { NEXT_INTO } else { 0 };
+            (self.d, self.from) = (shadow_d, Origin { prim: hit.prim, into: shadow_d.dot(n) < 0.0 });
         }
         true
     }
