@@ -22,6 +22,7 @@ use crate::geometry::split::{Split, SplitMut};
 use crate::geometry::triangle::Triangle;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::at;
+use crate::trace::bvh2::ENTER;
 
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
 /// nodes, root 0, depth-first order: a left child follows its parent, a
@@ -229,8 +230,9 @@ fn child_ref(c: &Node, internal_index: u32) -> (u32, u32) {
 /// `n - 1 + j`): the top level of an instanced scene
 /// ([`crate::trace::instances`]) in the [`Bvh2Node`] layout, node `i` at
 /// `i`, without the collapse's depth-first compaction or leaf primitives:
-/// a leaf child refers to its instance directly (`prim_indices[j]`, count
-/// 1). One tree of one leaf gets a root whose second child is an empty box.
+/// a leaf child refers to its instance directly (`prim_indices[j]` with
+/// [`ENTER`], count 0: walked to as a node, and entered). One tree of one
+/// leaf gets a root whose second child is an empty box.
 pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2Node> + ?Sized>(
     i: u32,
     n: u32,
@@ -240,7 +242,7 @@ pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2No
 ) {
     if n == 1 {
         if i == 0 {
-            out.store(0, &single_leaf_root(&nodes.load(0), at(prim_indices, 0), 1));
+            out.store(0, &single_leaf_root(&nodes.load(0), ENTER | at(prim_indices, 0), 0));
         }
         return;
     }
@@ -249,7 +251,7 @@ pub fn top_level_node_kernel<N: RecordLoad<Node> + ?Sized, O: RecordStore<Bvh2No
     }
     let node = nodes.load(i as usize);
     let (l, r) = (nodes.load(node.left as usize), nodes.load(node.right as usize));
-    let child = |index: u32, c: &Node| if c.is_leaf() { (at(prim_indices, c.left as usize), 1) } else { (index, 0) };
+    let child = |index: u32, c: &Node| if c.is_leaf() { (ENTER | at(prim_indices, c.left as usize), 0) } else { (index, 0) };
     out.store(i as usize, &two_boxes(&l, &r, child(node.left, &l), child(node.right, &r)));
 }
 

@@ -170,7 +170,7 @@ pub struct Path {
     /// roulette as well, 1.8 times). While one is pending, `(o, d, from)` is
     /// the shadow ray, `next_d` and [`NEXT_INTO`] the path's bounce (which
     /// leaves from the same point and primitive, so only its direction and
-    /// side are kept: three registers fewer), and `shadow_value` what
+    /// side are kept: eight words of state fewer), and `shadow_value` what
     /// the light adds if the ray reaches `shadow_light` first: if an
     /// occlusion query finds nothing else up to `shadow_t`, where the ray
     /// meets the light (it stops at the first occluder, and the light is

@@ -126,19 +126,23 @@ impl RecordLoad<InstanceRecord> for NoInstances {
     }
 }
 
-/// A top-level leaf's instance with this bit, walked to as a node is
-/// (entered rather than tested).
-const ENTER: u32 = 1 << 31;
+/// A top-level child that is an instance carries this bit on its index
+/// (and a count of 0: [`crate::layouts::bvh2::top_level_node_kernel`]), so
+/// the walk goes to it as to an internal node and enters it when it gets
+/// there; no node of a mesh's tree has an index this high.
+pub const ENTER: u32 = 1 << 31;
 
 /// The walk every traversal of this layout shares, nearer child first (see
 /// the module doc), from `query.start()`. With `INSTANCED`, `trees` holds
 /// an instanced scene's top level from node 0 (a tree over `instances`,
 /// [`crate::trace::instances`]) and every mesh's tree after it: a top-level
-/// leaf is an instance, entered when the walk gets to it by taking the ray
-/// into its mesh's space and going on in the mesh's tree (at the
-/// instance's bases), on the same stack, until the stack is back at its
-/// height on entering. One buffer for both levels, so every node is read
-/// by the one load (two loads under a branch made the walk slower).
+/// child is an instance ([`ENTER`]), entered when the walk gets to it by
+/// taking the ray into its mesh's space and going on in the mesh's tree
+/// (at the instance's bases), on the same stack, until the stack is back
+/// at its height on entering. One buffer for both levels, so every node is
+/// read by the one load (two loads under a branch made the walk slower),
+/// and one loop body for both (the top level has no leaves to test, so
+/// nothing in the loop asks which level it is in).
 /// Without, `trees` is the one tree and `instances` is never read: the
 /// same code as a plain walk. `STACK`: words of the stack (two an entry;
 /// [`STACK_DEPTH`] entries a level). Returns the hit and its instance
@@ -156,19 +160,19 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
 ) -> (Hit, u32) {
     let mut hit = query.start();
     let mut found_in = u32::MAX;
-    // Where the walk is: in a mesh (`inside`; the bases of its nodes and
-    // leaf primitives, the ray in its space), or in the top level.
-    let mut inside = !INSTANCED;
+    // The bases of the nodes and leaf primitives of the mesh the walk is
+    // in (0 in the top level), and the ray in its space.
     let (mut node_base, mut leaf_base) = (0u32, 0u32);
     let (mut slabs, mut ray, mut at_ray) = (SlabRay::new(o, d), WatertightRay::new(o, d), (o, d, from));
     // Entries: node index and the entry distance it was pushed with; below
-    // `floor`, the top level's. `STACK` words: two a level of depth, for
-    // both levels when instanced, and then the world ray and the instance
-    // entered in the last `WORLD` words: read only on entering and leaving
-    // a mesh, they stay out of the registers the walk's loop keeps (held
-    // there, the driver gave the engine's instanced kernel 80 registers
-    // against the plain walk's 64, so three workgroups an SM instead of
-    // four; now 64 as well).
+    // `floor`, the top level's (`usize::MAX` while in the top level).
+    // `STACK` words: two a level of depth, for both levels when
+    // instanced, and then the world ray and the instance entered in the
+    // last `WORLD` words: read only on entering and leaving a mesh, they
+    // stay out of the registers the walk's loop keeps (held there, the
+    // driver gave the engine's instanced kernel 80 registers against the
+    // plain walk's 64, so three workgroups an SM instead of four; now 64
+    // as well).
     let mut stack = [0u32; STACK];
     let entries = if INSTANCED { (STACK - WORLD) / 2 } else { STACK / 2 };
     if INSTANCED {
@@ -179,12 +183,10 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             k += 1;
         }
     }
-    let (mut top_len, mut floor) = (0usize, 0usize);
+    let (mut top_len, mut floor) = (0usize, usize::MAX);
     let mut node = 0u32;
     loop {
-        if INSTANCED && !inside && node & ENTER != 0 {
-            // The top level's leaves refer to their instances directly
-            // (`crate::layouts::bvh2::top_level_node_kernel`).
+        if INSTANCED && node & ENTER != 0 {
             let current = node & !ENTER;
             set(&mut stack, STACK - 1, current);
             let record = instances.load(current as usize);
@@ -192,7 +194,6 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             let (wo, wd) = world_ray::<STACK>(&stack);
             let (o2, d2) = record.to_object(wo, wd);
             (slabs, ray, at_ray) = (SlabRay::new(o2, d2), WatertightRay::new(o2, d2), (o2, d2, Origin::NONE));
-            inside = true;
             floor = top_len;
             node = 0;
         }
@@ -200,34 +201,24 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
         let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
         let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
-        let (mut left, mut right) = (n.left, n.right);
-        if inside {
-            // Leaves are tested at once; only internal children are walked.
-            let before = hit;
-            let leaves = (leaf_base, query, &ray, prims, trees.leaves);
-            if go_left && n.left_count > 0 {
-                leaf::<F>(&mut hit, leaves.0 + n.left, n.left_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
-                go_left = false;
-            }
-            if go_right && n.right_count > 0 {
-                leaf::<F>(&mut hit, leaves.0 + n.right, n.right_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
-                go_right = false;
-            }
-            if INSTANCED && (hit.t != before.t || hit.prim != before.prim) {
-                found_in = get(&stack, STACK - 1);
-            }
-            if query.done(&hit) {
-                return (hit, found_in);
-            }
-        } else {
-            // A top-level leaf (one instance) is walked to like a node.
-            if n.left_count > 0 {
-                left = ENTER | n.left;
-            }
-            if n.right_count > 0 {
-                right = ENTER | n.right;
-            }
+        // Leaves are tested at once; only internal children are walked.
+        let before = hit;
+        let leaves = (leaf_base, query, &ray, prims, trees.leaves);
+        if go_left && n.left_count > 0 {
+            leaf::<F>(&mut hit, leaves.0 + n.left, n.left_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
+            go_left = false;
         }
+        if go_right && n.right_count > 0 {
+            leaf::<F>(&mut hit, leaves.0 + n.right, n.right_count, at_ray, leaves.1, leaves.2, leaves.3, leaves.4);
+            go_right = false;
+        }
+        if INSTANCED && (hit.t != before.t || hit.prim != before.prim) {
+            found_in = get(&stack, STACK - 1);
+        }
+        if query.done(&hit) {
+            return (hit, found_in);
+        }
+        let (left, right) = (n.left, n.right);
         if go_left && go_right {
             let (near, far, far_t) = if ln <= rn { (left, right, rn) } else { (right, left, ln) };
             if top_len < entries {
@@ -245,8 +236,8 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             // the mesh when its entries are all taken.
             let mut next = u32::MAX;
             while next == u32::MAX {
-                if INSTANCED && inside && top_len == floor {
-                    inside = false;
+                if INSTANCED && top_len == floor {
+                    floor = usize::MAX;
                     node_base = 0;
                     let (wo, wd) = world_ray::<STACK>(&stack);
                     slabs = SlabRay::new(wo, wd);
