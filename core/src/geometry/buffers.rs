@@ -489,3 +489,7 @@ impl Sphere {
         Aabb::new(c - r, c + r)
     }
 }
+
+/// A top-level [`Bvh2Node`] child that is an instance carries this bit on
+/// its index, with a count of 0 (see [`crate::trace::bvh2::walk`]).
+pub const ENTER: u32 = 1 << 31;

@@ -22,7 +22,7 @@ use crate::geometry::split::{Split, SplitMut};
 use crate::geometry::triangle::Triangle;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::at;
-use crate::trace::bvh2::ENTER;
+use crate::geometry::buffers::ENTER;
 
 /// Kernel, one invocation per node `i` of a collapsed tree (`node_count`
 /// nodes, root 0, depth-first order: a left child follows its parent, a

@@ -130,7 +130,7 @@ impl RecordLoad<InstanceRecord> for NoInstances {
 /// (and a count of 0: [`crate::layouts::bvh2::top_level_node_kernel`]), so
 /// the walk goes to it as to an internal node and enters it when it gets
 /// there; no node of a mesh's tree has an index this high.
-pub const ENTER: u32 = 1 << 31;
+pub use crate::geometry::buffers::ENTER;
 
 /// The walk every traversal of this layout shares, nearer child first (see
 /// the module doc), from `query.start()`. With `INSTANCED`, `trees` holds
