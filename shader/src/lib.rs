@@ -31,6 +31,7 @@ pub mod depth;
 pub mod fill;
 pub mod fit;
 pub mod morton;
+pub mod presplit;
 pub mod multisplit;
 pub mod radix_tree;
 pub mod render;

@@ -5,6 +5,7 @@
 //! | stage | module | paper |
 //! |---|---|---|
 //! | primitive boxes | [`primitive_boxes`] | |
+//! | large triangles split into pieces (optional) | [`presplit`] | Karras & Aila 2013, section 5.1 |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
 //! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone), [`sort_ties`] (high digits first, then ties) | Adinets & Merrill 2022 (Onesweep) |
@@ -34,6 +35,7 @@ pub mod hploc;
 pub mod instances;
 pub mod morton;
 pub mod multisplit;
+pub mod presplit;
 pub mod primitive_boxes;
 pub mod radix_tree;
 pub mod sah;

@@ -101,6 +101,25 @@ pub struct BuildParams {
 }
 const _: () = assert!(core::mem::size_of::<BuildParams>() == 64);
 
+/// Parameters of the triangle splitting before a build
+/// (`construct::presplit`). repr(C), Pod, 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct SplitParams {
+    /// Number of primitives.
+    pub n: u32,
+    /// How many of them are spheres (the rest are triangles).
+    pub spheres: u32,
+    /// Extra pieces per unit of priority (the budget over the sum of priorities).
+    pub scale: f32,
+    pub _pad0: u32,
+    /// The primitives' Morton frame, whose grid planes the splits use
+    /// (min = offset, max = scale: see `construct::morton::MortonFrame`).
+    pub frame: Aabb,
+}
+const _: () = assert!(core::mem::size_of::<SplitParams>() == 48);
+
 /// Parameters of the radix sort's kernels. repr(C), Pod, 16 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]

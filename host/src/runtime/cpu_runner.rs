@@ -25,7 +25,7 @@ use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
 use treelet_core::construct::{
-    agglomerate, bounds, collapse, fill, fit, morton, primitive_boxes, radix_tree, scan, sort, treelet_kernels,
+    agglomerate, bounds, collapse, fill, fit, morton, presplit, primitive_boxes, radix_tree, scan, sort, treelet_kernels,
 };
 use treelet_core::layouts::{bvh2, cwbvh_build};
 
@@ -474,6 +474,47 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (boxes, keys, values, slots, zeroed) = (view(boxes), view(keys), view(values), view(slots), view(zeroed));
             for id in ids(groups) {
                 morton::morton_kernel(id, &p, boxes, keys, values, slots, zeroed);
+            }
+        }
+        (Kernel::SplitPriority, [p, triangles, priorities, partials]) => {
+            let p: treelet_core::SplitParams = params(p);
+            let (triangles, priorities, partials) = (view(triangles), view(priorities), view(partials));
+            let triangles = Split::whole(triangles);
+            let mut shared = [0f32; WG];
+            workgroups(groups, presplit::PRIORITY_PHASES, |g, phase, lid| {
+                presplit::priority_phase(phase, lid, g, &p, triangles, priorities, partials, &mut shared)
+            });
+        }
+        (Kernel::SplitCount, [p, priorities, counts]) => {
+            let p: treelet_core::SplitParams = params(p);
+            let (priorities, counts) = (view(priorities), view(counts));
+            for id in ids(groups) {
+                presplit::count_kernel(id, &p, priorities, counts);
+            }
+        }
+        (Kernel::SplitEmit, [p, spheres, triangles, offsets, ref_boxes, ref_prims]) => {
+            let p: treelet_core::SplitParams = params(p);
+            let (spheres, triangles, offsets) = (view(spheres), view(triangles), view(offsets));
+            let (ref_boxes, ref_prims) = (view::<Aabb>(ref_boxes), view(ref_prims));
+            let triangles = Split::whole(triangles);
+            for id in ids(groups) {
+                presplit::emit_kernel(id, &p, spheres, triangles, offsets, ref_boxes, ref_prims);
+            }
+        }
+        (Kernel::SplitBounds, [p, ref_boxes, boxes, bounds_words]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (ref_boxes, boxes, bounds_words) = (view::<Aabb>(ref_boxes), view::<Aabb>(boxes), view(bounds_words));
+            let mut shared = [Aabb::EMPTY; WG];
+            let mut source = presplit::StoredBoxes { boxes: ref_boxes };
+            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
+                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
+            });
+        }
+        (Kernel::SplitRemap, [p, ref_prims, values]) => {
+            let p: treelet_core::BuildParams = params(p);
+            let (ref_prims, values) = (view(ref_prims), view(values));
+            for id in ids(groups) {
+                presplit::remap_kernel(id, p.n, ref_prims, values);
             }
         }
         (Kernel::SortHistogram, [p, keys, sort_state]) => {

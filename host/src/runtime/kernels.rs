@@ -82,6 +82,17 @@ pub enum Kernel {
     /// [`Kernel::PrimitiveBoxes`] fused with the centroid bounds.
     PrimitiveBounds,
     Morton,
+    /// Triangle splitting (`treelet_core::construct::presplit`): each
+    /// primitive's priority and their sums per workgroup.
+    SplitPriority,
+    /// Triangle splitting: pieces per primitive.
+    SplitCount,
+    /// Triangle splitting: each primitive's pieces, boxes and primitive.
+    SplitEmit,
+    /// Triangle splitting: the pieces' boxes as the build's, with their centroid bounds.
+    SplitBounds,
+    /// Triangle splitting: leaf slots name primitives instead of pieces.
+    SplitRemap,
     /// Radix sort: digit counts of every pass.
     SortHistogram,
     /// Radix sort: where each digit starts, per pass.
@@ -214,7 +225,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 61] = [
+    const FIXED: [Kernel; 66] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -223,6 +234,11 @@ impl Kernel {
         Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
         Kernel::Morton,
+        Kernel::SplitPriority,
+        Kernel::SplitCount,
+        Kernel::SplitEmit,
+        Kernel::SplitBounds,
+        Kernel::SplitRemap,
         Kernel::SortHistogram,
         Kernel::SortOffsets,
         Kernel::SortSettleTies,
@@ -312,6 +328,11 @@ impl Kernel {
             Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
             Kernel::Morton => "morton::morton_cs",
+            Kernel::SplitPriority => "presplit::split_priority_cs",
+            Kernel::SplitCount => "presplit::split_count_cs",
+            Kernel::SplitEmit => "presplit::split_emit_cs",
+            Kernel::SplitBounds => "presplit::split_bounds_cs",
+            Kernel::SplitRemap => "presplit::split_remap_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
             Kernel::SortOffsets => "sort::sort_offsets_cs",
             Kernel::SortSettleTies => "sort::sort_settle_ties_cs",
@@ -384,6 +405,8 @@ impl Kernel {
         match self {
             Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
             Kernel::Fit | Kernel::FitRelaxed => &[3],
+            Kernel::SplitPriority => &[1],
+            Kernel::SplitEmit => &[2],
             Kernel::RefitState => &[1],
             Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7, 8],
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
@@ -430,6 +453,11 @@ impl Kernel {
             Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
+            Kernel::SplitPriority => &[Read, Read, ReadWrite, ReadWrite],
+            Kernel::SplitCount => &[Read, Read, ReadWrite],
+            Kernel::SplitEmit => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
+            Kernel::SplitBounds => &[Read, Read, ReadWrite, ReadWrite],
+            Kernel::SplitRemap => &[Read, Read, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
             Kernel::ScanReduce => &[Read, Read, ReadWrite],
             Kernel::ScanSpine => &[Read, ReadWrite],
