@@ -11,9 +11,9 @@ use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
-use treelet::bvh::tree::{traced_tree, Accel};
+use treelet::bvh::tree::{binary_tree_split, traced_tree, Accel};
 use treelet::scene::{random_spheres, Scene};
-use treelet::bvh::validate_layout::{validate_bvh2, validate_wide};
+use treelet::bvh::validate_layout::{validate_bvh2, validate_bvh2_split, validate_wide, validate_wide_split};
 use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
 use treelet_core::geometry::features::ALL;
 use treelet_core::geometry::prims::{Origin, Prims};
@@ -152,6 +152,147 @@ fn every_layout_traces_like_the_scan(what: &str, spheres: &[Sphere], triangles: 
             }
         }
     }
+}
+
+/// A tree over pieces of the triangles (`budget` times the triangles more
+/// at most), laid out, and its number of leaf slots.
+fn build_split<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout, budget: f32) -> (HostTree, usize) {
+    let built = binary_tree_split(b, prims, accel.builder().unwrap().unwrap(), budget).unwrap();
+    let buffers = built.prim_buffers(b, prims).unwrap();
+    let (tree, _) = built.lay_out(b, layout, &buffers).unwrap();
+    let slots = built.bvh.n as usize;
+    (read(b, &tree, slots), slots)
+}
+
+impl HostTree {
+    fn validate_split(&self, prims: Primitives, what: &str) {
+        let v = match self {
+            HostTree::Classic(..) => return,
+            HostTree::Bvh2(nodes, leaf) => validate_bvh2_split(prims, nodes, leaf),
+            HostTree::Wide(nodes, leaf) => validate_wide_split(prims, nodes, leaf),
+        };
+        assert!(v.is_valid(), "{what}: {:?}", v.errors);
+    }
+}
+
+/// Trees over pieces of triangles (`treelet_core::construct::presplit`),
+/// built by the CPU runner and, where there is one, the GPU: valid (each
+/// triangle covered by its pieces' leaves), with more leaf slots than
+/// primitives where `splits` says the scene has triangles worth splitting,
+/// and exactly the scan's hits in every layout. The GPU's reference count
+/// is the CPU runner's to 1% (priorities are sums of products the GPU may
+/// fuse, so a count at a rounding boundary may differ by one).
+fn split_trees_trace_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[Triangle], seed: u32, splits: bool) {
+    let prims = Primitives { spheres, triangles };
+    prims.check().unwrap();
+    let scene = Prims::new(spheres, triangles);
+    let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
+    let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 600);
+    let gpu = treelet_tests::gpu();
+    for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc] {
+        for layout in [Layout::Classic, Layout::Bvh2, Layout::Cwbvh] {
+            let cpu = build_split(&mut CpuBackend::new(), prims, accel, layout, 0.5);
+            let mut trees = vec![("CPU runner", cpu.0)];
+            assert!(!splits || cpu.1 > prims.len(), "{what}, {accel:?}: no triangle was split");
+            assert!(cpu.1 <= prims.len() + triangles.len() / 2, "{what}, {accel:?}: {} slots past the budget", cpu.1);
+            if let Some(ctx) = &gpu {
+                let g = build_split(&mut GpuBackend::new(ctx.clone()), prims, accel, layout, 0.5);
+                let diff = g.1.abs_diff(cpu.1);
+                assert!(diff * 100 <= cpu.1, "{what}, {accel:?}: {} references on the GPU, {} on the CPU runner", g.1, cpu.1);
+                trees.push(("GPU", g.0));
+            }
+            for (device, tree) in &trees {
+                let what = format!("{what}, {accel:?} in {} over pieces, {device}, seed {seed}", layout.name());
+                tree.validate_split(prims, &what);
+                for (k, &(o, d, from, scan)) in probes.iter().enumerate() {
+                    let hit = tree.trace(o, d, from, &scene);
+                    assert!(
+                        hit.t.to_bits() == scan.t.to_bits() && hit.prim == scan.prim,
+                        "{what}: ray {k} (o {o}, d {d}) hit {} at {}, the scan {} at {}",
+                        hit.prim,
+                        hit.t,
+                        scan.prim,
+                        scan.t
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Triangles of every size, as real scenes have: a ground of two huge
+/// triangles, long slivers across it, walls, and small terrain detail.
+fn irregular(seed: u32) -> Vec<Triangle> {
+    let mut out = vec![
+        Triangle::new([-500.0, 0.0, -500.0], [500.0, 0.0, -500.0], [500.0, 0.0, 500.0]),
+        Triangle::new([-500.0, 0.0, -500.0], [500.0, 0.0, 500.0], [-500.0, 0.0, 500.0]),
+    ];
+    for i in 0..40 {
+        let r = BounceRng::new(seed, i, 0, 0);
+        let (a, b) = (vec3(&r, 0) * 800.0 - 400.0, vec3(&r, 3) * 800.0 - 400.0);
+        // A cable: long, thin, diagonal.
+        out.push(Triangle::new(a.to_array(), b.to_array(), (b + Vec3::splat(0.05)).to_array()));
+        // A wall: a tall upright quad's half.
+        out.push(Triangle::new([a.x, 0.0, a.z], [b.x, 0.0, b.z], [b.x, 30.0 + 100.0 * r.uniform(6), b.z]));
+    }
+    out.extend(terrain(2000).iter().map(|t| {
+        let f = |v: [f32; 3]| [v[0] * 0.5 + 20.0, v[1] * 0.5 + 1.0, v[2] * 0.5 - 10.0];
+        Triangle::new(f(t.v0), f(t.v1), f(t.v2))
+    }));
+    out
+}
+
+#[test]
+fn split_trees_find_the_scans_hits() {
+    let seed = treelet_tests::fresh_seed() as u32;
+    let scene = irregular(seed);
+    split_trees_trace_like_the_scan("irregular", &[], &scene, seed, true);
+    let doubled: Vec<Triangle> = scene.iter().flat_map(|t| [*t, *t]).collect();
+    split_trees_trace_like_the_scan("irregular, every triangle twice", &[], &doubled, seed, true);
+    let far: Vec<Triangle> = scene.iter().map(|t| Triangle::new(t.v0.map(|x| x + 1e6), t.v1.map(|x| x + 1e6), t.v2.map(|x| x + 1e6))).collect();
+    split_trees_trace_like_the_scan("irregular at 1e6", &[], &far, seed, true);
+    let degenerate: Vec<Triangle> =
+        scene.iter().enumerate().map(|(i, t)| if i % 5 == 0 { Triangle::new(t.v0, t.v0, t.v1) } else { *t }).collect();
+    split_trees_trace_like_the_scan("irregular with zero-area triangles", &[], &degenerate, seed, true);
+    // Spheres are never split; the room's walls (radius 1e5) beside triangles.
+    let room = Scene::from_spec("terrain:1500").unwrap();
+    split_trees_trace_like_the_scan("terrain in the room", &room.spheres, &room.triangles, seed, false);
+    for n in [1usize, 2, 3, 5] {
+        split_trees_trace_like_the_scan(&format!("{n} irregular triangles"), &[], &scene[..n], seed, false);
+    }
+}
+
+/// The split validators must catch pieces that leave part of a triangle
+/// uncovered, or the checks above prove nothing.
+#[test]
+fn split_validators_catch_uncovered_triangles() {
+    let tris = irregular(7);
+    let prims = Primitives::triangles(&tris);
+    let b = &mut CpuBackend::new();
+    let (HostTree::Bvh2(nodes, leaf), _) = build_split(b, prims, Accel::Trbvh, Layout::Bvh2, 0.5) else { unreachable!() };
+    assert!(validate_bvh2_split(prims, &nodes, &leaf).is_valid());
+    // The ground's first triangle: the boxes of every leaf holding it shrunk to a corner.
+    let holds = |first: u32, count: u32| (first..first + count).any(|s| leaf[s as usize].prim == 0);
+    let mut bad = nodes.clone();
+    for n in bad.iter_mut() {
+        if n.left_count > 0 && holds(n.left, n.left_count) {
+            n.left_max = n.left_min;
+        }
+        if n.right_count > 0 && holds(n.right, n.right_count) {
+            n.right_max = n.right_min;
+        }
+    }
+    let v = validate_bvh2_split(prims, &bad, &leaf);
+    assert!(v.errors.iter().any(|e| e.contains("in none of its")), "{:?}", v.errors);
+    let (HostTree::Wide(nodes, leaf), _) = build_split(b, prims, Accel::Trbvh, Layout::Cwbvh, 0.5) else { unreachable!() };
+    assert!(validate_wide_split(prims, &nodes, &leaf).is_valid());
+    let mut bad = leaf.clone();
+    let other = *leaf.iter().find(|p| p.prim != 1).unwrap();
+    for p in bad.iter_mut().filter(|p| p.prim == 1) {
+        *p = other;
+    }
+    let v = validate_wide_split(prims, &nodes, &bad);
+    assert!(v.errors.iter().any(|e| e.contains("stored 0 times")), "{:?}", v.errors);
 }
 
 fn terrain(n: usize) -> Vec<Triangle> {

@@ -129,6 +129,9 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let ordered = b.ordered_atomics_in_divergent_flow();
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
+    if split_budget() > 0.0 {
+        k.extend(SPLIT_KERNELS);
+    }
     k.extend(crate::bvh::sort::kernels(b));
     match Hierarchy::from_env() {
         Some(h) => k.extend(h.kernels(ordered)),
@@ -146,16 +149,32 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
 /// The kernels [`build_primitives_with`] dispatches on `b` for `hierarchy`.
 pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
+    if split_budget() > 0.0 {
+        k.extend(SPLIT_KERNELS);
+    }
     k.extend(crate::bvh::sort::kernels(b));
     k.extend(hierarchy.kernels(b.ordered_atomics_in_divergent_flow()));
     k
 }
 
-/// [`build_primitives_on_device`] with the given way of making the hierarchy.
+/// [`build_primitives_on_device`] with the given way of making the hierarchy
+/// (and triangles split as `TREELET_SPLITS` says: [`split_budget`]).
 pub fn build_primitives_with<B: Backend>(
     b: &mut B,
     prims: Primitives,
     hierarchy: Hierarchy,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    build_primitives_split(b, prims, hierarchy, split_budget())
+}
+
+/// [`build_primitives_with`] over pieces of the triangles: at most
+/// `budget` times as many more leaf slots as there are triangles (0: no
+/// splitting; see `treelet_core::construct::presplit`).
+pub fn build_primitives_split<B: Backend>(
+    b: &mut B,
+    prims: Primitives,
+    hierarchy: Hierarchy,
+    budget: f32,
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
     let n = u32::try_from(prims.len())
         .ok()
@@ -179,6 +198,11 @@ pub fn build_primitives_with<B: Backend>(
     let mut params = BuildParams { spheres: prims.spheres.len() as u32, ..Default::default() };
     let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
+    if budget > 0.0 && !prims.triangles.is_empty() && n > 1 {
+        let (mut bvh, times) = build_split(b, prims, hierarchy, budget, &spheres, &triangles)?;
+        bvh.prims = Some((spheres, triangles));
+        return Ok((bvh, times));
+    }
     // The boxes and their centroid bounds in one kernel.
     let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
         b.dispatch(Kernel::PrimitiveBounds, &[p, &spheres, &triangles, boxes, bounds], groups);
@@ -187,6 +211,94 @@ pub fn build_primitives_with<B: Backend>(
     params.n = n;
     let (mut bvh, times) = build_from_first_pass(b, params, hierarchy, first_pass)?;
     bvh.prims = Some((spheres, triangles));
+    Ok((bvh, times))
+}
+
+/// Extra references that triangle splitting may add, as a fraction of the
+/// triangles (`treelet_core::construct::presplit`): `TREELET_SPLITS`
+/// (0: no splitting, the default).
+pub fn split_budget() -> f32 {
+    std::env::var("TREELET_SPLITS").ok().and_then(|v| v.parse::<f32>().ok()).filter(|b| b.is_finite() && *b >= 0.0).unwrap_or(0.0)
+}
+
+/// The kernels splitting adds to a build.
+pub const SPLIT_KERNELS: [Kernel; 7] =
+    [Kernel::SplitPriority, Kernel::SplitCount, Kernel::SplitEmit, Kernel::SplitBounds, Kernel::SplitRemap, Kernel::CopyWords, Kernel::PrimitiveBounds];
+
+/// The build over pieces of the triangles (Karras & Aila 2013, section
+/// 5.1; `treelet_core::construct::presplit`): at most `budget` times the
+/// triangles more references, given to the triangles whose boxes waste
+/// most space, then the usual build over the pieces' boxes, and the leaf
+/// slots turned back into primitive indices. The tree's `n` is the number
+/// of references (leaf slots), a primitive's index may appear in several.
+fn build_split<B: Backend>(
+    b: &mut B,
+    prims: Primitives,
+    hierarchy: Hierarchy,
+    budget: f32,
+    spheres: &B::Buffer,
+    triangles: &B::Buffer,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    use treelet_core::construct::presplit::PRIORITY_TILE;
+    use treelet_core::geometry::buffers::{CopyParams, SplitParams};
+    let n = prims.len() as u32;
+    b.stage("split");
+    // The primitives' centroid bounds: the Morton grid the pieces follow.
+    let params = BuildParams { n, spheres: prims.spheres.len() as u32, ..Default::default() };
+    let p = b.upload("build params", &[params])?;
+    let prim_boxes = b.scratch("primitive boxes", n as u64 * 32)?;
+    let bounds = b.upload("centroid bounds", &BOUNDS_START)?;
+    b.dispatch(Kernel::PrimitiveBounds, &[&p, spheres, triangles, &prim_boxes, &bounds], groups_for(n, REDUCE_TILE));
+    let words: [u32; BOUNDS_WORDS] = b.read::<u32>(&bounds, BOUNDS_WORDS)?.try_into().expect("six words read");
+    b.release(&[&prim_boxes]);
+    let frame = MortonFrame::new(&bounds_from_words(&words));
+    let mut split = SplitParams {
+        n,
+        spheres: params.spheres,
+        scale: 0.0,
+        _pad0: 0,
+        frame: Aabb::new(frame.offset, frame.scale),
+    };
+    // Priorities, and their sum (per workgroup on the device, added here in f64).
+    let sp = b.upload("split params", &[split])?;
+    let priorities = b.scratch("split priorities", n as u64 * 4)?;
+    let tiles = groups_for(n, PRIORITY_TILE);
+    let partials = b.scratch("split priority sums", tiles as u64 * 4)?;
+    b.dispatch(Kernel::SplitPriority, &[&sp, triangles, &priorities, &partials], tiles);
+    let sum: f64 = b.read::<f32>(&partials, tiles as usize)?.iter().map(|&s| s as f64).sum();
+    let extra = (budget as f64 * prims.triangles.len() as f64).min((MAX_PRIMITIVES - n) as f64);
+    split.scale = if sum > 0.0 && sum.is_finite() { (extra / sum) as f32 } else { 0.0 };
+    // Pieces per primitive, scanned into offsets; the total after the last.
+    let sp = b.upload("split params", &[split])?;
+    let offsets = b.scratch("split offsets", (n as u64 + 1) * 4)?;
+    b.dispatch(Kernel::SplitCount, &[&sp, &priorities, &offsets], groups_for(n + 1, WORKGROUP_SIZE));
+    crate::bvh::sort::exclusive_scan(b, &offsets, n + 1)?;
+    let copy = b.upload("copy params", &[CopyParams { len: 1, src_offset: n, dst_offset: 0, _pad0: 0 }])?;
+    let total = b.scratch("split total", 4)?;
+    b.dispatch(Kernel::CopyWords, &[&copy, &offsets, &total], 1);
+    let refs = b.read::<u32>(&total, 1)?[0];
+    anyhow::ensure!(
+        refs >= n && refs <= MAX_PRIMITIVES,
+        "internal: triangle splitting made {refs} references of {n} primitives"
+    );
+    b.release(&[&priorities, &partials]);
+    let ref_boxes = b.scratch("split boxes", refs as u64 * 32)?;
+    let ref_prims = b.scratch("split primitives", refs as u64 * 4)?;
+    b.dispatch(Kernel::SplitEmit, &[&sp, spheres, triangles, &offsets, &ref_boxes, &ref_prims], groups_for(n, WORKGROUP_SIZE));
+    let build = BuildParams { n: refs, spheres: params.spheres, ..Default::default() };
+    let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
+        b.dispatch(Kernel::SplitBounds, &[p, &ref_boxes, boxes, bounds], groups);
+        Ok(())
+    };
+    let (bvh, mut times) = build_from_first_pass(b, build, hierarchy, first_pass)?;
+    // Leaf slots name primitives from here on.
+    b.stage("split");
+    let p = b.upload("build params", &[build])?;
+    b.dispatch(Kernel::SplitRemap, &[&p, &ref_prims, &bvh.prim_indices], groups_for(refs, WORKGROUP_SIZE));
+    let more = b.take_times()?;
+    for s in &more.order {
+        times.add(s, more.get(s));
+    }
     Ok((bvh, times))
 }
 

@@ -101,6 +101,17 @@ pub fn traced_tree<B: Backend>(
     accel: Accel,
     layout: Layout,
 ) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
+    traced_tree_split(b, all, accel, layout, lbvh::split_budget())
+}
+
+/// [`traced_tree`] over pieces of the triangles (see [`binary_tree_split`]).
+pub fn traced_tree_split<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    accel: Accel,
+    layout: Layout,
+    budget: f32,
+) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
     let Some(builder) = accel.builder()? else {
         let buffers = PrimBuffers::upload(b, all)?;
         let tree = TracedTree {
@@ -112,7 +123,7 @@ pub fn traced_tree<B: Backend>(
         };
         return Ok((tree, buffers, 0.0));
     };
-    let built = binary_tree(b, all, builder)?;
+    let built = binary_tree_split(b, all, builder, budget)?;
     let buffers = built.prim_buffers(b, all)?;
     let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
     Ok((tree, buffers, built.build_ms + layout_ms))
@@ -184,10 +195,18 @@ impl<B: Backend> BuiltTree<B> {
 /// as built, the TRBVH's restructured tree (or the H-PLOC tree) before its leaf collapse, or the
 /// full-sweep tree built on the CPU and uploaded. Starts a new build on `b`.
 pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> Result<BuiltTree<B>> {
+    binary_tree_split(b, all, builder, lbvh::split_budget())
+}
+
+/// [`binary_tree`] over pieces of the triangles, `budget` times the
+/// triangles more at most (0: none; see `treelet_core::construct::presplit`;
+/// the sweep takes whole primitives).
+pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builder, budget: f32) -> Result<BuiltTree<B>> {
     let config = TreeletConfig::default();
     Ok(match builder {
         Builder::Lbvh | Builder::Trbvh => {
-            let (mut bvh, times) = lbvh::build_primitives_on_device(b, all)?;
+            let hierarchy = lbvh::Hierarchy::for_device(b, all.len());
+            let (mut bvh, times) = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
             let mut build_ms = times.total();
             if builder == Builder::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
@@ -200,7 +219,7 @@ pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> 
             BuiltTree { bvh, max_leaf, build_ms }
         }
         Builder::Hploc => {
-            let (bvh, times) = lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?;
+            let (bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
             // Leaves collapsed by SAH when laid out, as the TRBVH's.
             BuiltTree { bvh, max_leaf: config.max_leaf, build_ms: times.total() }
         }

@@ -72,6 +72,71 @@ pub fn validate(spheres: &[Sphere], nodes: &[Node], parents: &[u32], prim_indice
 
 /// [`validate`] for any primitives (boxes recomputed here, not by the builder's code).
 pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    validate_tree(prims, nodes, parents, prim_indices, false)
+}
+
+/// [`validate_primitives`] for a tree over pieces of triangles
+/// (`treelet_core::construct::presplit`): as many leaf slots as pieces,
+/// each primitive in one leaf or more, each leaf box meeting its
+/// primitives' boxes rather than containing them, and the pieces covering
+/// their triangle: points spread over each triangle (its corners, points on
+/// its edges and inside, computed here in f64) each lie in the box of a
+/// leaf that holds the triangle, give or take their rounding. Spheres and
+/// flat shapes that are not triangles are never split: a leaf holding one
+/// contains it.
+pub fn validate_split(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32]) -> Validation {
+    validate_tree(prims, nodes, parents, prim_indices, true)
+}
+
+/// Points of triangle `t` as `f32`: barycentric `(i, j) / STEPS` over a grid.
+pub(crate) fn triangle_points(t: &Triangle) -> Vec<[f32; 3]> {
+    const STEPS: usize = 6;
+    let mut out = Vec::new();
+    for i in 0..=STEPS {
+        for j in 0..=STEPS - i {
+            // Weights from integers, so that points on an edge have a zero weight exactly.
+            let (u, v, w) = (i as f64 / STEPS as f64, j as f64 / STEPS as f64, (STEPS - i - j) as f64 / STEPS as f64);
+            out.push([0, 1, 2].map(|k| (t.v0[k] as f64 * w + t.v1[k] as f64 * u + t.v2[k] as f64 * v) as f32));
+        }
+    }
+    out
+}
+
+/// Whether `p` is in the box `lo..hi`, give or take its rounding (an ulp).
+pub(crate) fn holds_point(lo: &[f32; 3], hi: &[f32; 3], p: &[f32; 3]) -> bool {
+    (0..3).all(|k| {
+        let slack = p[k].abs() * 1.2e-7;
+        lo[k] - slack <= p[k] && p[k] <= hi[k] + slack
+    })
+}
+
+/// Whether a primitive is split into pieces by a split build (triangles only).
+pub(crate) fn splittable(prims: Primitives, p: usize) -> bool {
+    p.checked_sub(prims.spheres.len()).is_some_and(|t| prims.triangles[t].shape == 0)
+}
+
+/// The errors of primitives whose pieces, `boxes[p]` (the boxes of the
+/// leaves holding `p`), do not cover them (see [`validate_split`]).
+pub(crate) fn coverage_errors(prims: Primitives, boxes: &[Vec<([f32; 3], [f32; 3])>], mut err: impl FnMut(String)) {
+    for (p, leaves) in boxes.iter().enumerate() {
+        if leaves.is_empty() {
+            continue;
+        }
+        if splittable(prims, p) {
+            let t = &prims.triangles[p - prims.spheres.len()];
+            if let Some(q) = triangle_points(t).into_iter().find(|q| !leaves.iter().any(|(lo, hi)| holds_point(lo, hi, q))) {
+                err(format!("primitive {p}: its point {q:?} is in none of its {} leaves' boxes", leaves.len()));
+            }
+        } else {
+            let (lo, hi) = primitive_box(prims, p);
+            if !leaves.iter().any(|(l, h)| encloses(l, h, &lo, &hi)) {
+                err(format!("primitive {p} (not a triangle) is in no leaf whose box contains it"));
+            }
+        }
+    }
+}
+
+fn validate_tree(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u32], split: bool) -> Validation {
     let prim_box = |p: usize| match p.checked_sub(prims.spheres.len()) {
         None => sphere_box(&prims.spheres[p]),
         Some(t) => triangle_box(&prims.triangles[t]),
@@ -89,11 +154,13 @@ pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], p
         }
         return v;
     }
-    if nodes.is_empty() || nodes.len() > 2 * n - 1 {
-        err(format!("{} nodes for {n} primitives (expected 1 to {})", nodes.len(), 2 * n - 1));
+    // Leaf slots: one per primitive, or one per piece.
+    let slots = if split { prim_indices.len().max(n) } else { n };
+    if nodes.is_empty() || nodes.len() > 2 * slots - 1 {
+        err(format!("{} nodes for {slots} leaf slots (expected 1 to {})", nodes.len(), 2 * slots - 1));
         return v;
     }
-    if parents.len() != nodes.len() || prim_indices.len() != n {
+    if parents.len() != nodes.len() || prim_indices.len() != slots {
         err(format!(
             "{} parents and {} primitive indices for {} nodes",
             parents.len(),
@@ -107,6 +174,8 @@ pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], p
     }
     let mut visited = vec![false; nodes.len()];
     let mut prim_seen = vec![0u32; n];
+    // With pieces: the boxes of the leaves holding each primitive.
+    let mut leaf_boxes: Vec<Vec<([f32; 3], [f32; 3])>> = if split { vec![Vec::new(); n] } else { Vec::new() };
     let mut stack = vec![0usize];
     while let Some(i) = stack.pop() {
         if visited[i] {
@@ -118,8 +187,8 @@ pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], p
         if node.right & LEAF_FLAG != 0 {
             let count = (node.right & !LEAF_FLAG) as usize;
             let first = node.left as usize;
-            if count == 0 || first + count > n {
-                err(format!("leaf {i}: primitives {first}..{} out of 0..{n}", first + count));
+            if count == 0 || first + count > slots {
+                err(format!("leaf {i}: primitives {first}..{} out of 0..{slots}", first + count));
                 continue;
             }
             for &p in &prim_indices[first..first + count] {
@@ -130,7 +199,12 @@ pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], p
                 }
                 prim_seen[p] += 1;
                 let (lo, hi) = prim_box(p);
-                if !encloses(&node.min, &node.max, &lo, &hi) {
+                if split {
+                    if (0..3).any(|k| node.min[k] > hi[k] || node.max[k] < lo[k]) {
+                        err(format!("leaf {i}: box {:?}..{:?} misses primitive {p}", node.min, node.max));
+                    }
+                    leaf_boxes[p].push((node.min, node.max));
+                } else if !encloses(&node.min, &node.max, &lo, &hi) {
                     err(format!("leaf {i}: box {:?}..{:?} does not contain primitive {p}", node.min, node.max));
                 }
             }
@@ -158,9 +232,12 @@ pub fn validate_primitives(prims: Primitives, nodes: &[Node], parents: &[u32], p
         ));
     }
     for (p, &count) in prim_seen.iter().enumerate() {
-        if count != 1 {
-            err(format!("primitive {p} is in {count} leaves (expected exactly 1)"));
+        if count == 0 || (count > 1 && !split) {
+            err(format!("primitive {p} is in {count} leaves (expected {})", if split { "1 or more" } else { "exactly 1" }));
         }
+    }
+    if split {
+        coverage_errors(prims, &leaf_boxes, &mut err);
     }
     let root = &nodes[0];
     for p in 0..n {

@@ -21,16 +21,39 @@ fn union(a: Box3, b: Box3) -> Box3 {
 
 const EMPTY: Box3 = ([f32::MAX; 3], [-f32::MAX; 3]);
 
+fn intersect(a: Box3, b: Box3) -> Box3 {
+    ([0, 1, 2].map(|k| a.0[k].max(b.0[k])), [0, 1, 2].map(|k| a.1[k].min(b.1[k])))
+}
+
 /// Collects errors and the primitives seen.
 struct Check<'a> {
     prims: Primitives<'a>,
     v: Validation,
     seen_prim: Vec<u32>,
+    /// A tree over pieces of triangles: the boxes of the leaves holding
+    /// each primitive (see [`crate::bvh::validate::validate_split`]).
+    pieces: Option<Vec<Vec<Box3>>>,
 }
 
 impl<'a> Check<'a> {
-    fn new(prims: Primitives<'a>) -> Self {
-        Check { prims, v: Validation::default(), seen_prim: vec![0; prims.len()] }
+    fn new(prims: Primitives<'a>, split: bool) -> Self {
+        let pieces = split.then(|| vec![Vec::new(); prims.len()]);
+        Check { prims, v: Validation::default(), seen_prim: vec![0; prims.len()], pieces }
+    }
+
+    /// With pieces, a leaf's own box stands for its primitives' (which it
+    /// need not contain): the leaf `slots` of `stored` are recorded for the
+    /// coverage check, and `stored` is what the nodes above must contain.
+    fn leaf_of_pieces(&mut self, leaf_prims: &[LeafPrim], slots: std::ops::Range<u32>, stored: Box3, at: &str) -> Box3 {
+        for slot in slots {
+            self.leaf(leaf_prims, slot as usize, at);
+            if let (Some(pieces), Some(p)) = (self.pieces.as_mut(), leaf_prims.get(slot as usize)) {
+                if let Some(list) = pieces.get_mut(p.prim as usize) {
+                    list.push(stored);
+                }
+            }
+        }
+        stored
     }
 
     fn err(&mut self, e: String) {
@@ -69,9 +92,17 @@ impl<'a> Check<'a> {
     }
 
     fn finish(mut self) -> Validation {
+        let split = self.pieces.is_some();
         for (i, &c) in self.seen_prim.clone().iter().enumerate() {
-            if c != 1 {
+            if c == 0 || (c > 1 && !split) {
                 self.err(format!("primitive {i} is stored {c} times"));
+            }
+        }
+        if let Some(pieces) = self.pieces.take() {
+            let mut errors = Vec::new();
+            crate::bvh::validate::coverage_errors(self.prims, &pieces, |e| errors.push(e));
+            for e in errors {
+                self.err(e);
             }
         }
         self.v
@@ -104,13 +135,25 @@ fn plane_at_least(origin: f32, q: u32, s: f64, x: f32) -> bool {
 /// slots, the internal-child mask, leaves of 1 to 3 primitives within the
 /// node's 24.
 pub fn validate_wide(prims: Primitives, nodes: &[WideNode], leaf_prims: &[LeafPrim]) -> Validation {
-    let mut c = Check::new(prims);
+    validate_wide_tree(prims, nodes, leaf_prims, false)
+}
+
+/// [`validate_wide`] for a tree over pieces of triangles: see
+/// [`crate::bvh::validate::validate_split`] (a leaf's dequantized box
+/// stands for its pieces).
+pub fn validate_wide_split(prims: Primitives, nodes: &[WideNode], leaf_prims: &[LeafPrim]) -> Validation {
+    validate_wide_tree(prims, nodes, leaf_prims, true)
+}
+
+fn validate_wide_tree(prims: Primitives, nodes: &[WideNode], leaf_prims: &[LeafPrim], split: bool) -> Validation {
+    let mut c = Check::new(prims, split);
     if nodes.is_empty() {
         c.err("no nodes".into());
         return c.finish();
     }
     let mut seen_node = vec![0u32; nodes.len()];
-    let root = wide_box(&mut c, nodes, leaf_prims, 0, &mut seen_node, 0);
+    let everywhere = ([f32::MIN; 3], [f32::MAX; 3]);
+    let root = wide_box(&mut c, nodes, leaf_prims, 0, &mut seen_node, 0, everywhere);
     let _ = root;
     for (i, &s) in seen_node.iter().enumerate() {
         if s != 1 {
@@ -121,7 +164,10 @@ pub fn validate_wide(prims: Primitives, nodes: &[WideNode], leaf_prims: &[LeafPr
 }
 
 /// The exact box of wide node `i`'s subtree, checking it on the way.
-fn wide_box(c: &mut Check, nodes: &[WideNode], leaf_prims: &[LeafPrim], i: usize, seen: &mut [u32], depth: u32) -> Box3 {
+/// `clip`: the common part of the boxes of the slots on the way down, where
+/// a ray must pass to reach this node (with pieces of triangles, what a
+/// leaf's pieces must cover; see [`Check::leaf_of_pieces`]).
+fn wide_box(c: &mut Check, nodes: &[WideNode], leaf_prims: &[LeafPrim], i: usize, seen: &mut [u32], depth: u32, clip: Box3) -> Box3 {
     let Some(node) = nodes.get(i) else {
         c.err(format!("node index {i} out of range ({})", nodes.len()));
         return EMPTY;
@@ -152,7 +198,8 @@ fn wide_box(c: &mut Check, nodes: &[WideNode], leaf_prims: &[LeafPrim], i: usize
             }
             let child = node.child_base as usize + internal_rank;
             internal_rank += 1;
-            wide_box(c, nodes, leaf_prims, child, seen, depth + 1)
+            let inner = intersect(clip, dequantized(node, slot, &exps));
+            wide_box(c, nodes, leaf_prims, child, seen, depth + 1, inner)
         } else {
             let count = match meta >> 5 {
                 0b001 => 1,
@@ -168,13 +215,26 @@ fn wide_box(c: &mut Check, nodes: &[WideNode], leaf_prims: &[LeafPrim], i: usize
                 c.err(format!("{at}: leaf primitives {offset}..{} past the node's 24", offset + count));
             }
             prims_used += count;
-            let mut b = EMPTY;
-            for k in 0..count {
-                b = union(b, c.leaf(leaf_prims, (node.prim_base + offset + k) as usize, &at));
+            let first = node.prim_base + offset;
+            if c.pieces.is_some() {
+                // Where a ray reaches these pieces: every box on the way.
+                let reach = intersect(clip, dequantized(node, slot, &exps));
+                c.leaf_of_pieces(leaf_prims, first..first + count, reach, &at)
+            } else {
+                let mut b = EMPTY;
+                for k in 0..count {
+                    b = union(b, c.leaf(leaf_prims, (first + k) as usize, &at));
+                }
+                b
             }
-            b
         };
-        // The dequantized box must contain the exact one.
+        // The dequantized box must contain the exact one. (With pieces,
+        // leaves stand for themselves by the boxes on their way down, the
+        // `clip` above, and the coverage check replaces this one.)
+        if c.pieces.is_some() {
+            total = union(total, exact);
+            continue;
+        }
         let q = [
             (byte(&node.lo_x, slot), byte(&node.hi_x, slot)),
             (byte(&node.lo_y, slot), byte(&node.hi_y, slot)),
@@ -207,9 +267,37 @@ fn wide_box(c: &mut Check, nodes: &[WideNode], leaf_prims: &[LeafPrim], i: usize
     total
 }
 
+/// Slot `slot`'s box of wide node `node` as its bytes say, widened to the
+/// `f32`s that hold it (the validator's own decoding).
+fn dequantized(node: &WideNode, slot: usize, exps: &[u32; 3]) -> Box3 {
+    let byte = |w: &[u32; 2]| (w[slot / 4] >> (8 * (slot % 4))) & 0xFF;
+    let q = [(byte(&node.lo_x), byte(&node.hi_x)), (byte(&node.lo_y), byte(&node.hi_y)), (byte(&node.lo_z), byte(&node.hi_z))];
+    let mut lo = [0f32; 3];
+    let mut hi = [0f32; 3];
+    for k in 0..3 {
+        let s = 2f64.powi(exps[k] as i32 - 127);
+        let (l, h) = (node.origin[k] as f64 + q[k].0 as f64 * s, node.origin[k] as f64 + q[k].1 as f64 * s);
+        // Rounded outwards, so that the f32 box holds the exact one.
+        lo[k] = if (l as f32) as f64 > l { (l as f32).next_down() } else { l as f32 };
+        hi[k] = if ((h as f32) as f64) < h { (h as f32).next_up() } else { h as f32 };
+    }
+    (lo, hi)
+}
+
 /// Checks a two-box binary BVH (root 0) over `prims`; see the module doc.
 pub fn validate_bvh2(prims: Primitives, nodes: &[Bvh2Node], leaf_prims: &[LeafPrim]) -> Validation {
-    let mut c = Check::new(prims);
+    validate_bvh2_tree(prims, nodes, leaf_prims, false)
+}
+
+/// [`validate_bvh2`] for a tree over pieces of triangles: see
+/// [`crate::bvh::validate::validate_split`] (a leaf child's stored box
+/// stands for its pieces).
+pub fn validate_bvh2_split(prims: Primitives, nodes: &[Bvh2Node], leaf_prims: &[LeafPrim]) -> Validation {
+    validate_bvh2_tree(prims, nodes, leaf_prims, true)
+}
+
+fn validate_bvh2_tree(prims: Primitives, nodes: &[Bvh2Node], leaf_prims: &[LeafPrim], split: bool) -> Validation {
+    let mut c = Check::new(prims, split);
     if nodes.is_empty() {
         c.err("no nodes".into());
         return c.finish();
@@ -238,8 +326,12 @@ pub fn validate_bvh2(prims: Primitives, nodes: &[Bvh2Node], leaf_prims: &[LeafPr
                 let empty_box = lo[0] > hi[0];
                 // A root over one primitive has a second child no ray reaches.
                 if !(empty_box && nodes.len() == 1 && side == "right") {
-                    for k in 0..count {
-                        b = union(b, c.leaf(leaf_prims, (index + k) as usize, &at));
+                    if c.pieces.is_some() {
+                        b = c.leaf_of_pieces(leaf_prims, index..index + count, (lo, hi), &at);
+                    } else {
+                        for k in 0..count {
+                            b = union(b, c.leaf(leaf_prims, (index + k) as usize, &at));
+                        }
                     }
                 }
                 b
