@@ -38,7 +38,7 @@ struct Cli {
 enum Command {
     /// Build a BVH over a scene, check it, and report its cost and stage times.
     Build {
-        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), cornell, a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), cornell, a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
         #[arg(long, default_value = "random:100000")]
         scene: String,
         #[arg(long, value_enum, default_value = "lbvh")]
@@ -79,6 +79,16 @@ enum Command {
         #[arg(long)]
         reference: std::path::PathBuf,
     },
+    /// Write a scene's triangles as a binary PLY mesh, for other tracers
+    /// (`peers/mitsuba/rays.py` times OptiX on it): a generated scene, a
+    /// glTF or scene file flattened, or a mesh.
+    Export {
+        /// Scene: terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+        #[arg(long)]
+        scene: String,
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// Benchmarks (medians over repeats; GPU stage times from timestamp queries).
     Bench {
         #[command(subcommand)]
@@ -89,7 +99,7 @@ enum Command {
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
 struct RenderArgs {
-    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
     /// Trace a scene file's or glTF file's copies of meshes flattened into
@@ -673,6 +683,22 @@ fn run(cli: Cli) -> Result<bool> {
                 info.samples.end,
                 parts.len(),
                 out.display()
+            );
+            Ok(true)
+        }
+        Command::Export { scene, out } => {
+            let scene = Scene::from_spec(&scene)?;
+            let w = treelet::scene::ply::write(&scene, &out)?;
+            if !w.left_out.is_empty() {
+                eprintln!("note: left out {} (a PLY mesh holds triangles)", w.left_out.join(", "));
+            }
+            println!(
+                "{}: {} triangles, areas {:.3e} to {:.3e} ({:.1e} apart)",
+                out.display(),
+                w.triangles,
+                w.min_area,
+                w.max_area,
+                w.max_area / w.min_area.max(f64::MIN_POSITIVE)
             );
             Ok(true)
         }

@@ -1,7 +1,9 @@
 //! Scene names as the command line takes them: `cornell`, `random:N[:SEED]`,
-//! `terrain:N`, a JSON scene file, a glTF 2.0 scene, or an `.obj` / `.ply` mesh.
+//! `terrain:N`, `city:N[:SEED]`, a JSON scene file, a glTF 2.0 scene, or an
+//! `.obj` / `.ply` mesh.
 use anyhow::{bail, Context as _, Result};
 
+use super::city::city;
 use super::instanced::InstancedScene;
 use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
 use super::primitives::MAX_PRIMITIVES;
@@ -10,8 +12,9 @@ use treelet_core::geometry::buffers::{Material, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 
 impl Scene {
-    /// Parses a scene: `cornell`, `random:N[:SEED]`, or a path to a JSON
-    /// scene file or an `.obj` / `.ply` mesh.
+    /// Parses a scene: `cornell`, `random:N[:SEED]`, `terrain:N`,
+    /// `city:N[:SEED]`, or a path to a JSON scene file, a glTF scene or an
+    /// `.obj` / `.ply` mesh.
     pub fn from_spec(spec: &str) -> Result<Scene> {
         if spec == "cornell" {
             return Ok(cornell());
@@ -59,8 +62,25 @@ impl Scene {
                 memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))?;
                 Ok(mesh_scene(spec, &terrain(n)))
             }
+            Some("city") => {
+                let n = parts.next().with_context(|| format!("scene `{spec}`: expected city:N[:SEED]"))?;
+                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a triangle count"))?;
+                let seed = match parts.next() {
+                    Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
+                    None => 1,
+                };
+                if parts.next().is_some() || n == 0 {
+                    bail!("scene `{spec}`: expected city:N[:SEED] with N > 0 triangles");
+                }
+                if n > MAX_PRIMITIVES as usize {
+                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
+                }
+                let bytes = n as u64 * (2 * std::mem::size_of::<Triangle>() + std::mem::size_of::<Material>()) as u64;
+                memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))?;
+                Ok(mesh_scene(spec, &city(n, seed)))
+            }
             _ => bail!(
-                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh"
+                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh"
             ),
         }
     }
