@@ -141,6 +141,13 @@ pub enum BenchCommand {
         /// Cast at the scene's triangles alone, framed by the camera (no room).
         #[arg(long)]
         mesh_only: bool,
+        /// The camera instead of the scene's (or the mesh-only framing): its
+        /// eye and the point it looks at, `EX,EY,EZ,TX,TY,TZ` (a camera
+        /// inside a building, say), in the coordinates of the scene's file
+        /// (an .obj or .ply mesh is moved into smallpt's room when loaded,
+        /// and the camera with it); `peers/mitsuba/rays.py` takes the same.
+        #[arg(long, allow_hyphen_values = true)]
+        camera: Option<String>,
         #[arg(long)]
         json: Option<std::path::PathBuf>,
         /// Also draw build time against rays per second (`tradeoff-primary`
@@ -395,11 +402,25 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, json, figure, optix } => {
+        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, camera, json, figure, optix } => {
             // The peer's file first: a bad one fails before minutes of timing.
             let peer = optix.as_deref().map(tradeoff::read_peer).transpose()?;
-            let scene = Scene::from_spec(&scene)?;
-            let scene = if mesh_only { scene.mesh_only()? } else { scene };
+            let spec = scene;
+            let scene = Scene::from_spec(&spec)?;
+            let mut scene = if mesh_only { scene.mesh_only()? } else { scene };
+            if let Some(text) = camera {
+                let c: Vec<f32> = text.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().ok().filter(|c: &Vec<f32>| c.len() == 6).ok_or_else(|| {
+                    anyhow::anyhow!("--camera {text}: expected six numbers EX,EY,EZ,TX,TY,TZ (eye, then the point looked at)")
+                })?;
+                let (mut eye, mut target) = ([c[0], c[1], c[2]], [c[3], c[4], c[5]]);
+                let lower = spec.to_ascii_lowercase();
+                if lower.ends_with(".ply") || lower.ends_with(".obj") {
+                    // Where the loader put the mesh, the camera goes too.
+                    let place = treelet::scene::model::mesh_placement(&treelet::scene::mesh::load(std::path::Path::new(&spec))?);
+                    (eye, target) = (place(eye), place(target));
+                }
+                scene.camera = treelet::scene::model::CameraSpec::looking_at(eye, target)?;
+            }
             if let Some(p) = &peer {
                 tradeoff::check_peer(p, scene.triangles.len(), (width, height))?;
             }

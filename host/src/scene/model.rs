@@ -53,6 +53,18 @@ pub struct CameraSpec {
     pub fov: f32,
 }
 
+impl CameraSpec {
+    /// smallpt's lens at `eye`, looking at `target`: refused where either is
+    /// not finite or they are the same point.
+    pub fn looking_at(eye: [f32; 3], target: [f32; 3]) -> Result<CameraSpec> {
+        let direction = Vec3::from_array(target) - Vec3::from_array(eye);
+        if !eye.iter().chain(&target).all(|x| x.is_finite()) || direction.length_squared() == 0.0 || !direction.is_finite() {
+            bail!("camera from {eye:?} to {target:?}: both points must be finite and apart");
+        }
+        Ok(CameraSpec { origin: eye, direction: direction.to_array(), near: 0.0, fov: SMALLPT_FOV })
+    }
+}
+
 fn default_fov() -> f32 {
     SMALLPT_FOV
 }
@@ -116,16 +128,22 @@ pub fn terrain(n: usize) -> Vec<Triangle> {
     tris
 }
 
-/// A mesh alone in smallpt's room, under its light and camera: scaled to fit
-/// a 60-unit cube, centred in the room and standing on the floor, in a
-/// light diffuse grey. (`treelet build` builds over the triangles alone.)
-pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
+/// Where [`mesh_scene`] puts a point of `mesh`: scaled so that the mesh
+/// fits a 60-unit cube, centred in smallpt's room, standing on its floor.
+pub fn mesh_placement(mesh: &[Triangle]) -> impl Fn([f32; 3]) -> [f32; 3] {
     let bounds = mesh.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
     let size = bounds.extent().max_element();
     let scale = if size > 0.0 { 60.0 / size } else { 1.0 };
     let (lo, hi) = (bounds.lo(), bounds.hi());
     let shift = Vec3::new(50.0, 0.0, 80.0) - Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5) * scale;
-    let place = |v: [f32; 3]| (Vec3::from_array(v) * scale + shift).to_array();
+    move |v: [f32; 3]| (Vec3::from_array(v) * scale + shift).to_array()
+}
+
+/// A mesh alone in smallpt's room, under its light and camera: scaled to fit
+/// a 60-unit cube, centred in the room and standing on the floor, in a
+/// light diffuse grey. (`treelet build` builds over the triangles alone.)
+pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
+    let place = mesh_placement(mesh);
     let triangles: Vec<Triangle> = mesh.iter().map(|t| Triangle::new(place(t.v0), place(t.v1), place(t.v2))).collect();
     let (spheres, mut materials): (Vec<_>, Vec<_>) = cornell_room().into_iter().unzip();
     let room = spheres.len();
