@@ -13,7 +13,7 @@ use treelet_core::geometry::triangle::{SHAPE_DISK, SHAPE_PARALLELOGRAM, SHAPE_TR
 
 use super::model::Scene;
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Written {
     pub triangles: usize,
