@@ -157,7 +157,8 @@ fn validate_tree(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indice
     // Leaf slots: one per primitive, or one per piece.
     let slots = if split { prim_indices.len().max(n) } else { n };
     if nodes.is_empty() || nodes.len() > 2 * slots - 1 {
-        err(format!("{} nodes for {slots} leaf slots (expected 1 to {})", nodes.len(), 2 * slots - 1));
+        let what = if split { "leaf slots" } else { "primitives" };
+        err(format!("{} nodes for {slots} {what} (expected 1 to {})", nodes.len(), 2 * slots - 1));
         return v;
     }
     if parents.len() != nodes.len() || prim_indices.len() != slots {
