@@ -198,7 +198,7 @@ fn split_trees_trace_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[
             if let Some(ctx) = &gpu {
                 let g = build_split(&mut GpuBackend::new(ctx.clone()), prims, accel, layout, 0.5);
                 let diff = g.1.abs_diff(cpu.1);
-                assert!(diff * 100 <= cpu.1, "{what}, {accel:?}: {} references on the GPU, {} on the CPU runner", g.1, cpu.1);
+                assert!(diff * 100 <= cpu.1, "{what}, {accel:?}: {} references on the GPU, {} on the CPU runner; {triangles:?}", g.1, cpu.1);
                 trees.push(("GPU", g.0));
             }
             for (device, tree) in &trees {
