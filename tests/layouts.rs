@@ -180,7 +180,7 @@ impl HostTree {
 /// triangle covered by its pieces' leaves), with more leaf slots than
 /// primitives where `splits` says the scene has triangles worth splitting,
 /// and exactly the scan's hits in every layout. The GPU's reference count
-/// is the CPU runner's to 1% (priorities are sums of products the GPU may
+/// is the CPU runner's to 1% or one (priorities are sums of products the GPU may
 /// fuse, so a count at a rounding boundary may differ by one).
 fn split_trees_trace_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[Triangle], seed: u32, splits: bool) {
     let prims = Primitives { spheres, triangles };
@@ -198,7 +198,7 @@ fn split_trees_trace_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[
             if let Some(ctx) = &gpu {
                 let g = build_split(&mut GpuBackend::new(ctx.clone()), prims, accel, layout, 0.5);
                 let diff = g.1.abs_diff(cpu.1);
-                assert!(diff * 100 <= cpu.1, "{what}, {accel:?}: {} references on the GPU, {} on the CPU runner; {triangles:?}", g.1, cpu.1);
+                assert!(diff <= 1 || diff * 100 <= cpu.1, "{what}, {accel:?}: {} references on the GPU, {} on the CPU runner; {triangles:?}", g.1, cpu.1);
                 trees.push(("GPU", g.0));
             }
             for (device, tree) in &trees {

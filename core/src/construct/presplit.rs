@@ -73,19 +73,35 @@ const GRID: u32 = 1 << 21;
 /// that boxes of ever smaller pieces tend to (the triangle's area projected
 /// on the three planes, `(|nx| + |ny| + |nz|) / 2` of the unnormalized
 /// normal). 0 for flat shapes that are not triangles, degenerate
-/// triangles and boxes too large for `f32` areas.
+/// triangles, boxes too large for `f32` areas, and triangles longer than
+/// `reach` ([`reach`]: twice the spread of all centroids, as a ground
+/// around a building is): an optimizer lifts such a triangle whole to the
+/// root, where every ray tests it once, while its pieces would fall into the
+/// Morton cells of the detail they lie under, out of the treelets' reach
+/// (the classroom of `docs/results/h200-real-scenes-2026-11-29/`).
 #[inline]
-pub fn priority(t: &Triangle) -> f32 {
+pub fn priority(t: &Triangle, reach: f32) -> f32 {
     if !t.is_triangle() {
         return 0.0;
     }
     let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
     let d = a.max(b).max(c) - a.min(b).min(c);
+    let longest = d.x.max(d.y).max(d.z);
     let half_area = d.x * d.y + d.y * d.z + d.z * d.x;
     let n = (b - a).cross(c - a);
     let ideal = 0.5 * (n.x.abs() + n.y.abs() + n.z.abs());
-    let p = libm::cbrtf(d.max_element() * (half_area - ideal).max(0.0));
-    if p.is_finite() { p } else { 0.0 }
+    let p = libm::cbrtf(longest * (half_area - ideal).max(0.0));
+    if p.is_finite() && longest <= reach { p } else { 0.0 }
+}
+
+/// The longest triangle that [`priority`] lets be split: twice the largest
+/// side of the primitives' centroid bounds, from the Morton frame (its
+/// scale is `2^21` cells over half that side); no limit where all
+/// centroids are one point.
+#[inline]
+pub fn reach(frame: &MortonFrame) -> f32 {
+    let scale = frame.scale.max_element();
+    if scale > 0.0 { 4.0 * (GRID as f32) / scale } else { f32::MAX }
 }
 
 /// Kernel: the priority of each of the `n` primitives (spheres first, 0)
@@ -107,7 +123,7 @@ pub fn priority_phase(
         for k in 0..PRIORITY_ITEMS {
             let i = group * PRIORITY_TILE + k * WORKGROUP_SIZE + lid;
             if i < params.n {
-                let p = if i < params.spheres { 0.0 } else { priority(&triangles.get((i - params.spheres) as usize)) };
+                let p = if i < params.spheres { 0.0 } else { priority(&triangles.get((i - params.spheres) as usize), params.reach) };
                 priorities[i as usize] = p;
                 sum += p;
             }
@@ -410,13 +426,21 @@ mod tests {
     fn an_axis_aligned_square_half_wastes_nothing_and_a_diagonal_sliver_wastes_much() {
         let flat = tri([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         // Box half area 1, projected area 0.5: wasted 0.5.
-        assert!((priority(&flat) - libm::cbrtf(0.5)).abs() < 1e-6);
+        assert!((priority(&flat, f32::MAX) - libm::cbrtf(0.5)).abs() < 1e-6);
+        assert_eq!(priority(&flat, 0.5), 0.0);
         let sliver = tri([0.0, 0.0, 0.0], [100.0, 100.0, 100.0], [100.0, 100.0, 100.01]);
-        assert!(priority(&sliver) > 10.0 * priority(&flat));
+        assert!(priority(&sliver, f32::MAX) > 10.0 * priority(&flat, f32::MAX));
         let degenerate = tri([1.0; 3], [1.0; 3], [1.0; 3]);
-        assert_eq!(priority(&degenerate), 0.0);
+        assert_eq!(priority(&degenerate, f32::MAX), 0.0);
         let huge = tri([-3e38, 0.0, 0.0], [3e38, 1.0, 0.0], [0.0, 3e38, 3e38]);
-        assert_eq!(priority(&huge), 0.0);
+        assert_eq!(priority(&huge, f32::MAX), 0.0);
+    }
+
+    #[test]
+    fn reach_is_twice_the_centroids_spread() {
+        let frame = MortonFrame::new(&Aabb::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::new(7.0, 2.0, 1.0)));
+        assert!((reach(&frame) - 20.0).abs() < 1e-4, "{}", reach(&frame));
+        assert_eq!(reach(&MortonFrame::new(&Aabb::point(Vec3::ONE))), f32::MAX);
     }
 
     #[test]

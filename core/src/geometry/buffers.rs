@@ -113,7 +113,9 @@ pub struct SplitParams {
     pub spheres: u32,
     /// Extra pieces per unit of priority (the budget over the sum of priorities).
     pub scale: f32,
-    pub _pad0: u32,
+    /// Longest triangle split (`construct::presplit::reach`), computed once
+    /// on the host so that the GPU and the CPU runner compare with one value.
+    pub reach: f32,
     /// The primitives' Morton frame, whose grid planes the splits use
     /// (min = offset, max = scale: see `construct::morton::MortonFrame`).
     pub frame: Aabb,

@@ -256,7 +256,7 @@ fn build_split<B: Backend>(
         n,
         spheres: params.spheres,
         scale: 0.0,
-        _pad0: 0,
+        reach: treelet_core::construct::presplit::reach(&frame),
         frame: Aabb::new(frame.offset, frame.scale),
     };
     // Priorities, and their sum (per workgroup on the device, added here in f64).
