@@ -15,25 +15,7 @@ import drjit as dr
 import mitsuba as mi
 mi.set_variant('cuda_ad_rgb')
 from mitsuba import ScalarTransform4f as T
-
-def ply_arrays(path):
-    with open(path, 'rb') as f:
-        hdr = []
-        while True:
-            line = f.readline().decode().strip(); hdr.append(line)
-            if line == 'end_header': break
-        nv = int([l for l in hdr if l.startswith('element vertex')][0].split()[2])
-        nf = int([l for l in hdr if l.startswith('element face')][0].split()[2])
-        v = np.frombuffer(f.read(nv * 12), dtype='<f4').reshape(nv, 3)
-        raw = np.frombuffer(f.read(nf * 13), dtype=np.uint8).reshape(nf, 13)
-        idx = raw[:, 1:].copy().view('<i4').reshape(nf, 3)
-    return v, idx
-
-def kernel_ms(fn):
-    dr.kernel_history_clear() if hasattr(dr, 'kernel_history_clear') else dr.kernel_history()
-    fn()
-    dr.sync_thread()
-    return sum(k.get('execution_time', 0.0) for k in dr.kernel_history() if k.get('type') == dr.KernelType.JIT)
+from meshes import ply_arrays, kernel_ms
 
 dr.set_flag(dr.JitFlag.KernelHistory, True)
 path = sys.argv[1]

@@ -55,11 +55,7 @@ impl Scene {
                 if parts.next().is_some() || n == 0 {
                     bail!("scene `{spec}`: expected terrain:N with N > 0 triangles");
                 }
-                if n > MAX_PRIMITIVES as usize {
-                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
-                }
-                let bytes = n as u64 * (2 * std::mem::size_of::<Triangle>() + std::mem::size_of::<Material>()) as u64;
-                memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))?;
+                check_generated_mesh(spec, n)?;
                 Ok(mesh_scene(spec, &terrain(n)))
             }
             Some("city") => {
@@ -72,11 +68,7 @@ impl Scene {
                 if parts.next().is_some() || n == 0 {
                     bail!("scene `{spec}`: expected city:N[:SEED] with N > 0 triangles");
                 }
-                if n > MAX_PRIMITIVES as usize {
-                    bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
-                }
-                let bytes = n as u64 * (2 * std::mem::size_of::<Triangle>() + std::mem::size_of::<Material>()) as u64;
-                memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))?;
+                check_generated_mesh(spec, n)?;
                 Ok(mesh_scene(spec, &city(n, seed)))
             }
             _ => bail!(
@@ -84,6 +76,16 @@ impl Scene {
             ),
         }
     }
+}
+
+/// Refuses a generated mesh (`terrain:N`, `city:N`) of more triangles than
+/// a build supports, or than the machine's memory holds.
+fn check_generated_mesh(spec: &str, n: usize) -> Result<()> {
+    if n > MAX_PRIMITIVES as usize {
+        bail!("scene `{spec}`: {n} triangles, at most {} are supported", MAX_PRIMITIVES);
+    }
+    let bytes = n as u64 * (2 * std::mem::size_of::<Triangle>() + std::mem::size_of::<Material>()) as u64;
+    memory::check_fits(&format!("scene `{spec}`"), 2 * bytes, &format!("{n} triangles and their materials"))
 }
 
 impl Scene {
