@@ -412,14 +412,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let c: Vec<f32> = text.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().ok().filter(|c: &Vec<f32>| c.len() == 6).ok_or_else(|| {
                     anyhow::anyhow!("--camera {text}: expected six numbers EX,EY,EZ,TX,TY,TZ (eye, then the point looked at)")
                 })?;
-                let (mut eye, mut target) = ([c[0], c[1], c[2]], [c[3], c[4], c[5]]);
-                let lower = spec.to_ascii_lowercase();
-                if lower.ends_with(".ply") || lower.ends_with(".obj") {
-                    // Where the loader put the mesh, the camera goes too.
-                    let place = treelet::scene::model::mesh_placement(&treelet::scene::mesh::load(std::path::Path::new(&spec))?);
-                    (eye, target) = (place(eye), place(target));
-                }
-                scene.camera = treelet::scene::model::CameraSpec::looking_at(eye, target)?;
+                scene.camera = Scene::camera_in_file(&spec, [c[0], c[1], c[2]], [c[3], c[4], c[5]])?;
             }
             if let Some(p) = &peer {
                 tradeoff::check_peer(p, scene.triangles.len(), (width, height))?;

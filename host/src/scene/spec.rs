@@ -5,7 +5,7 @@ use anyhow::{bail, Context as _, Result};
 
 use super::city::city;
 use super::instanced::InstancedScene;
-use super::model::{cornell, mesh_scene, random_scene, terrain, Scene};
+use super::model::{cornell, mesh_scene, random_scene, terrain, CameraSpec, Scene};
 use super::primitives::MAX_PRIMITIVES;
 use crate::runtime::memory;
 use treelet_core::geometry::buffers::{Material, Sphere};
@@ -89,6 +89,20 @@ fn check_generated_mesh(spec: &str, n: usize) -> Result<()> {
 }
 
 impl Scene {
+    /// smallpt's lens at `eye`, looking at `target`, both in the coordinates
+    /// of the scene `spec` names: an `.obj` or `.ply` mesh is moved into
+    /// smallpt's room when loaded ([`super::model::mesh_placement`]), and the
+    /// camera with it (the mesh is read again for its bounds: a command's
+    /// set-up, not a hot path); other scenes keep their coordinates.
+    pub fn camera_in_file(spec: &str, eye: [f32; 3], target: [f32; 3]) -> Result<CameraSpec> {
+        let lower = spec.to_ascii_lowercase();
+        if lower.ends_with(".ply") || lower.ends_with(".obj") {
+            let place = super::model::mesh_placement(&super::mesh::load(std::path::Path::new(spec))?);
+            return CameraSpec::looking_at(place(eye), place(target));
+        }
+        CameraSpec::looking_at(eye, target)
+    }
+
     /// [`Scene::from_spec`] for `render`: a glTF or scene file keeps the
     /// copies of meshes it places more than once placed
     /// ([`InstancedScene::for_render`]); every other scene as `from_spec`
@@ -115,5 +129,46 @@ impl InstancedScene {
         } else {
             bail!("{}: expected a .gltf/.glb or a .json scene file", path.display())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use treelet_core::geometry::prims::{Origin, Prims};
+    use treelet_core::trace::classic::closest_hit_linear;
+
+    /// A camera given in a mesh file's coordinates looks at what it looked at
+    /// there once the loader has moved the mesh: its centre ray hits the
+    /// triangle it was aimed at, for each of a row of small triangles far
+    /// from the room.
+    #[test]
+    fn a_camera_in_file_coordinates_hits_what_it_aimed_at() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("row.obj");
+        let mut obj = String::new();
+        let corner = |k: usize| Vec3::new(1000.0 + 40.0 * k as f32, -300.0 + 7.0 * k as f32, 500.0);
+        for k in 0..10 {
+            let c = corner(k);
+            for v in [c, c + Vec3::new(10.0, 0.0, 0.0), c + Vec3::new(0.0, 10.0, 0.0)] {
+                obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+            }
+            obj += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+        }
+        std::fs::write(&path, obj).unwrap();
+        let spec = path.to_str().unwrap();
+        let scene = Scene::from_spec(spec).unwrap();
+        let prims = Prims::new(&[], &scene.triangles);
+        for k in 0..10 {
+            let aim = corner(k) + Vec3::new(3.0, 3.0, 0.0);
+            let eye = aim - Vec3::new(5.0, -2.0, 400.0);
+            let camera = Scene::camera_in_file(spec, eye.to_array(), aim.to_array()).unwrap();
+            let (o, d) = (Vec3::from_array(camera.origin), Vec3::from_array(camera.direction).normalize());
+            let hit = closest_hit_linear(o, d, Origin::NONE, &prims);
+            assert!(hit.is_hit() && hit.prim == k as u32, "aimed at triangle {k}, hit {} at {}", hit.prim, hit.t);
+        }
+        // Refused: a camera that looks nowhere.
+        assert!(Scene::camera_in_file(spec, [1.0; 3], [1.0; 3]).is_err());
     }
 }
