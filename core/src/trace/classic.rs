@@ -8,6 +8,7 @@ use crate::geometry::features::{self};
 use crate::geometry::intersect::{MISS, ray_box, safe_inverse};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
+use crate::gpu::unchecked::scratch;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
 /// Every primitive tested: no tree. (Not zero-sized: rust-gpu cannot take
@@ -128,8 +129,9 @@ pub fn trace_bvh<const F: u32>(
     }
     let inv_d = safe_inverse(d);
     let ray = WatertightRay::new(o, d);
-    let mut stack = [0u32; STACK_DEPTH];
-    let mut top = 1usize; // stack[0] = root
+    let mut stack = scratch::<STACK_DEPTH>();
+    stack[0] = 0; // the root
+    let mut top = 1usize;
     while top > 0 {
         top -= 1;
         let node = nodes[stack[top] as usize];

@@ -41,7 +41,7 @@ use crate::geometry::buffers::{LeafPrim, WideNode};
 use crate::geometry::intersect::SlabRay;
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::WatertightRay;
-use crate::gpu::unchecked::{get, set};
+use crate::gpu::unchecked::{get, scratch, set};
 use crate::layouts::cwbvh::grid_step;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
@@ -167,7 +167,7 @@ impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> ClosestHit for WideTree<N
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit {
-        let mut private = [0u32; 2 * WIDE_STACK];
+        let mut private = scratch::<{ 2 * WIDE_STACK }>();
         trace_cwbvh_with::<F, S>(o, d, from, query, prims, &self.nodes, &self.leaf_prims, &mut private, stack, lane as usize)
     }
 }
@@ -199,7 +199,7 @@ pub fn closest_hit_cwbvh<const F: u32>(
     nodes: &[WideNode],
     leaf_prims: &[LeafPrim],
 ) -> Hit {
-    let mut stack = [0u32; 2 * WIDE_STACK];
+    let mut stack = scratch::<{ 2 * WIDE_STACK }>();
     trace_cwbvh_with::<F, 1>(o, d, from, Query::CLOSEST, prims, nodes, leaf_prims, &mut stack, &mut [0u32; 1], 0)
 }
 
