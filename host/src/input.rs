@@ -64,7 +64,51 @@ pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
     if bytes.len() as u64 > max {
         bail!("{what} {} grew past the {max} bytes an input may have while it was read", path.display());
     }
+    if is_xz(path) {
+        return decompress_xz(path, what, &bytes, max);
+    }
     Ok(bytes)
+}
+
+/// Whether `path` names an xz-compressed file (`.xz`), which [`read`]
+/// decompresses.
+pub fn is_xz(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("xz"))
+}
+
+/// `path` without its `.xz`: the name whose extension says what the
+/// content is (`mesh.ply.xz` is a PLY mesh).
+pub fn content_name(path: &Path) -> std::borrow::Cow<'_, Path> {
+    if is_xz(path) { std::borrow::Cow::Owned(path.with_extension("")) } else { std::borrow::Cow::Borrowed(path) }
+}
+
+/// The content of the xz file `path` (its bytes read), held to `max` bytes
+/// as any input is: a small file may decompress to far more.
+fn decompress_xz(path: &Path, what: &str, bytes: &[u8], max: u64) -> Result<Vec<u8>> {
+    struct Capped {
+        out: Vec<u8>,
+        max: u64,
+        over: bool,
+    }
+    impl std::io::Write for Capped {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            if self.out.len() as u64 + buf.len() as u64 > self.max {
+                self.over = true;
+                return Err(std::io::Error::other("past the cap"));
+            }
+            self.out.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let mut capped = Capped { out: Vec::new(), max, over: false };
+    match lzma_rs::xz_decompress(&mut std::io::BufReader::new(bytes), &mut capped) {
+        Ok(()) => Ok(capped.out),
+        Err(_) if capped.over => bail!("{what} {}: decompresses to more than the {max} bytes an input may have", path.display()),
+        Err(e) => bail!("{what} {}: not a valid xz file ({e})", path.display()),
+    }
 }
 
 /// Reads `path` as UTF-8 text (see [`read`]); an error names the line of

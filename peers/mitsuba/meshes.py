@@ -3,8 +3,10 @@ import numpy as np
 
 def ply_arrays(path):
     """Vertices (n x 3 float32) and triangles (m x 3 int32) of a binary little-endian PLY of float x y z
-    vertices and uchar-counted int triangle lists, as Treelet's loader and `treelet export` have them."""
-    with open(path, 'rb') as f:
+    vertices and uchar-counted int triangle lists, as Treelet's loader and `treelet export` have them;
+    xz-compressed (`.ply.xz`, as `scenes/real/` keeps them) or not."""
+    import lzma
+    with (lzma.open(path, 'rb') if path.lower().endswith('.xz') else open(path, 'rb')) as f:
         hdr = []
         while True:
             line = f.readline().decode().strip(); hdr.append(line)

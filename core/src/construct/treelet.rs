@@ -31,7 +31,7 @@
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::geometry::records::{RecordLoad, RecordStore};
-use crate::gpu::unchecked::{at, get, put, set};
+use crate::gpu::unchecked::{at, get, put, scratch, set};
 
 /// Leaves of a treelet (the paper's 7).
 pub const TREELET_LEAVES: usize = 7;
@@ -413,14 +413,16 @@ pub fn optimize<const N: usize>(stage: &[u32; N], b: usize, costs: &TreeletCosts
 
 /// [`optimize`] into tables of `C` costs and `P` packed words, which must
 /// hold the staged treelet's subsets (`2^n <= C`): smaller tables for
-/// small treelets cost less private memory to clear.
+/// small treelets take less private memory.
 #[inline]
 pub fn optimize_sized<const N: usize, const C: usize, const P: usize>(
     stage: &[u32; N],
     b: usize,
     costs: &TreeletCosts,
 ) -> TreeletSolution<C, P> {
-    let mut sol = TreeletSolution { cost: [0.0; C], parts: [0u32; P] };
+    // Every subset's cost is written before it is read (see above); the
+    // packed words are or-ed into.
+    let mut sol = TreeletSolution { cost: scratch::<f32, C>(), parts: [0u32; P] };
     let n = stage[b + T_COUNT];
     let mut i = 0;
     while i < n as usize {

@@ -67,22 +67,23 @@ pub fn put<T: Copy>(a: &mut [T], i: usize, v: T) {
     }
 }
 
-/// A private array a kernel writes before it reads each word (a traversal
-/// stack): undefined on the GPU, zeros on the CPU. Zero-filling it is not
+/// A private array a kernel writes before it reads each element (a
+/// traversal stack, a DP table): undefined on the GPU, zeros
+/// (`T::default()`) on the CPU. Zero-filling it is not
 /// free there: rust-gpu stores a constant of the whole array, which the
 /// driver keeps as one store per word into local memory, for every ray
 /// (a 128-word stack: 512 bytes a ray, before the walk reads a node).
 #[inline]
-pub fn scratch<const N: usize>() -> [u32; N] {
+pub fn scratch<T: Copy + Default, const N: usize>() -> [T; N] {
     #[cfg(target_arch = "spirv")]
     {
         // SAFETY: SPIR-V's undefined value (OpUndef) is some bit pattern, and
-        // callers write each word before reading it; the CPU build, which
+        // callers write each element before reading it; the CPU build, which
         // runs the same kernels in the tests, zero-fills.
-        unsafe { core::mem::MaybeUninit::<[u32; N]>::uninit().assume_init() }
+        unsafe { core::mem::MaybeUninit::<[T; N]>::uninit().assume_init() }
     }
     #[cfg(not(target_arch = "spirv"))]
     {
-        [0; N]
+        [T::default(); N]
     }
 }

@@ -173,7 +173,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     // driver gave the engine's instanced kernel 80 registers against the
     // plain walk's 64, so three workgroups an SM instead of four; now 64
     // as well).
-    let mut stack = scratch::<STACK>();
+    let mut stack = scratch::<u32, STACK>();
     let entries = if INSTANCED { (STACK - WORLD) / 2 } else { STACK / 2 };
     if INSTANCED {
         let w = [o.x, o.y, o.z, d.x, d.y, d.z];

@@ -129,7 +129,7 @@ pub fn trace_bvh<const F: u32>(
     }
     let inv_d = safe_inverse(d);
     let ray = WatertightRay::new(o, d);
-    let mut stack = scratch::<STACK_DEPTH>();
+    let mut stack = scratch::<u32, STACK_DEPTH>();
     stack[0] = 0; // the root
     let mut top = 1usize;
     while top > 0 {

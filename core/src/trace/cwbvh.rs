@@ -167,7 +167,7 @@ impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> ClosestHit for WideTree<N
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit {
-        let mut private = scratch::<{ 2 * WIDE_STACK }>();
+        let mut private = scratch::<u32, { 2 * WIDE_STACK }>();
         trace_cwbvh_with::<F, S>(o, d, from, query, prims, &self.nodes, &self.leaf_prims, &mut private, stack, lane as usize)
     }
 }
@@ -199,7 +199,7 @@ pub fn closest_hit_cwbvh<const F: u32>(
     nodes: &[WideNode],
     leaf_prims: &[LeafPrim],
 ) -> Hit {
-    let mut stack = scratch::<{ 2 * WIDE_STACK }>();
+    let mut stack = scratch::<u32, { 2 * WIDE_STACK }>();
     trace_cwbvh_with::<F, 1>(o, d, from, Query::CLOSEST, prims, nodes, leaf_prims, &mut stack, &mut [0u32; 1], 0)
 }
 

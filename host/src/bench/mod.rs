@@ -23,6 +23,7 @@ mod figure;
 mod instances;
 mod measure;
 mod placed;
+mod rays_suite;
 pub mod results;
 mod suite;
 mod tradeoff;
@@ -158,6 +159,21 @@ pub enum BenchCommand {
         /// `../shared/tools/optix-peer/peer.py` for the same mesh and size.
         #[arg(long, requires = "figure")]
         optix: Option<std::path::PathBuf>,
+        /// The real-scene suite instead of `--scene`: the interiors of
+        /// scenes/real (outside and from each one's camera) and the
+        /// generated city (300k and 1M triangles, from above and from a
+        /// street), in one table.
+        #[arg(long, conflicts_with_all = ["camera", "figure"])]
+        suite: bool,
+        /// The suite's folder of .ply.xz scenes and cameras.json (default:
+        /// scenes/real of this repository).
+        #[arg(long, requires = "suite")]
+        suite_dir: Option<std::path::PathBuf>,
+        /// Time OptiX on each of the suite's scenes and views too
+        /// (`peers/mitsuba/rays.py` through `python3`, or `$TREELET_PYTHON`;
+        /// needs Mitsuba 3 and an NVIDIA GPU), with the ratios.
+        #[arg(long, requires = "suite")]
+        with_optix: bool,
     },
     /// An animated mesh through the engine API: per frame, refit against
     /// rebuild (LBVH, TRBVH), and one frame's rays (closest hits and
@@ -402,7 +418,35 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, camera, json, figure, optix } => {
+        BenchCommand::Rays { suite: true, suite_dir, with_optix, accels, layouts, workgroup_stack, width, height, device, repeats, json, .. } => {
+            let plan = RaysPlan { layouts, workgroup_stack };
+            let dir = suite_dir.as_deref();
+            let (adapter, rows, clocks) = match device.open()? {
+                Device::Gpu(ctx) => {
+                    let mut b = GpuBackend::new(ctx);
+                    let before = clocks::read();
+                    let rows = rays_suite::run(&mut b, dir, &accels, &plan, (width, height), repeats, with_optix)?;
+                    (b.adapter(), rows, Some((before, clocks::read())))
+                }
+                Device::Cpu => {
+                    let mut b = CpuBackend::new();
+                    let rows = rays_suite::run(&mut b, dir, &accels, &plan, (width, height), repeats, with_optix)?;
+                    (b.adapter(), rows, None)
+                }
+            };
+            println!("rays per second, the real-scene suite, {width}x{height}, {adapter}, median of {repeats}");
+            if let Some((before, after)) = clocks {
+                println!("{}", clocks::describe(before, after));
+            }
+            rays_suite::print(&rows);
+            if let Some(path) = json {
+                let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
+                let doc = serde_json::json!({ "adapter": adapter, "width": width, "height": height, "repeats": repeats, "rows": rows, "clocks": clocks });
+                std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Rays { scene, accels, layouts, workgroup_stack, width, height, device, repeats, mesh_only, camera, json, figure, optix, .. } => {
             // The peer's file first: a bad one fails before minutes of timing.
             let peer = optix.as_deref().map(tradeoff::read_peer).transpose()?;
             let spec = scene;

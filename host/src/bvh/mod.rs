@@ -13,8 +13,11 @@
 //! - [`choice`]: which builder finishes a render's or a frame's work first;
 //! - [`validate`], [`validate_layout`]: independent checks that share no
 //!   code with the kernels;
-//! - [`report`]: one build, timed and checked (the `treelet build` command).
+//! - [`report`]: one build, timed and checked (the `treelet build` command),
+//!   with its SAH and [`epo`] (end-point overlap).
 pub mod choice;
+pub mod clip;
+pub mod epo;
 pub mod layout;
 pub mod lbvh;
 pub mod refit;

@@ -10,14 +10,25 @@ use treelet_core::geometry::triangle::Triangle;
 
 use crate::scene::primitives::Primitives;
 
-/// Loads the triangles of an `.obj` or `.ply` file and checks them
-/// (finite coordinates, at least one triangle).
+/// What kind of mesh file `path` names: `"obj"` or `"ply"`, either also
+/// compressed (`mesh.ply.xz`, read through [`crate::input::read`]).
+pub fn mesh_kind(path: &Path) -> Option<&'static str> {
+    let name = crate::input::content_name(path);
+    let ext = name.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("obj") => Some("obj"),
+        Some("ply") => Some("ply"),
+        _ => None,
+    }
+}
+
+/// Loads the triangles of an `.obj` or `.ply` file (or either as `.xz`)
+/// and checks them (finite coordinates, at least one triangle).
 pub fn load(path: &Path) -> Result<Vec<Triangle>> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let triangles = match ext.as_deref() {
+    let triangles = match mesh_kind(path) {
         Some("obj") => load_obj(path)?,
         Some("ply") => load_ply(path)?,
-        _ => bail!("{}: not a mesh file (expected .obj or .ply)", path.display()),
+        _ => bail!("{}: not a mesh file (expected .obj or .ply, either compressed as .xz)", path.display()),
     };
     if triangles.is_empty() {
         bail!("{}: the mesh has no triangles", path.display());
@@ -321,6 +332,30 @@ mod tests {
     }
 
     const QUAD_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+
+    fn xz(bytes: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        lzma_rs::xz_compress(&mut std::io::BufReader::new(bytes), &mut out).unwrap();
+        out
+    }
+
+    #[test]
+    fn an_xz_compressed_mesh_loads_as_the_plain_one() {
+        let plain = load(&write("quad-plain.obj", QUAD_OBJ.as_bytes())).unwrap();
+        let packed = load(&write("quad-packed.obj.xz", &xz(QUAD_OBJ.as_bytes()))).unwrap();
+        assert_eq!(plain.len(), 2);
+        assert_eq!(plain, packed);
+    }
+
+    #[test]
+    fn a_broken_xz_file_is_named_as_such() {
+        let mut bytes = xz(QUAD_OBJ.as_bytes());
+        bytes.truncate(bytes.len() / 2);
+        let err = format!("{:#}", load(&write("quad-cut.obj.xz", &bytes)).unwrap_err());
+        assert!(err.contains("quad-cut.obj.xz") && err.contains("not a valid xz file"), "{err}");
+        let err = format!("{:#}", load(&write("quad.xz", &xz(QUAD_OBJ.as_bytes()))).unwrap_err());
+        assert!(err.contains("not a mesh file"), "{err}");
+    }
 
     #[test]
     fn obj_and_ply_load_the_same_quad() {

@@ -14,7 +14,7 @@ use treelet_core::geometry::triangle::Triangle;
 impl Scene {
     /// Parses a scene: `cornell`, `random:N[:SEED]`, `terrain:N`,
     /// `city:N[:SEED]`, or a path to a JSON scene file, a glTF scene or an
-    /// `.obj` / `.ply` mesh.
+    /// `.obj` / `.ply` mesh (either also as `.xz`).
     pub fn from_spec(spec: &str) -> Result<Scene> {
         if spec == "cornell" {
             return Ok(cornell());
@@ -26,7 +26,7 @@ impl Scene {
         if lower.ends_with(".gltf") || lower.ends_with(".glb") {
             return super::gltf::load(std::path::Path::new(spec));
         }
-        if lower.ends_with(".obj") || lower.ends_with(".ply") {
+        if super::mesh::mesh_kind(std::path::Path::new(spec)).is_some() {
             let triangles = super::mesh::load(std::path::Path::new(spec))?;
             return Ok(mesh_scene(spec, &triangles));
         }
@@ -72,7 +72,7 @@ impl Scene {
                 Ok(mesh_scene(spec, &city(n, seed)))
             }
             _ => bail!(
-                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh"
+                "unknown scene `{spec}`: expected cornell, random:N[:SEED], terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh (or .obj.xz/.ply.xz)"
             ),
         }
     }
@@ -95,8 +95,7 @@ impl Scene {
     /// camera with it (the mesh is read again for its bounds: a command's
     /// set-up, not a hot path); other scenes keep their coordinates.
     pub fn camera_in_file(spec: &str, eye: [f32; 3], target: [f32; 3]) -> Result<CameraSpec> {
-        let lower = spec.to_ascii_lowercase();
-        if lower.ends_with(".ply") || lower.ends_with(".obj") {
+        if super::mesh::mesh_kind(std::path::Path::new(spec)).is_some() {
             let place = super::model::mesh_placement(&super::mesh::load(std::path::Path::new(spec))?);
             return CameraSpec::looking_at(place(eye), place(target));
         }
