@@ -51,35 +51,45 @@ fn real_scenes_dir(dir: Option<&Path>) -> Result<PathBuf> {
     })
 }
 
-fn entries(dir: Option<&Path>) -> Result<Vec<Entry>> {
-    let dir = real_scenes_dir(dir)?;
+/// The scenes of `dir` (`NAME.ply.xz`, sorted) and their inside cameras
+/// (`cameras.json`: `NAME: {eye, look_at}` in the file's coordinates).
+fn listing(dir: &Path) -> Result<(Vec<String>, std::collections::HashMap<String, ([f32; 3], [f32; 3])>)> {
     let cameras_path = dir.join("cameras.json");
     let cameras: serde_json::Value = serde_json::from_str(&treelet::input::read_text(&cameras_path, "camera list")?)
         .with_context(|| format!("{}: not valid JSON", cameras_path.display()))?;
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+    let mut names: Vec<String> = std::fs::read_dir(dir)
         .with_context(|| format!("{}: cannot list it", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.to_string_lossy().ends_with(".ply.xz"))
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().to_string()))
+        .filter_map(|f| f.strip_suffix(".ply.xz").map(str::to_string))
         .collect();
-    files.sort();
-    if files.is_empty() {
+    names.sort();
+    if names.is_empty() {
         bail!("{}: no .ply.xz scenes", dir.display());
     }
-    let mut out = Vec::new();
-    for file in files {
-        let name = file.file_name().unwrap_or_default().to_string_lossy().trim_end_matches(".ply.xz").to_string();
+    let mut out = std::collections::HashMap::new();
+    for name in &names {
         let point = |key: &str| -> Option<[f32; 3]> {
-            let v = cameras.get(&name)?.get(key)?.as_array()?;
+            let v = cameras.get(name)?.get(key)?.as_array()?;
             let p: Vec<f32> = v.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect();
             (p.len() == 3).then(|| [p[0], p[1], p[2]])
         };
-        let inside = match (point("eye"), point("look_at")) {
-            (Some(e), Some(t)) => Some((e, t)),
-            _ => bail!("{}: no camera (eye, look_at) for {name}", cameras_path.display()),
+        match (point("eye"), point("look_at")) {
+            (Some(e), Some(t)) => out.insert(name.clone(), (e, t)),
+            _ => bail!("{}: no camera (eye, look_at: three numbers each) for {name}", cameras_path.display()),
         };
+    }
+    Ok((names, out))
+}
+
+fn entries(dir: Option<&Path>) -> Result<Vec<Entry>> {
+    let dir = real_scenes_dir(dir)?;
+    let (names, cameras) = listing(&dir)?;
+    let mut out = Vec::new();
+    for name in names {
+        let file = dir.join(format!("{name}.ply.xz"));
         eprintln!("loading {}", file.display());
         let triangles = treelet::scene::mesh::load(&file)?;
-        out.push(Entry { name, triangles, inside, file: Some(file) });
+        out.push(Entry { inside: Some(cameras[&name]), name, triangles, file: Some(file) });
     }
     for n in CITY_SIZES {
         out.push(Entry { name: format!("city:{n}"), triangles: treelet::scene::city::city(n, 1), inside: Some(CITY_STREET), file: None });
@@ -129,7 +139,6 @@ pub(crate) struct SuiteRow {
     pub(crate) scene: String,
     pub(crate) view: &'static str,
     pub(crate) triangles: usize,
-    #[serde(flatten)]
     pub(crate) treelet: RaysRow,
     pub(crate) optix: Option<PeerRow>,
 }
@@ -228,4 +237,39 @@ pub(crate) fn print(rows: &[SuiteRow]) {
         );
     }
     println!("rates in M rays/s; build ms: the tree and its layout (GPU timestamps); OptiX's build is the wall time of making its scene");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every scene of scenes/real has its inside camera, with the eye inside
+    /// the scene's bounds (a camera outside would time the outside view
+    /// twice).
+    #[test]
+    fn every_real_scene_has_a_camera_inside_it() {
+        let dir = real_scenes_dir(None).unwrap();
+        let (names, cameras) = listing(&dir).unwrap();
+        assert!(names.len() >= 4, "{names:?}");
+        for name in &names {
+            let (eye, _) = cameras[name];
+            let tris = treelet::scene::mesh::load(&dir.join(format!("{name}.ply.xz"))).unwrap();
+            let b = tris.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
+            let e = glam::Vec3::from_array(eye);
+            assert!(e.cmpge(b.lo()).all() && e.cmple(b.hi()).all(), "{name}: eye {eye:?} outside {b:?}");
+        }
+    }
+
+    /// The city's street camera stands in the open: no triangle's box comes
+    /// within a metre of the eye.
+    #[test]
+    fn the_city_street_camera_stands_in_the_street() {
+        let eye = glam::Vec3::from_array(CITY_STREET.0);
+        for t in treelet::scene::city::city(300_000, 1) {
+            let b = t.aabb();
+            let near = b.lo() - glam::Vec3::ONE;
+            let far = b.hi() + glam::Vec3::ONE;
+            assert!(!(eye.cmpge(near).all() && eye.cmple(far).all()), "a triangle within a metre of the eye: {t:?}");
+        }
+    }
 }

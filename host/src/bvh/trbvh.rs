@@ -54,15 +54,17 @@ pub struct TreeletConfig {
 }
 
 impl Default for TreeletConfig {
+    /// The paper's three rounds, gamma 3 and leaves of at most 8; for
+    /// developers tuning them, `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF`.
     fn default() -> Self {
-        Self {
-            rounds: 3,
-            gamma: 3,
-            max_leaf: 8,
-            skip_kept: true,
-            verify: false,
-            single_heights: single_invocation_heights(),
-        }
+        let (rounds, gamma, max_leaf) = std::env::var("TREELET_TREELETS")
+            .ok()
+            .and_then(|v| {
+                let n: Vec<u32> = v.split(',').map(|x| x.trim().parse().ok()).collect::<Option<_>>()?;
+                (n.len() == 3 && n[2] >= 1).then(|| (n[0], n[1], n[2]))
+            })
+            .unwrap_or((3, 3, 8));
+        Self { rounds, gamma, max_leaf, skip_kept: true, verify: false, single_heights: single_invocation_heights() }
     }
 }
 
