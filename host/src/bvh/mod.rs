@@ -14,7 +14,7 @@
 //! - [`validate`], [`validate_layout`]: independent checks that share no
 //!   code with the kernels;
 //! - [`report`]: one build, timed and checked (the `treelet build` command),
-//!   with its SAH and [`epo`] (end-point overlap).
+//!   with its SAH and [`epo`] (end-point overlap; [`clip`] cuts triangles to boxes).
 pub mod choice;
 pub mod clip;
 pub mod epo;
