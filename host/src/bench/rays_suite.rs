@@ -225,7 +225,7 @@ pub(crate) fn print(rows: &[SuiteRow]) {
             r.view,
             r.triangles,
             format!("{:?}", t.accel).to_lowercase(),
-            t.layout.name(),
+            if t.stack == "private" { t.layout.name().to_string() } else { format!("{}/wg", t.layout.name()) },
             t.build_ms + t.layout_ms,
             t.primary_mrays_per_s,
             t.diffuse_mrays_per_s,
