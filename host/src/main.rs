@@ -16,7 +16,7 @@ use treelet::render::parts::{self, PartInfo};
 use treelet::render::settings::MemoryEstimate;
 use treelet::render::{Control, Integrator, PassRow, RenderSettings, Sampler, Stopped};
 use treelet::runtime::memory::{available_bytes, human};
-use treelet::bvh::report::{run_build_with, run_build_sweep, BuildReport};
+use treelet::bvh::report::{run_build_with, run_build_cpu, BuildReport};
 use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
@@ -631,14 +631,15 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
-            if (builder, device) == (Builder::Sweep, DeviceChoice::Gpu) {
-                anyhow::bail!("the sweep builder runs on the CPU only: add --device cpu");
+            let on_cpu = matches!(builder, Builder::Sweep | Builder::Reference);
+            if on_cpu && device == DeviceChoice::Gpu {
+                anyhow::bail!("the {} builder runs on the CPU only: add --device cpu", builder.name());
             }
             // The device opens while the scene loads.
-            let opening = (builder != Builder::Sweep).then(|| OpenDevices::one(device));
+            let opening = (!on_cpu).then(|| OpenDevices::one(device));
             let scene = Scene::from_spec(&scene)?;
             let (_, report) = match opening {
-                None => run_build_sweep(&scene, max_leaf)?,
+                None => run_build_cpu(&scene, builder, max_leaf)?,
                 Some(opening) => {
                     let device = opening.finish()?.pop().expect("one device opened");
                     treelet::with_backend!(device, |b| run_build_with(b, &scene, builder, config)?)

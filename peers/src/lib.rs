@@ -96,25 +96,50 @@ pub fn bvh_crate(boxes: &[Aabb]) -> PeerTree {
 
 /// `obvhs` 0.4's PLOC builder (medium preset).
 pub fn obvhs_ploc(boxes: &[Aabb]) -> PeerTree {
-    use obvhs::aabb::Aabb as OAabb;
-    use obvhs::bvh2::builder::build_bvh2;
-    use obvhs::{Boundable, BvhBuildParams};
+    use obvhs::BvhBuildParams;
+    let prims: Vec<Prim> = boxes.iter().map(prim).collect();
+    obvhs_with(&prims, BvhBuildParams::medium_build(), "obvhs")
+}
 
-    struct Prim(OAabb);
-    impl Boundable for Prim {
-        fn aabb(&self) -> OAabb {
-            self.0
-        }
+/// `obvhs` 0.4's best tree over boxes, one primitive per leaf, for
+/// Treelet's quality reference (`treelet build --builder reference`): PLOC
+/// with its widest search, then reinsertion over every node
+/// (`very_slow_build`'s ratio 1.0; its pre-splitting needs triangles, so
+/// it is off here), no leaf collapse (Treelet's own SAH collapse runs
+/// after, as for its other trees).
+pub fn obvhs_reference(boxes: &[Aabb]) -> PeerTree {
+    use obvhs::BvhBuildParams;
+    use obvhs::ploc::PlocSearchDistance;
+    let prims: Vec<Prim> = boxes.iter().map(prim).collect();
+    let params = BvhBuildParams {
+        pre_split: false,
+        ploc_search_distance: PlocSearchDistance::High,
+        search_depth_threshold: 0,
+        reinsertion_batch_ratio: 1.0,
+        post_collapse_reinsertion_batch_ratio_multiplier: 0.0,
+        max_prims_per_leaf: 1,
+        ..BvhBuildParams::very_slow_build()
+    };
+    obvhs_with(&prims, params, "obvhs reference")
+}
+
+struct Prim(obvhs::aabb::Aabb);
+
+impl obvhs::Boundable for Prim {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        self.0
     }
-    let prims: Vec<Prim> = boxes
-        .iter()
-        .map(|b| {
-            Prim(OAabb { min: glam::Vec3A::from_array(b.min), max: glam::Vec3A::from_array(b.max) })
-        })
-        .collect();
+}
+
+fn prim(b: &Aabb) -> Prim {
+    Prim(obvhs::aabb::Aabb { min: glam::Vec3A::from_array(b.min), max: glam::Vec3A::from_array(b.max) })
+}
+
+fn obvhs_with(prims: &[Prim], params: obvhs::BvhBuildParams, name: &'static str) -> PeerTree {
+    use obvhs::bvh2::builder::build_bvh2;
     let mut core = std::time::Duration::ZERO;
     let start = Instant::now();
-    let bvh = build_bvh2(&prims, BvhBuildParams::medium_build(), &mut core);
+    let bvh = build_bvh2(prims, params, &mut core);
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
     // Inner nodes: children at first_index and first_index + 1.
     let mut nodes = Vec::with_capacity(bvh.nodes.len());
@@ -135,7 +160,7 @@ pub fn obvhs_ploc(boxes: &[Aabb]) -> PeerTree {
             stack.push((n.first_index as usize + 1, r));
         }
     }
-    PeerTree { name: "obvhs", nodes, prim_indices, build_ms }
+    PeerTree { name, nodes, prim_indices, build_ms }
 }
 
 #[cfg(test)]

@@ -601,8 +601,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
             let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
-            if builder == Builder::Sweep {
-                anyhow::bail!("bench build times the device builders (lbvh, trbvh, hploc); time the sweep builder with `treelet build --builder sweep --device cpu`");
+            if matches!(builder, Builder::Sweep | Builder::Reference) {
+                anyhow::bail!("bench build times the device builders (lbvh, trbvh, hploc); time the CPU builders with `treelet build --builder {} --device cpu`", builder.name());
             }
             let treelets = (builder, &config);
             let (adapter, timing, rows, clocks) = match device.open()? {

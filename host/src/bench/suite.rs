@@ -98,6 +98,7 @@ fn accel_name(a: Accel) -> &'static str {
         Accel::Trbvh => "TRBVH",
         Accel::Hploc => "H-PLOC",
         Accel::Sweep => "full-sweep SAH",
+        Accel::Reference => "reference (obvhs PLOC + reinsertion)",
     }
 }
 

@@ -6,7 +6,9 @@
 //!   agglomerative hierarchy, bottom-up boxes);
 //! - [`trbvh`]: Karras & Aila 2013 treelet restructuring and SAH leaf collapse;
 //! - [`refit`]: new boxes for a tree whose primitives moved;
-//! - [`sweep`]: the full-sweep SAH tree on the CPU, the quality reference;
+//! - [`sweep`]: the full-sweep SAH tree on the CPU;
+//! - [`reference`]: the quality reference, the peers crate's best tree (PLOC
+//!   with full reinsertion, on the CPU; feature `peers`);
 //! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
 //! - [`tree`]: the tree a render or an engine asks for: the builder's
 //!   choice ([`tree::Accel`]), its binary tree, and that tree laid out;
@@ -20,6 +22,7 @@ pub mod clip;
 pub mod epo;
 pub mod layout;
 pub mod lbvh;
+pub mod reference;
 pub mod refit;
 pub mod report;
 pub mod sort;

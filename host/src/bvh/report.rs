@@ -63,22 +63,28 @@ pub struct BuildReport {
     pub round_ms: Option<Vec<f64>>,
 }
 
-/// The full-sweep SAH reference build (CPU only), reported like the others.
-pub fn run_build_sweep(scene: &Scene, max_leaf: u32) -> Result<(Bvh, BuildReport)> {
+/// A CPU build (`sweep`, or `reference`: the quality reference), its
+/// leaves collapsed by SAH, reported like the others.
+pub fn run_build_cpu(scene: &Scene, builder: Builder, max_leaf: u32) -> Result<(Bvh, BuildReport)> {
     let prims = scene.primitives();
     prims.check()?;
     let start = Instant::now();
-    let bvh = crate::bvh::sweep::build_collapsed_boxes(&prims.boxes(), max_leaf)?;
+    let tree = match builder {
+        Builder::Sweep => crate::bvh::sweep::build_boxes(&prims.boxes()),
+        Builder::Reference => crate::bvh::reference::build_boxes(&prims.boxes())?.0,
+        _ => anyhow::bail!("internal: {} is a device builder", builder.name()),
+    };
+    let bvh = crate::bvh::sweep::collapse(tree, max_leaf)?;
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     let check = validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices);
     let mut ms = serde_json::Map::new();
-    ms.insert("sweep".into(), serde_json::json!(wall_ms));
+    ms.insert(builder.name().into(), serde_json::json!(wall_ms));
     let report = BuildReport {
         scene: scene.name.clone(),
         primitives: prims.len(),
         spheres: prims.counts().0,
         triangles: prims.counts().1,
-        builder: "sweep",
+        builder: builder.name(),
         device: "cpu",
         adapter: "cpu".into(),
         nodes: bvh.nodes.len(),
@@ -127,7 +133,7 @@ pub fn run_build_with<B: Backend>(
     let hierarchy = match builder {
         Builder::Hploc => Some(lbvh::Hierarchy::Hploc),
         Builder::Lbvh | Builder::Trbvh => None,
-        Builder::Sweep => anyhow::bail!("internal: the sweep builder is run by run_build_sweep"),
+        Builder::Sweep | Builder::Reference => anyhow::bail!("internal: the {} builder is run by run_build_cpu", builder.name()),
     };
     let prims = scene.primitives();
     prims.check()?;

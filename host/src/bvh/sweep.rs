@@ -24,8 +24,13 @@ pub fn build_collapsed(spheres: &[Sphere], max_leaf: u32) -> anyhow::Result<Bvh>
 
 /// [`build_collapsed`] over primitive boxes.
 pub fn build_collapsed_boxes(boxes: &[Aabb], max_leaf: u32) -> anyhow::Result<Bvh> {
-    let tree = build_boxes(boxes);
-    let n = boxes.len() as u32;
+    collapse(build_boxes(boxes), max_leaf)
+}
+
+/// The SAH leaf collapse of a CPU-built tree of one primitive per leaf in
+/// the LBVH's layout, by the CPU runner over the TRBVH's kernels.
+pub fn collapse(tree: Bvh, max_leaf: u32) -> anyhow::Result<Bvh> {
+    let n = tree.prim_indices.len() as u32;
     if n < 2 {
         return Ok(tree);
     }

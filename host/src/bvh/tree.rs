@@ -26,8 +26,12 @@ pub enum Builder {
     /// neighbours merged within subgroups as the climbs go up, on the
     /// chosen device (subgroups of 4 lanes or more).
     Hploc,
-    /// Full-sweep SAH, top-down on the CPU: the quality reference.
+    /// Full-sweep SAH, top-down on the CPU (beaten by the TRBVH on scenes
+    /// of mixed triangle sizes).
     Sweep,
+    /// The quality reference: `obvhs`'s PLOC with full reinsertion on the
+    /// CPU ([`crate::bvh::reference`]; needs the `peers` feature).
+    Reference,
 }
 
 impl Builder {
@@ -38,6 +42,7 @@ impl Builder {
             Builder::Trbvh => "trbvh",
             Builder::Hploc => "hploc",
             Builder::Sweep => "sweep",
+            Builder::Reference => "reference",
         }
     }
 }
@@ -58,8 +63,11 @@ pub enum Accel {
     Trbvh,
     /// Traverse the H-PLOC tree (Benthin et al. 2024).
     Hploc,
-    /// Traverse the full-sweep SAH tree, built on the CPU (the quality reference).
+    /// Traverse the full-sweep SAH tree, built on the CPU.
     Sweep,
+    /// Traverse the quality reference, built on the CPU (`obvhs`'s PLOC
+    /// with full reinsertion; needs the `peers` feature).
+    Reference,
 }
 
 impl Accel {
@@ -72,6 +80,7 @@ impl Accel {
             Accel::Trbvh => "trbvh",
             Accel::Hploc => "hploc",
             Accel::Sweep => "sweep",
+            Accel::Reference => "reference",
         }
     }
 
@@ -85,6 +94,7 @@ impl Accel {
             Accel::Trbvh => Some(Builder::Trbvh),
             Accel::Hploc => Some(Builder::Hploc),
             Accel::Sweep => Some(Builder::Sweep),
+            Accel::Reference => Some(Builder::Reference),
         })
     }
 }
@@ -142,7 +152,7 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
         Builder::Lbvh => lbvh::kernels(b),
         Builder::Trbvh => [lbvh::kernels(b), trbvh::kernels(b)].concat(),
         Builder::Hploc => lbvh::kernels_with(b, lbvh::Hierarchy::Hploc),
-        Builder::Sweep => Vec::new(),
+        Builder::Sweep | Builder::Reference => Vec::new(),
     };
     k.extend(crate::bvh::layout::kernels(b, layout));
     k.sort();
@@ -230,6 +240,11 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
             b.begin_build();
             BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
         }
+        Builder::Reference => {
+            let (tree, build_ms) = crate::bvh::reference::build_boxes(&all.boxes())?;
+            b.begin_build();
+            BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
+        }
     })
 }
 
@@ -247,7 +262,7 @@ pub fn collapsed_tree<B: Backend>(
     let (bvh, mut times) = match builder {
         Builder::Lbvh | Builder::Trbvh => lbvh::build_primitives_on_device(b, all)?,
         Builder::Hploc => lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?,
-        Builder::Sweep => bail!("internal: the sweep builder runs on the CPU"),
+        Builder::Sweep | Builder::Reference => bail!("internal: the {} builder runs on the CPU", builder.name()),
     };
     let (bvh, more) = match builder {
         Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 => {

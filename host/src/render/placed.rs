@@ -20,7 +20,7 @@ pub fn mesh_quality(asked: Accel, paths: u64) -> Quality {
         Accel::Lbvh => Quality::Fast,
         Accel::Trbvh => Quality::High,
         Accel::Hploc => Quality::Balanced,
-        Accel::Auto | Accel::None | Accel::Sweep => Quality::ForRays(paths),
+        Accel::Auto | Accel::None | Accel::Sweep | Accel::Reference => Quality::ForRays(paths),
     }
 }
 

@@ -234,7 +234,7 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
             let accel = match builder {
                 Builder::Trbvh => Accel::Trbvh,
                 Builder::Hploc => Accel::Hploc,
-                Builder::Lbvh | Builder::Sweep => Accel::Lbvh,
+                Builder::Lbvh | Builder::Sweep | Builder::Reference => Accel::Lbvh,
             };
             (
                 accel,
