@@ -7,7 +7,7 @@
 //! - [`trbvh`]: Karras & Aila 2013 treelet restructuring and SAH leaf collapse;
 //! - [`refit`]: new boxes for a tree whose primitives moved;
 //! - [`sweep`]: the full-sweep SAH tree on the CPU;
-//! - [`reference`]: the quality reference, the peers crate's best tree (PLOC
+//! - [`mod@reference`]: the quality reference, the peers crate's best tree (PLOC
 //!   with full reinsertion, on the CPU; feature `peers`);
 //! - [`layout`]: the traversal layouts (binary, classic, compressed wide);
 //! - [`tree`]: the tree a render or an engine asks for: the builder's
