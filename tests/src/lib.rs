@@ -3,17 +3,20 @@ use std::sync::{Arc, OnceLock};
 
 use treelet::runtime::gpu::GpuContext;
 
-/// The GPU context for tests. With `CI` set, a missing adapter fails the
-/// test; elsewhere the test is skipped with a printed reason (never silently).
+/// The GPU context for tests. A missing adapter fails the test (install
+/// lavapipe: `scripts/setup`), unless `TREELET_TESTS_WITHOUT_GPU=1` asks to
+/// skip GPU tests on a machine without Vulkan (never under `CI`); a skip
+/// prints its reason.
 pub fn gpu() -> Option<Arc<GpuContext>> {
     static CTX: OnceLock<Result<Arc<GpuContext>, String>> = OnceLock::new();
     match CTX.get_or_init(|| GpuContext::new().map_err(|e| format!("{e:#}"))) {
         Ok(ctx) => Some(ctx.clone()),
         Err(e) if std::env::var_os("CI").is_some() => panic!("CI is set and no GPU adapter is usable: {e}"),
-        Err(e) => {
-            eprintln!("SKIPPED (no GPU adapter, CI not set): {e}");
+        Err(e) if std::env::var("TREELET_TESTS_WITHOUT_GPU").is_ok_and(|v| v == "1") => {
+            eprintln!("SKIPPED (no GPU adapter, TREELET_TESTS_WITHOUT_GPU=1): {e}");
             None
         }
+        Err(e) => panic!("no GPU adapter is usable ({e}): install lavapipe (sh scripts/setup), or set TREELET_TESTS_WITHOUT_GPU=1 to skip GPU tests"),
     }
 }
 
