@@ -33,12 +33,7 @@ impl Scene {
         let mut parts = spec.split(':');
         match parts.next() {
             Some("random") => {
-                let n = parts.next().with_context(|| format!("scene `{spec}`: expected random:N[:SEED]"))?;
-                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a primitive count"))?;
-                let seed = match parts.next() {
-                    Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
-                    None => 1,
-                };
+                let (n, seed) = count_and_seed(spec, &mut parts, "random:N[:SEED]", "primitive")?;
                 if parts.next().is_some() {
                     bail!("scene `{spec}`: expected random:N[:SEED]");
                 }
@@ -59,12 +54,7 @@ impl Scene {
                 Ok(mesh_scene(spec, &terrain(n)))
             }
             Some("city") => {
-                let n = parts.next().with_context(|| format!("scene `{spec}`: expected city:N[:SEED]"))?;
-                let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a triangle count"))?;
-                let seed = match parts.next() {
-                    Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
-                    None => 1,
-                };
+                let (n, seed) = count_and_seed(spec, &mut parts, "city:N[:SEED]", "triangle")?;
                 if parts.next().is_some() || n == 0 {
                     bail!("scene `{spec}`: expected city:N[:SEED] with N > 0 triangles");
                 }
@@ -76,6 +66,19 @@ impl Scene {
             ),
         }
     }
+}
+
+/// The count and optional seed (1 if none) of a generated scene `form`
+/// (`random:N[:SEED]`, `city:N[:SEED]`), from the parts after its name;
+/// `unit` names what is counted.
+fn count_and_seed<'a>(spec: &str, parts: &mut impl Iterator<Item = &'a str>, form: &str, unit: &str) -> Result<(usize, u64)> {
+    let n = parts.next().with_context(|| format!("scene `{spec}`: expected {form}"))?;
+    let n: usize = n.parse().with_context(|| format!("scene `{spec}`: `{n}` is not a {unit} count"))?;
+    let seed = match parts.next() {
+        Some(s) => s.parse().with_context(|| format!("scene `{spec}`: `{s}` is not a seed"))?,
+        None => 1,
+    };
+    Ok((n, seed))
 }
 
 /// Refuses a generated mesh (`terrain:N`, `city:N`) of more triangles than
