@@ -26,52 +26,86 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// The shader crate's groups of entry points (its features), built one per
+/// rust-gpu run: the linker holds all of a run's kernels at once, and one
+/// run of every kernel peaked at 22 GB of memory (issue 69). The split
+/// follows the SPIR-V's size: about 1.1 to 2.6 MB of modules per group.
+#[cfg(feature = "rebuild-shaders")]
+const GROUPS: [&str; 5] = ["kernels", "render-linear", "render-bvh2", "render-bvh2-light", "render-cwbvh"];
+
 #[cfg(feature = "rebuild-shaders")]
 fn rebuild() -> Result<(), Box<dyn std::error::Error>> {
     use spirv_builder::{Capability, ModuleResult, SpirvBuilder};
     let shader = concat!(env!("CARGO_MANIFEST_DIR"), "/../shader");
-    let mut builder = SpirvBuilder::new(shader, "spirv-unknown-vulkan1.2")
-        // u64 Morton codes and radix-sort keys.
-        .capability(Capability::Int64)
-        // Device-scope atomics (bottom-up fit): needs SPIR-V passthrough in wgpu.
-        .capability(Capability::VulkanMemoryModelDeviceScope)
-        // Subgroup operations (Vulkan 1.1 core): ids, ballots, shuffles, sums.
-        .capability(Capability::GroupNonUniform)
-        .capability(Capability::GroupNonUniformBallot)
-        .capability(Capability::GroupNonUniformShuffle)
-        .capability(Capability::GroupNonUniformArithmetic)
-        // NVIDIA's partition instruction (the sort's digit match), kept only
-        // in the modules that use it (see `strip_unused_partitioned`).
-        .capability(Capability::GroupNonUniformPartitionedNV)
-        .extension("SPV_NV_shader_subgroup_partitioned")
-        .multimodule(true);
-    builder.release = true;
-    builder.build_script.defaults = true;
-    let result = builder.build()?;
-    let ModuleResult::MultiModule(modules) = result.module else {
-        return Err("spirv-builder gave one module where one per entry point was asked for".into());
-    };
-    // Sorted by entry point (a BTreeMap), so the same sources pack the same bytes.
-    let mut words: Vec<u32> = vec![u32::from_le_bytes(*b"TRLT"), u32::from_le_bytes(*b"SPV1"), modules.len() as u32];
-    for (name, path) in &modules {
-        let bytes = std::fs::read(path)?;
-        if bytes.len() % 4 != 0 {
-            return Err(format!("{}: not whole SPIR-V words", path.display()).into());
+    // Sorted by entry point, so the same sources pack the same bytes.
+    let mut modules: std::collections::BTreeMap<String, Vec<u32>> = Default::default();
+    for group in GROUPS {
+        let mut builder = SpirvBuilder::new(shader, "spirv-unknown-vulkan1.2")
+            // u64 Morton codes and radix-sort keys.
+            .capability(Capability::Int64)
+            // Device-scope atomics (bottom-up fit): needs SPIR-V passthrough in wgpu.
+            .capability(Capability::VulkanMemoryModelDeviceScope)
+            // Subgroup operations (Vulkan 1.1 core): ids, ballots, shuffles, sums.
+            .capability(Capability::GroupNonUniform)
+            .capability(Capability::GroupNonUniformBallot)
+            .capability(Capability::GroupNonUniformShuffle)
+            .capability(Capability::GroupNonUniformArithmetic)
+            // NVIDIA's partition instruction (the sort's digit match), kept only
+            // in the modules that use it (see `strip_unused_partitioned`).
+            .capability(Capability::GroupNonUniformPartitionedNV)
+            .extension("SPV_NV_shader_subgroup_partitioned")
+            .shader_crate_default_features(false)
+            .shader_crate_features([group.to_string()])
+            .multimodule(true);
+        builder.release = true;
+        builder.build_script.defaults = true;
+        let result = builder.build()?;
+        let ModuleResult::MultiModule(built) = result.module else {
+            return Err("spirv-builder gave one module where one per entry point was asked for".into());
+        };
+        // Read now: the next group's run may write where this one did.
+        for (name, path) in built {
+            let bytes = std::fs::read(&path)?;
+            if bytes.len() % 4 != 0 {
+                return Err(format!("{}: not whole SPIR-V words", path.display()).into());
+            }
+            let module: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+            let module = strip_unused_partitioned(&module).map_err(|e| format!("{}: {e}", path.display()))?;
+            if modules.insert(name.clone(), module).is_some() {
+                return Err(format!("entry point {name} is in two groups of the shader crate").into());
+            }
         }
-        let module: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-        let module = strip_unused_partitioned(&module).map_err(|e| format!("{}: {e}", path.display()))?;
-        let bytes: Vec<u8> = module.iter().flat_map(|w| w.to_le_bytes()).collect();
+    }
+    let mut words: Vec<u32> = vec![u32::from_le_bytes(*b"TRLT"), u32::from_le_bytes(*b"SPV1"), modules.len() as u32];
+    for (name, module) in &modules {
         let mut padded = name.as_bytes().to_vec();
         padded.resize(name.len().div_ceil(4) * 4, 0);
         words.push(name.len() as u32);
         words.extend(padded.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
-        words.push((bytes.len() / 4) as u32);
-        words.extend(bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+        words.push(module.len() as u32);
+        words.extend_from_slice(module);
     }
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("treelet_shaders.bin");
     std::fs::write(&out, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())?;
     println!("cargo:rustc-env=treelet_shaders.bin={}", out.display());
+    // The largest resident size of any process these runs started (rustc
+    // with the SPIR-V backend): CI holds it under 8 GB (tests/layering.rs).
+    println!("cargo:rustc-env=treelet_shader_build_peak_rss_kb={}", children_peak_rss_kb());
     Ok(())
+}
+
+/// The peak resident set size, in KiB, of the largest child process this
+/// build script has waited for (`getrusage(RUSAGE_CHILDREN)`; on Linux a
+/// child's figure includes its own children's).
+#[cfg(feature = "rebuild-shaders")]
+fn children_peak_rss_kb() -> i64 {
+    // SAFETY: getrusage writes the struct it is given, nothing else.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) } != 0 {
+        return -1;
+    }
+    // KiB on Linux (bytes on macOS, where the shaders are not built in CI).
+    usage.ru_maxrss
 }
 
 /// `module` without the partitioned capability and extension where it has

@@ -429,22 +429,3 @@ fn clean_tree_passes() {
     ]);
     assert!(v.is_empty(), "{v:#?}");
 }
-
-/// The committed SPIR-V modules (what `treelet` builds without feature
-/// `rebuild-shaders` load, so that they need no nightly) are the modules
-/// rust-gpu compiles from today's `shader/` and `core/` (these tests build
-/// with the feature). rust-gpu's output depends on the sources alone (the
-/// same bytes from two checkouts at different paths).
-#[test]
-fn committed_spirv_is_the_shader_sources_build() {
-    let committed = std::fs::read(treelet::runtime::gpu::COMMITTED_SHADERS_PATH).expect("the committed SPIR-V modules");
-    let fresh = treelet::runtime::gpu::SHADERS;
-    assert!(
-        committed == fresh,
-        "{} ({} bytes) is not the build of today's shader sources ({} bytes): run \
-         `cargo run -p treelet --features rebuild-shaders --example update_shaders` and commit it",
-        treelet::runtime::gpu::COMMITTED_SHADERS_PATH,
-        committed.len(),
-        fresh.len()
-    );
-}

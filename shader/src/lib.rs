@@ -5,6 +5,7 @@
 //! Binding 0 of every entry point is its parameter struct; the host's kernel
 //! table (`treelet::runtime::kernels`) lists the rest in the same order.
 #![cfg_attr(target_arch = "spirv", no_std)]
+#![cfg_attr(not(feature = "kernels"), allow(unused_macros))]
 
 /// Runs a phase function once per phase, a workgroup barrier after each,
 /// with the phase numbers as literals (checked against the kernel's phase
@@ -24,20 +25,39 @@ macro_rules! unrolled_phases {
     }};
 }
 
+// The entry points come in groups, one per feature of this crate, so that
+// the SPIR-V is built one group per rust-gpu run: its linker holds a whole
+// run's kernels at once, and all of them in one run peaked at 22 GB
+// (host/build.rs lists the groups).
+#[cfg(feature = "kernels")]
 pub mod bounds;
+#[cfg(feature = "kernels")]
 pub mod bvh2;
+#[cfg(feature = "kernels")]
 pub mod cwbvh;
+#[cfg(feature = "kernels")]
 pub mod depth;
+#[cfg(feature = "kernels")]
 pub mod fill;
+#[cfg(feature = "kernels")]
 pub mod fit;
+#[cfg(feature = "kernels")]
 pub mod morton;
+#[cfg(feature = "kernels")]
 pub mod presplit;
+#[cfg(feature = "kernels")]
 pub mod multisplit;
+#[cfg(feature = "kernels")]
 pub mod radix_tree;
+#[cfg(any(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-cwbvh"))]
 pub mod render;
+#[cfg(feature = "kernels")]
 pub mod scan;
+#[cfg(feature = "kernels")]
 pub mod scene;
+#[cfg(feature = "kernels")]
 pub mod sort;
+#[cfg(feature = "kernels")]
 pub mod treelet;
 
 // `#[spirv(compute(threads(256)))]` takes a literal: keep it in step

@@ -1,3 +1,9 @@
+// Built in groups (this crate's features, one rust-gpu run each; see
+// host/build.rs): a group leaves the others' imports and macros unused.
+#![cfg_attr(
+    not(all(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-cwbvh")),
+    allow(unused_imports, unused_macros)
+)]
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{Material, Node, PlacedInfo, RenderParams, Sphere};
@@ -102,11 +108,17 @@ macro_rules! render_entry_points {
         $(
             pub mod $name {
                 use super::*;
+                #[cfg(feature = "render-linear")]
                 render_kernel!(camera whole linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                #[cfg(feature = "render-bvh2")]
                 render_kernel!(camera bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                #[cfg(feature = "render-cwbvh")]
                 render_kernel!(camera whole cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
+                #[cfg(feature = "render-linear")]
                 render_kernel!(light whole light_linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
+                #[cfg(feature = "render-bvh2-light")]
                 render_kernel!(light light_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                #[cfg(feature = "render-cwbvh")]
                 render_kernel!(light whole light_cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
             }
         )*
@@ -116,6 +128,7 @@ treelet_core::for_each_render_variant!(render_entry_points);
 
 // The seed's layout, kept for comparison: the general kernel only
 // (`render::classic_cs`).
+#[cfg(feature = "render-linear")]
 render_kernel!(camera whole classic_cs, Node, u32, ClassicTree::new, ALL);
 
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
@@ -167,14 +180,21 @@ macro_rules! cast_kernel {
 }
 
 // Every kind of primitive, and triangles alone (meshes).
+#[cfg(feature = "render-linear")]
 cast_kernel!(whole cast_classic_cs, Node, u32, ClassicTree::new, ALL);
+#[cfg(feature = "render-bvh2")]
 cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
+#[cfg(feature = "render-cwbvh")]
 cast_kernel!(whole cast_cwbvh_cs, Vec4, Vec4, WideTree::new, ALL);
+#[cfg(feature = "render-linear")]
 cast_kernel!(whole cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
+#[cfg(feature = "render-bvh2")]
 cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
+#[cfg(feature = "render-cwbvh")]
 cast_kernel!(whole cast_cwbvh_triangles_cs, Vec4, Vec4, WideTree::new, TRIANGLES);
 
 /// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.
+#[cfg(feature = "render-cwbvh")]
 #[spirv(compute(threads(256)))]
 pub fn cast_cwbvh_workgroup_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -199,6 +219,7 @@ pub fn cast_cwbvh_workgroup_cs(
 /// An engine's rays through an instanced scene: the top-level tree over
 /// the instances, then each instance's mesh tree (bindings: see
 /// `treelet_core::render::rays::cast_instances_kernel`).
+#[cfg(feature = "render-bvh2")]
 #[spirv(compute(threads(64)))]
 pub fn cast_instances_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
@@ -281,6 +302,9 @@ macro_rules! placed_kernel {
 // (`treelet_core::render::caustics`) where none are traced: compiled in,
 // it made the placed render 1.7% slower with NEE (H100).
 // Placed copies' kernels draw either sampler's numbers, as the render asks.
+#[cfg(feature = "render-bvh2-light")]
 placed_kernel!(camera render_placed_cs, ALL | INSTANCES | INDEPENDENT_NUMBERS);
+#[cfg(feature = "render-bvh2-light")]
 placed_kernel!(camera render_placed_caustics_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);
+#[cfg(feature = "render-bvh2-light")]
 placed_kernel!(light light_placed_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);

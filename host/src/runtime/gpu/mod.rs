@@ -8,4 +8,4 @@ pub mod shaders;
 
 pub use backend::GpuBackend;
 pub use context::{quiet_mesa_runtime_dir, GpuContext};
-pub use shaders::{COMMITTED_SHADERS_PATH, SHADERS};
+pub use shaders::{COMMITTED_SHADERS_PATH, SHADER_BUILD_PEAK_RSS_KB, SHADERS, SHADERS_REBUILT};

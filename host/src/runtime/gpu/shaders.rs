@@ -10,6 +10,11 @@ pub const SHADERS: &[u8] = include_bytes!(env!("treelet_shaders.bin"));
 /// Where the committed packed modules live (`host/shaders/`): what builds
 /// without feature `rebuild-shaders` use as [`SHADERS`].
 pub const COMMITTED_SHADERS_PATH: &str = env!("treelet_shaders_committed.bin");
+/// Whether [`SHADERS`] was compiled by this build (feature `rebuild-shaders`).
+pub const SHADERS_REBUILT: bool = cfg!(feature = "rebuild-shaders");
+/// With feature `rebuild-shaders`, the shader build's peak memory in KiB:
+/// the largest resident size of any process it ran (rust-gpu's rustc).
+pub const SHADER_BUILD_PEAK_RSS_KB: Option<&str> = option_env!("treelet_shader_build_peak_rss_kb");
 
 /// One entry point's module.
 #[derive(Clone, Copy, Debug)]
