@@ -65,3 +65,9 @@ pub use runtime::cpu_runner::CpuBackend;
 pub use runtime::gpu::{GpuBackend, GpuContext};
 pub use tracer::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer};
 pub use treelet_core::{Sphere, Triangle};
+
+/// The README's Rust snippets, run as doc tests: what a newcomer copies
+/// first compiles and passes.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;

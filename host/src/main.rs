@@ -22,6 +22,8 @@ use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
 
 mod bench;
+#[cfg(test)]
+mod cli_help;
 
 #[derive(Parser)]
 #[command(name = "treelet", version, about = "GPU BVH construction (Karras 2012) and a smallpt path tracer, in Rust")]
@@ -38,7 +40,7 @@ struct Cli {
 enum Command {
     /// Build a BVH over a scene, check it, and report its cost and stage times.
     Build {
-        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), cornell, a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+        /// Scene: random:N[:SEED] (N spheres), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), cornell, room_disk, a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
         #[arg(long, default_value = "random:100000")]
         scene: String,
         #[arg(long, value_enum, default_value = "lbvh")]
@@ -55,13 +57,16 @@ enum Command {
         /// Largest leaf the final SAH collapse makes; 1 keeps one primitive per leaf (trbvh, sweep).
         #[arg(long, default_value_t = TreeletConfig::default().max_leaf, value_parser = clap::value_parser!(u32).range(1..=1024))]
         max_leaf: u32,
+        /// Iterations of parallel reinsertion after the rounds (Meister and Bittner 2018: nodes moved where they lower the SAH most; trbvh, hploc).
+        #[arg(long, default_value_t = TreeletConfig::default().reinsert, value_parser = clap::value_parser!(u32).range(0..=64))]
+        reinsert: u32,
         /// Print one JSON object instead of a summary.
         #[arg(long)]
         json: bool,
     },
     /// Path-trace a scene (smallpt) and write the image, with an error report.
     Render(RenderArgs),
-    /// Add the parts of a render (`render --samples A..B --out part.exr`,
+    /// Add the parts of a render (render --samples A..B --out part.exr,
     /// from other processes or machines) into one image; checks that they
     /// share scene, size, seed and integrator, and that their sample ranges
     /// neither overlap nor leave gaps.
@@ -73,14 +78,14 @@ enum Command {
         out: std::path::PathBuf,
     },
     /// Score an image (.exr or .pfm, linear) against a reference with the
-    /// render's own error measure; prints one JSON object (`rmse`, `rel_mse`).
+    /// render's own error measure; prints one JSON object (rmse, rel_mse).
     Compare {
         image: std::path::PathBuf,
         #[arg(long)]
         reference: std::path::PathBuf,
     },
     /// Write a scene's triangles as a binary PLY mesh, for other tracers
-    /// (`peers/mitsuba/rays.py` times OptiX on it): a generated scene, a
+    /// (peers/mitsuba/rays.py times OptiX on it): a generated scene, a
     /// glTF or scene file flattened, or a mesh.
     Export {
         /// Scene: terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
@@ -99,11 +104,11 @@ enum Command {
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
 struct RenderArgs {
-    /// Scene: cornell, random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+    /// Scene: cornell, room_disk, cornell_diffuse or cornell_mirrors (built in), random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
     #[arg(long, default_value = "cornell")]
     scene: String,
     /// Trace a scene file's or glTF file's copies of meshes flattened into
-    /// the scene's own triangles, as `build` does (by default a mesh placed
+    /// the scene's own triangles, as build does (by default a mesh placed
     /// more than once keeps its copies placed: one tree per mesh).
     #[arg(long)]
     flatten: bool,
@@ -116,14 +121,13 @@ struct RenderArgs {
     spp: u32,
     /// Render only samples FIRST..LAST (LAST excluded) and write them to
     /// --out (.exr) as a part: per-pixel sums and the range in its header,
-    /// for `treelet merge` to add to the other parts.
+    /// for treelet merge to add to the other parts.
     #[arg(long, value_name = "FIRST..LAST", value_parser = parse_range)]
     samples: Option<std::ops::Range<u32>>,
-    /// How closest hits are found; auto: a linear scan below the measured
-    /// crossover in primitive count, else the treelet-optimized BVH.
+    /// How closest hits are found: through which tree, or a linear scan.
     #[arg(long, value_enum, default_value = "auto")]
     accel: Accel,
-    /// How the tree is laid out for traversal; auto: the fastest measured (cwbvh).
+    /// How the tree is laid out for traversal.
     #[arg(long, value_enum, default_value = "auto")]
     layout: Layout,
     /// Render kernel: auto, the variant compiled for the scene's features
@@ -143,10 +147,10 @@ struct RenderArgs {
     device: DeviceChoice,
     /// Render on several devices at once, each taking chunks of samples as
     /// it finishes the last (without it, a machine with several GPUs renders
-    /// on all its GPUs; `--devices 0` takes one): all (every Vulkan adapter; the CPU runner where
+    /// on all its GPUs; --devices 0 takes one): all (every Vulkan adapter; the CPU runner where
     /// there is none: beside a GPU or lavapipe it slowed renders, measured),
     /// gpu (every adapter), or a list of adapter indices or names and cpu
-    /// (`--devices list` prints the adapters).
+    /// (--devices list prints the adapters).
     #[arg(long, value_name = "all|gpu|LIST", conflicts_with = "device")]
     devices: Option<String>,
     #[arg(long, default_value_t = 0)]
@@ -174,7 +178,7 @@ struct RenderArgs {
     resume: Option<std::path::PathBuf>,
 }
 
-/// How radiance is estimated (`--integrator`): one by name, or `auto`.
+/// How radiance is estimated (--integrator): one by name, or auto.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum IntegratorArg {
     /// smallpt's: emitters count only where paths hit them.
@@ -190,7 +194,7 @@ enum IntegratorArg {
     /// nee or caustics, whichever a pilot (four short images, thrown away)
     /// measures to give less error in equal time; nee without mirrors or
     /// glass lit by a lamp, or where the pilot would take over an eighth of
-    /// the render's samples. `--explain` gives the measurements.
+    /// the render's samples. --explain gives the measurements.
     Auto,
 }
 
@@ -628,9 +632,9 @@ fn bound_threads() {
 fn run(cli: Cli) -> Result<bool> {
     treelet::input::set_max_input_bytes(cli.max_input_bytes);
     match cli.command {
-        Command::Build { scene, builder, device, rounds, gamma, max_leaf, json } => {
+        Command::Build { scene, builder, device, rounds, gamma, max_leaf, reinsert, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
-            let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
+            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert, ..Default::default() };
             let on_cpu = matches!(builder, Builder::Sweep | Builder::Reference);
             if on_cpu && device == DeviceChoice::Gpu {
                 anyhow::bail!("the {} builder runs on the CPU only: add --device cpu", builder.name());

@@ -49,6 +49,8 @@ pub mod presplit;
 pub mod multisplit;
 #[cfg(feature = "kernels")]
 pub mod radix_tree;
+#[cfg(feature = "kernels")]
+pub mod reinsert;
 #[cfg(any(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-cwbvh"))]
 pub mod render;
 #[cfg(feature = "kernels")]

@@ -87,6 +87,19 @@ pub fn fit_kernel<const ORDERED: bool>(
     climb_boxes::<ORDERED>(leaf_node(n, i), b, nodes, parents, flags);
 }
 
+/// Kernel: leaf `i` of a tree of `n` leaves in the LBVH layout whose
+/// shape changed ([`crate::construct::reinsert`]): climbs as [`fit_kernel`]
+/// does, from the box the leaf holds, so every internal node gets the
+/// union of its children's boxes again. `flags` are zeroed counters.
+pub fn refit_nodes_kernel<const ORDERED: bool>(i: u32, n: u32, nodes: &mut SplitMut<Node>, parents: &[u32], flags: &mut [u32]) {
+    if i >= n || n == 1 {
+        return;
+    }
+    let leaf = leaf_node(n, i);
+    let own = nodes.with(leaf as usize, load_box);
+    climb_boxes::<ORDERED>(leaf, own, nodes, parents, flags);
+}
+
 /// The climb of [`fit_kernel`] from node `start`, whose box `own` is
 /// written: each internal node it arrives at second gets the union of its
 /// children's boxes. (The `bvh2` layout's refit climbs the same way but

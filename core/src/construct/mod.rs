@@ -14,6 +14,7 @@
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
 //! | hierarchy and boxes in one pass | [`agglomerate`]; [`agglomerate_subgroup`] (its lowest levels merged within subgroups) | Apetrei 2014 |
 //! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
+//! | reinsertion of nodes where they lower the SAH most | [`reinsert`] | Meister & Bittner 2018 |
 //! | SAH leaf collapse, depth-first compaction | [`collapse`] | Karras & Aila 2013, section 4.4 |
 //! | SAH cost | [`sah`] | MacDonald & Booth 1990 |
 //! | an instanced scene's top level: instance records and world boxes | [`instances`] | |
@@ -38,6 +39,7 @@ pub mod multisplit;
 pub mod presplit;
 pub mod primitive_boxes;
 pub mod radix_tree;
+pub mod reinsert;
 pub mod sah;
 pub mod scan;
 pub mod sort;

@@ -300,6 +300,37 @@ pub struct TreeletParams {
 }
 const _: () = assert!(core::mem::size_of::<TreeletParams>() == 48);
 
+/// Parameters of the reinsertion kernels
+/// ([`crate::construct::reinsert`]). repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct ReinsertParams {
+    /// Number of primitives (leaves).
+    pub n: u32,
+    /// The iteration, from 0: where the apply kernel counts its moves.
+    pub iteration: u32,
+    /// Boxes are scaled by this before taking areas.
+    pub inv_extent: f32,
+    pub _pad: u32,
+}
+const _: () = assert!(core::mem::size_of::<ReinsertParams>() == 16);
+
+/// The best move one node found ([`crate::construct::reinsert`]): node
+/// `from` to become the sibling of node `to`, lowering the tree's summed
+/// surface area by `gain` (scaled; 0 and `to` = [`INVALID`]: no move).
+/// repr(C), Pod, 16 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Reinsertion {
+    pub from: u32,
+    pub to: u32,
+    pub gain: f32,
+    pub _pad: u32,
+}
+const _: () = assert!(core::mem::size_of::<Reinsertion>() == 16);
+
 /// A primitive stored where its leaf reads it (the traversal layouts
 /// [`Bvh2Node`] and [`WideNode`] keep primitives in leaf order, so a leaf
 /// reads them directly instead of through an index). repr(C), Pod, 48 bytes:

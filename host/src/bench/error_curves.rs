@@ -23,11 +23,11 @@ use treelet::render::{image_error, PassRow};
 
 /// The scenes: smallpt's room with its big sphere light, and the room lit by
 /// a small disk of triangles (as Mitsuba sees it).
-const SCENES: [(&str, &str); 2] = [("cornell", "cornell"), ("room_disk", "scenes/room_disk.json")];
+const SCENES: [(&str, &str); 2] = [("cornell", "cornell"), ("room_disk", "room_disk")];
 
 /// Both figures: against wall time, then against kernel time.
 pub(crate) fn measure(s: &Suite, runner: &Device) -> Result<Vec<FigureDoc>> {
-    let (w, h, spp, reference_spp) = if s.quick { (128, 96, 256, 2048) } else { (1024, 768, 1024, 4096) };
+    let (w, h, spp, reference_spp) = if s.quick { (96, 72, 64, 1024) } else { (1024, 768, 1024, 4096) };
     let mut wall = doc(Figure::Error, &format!("RMSE against wall time, {w}x{h}"), "wall time (s)", "RMSE against the reference", (true, true));
     let mut kernel = doc(Figure::Error, &format!("RMSE against kernel time, {w}x{h}"), "kernel time (s)", "RMSE against the reference", (true, true));
     kernel.figure = ERROR_KERNEL.into();

@@ -36,7 +36,7 @@ pub struct FigureArgs {
     /// Small sizes: minutes on lavapipe or a CPU (default: the seed's sizes and beyond).
     #[arg(long)]
     quick: bool,
-    /// Where the JSON and PNG of each figure (and RESULTS.md for `all`) go.
+    /// Where the JSON and PNG of each figure (and RESULTS.md for all) go.
     #[arg(long)]
     out: std::path::PathBuf,
     /// Timed repeats per measurement (median, min and max are recorded).
@@ -62,11 +62,11 @@ pub enum BenchCommand {
     #[command(name = "graph3.5")]
     Graph35(FigureArgs),
     /// Figures: RMSE against wall and kernel time for each integrator on
-    /// cornell and the disk-lit room, Mitsuba 3 beside (`--mitsuba`).
+    /// cornell and the disk-lit room, Mitsuba 3 beside (--mitsuba).
     Error {
         #[command(flatten)]
         figure: FigureArgs,
-        /// Folder of `peers/mitsuba/room_disk.py`'s output (`mitsuba.jsonl` and
+        /// Folder of peers/mitsuba/room_disk.py's output (mitsuba.jsonl and
         /// its images): Mitsuba 3's renders of the room, scored beside Treelet's.
         #[arg(long)]
         mitsuba: Option<std::path::PathBuf>,
@@ -78,9 +78,9 @@ pub enum BenchCommand {
     RaysFigure(FigureArgs),
     /// Every figure, then RESULTS.md in --out.
     All(FigureArgs),
-    /// One RESULTS.md from the figure files of several `bench all` runs (how docs/RESULTS.md is made).
+    /// One RESULTS.md from the figure files of several bench all runs (how docs/RESULTS.md is made).
     Results {
-        /// Run directories, each written by `treelet bench all --out DIR`.
+        /// Run directories, each written by treelet bench all --out DIR.
         #[arg(long, value_delimiter = ',', required = true)]
         runs: Vec<std::path::PathBuf>,
         #[arg(long, default_value = "docs/RESULTS.md")]
@@ -101,6 +101,9 @@ pub enum BenchCommand {
         gamma: u32,
         #[arg(long, default_value_t = TreeletConfig::default().max_leaf)]
         max_leaf: u32,
+        /// Iterations of parallel reinsertion after the rounds (trbvh, hploc).
+        #[arg(long, default_value_t = TreeletConfig::default().reinsert)]
+        reinsert: u32,
         /// Primitive counts (the seed's table, then millions).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
         sizes: Vec<usize>,
@@ -143,23 +146,23 @@ pub enum BenchCommand {
         #[arg(long)]
         mesh_only: bool,
         /// The camera instead of the scene's (or the mesh-only framing): its
-        /// eye and the point it looks at, `EX,EY,EZ,TX,TY,TZ` (a camera
+        /// eye and the point it looks at, EX,EY,EZ,TX,TY,TZ (a camera
         /// inside a building, say), in the coordinates of the scene's file
         /// (an .obj or .ply mesh is moved into smallpt's room when loaded,
-        /// and the camera with it); `peers/mitsuba/rays.py` takes the same.
+        /// and the camera with it); peers/mitsuba/rays.py takes the same.
         #[arg(long, allow_hyphen_values = true)]
         camera: Option<String>,
         #[arg(long)]
         json: Option<std::path::PathBuf>,
-        /// Also draw build time against rays per second (`tradeoff-primary`
-        /// and `tradeoff-diffuse`, JSON and PNG) into this folder.
+        /// Also draw build time against rays per second (tradeoff-primary
+        /// and tradeoff-diffuse, JSON and PNG) into this folder.
         #[arg(long)]
         figure: Option<std::path::PathBuf>,
         /// OptiX's point for that figure: the output of
-        /// `../shared/tools/optix-peer/peer.py` for the same mesh and size.
+        /// ../shared/tools/optix-peer/peer.py for the same mesh and size.
         #[arg(long, requires = "figure")]
         optix: Option<std::path::PathBuf>,
-        /// The real-scene suite instead of `--scene`: the interiors of
+        /// The real-scene suite instead of --scene: the interiors of
         /// scenes/real (outside and from each one's camera) and the
         /// generated city (300k and 1M triangles, from above and from a
         /// street), in one table.
@@ -170,7 +173,7 @@ pub enum BenchCommand {
         #[arg(long, requires = "suite")]
         suite_dir: Option<std::path::PathBuf>,
         /// Time OptiX on each of the suite's scenes and views too
-        /// (`peers/mitsuba/rays.py` through `python3`, or `$TREELET_PYTHON`;
+        /// (peers/mitsuba/rays.py through python3, or $TREELET_PYTHON;
         /// needs Mitsuba 3 and an NVIDIA GPU), with the ratios.
         #[arg(long, requires = "suite")]
         with_optix: bool,
@@ -293,9 +296,9 @@ fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) ->
 /// BVH; a mesh in smallpt's room).
 const VARIANT_SCENES: [&str; 6] = [
     "cornell",
-    "scenes/cornell_diffuse.json",
-    "scenes/cornell_mirrors.json",
-    "scenes/room_disk.json",
+    "cornell_diffuse",
+    "cornell_mirrors",
+    "room_disk",
     "random:1000",
     "terrain:100000",
 ];
@@ -598,9 +601,9 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Build { builder, rounds, gamma, max_leaf, sizes, device, repeats, json, per_kernel } => {
+        BenchCommand::Build { builder, rounds, gamma, max_leaf, reinsert, sizes, device, repeats, json, per_kernel } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
-            let config = TreeletConfig { rounds, gamma, max_leaf, ..Default::default() };
+            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert, ..Default::default() };
             if matches!(builder, Builder::Sweep | Builder::Reference) {
                 anyhow::bail!("bench build times the device builders (lbvh, trbvh, hploc); time the CPU builders with `treelet build --builder {} --device cpu`", builder.name());
             }

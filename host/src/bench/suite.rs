@@ -23,6 +23,14 @@ const CUB_SORT_H100: &str = include_str!("../../../docs/results/h100-sort/cub_so
 
 
 pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
+    // Inputs first: a run of minutes must not fail at its last figure.
+    // (Its scenes are built in: `treelet::scene::builtin`.)
+    if let Some(dir) = suite.mitsuba.as_ref().filter(|_| matches!(figure, Figure::Error | Figure::All)) {
+        let list = dir.join("mitsuba.jsonl");
+        if !list.is_file() {
+            anyhow::bail!("--mitsuba {}: no mitsuba.jsonl there (peers/mitsuba/room_disk.py writes it)", dir.display());
+        }
+    }
     std::fs::create_dir_all(&suite.out).with_context(|| format!("creating {}", suite.out.display()))?;
     let runner = suite.device.open()?;
     let adapter = runner.name();

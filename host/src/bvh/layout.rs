@@ -20,9 +20,13 @@ use crate::scene::primitives::Primitives;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Layout {
-    /// The fastest measured on the device: bvh2 on GPUs and the CPU runner,
-    /// cwbvh on lavapipe (see [`Layout::resolve`]); a long render on a
-    /// Vulkan device times both first (`crate::render::variant::PILOT_MIN_SPP`).
+    /// The fastest measured on the device: bvh2 on GPUs and on the CPU
+    /// runner, cwbvh on CPU Vulkan adapters (lavapipe); a render of 256
+    /// samples per pixel or more on a Vulkan device times both first and
+    /// keeps the faster.
+    // (Plain words: this is `--layout auto`'s help. The code is `resolve`
+    // and `render::variant::PILOT_MIN_SPP`; a test in main.rs holds them
+    // to this text.)
     Auto,
     /// The seed's: 32-byte nodes that hold their own box; leaves name their
     /// primitives through an index array.

@@ -24,6 +24,7 @@ pub mod layout;
 pub mod lbvh;
 pub mod reference;
 pub mod refit;
+pub mod reinsert;
 pub mod report;
 pub mod sort;
 pub mod sweep;

@@ -36,6 +36,9 @@ pub struct TreeletConfig {
     /// no collapse). The paper sets no bound; a bound keeps the worst leaf
     /// a ray must test small.
     pub max_leaf: u32,
+    /// Iterations of parallel reinsertion after the rounds (Meister &
+    /// Bittner 2018, [`crate::bvh::reinsert`]); 0: none.
+    pub reinsert: u32,
     /// Skip treelets kept in an earlier round under which nothing has
     /// changed since (their DP would keep them again). Off: solve them all
     /// (the same tree, slower; for tests).
@@ -54,8 +57,9 @@ pub struct TreeletConfig {
 }
 
 impl Default for TreeletConfig {
-    /// The paper's three rounds, gamma 3 and leaves of at most 8; for
-    /// developers tuning them, `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF`.
+    /// The paper's three rounds, gamma 3 and leaves of at most 8, no
+    /// reinsertion; for developers tuning them,
+    /// `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF` and `TREELET_REINSERT=ITERATIONS`.
     fn default() -> Self {
         let (rounds, gamma, max_leaf) = std::env::var("TREELET_TREELETS")
             .ok()
@@ -64,7 +68,8 @@ impl Default for TreeletConfig {
                 (n.len() == 3 && n[2] >= 1).then(|| (n[0], n[1], n[2]))
             })
             .unwrap_or((3, 3, 8));
-        Self { rounds, gamma, max_leaf, skip_kept: true, verify: false, single_heights: single_invocation_heights() }
+        let reinsert = std::env::var("TREELET_REINSERT").ok().and_then(|v| v.trim().parse().ok()).unwrap_or(0);
+        Self { rounds, gamma, max_leaf, reinsert, skip_kept: true, verify: false, single_heights: single_invocation_heights() }
     }
 }
 
@@ -220,6 +225,15 @@ fn rounds<B: Backend>(
     if config.verify {
         verify_current(b, &bvh, &scratch, &base)?;
     }
+    if config.reinsert > 0 {
+        // Moves nodes anywhere: the counts and costs above go stale (the
+        // collapse climbs afresh).
+        b.stage("reinsert");
+        let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, config.reinsert)?;
+        if std::env::var_os("TREELET_PROFILE_REINSERT").is_some() {
+            eprintln!("reinsertion: moves made per iteration {made:?}");
+        }
+    }
     Ok((bvh, scratch, base))
 }
 
@@ -343,6 +357,9 @@ fn collapse_pass<B: Backend>(
 /// question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = collapse_kernels(b);
+    if TreeletConfig::default().reinsert > 0 {
+        k.extend(crate::bvh::reinsert::kernels(b));
+    }
     k.extend([
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,

@@ -29,8 +29,8 @@ pub enum Builder {
     /// Full-sweep SAH, top-down on the CPU (beaten by the TRBVH on scenes
     /// of mixed triangle sizes).
     Sweep,
-    /// The quality reference: `obvhs`'s PLOC with full reinsertion on the
-    /// CPU ([`crate::bvh::reference`]; needs the `peers` feature).
+    /// The quality reference, built on the CPU: PLOC with reinsertion over
+    /// every node, from the obvhs crate (build with --features peers).
     Reference,
 }
 
@@ -51,9 +51,12 @@ impl Builder {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Accel {
-    /// A linear scan for scenes below the measured crossover, else lbvh or
-    /// trbvh, whichever the measured costs say finishes the render first
-    /// (see `treelet::render::variant::plan`, `treelet::bvh::choice`).
+    /// A linear scan for scenes below a measured size; above it lbvh,
+    /// hploc (GPUs only) or trbvh, whichever measured costs say finishes the
+    /// build and the render first (--explain shows the numbers).
+    // (Plain words: this is `--accel auto`'s help. The code is
+    // `render::variant::plan` and `bvh::choice::cheaper_builder`; a test in
+    // main.rs holds them to this text.)
     Auto,
     /// Test every primitive.
     None,
@@ -65,8 +68,9 @@ pub enum Accel {
     Hploc,
     /// Traverse the full-sweep SAH tree, built on the CPU.
     Sweep,
-    /// Traverse the quality reference, built on the CPU (`obvhs`'s PLOC
-    /// with full reinsertion; needs the `peers` feature).
+    /// Traverse the quality reference, built on the CPU: PLOC with
+    /// reinsertion over every node, from the obvhs crate (build with
+    /// --features peers).
     Reference,
 }
 
@@ -229,9 +233,17 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
             BuiltTree { bvh, max_leaf, build_ms }
         }
         Builder::Hploc => {
-            let (bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
+            let (mut bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
+            let mut build_ms = times.total();
+            if config.reinsert > 0 {
+                // Reinsertion over H-PLOC's tree, without treelet rounds.
+                let root = trbvh::root_box(b, &bvh)?;
+                let (reinserted, times) = trbvh::restructure(b, bvh, &root, &TreeletConfig { rounds: 0, ..config })?;
+                bvh = reinserted;
+                build_ms += times.total();
+            }
             // Leaves collapsed by SAH when laid out, as the TRBVH's.
-            BuiltTree { bvh, max_leaf: config.max_leaf, build_ms: times.total() }
+            BuiltTree { bvh, max_leaf: config.max_leaf, build_ms }
         }
         Builder::Sweep => {
             let build = std::time::Instant::now();
@@ -265,7 +277,7 @@ pub fn collapsed_tree<B: Backend>(
         Builder::Sweep | Builder::Reference => bail!("internal: the {} builder runs on the CPU", builder.name()),
     };
     let (bvh, more) = match builder {
-        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 => {
+        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 || config.reinsert > 0 => {
             let root = trbvh::root_box(b, &bvh)?;
             trbvh::optimize(b, bvh, &root, config)?
         }

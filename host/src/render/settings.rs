@@ -15,11 +15,10 @@ pub enum Integrator {
     /// smallpt's: emitters count only where a path hits them.
     Smallpt,
     /// Next-event estimation: a light sampled at every diffuse bounce, with
-    /// multiple importance sampling (`treelet_core::render::lights`).
+    /// multiple importance sampling.
     Nee,
     /// Next-event estimation, and light paths for the caustics it cannot
-    /// find (`treelet_core::render::caustics`): light through mirrors and
-    /// glass onto what the camera sees.
+    /// find: light through mirrors and glass onto what the camera sees.
     Caustics,
 }
 
@@ -61,11 +60,11 @@ impl Integrator {
 #[serde(rename_all = "lowercase")]
 pub enum Sampler {
     /// Every number an independent hash of (seed, pixel, sample, bounce,
-    /// dimension); sample `s` of a pixel in subpixel `s % 4` (smallpt's).
+    /// dimension); sample s of a pixel in subpixel s mod 4 (smallpt's).
     Independent,
     /// The pixel position, the diffuse direction and the point on a light
-    /// from Owen-scrambled Sobol pairs (`treelet_core::render::sampler`):
-    /// less error at equal samples, as unbiased.
+    /// from Owen-scrambled Sobol pairs: less error at equal samples, as
+    /// unbiased.
     Sobol,
 }
 

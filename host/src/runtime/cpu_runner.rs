@@ -25,7 +25,7 @@ use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
 use treelet_core::construct::{
-    agglomerate, bounds, collapse, fill, fit, morton, presplit, primitive_boxes, radix_tree, scan, sort, treelet_kernels,
+    agglomerate, bounds, collapse, fill, fit, morton, presplit, primitive_boxes, radix_tree, reinsert, scan, sort, treelet_kernels,
 };
 use treelet_core::layouts::{bvh2, cwbvh_build};
 
@@ -731,6 +731,43 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 } else {
                     treelet_kernels::treelet_init_climb_kernel::<true, [treelet_core::Node]>(id, &p, nodes, parents, flags, summaries, queue, queued);
                 }
+            }
+        }
+        (Kernel::ReinsertSearch, [p, nodes, parents, moves]) => {
+            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
+            let (nodes, parents, moves) = (view::<treelet_core::Node>(nodes), view(parents), view(moves));
+            for id in ids(groups) {
+                reinsert::search_kernel(id, &p, nodes, parents, moves);
+            }
+        }
+        (Kernel::ReinsertBid, [p, nodes, parents, moves, bids]) => {
+            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
+            let (nodes, parents, moves, bids) = (view::<treelet_core::Node>(nodes), view(parents), view(moves), view(bids));
+            for id in ids(groups) {
+                reinsert::bid_kernel(id, &p, nodes, parents, moves, bids);
+            }
+        }
+        (Kernel::ReinsertClaim, [p, nodes, parents, moves, bids, owners]) => {
+            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
+            let (nodes, parents, moves) = (view::<treelet_core::Node>(nodes), view(parents), view(moves));
+            let (bids, owners) = (view(bids), view(owners));
+            for id in ids(groups) {
+                reinsert::claim_kernel(id, &p, nodes, parents, moves, bids, owners);
+            }
+        }
+        (Kernel::ReinsertApply, [p, nodes, parents, moves, bids, owners, made]) => {
+            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
+            let (nodes, parents, moves) = (&mut SplitMut::whole(view::<treelet_core::Node>(nodes)), view(parents), view(moves));
+            let (bids, owners, made) = (view(bids), view(owners), view(made));
+            for id in ids(groups) {
+                reinsert::apply_kernel(id, &p, nodes, parents, moves, bids, owners, made);
+            }
+        }
+        (Kernel::ReinsertRefit | Kernel::ReinsertRefitRelaxed, [p, nodes, parents, flags]) => {
+            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
+            let (nodes, parents, flags) = (&mut SplitMut::whole(view::<treelet_core::Node>(nodes)), view(parents), view(flags));
+            for id in ids(groups) {
+                fit::refit_nodes_kernel::<true>(id, p.n, nodes, parents, flags);
             }
         }
         (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {

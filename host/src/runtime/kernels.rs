@@ -173,6 +173,18 @@ pub enum Kernel {
     TreeletRestructure,
     /// Treelet optimization: restructure the treelets of one height, one invocation each.
     TreeletRestructureSingle,
+    /// Reinsertion (Meister & Bittner 2018): each node's best move.
+    ReinsertSearch,
+    /// Reinsertion: moves bid their gains on their nodes.
+    ReinsertBid,
+    /// Reinsertion: moves that won every bid claim their nodes.
+    ReinsertClaim,
+    /// Reinsertion: the moves that hold all their nodes are made.
+    ReinsertApply,
+    /// Reinsertion: boxes refit from the leaves after the moves.
+    ReinsertRefit,
+    /// [`Kernel::ReinsertRefit`] with relaxed counters, for CPU adapters.
+    ReinsertRefitRelaxed,
     /// SAH leaf collapse and depth-first compaction into fresh arrays.
     Collapse,
     /// The two-box binary layout from a collapsed tree.
@@ -225,7 +237,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 66] = [
+    const FIXED: [Kernel; 72] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -277,6 +289,12 @@ impl Kernel {
         Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
         Kernel::TreeletRestructureSingle,
+        Kernel::ReinsertSearch,
+        Kernel::ReinsertBid,
+        Kernel::ReinsertClaim,
+        Kernel::ReinsertApply,
+        Kernel::ReinsertRefit,
+        Kernel::ReinsertRefitRelaxed,
         Kernel::Collapse,
         Kernel::Bvh2Nodes,
         Kernel::LeafPrims,
@@ -371,6 +389,12 @@ impl Kernel {
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
             Kernel::TreeletRestructureSingle => "treelet::treelet_restructure_single_cs",
+            Kernel::ReinsertSearch => "reinsert::reinsert_search_cs",
+            Kernel::ReinsertBid => "reinsert::reinsert_bid_cs",
+            Kernel::ReinsertClaim => "reinsert::reinsert_claim_cs",
+            Kernel::ReinsertApply => "reinsert::reinsert_apply_cs",
+            Kernel::ReinsertRefit => "reinsert::reinsert_refit_cs",
+            Kernel::ReinsertRefitRelaxed => "reinsert::reinsert_refit_relaxed_cs",
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
             Kernel::LeafPrims => "bvh2::leaf_prims_cs",
@@ -412,6 +436,12 @@ impl Kernel {
             Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
             Kernel::Collapse => &[1, 6],
+            Kernel::ReinsertSearch
+            | Kernel::ReinsertBid
+            | Kernel::ReinsertClaim
+            | Kernel::ReinsertApply
+            | Kernel::ReinsertRefit
+            | Kernel::ReinsertRefitRelaxed => &[1],
             Kernel::TreeletRestructure => &[3],
             Kernel::TreeletRestructureSingle => &[2],
             Kernel::Bvh2Nodes => &[1, 3],
@@ -499,6 +529,11 @@ impl Kernel {
             Kernel::TreeletRestructureSingle => {
                 &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
+            Kernel::ReinsertSearch => &[Read, Read, Read, ReadWrite],
+            Kernel::ReinsertBid => &[Read, Read, Read, Read, ReadWrite],
+            Kernel::ReinsertClaim => &[Read, Read, Read, Read, Read, ReadWrite],
+            Kernel::ReinsertApply => &[Read, ReadWrite, ReadWrite, Read, Read, Read, ReadWrite],
+            Kernel::ReinsertRefit | Kernel::ReinsertRefitRelaxed => &[Read, ReadWrite, Read, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],

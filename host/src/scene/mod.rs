@@ -9,6 +9,7 @@
 //! reference (and flattens them), [`placed`] the copies a render keeps
 //! placed, and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
+pub mod builtin;
 pub mod city;
 pub mod file;
 pub mod gltf;

@@ -12,12 +12,16 @@ use treelet_core::geometry::buffers::{Material, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 
 impl Scene {
-    /// Parses a scene: `cornell`, `random:N[:SEED]`, `terrain:N`,
+    /// Parses a scene: `cornell`, a built-in scene file by name
+    /// ([`super::builtin::BUILT_IN`]: `room_disk`, ...), `random:N[:SEED]`, `terrain:N`,
     /// `city:N[:SEED]`, or a path to a JSON scene file, a glTF scene or an
     /// `.obj` / `.ply` mesh (either also as `.xz`).
     pub fn from_spec(spec: &str) -> Result<Scene> {
         if spec == "cornell" {
             return Ok(cornell());
+        }
+        if let Some(scene) = super::builtin::scene(spec) {
+            return scene;
         }
         if spec.ends_with(".json") {
             return super::file::load(std::path::Path::new(spec));

@@ -1,0 +1,53 @@
+//! Parallel reinsertion on the device (Meister & Bittner 2018; the kernels
+//! and the reasoning: `treelet_core::construct::reinsert`): each iteration
+//! every node finds its best move, the moves that share no node with a
+//! better one are made, and the boxes are refit. It runs after the treelet
+//! rounds (`trbvh`), on a tree of one primitive per leaf in the LBVH layout,
+//! which it keeps.
+use anyhow::Result;
+use treelet_core::geometry::buffers::{FillParams, ReinsertParams};
+use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
+use treelet_core::Aabb;
+
+use crate::bvh::lbvh::DeviceBvh;
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::Kernel;
+
+/// Runs `iterations` iterations over `bvh` in place; returns the number of
+/// moves made in each.
+pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iterations: u32) -> Result<Vec<u32>> {
+    let n = bvh.n;
+    if n < 3 || iterations == 0 {
+        return Ok(Vec::new());
+    }
+    let (node_count, movers) = (2 * n - 1, 2 * n - 2);
+    let extent = root_box.extent().max_element();
+    let inv_extent = if extent > 0.0 { (1.0 / extent).min(f32::MAX) } else { 1.0 };
+    let moves = b.scratch("reinsertion moves", movers as u64 * 16)?;
+    let bids = b.scratch("reinsertion bids", node_count as u64 * 4)?;
+    let owners = b.scratch("reinsertion owners", node_count as u64 * 4)?;
+    let flags = b.scratch("reinsertion refit flags", (n as u64 - 1) * 4)?;
+    let made = b.zeroed("reinsertion moves made", iterations as u64 * 4)?;
+    let unowned = b.upload("reinsertion owners fill", &[FillParams { len: node_count, value: u32::MAX, _pad0: [0; 2] }])?;
+    let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
+    let (move_groups, node_groups) = (groups_for(movers, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
+    for iteration in 0..iterations {
+        let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, _pad: 0 }])?;
+        b.dispatch(Kernel::ReinsertSearch, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);
+        b.zero_words(&bids, node_count)?;
+        b.dispatch(Kernel::Fill, &[&unowned, &owners], node_groups);
+        b.dispatch(Kernel::ReinsertBid, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids], move_groups);
+        b.dispatch(Kernel::ReinsertClaim, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners], move_groups);
+        b.dispatch(Kernel::ReinsertApply, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners, &made], move_groups);
+        b.zero_words(&flags, n - 1)?;
+        b.dispatch(refit, &[&p, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    }
+    b.read::<u32>(&made, iterations as usize)
+}
+
+/// The kernels [`reinsert`] dispatches on `b` (relaxed refit counters where
+/// the device needs them), for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::ReinsertRefit } else { Kernel::ReinsertRefitRelaxed };
+    vec![Kernel::ReinsertSearch, Kernel::ReinsertBid, Kernel::ReinsertClaim, Kernel::ReinsertApply, refit]
+}
