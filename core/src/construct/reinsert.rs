@@ -72,11 +72,13 @@ pub fn search_kernel<N: RecordLoad<Node> + ?Sized>(
     if n < 3 || i >= 2 * n - 2 {
         return;
     }
-    moves[i as usize] = best_move(i + 1, params.inv_extent, nodes, parents);
+    moves[i as usize] = best_move(i + 1, params.inv_extent, params.max_climb, nodes, parents);
 }
 
-/// The move of node `from` that lowers the summed area most, if any.
-pub fn best_move<N: RecordLoad<Node> + ?Sized>(from: u32, s: f32, nodes: &N, parents: &[u32]) -> Reinsertion {
+/// The move of node `from` that lowers the summed area most, if any,
+/// searching below at most `max_climb` of its ancestors, its parent first
+/// (0: all of them).
+pub fn best_move<N: RecordLoad<Node> + ?Sized>(from: u32, s: f32, max_climb: u32, nodes: &N, parents: &[u32]) -> Reinsertion {
     let none = Reinsertion { from, to: INVALID, gain: 0.0, _pad: 0 };
     let parent = parents[from as usize];
     if parent == 0 || parent == INVALID {
@@ -94,6 +96,7 @@ pub fn best_move<N: RecordLoad<Node> + ?Sized>(from: u32, s: f32, nodes: &N, par
     let (mut pivot, mut sibling) = (parent, first_sibling);
     let mut gains: [f32; SEARCH_STACK] = scratch();
     let mut places: [u32; SEARCH_STACK] = scratch();
+    let mut climbed = 0u32;
     loop {
         // Down the pivot's other subtree: each entry is the gain left once
         // the boxes above it have grown to hold `from`.
@@ -130,9 +133,10 @@ pub fn best_move<N: RecordLoad<Node> + ?Sized>(from: u32, s: f32, nodes: &N, par
             without = without.union(&nodes.load(sibling as usize).aabb());
             removal += area(&nodes.load(pivot as usize).aabb(), s) - area(&without, s);
         }
-        if pivot == 0 {
+        if pivot == 0 || climbed == max_climb.wrapping_sub(1) {
             break;
         }
+        climbed += 1;
         let up = parents[pivot as usize];
         sibling = other_child(&nodes.load(up as usize), pivot);
         pivot = up;
@@ -265,8 +269,8 @@ mod tests {
 
     /// One iteration on the CPU, as the host schedules it: search, bid,
     /// claim, apply, then boxes refit from the leaves (recursively here).
-    fn iterate(nodes: &mut Vec<Node>, parents: &mut Vec<u32>, n: u32) -> u32 {
-        let p = ReinsertParams { n, iteration: 0, inv_extent: 1.0, _pad: 0 };
+    fn iterate(nodes: &mut Vec<Node>, parents: &mut Vec<u32>, n: u32, max_climb: u32) -> u32 {
+        let p = ReinsertParams { n, iteration: 0, inv_extent: 1.0, max_climb };
         let count = 2 * n - 2;
         let mut moves = std::vec![Reinsertion::default(); count as usize];
         for i in 0..count {
@@ -360,7 +364,7 @@ mod tests {
 
     #[test]
     fn reinsertion_keeps_a_valid_tree_and_lowers_its_area() {
-        for n in [3u32, 4, 5, 17, 100, 1000] {
+        for (n, max_climb) in [(3u32, 0), (4, 0), (5, 0), (17, 0), (100, 0), (1000, 0), (17, 1), (1000, 1), (1000, 4)] {
             let boxes: Vec<Aabb> = (0..n)
                 .map(|j| {
                     let x = (j * 37 % 101) as f32;
@@ -386,12 +390,12 @@ mod tests {
             let (before, sah_before) = (area_sum(&nodes), sah_cost(&nodes, SahCosts::KARRAS_AILA));
             let mut total = 0;
             for _ in 0..8 {
-                let made = iterate(&mut nodes, &mut parents, n);
+                let made = iterate(&mut nodes, &mut parents, n, max_climb);
                 check_tree(&nodes, &parents, n);
                 total += made;
             }
             let (after, sah_after) = (area_sum(&nodes), sah_cost(&nodes, SahCosts::KARRAS_AILA));
-            assert!(after <= before * (1.0 + 1e-6), "n {n}: area {before} -> {after}");
+            assert!(after <= before * (1.0 + 1e-6), "n {n}, climb {max_climb}: area {before} -> {after}");
             if n >= 17 {
                 assert!(total > 0 && after < before * 0.95, "n {n}: {total} moves, area {before} -> {after}");
                 assert!(sah_after < sah_before, "n {n}: SAH {sah_before} -> {sah_after}");
@@ -426,12 +430,12 @@ mod tests {
         };
         let mut checked = 0;
         for from in 1..2 * n - 1 {
-            let m = best_move(from, 1.0, nodes.as_slice(), &parents);
+            let m = best_move(from, 1.0, 0, nodes.as_slice(), &parents);
             if m.to == INVALID {
                 continue;
             }
             let (mut moved, mut moved_parents) = (nodes.clone(), parents.clone());
-            let p = ReinsertParams { n, iteration: 0, inv_extent: 1.0, _pad: 0 };
+            let p = ReinsertParams { n, iteration: 0, inv_extent: 1.0, max_climb: 0 };
             let mut moves = std::vec![Reinsertion::default(); (2 * n - 2) as usize];
             moves[(from - 1) as usize] = m;
             let mut bids = std::vec![0u32; nodes.len()];

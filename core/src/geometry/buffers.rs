@@ -312,7 +312,9 @@ pub struct ReinsertParams {
     pub iteration: u32,
     /// Boxes are scaled by this before taking areas.
     pub inv_extent: f32,
-    pub _pad: u32,
+    /// How many ancestors a search climbs past its node's parent (0: up to
+    /// the root): a bound on the search's work.
+    pub max_climb: u32,
 }
 const _: () = assert!(core::mem::size_of::<ReinsertParams>() == 16);
 

@@ -30,9 +30,11 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let made = b.zeroed("reinsertion moves made", iterations as u64 * 4)?;
     let unowned = b.upload("reinsertion owners fill", &[FillParams { len: node_count, value: u32::MAX, _pad0: [0; 2] }])?;
     let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
+    // Developers' switch: searches climb at most this many ancestors.
+    let max_climb = std::env::var("TREELET_REINSERT_CLIMB").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
     let (move_groups, node_groups) = (groups_for(movers, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
     for iteration in 0..iterations {
-        let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, _pad: 0 }])?;
+        let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, max_climb }])?;
         b.dispatch(Kernel::ReinsertSearch, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);
         b.zero_words(&bids, node_count)?;
         b.dispatch(Kernel::Fill, &[&unowned, &owners], node_groups);
