@@ -32,7 +32,11 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
     // Developers' switch: searches climb at most this many ancestors.
     let max_climb = std::env::var("TREELET_REINSERT_CLIMB").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
-    let (move_groups, node_groups) = (groups_for(movers, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
+    // ... and `TREELET_REINSERT_LEAVES=0` moves internal nodes only (nodes
+    // 1 to n - 2 in the LBVH layout: the first n - 2 moves), half the searches.
+    let leaves = std::env::var("TREELET_REINSERT_LEAVES").map_or(true, |v| v != "0");
+    let searched = if leaves { movers } else { n - 2 };
+    let (move_groups, node_groups) = (groups_for(searched, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
     for iteration in 0..iterations {
         let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, max_climb }])?;
         b.dispatch(Kernel::ReinsertSearch, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);

@@ -41,6 +41,8 @@ pub struct GpuBackend {
     used: Vec<(PoolKey, wgpu::Buffer)>,
     /// Time each dispatch alone, under its kernel's name (profiling).
     per_kernel: bool,
+    /// Device memory this backend may use, below what the adapter reports.
+    memory_cap: Option<u64>,
     stage: &'static str,
     pending: Vec<Segment>,
     times: StageTimes,
@@ -73,6 +75,7 @@ impl GpuBackend {
             free: Default::default(),
             used: Vec::new(),
             per_kernel: false,
+            memory_cap: None,
             stage: "unnamed",
             pending: Vec::new(),
             times: StageTimes::default(),
@@ -83,6 +86,14 @@ impl GpuBackend {
     /// instead of one pass per stage. Adds a little overhead per dispatch.
     pub fn with_per_kernel_times(mut self, on: bool) -> Self {
         self.per_kernel = on;
+        self
+    }
+
+    /// Uses at most `bytes` of device memory (a GPU shared with an engine's
+    /// own work): renders that need more are refused as if the adapter had
+    /// no more.
+    pub fn with_device_memory_cap(mut self, bytes: u64) -> Self {
+        self.memory_cap = Some(bytes);
         self
     }
 
@@ -256,7 +267,10 @@ impl Backend for GpuBackend {
         self.ctx.max_buffer_bytes()
     }
     fn device_memory_bytes(&self) -> Option<u64> {
-        self.ctx.device_memory
+        match (self.ctx.device_memory, self.memory_cap) {
+            (Some(heap), Some(cap)) => Some(heap.min(cap)),
+            (heap, cap) => heap.or(cap),
+        }
     }
     fn prepare_kernels(&mut self, kernels: &[Kernel]) -> f64 {
         self.ctx.prepare(kernels)
