@@ -39,9 +39,10 @@ pub struct FigureArgs {
     /// Where the JSON and PNG of each figure (and RESULTS.md for all) go.
     #[arg(long)]
     out: std::path::PathBuf,
-    /// Timed repeats per measurement (median, min and max are recorded).
-    #[arg(long, default_value_t = 3)]
-    repeats: usize,
+    /// Timed repeats per measurement (median, min and max are recorded);
+    /// default 3, with --quick 2.
+    #[arg(long)]
+    repeats: Option<usize>,
 }
 
 #[derive(Subcommand)]
@@ -286,7 +287,8 @@ fn figure(f: Figure, a: FigureArgs) -> Result<()> {
 }
 
 fn figure_with(f: Figure, a: FigureArgs, mitsuba: Option<std::path::PathBuf>) -> Result<()> {
-    let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats: a.repeats.max(1), mitsuba };
+    let repeats = a.repeats.unwrap_or(if a.quick { 2 } else { 3 }).max(1);
+    let suite = Suite { device: a.device, quick: a.quick, out: a.out, repeats, mitsuba };
     suite::run(f, &suite)
 }
 
