@@ -314,3 +314,47 @@ fn tracers_on_one_device_keep_their_own_trees() {
         assert!(b.pooled_bytes() <= 2 * first.max(1 << 20), "{quality:?}: the pool grew from {first} to {} bytes over 20 refits", b.pooled_bytes());
     }
 }
+
+/// An engine's own device: opened by the engine (a wgpu instance of its
+/// own, Treelet's required features and limits), handed to
+/// `GpuContext::from_wgpu`; the tracer on it finds the scan's hits. A
+/// device opened with wgpu's defaults is refused, the missing feature and
+/// the short limit named.
+#[test]
+fn tracer_on_an_engines_own_device() {
+    use treelet::runtime::gpu::GpuContext;
+    use treelet::wgpu;
+    let Some(ours) = gpu() else { return };
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::VULKAN;
+    let instance = wgpu::Instance::new(desc);
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
+    let adapter = adapters.into_iter().find(|a| a.get_info().name == ours.info.name).expect("the tests' adapter, listed again");
+
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default())).unwrap();
+    let e = format!("{:#}", GpuContext::from_wgpu(&adapter, device, queue).err().expect("a device without Treelet's features"));
+    assert!(e.contains("PASSTHROUGH_SHADERS") && e.contains("max_storage_buffers_per_shader_stage is 8"), "{e}");
+
+    let descriptor = wgpu::DeviceDescriptor {
+        label: Some("an engine's device"),
+        required_features: GpuContext::required_features(),
+        required_limits: GpuContext::required_limits(wgpu::Limits::default()),
+        // SAFETY: SPIR-V passthrough is an experimental wgpu feature; the
+        // modules are rust-gpu's, validated by the driver.
+        experimental_features: unsafe { wgpu::ExperimentalFeatures::enabled() },
+        ..Default::default()
+    };
+    let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).unwrap();
+    let ctx = GpuContext::from_wgpu(&adapter, device, queue).unwrap();
+    assert_eq!(ctx.info.name, ours.info.name);
+    let b = &mut GpuBackend::new(ctx);
+    let seed = fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let g = geometry(&mut rng, 300, 700);
+    let rs = rays(&mut rng, 2000);
+    let mut tracer = Tracer::build(b, &g.0, &g.1, Quality::High).unwrap();
+    check("the engine's device", &tracer.closest_hits(b, &rs).unwrap(), &g, &rs);
+    let m = moved(&g, &mut rng);
+    tracer.refit(b, &m.0, &m.1).unwrap();
+    check("the engine's device, refit", &tracer.closest_hits(b, &rs).unwrap(), &m, &rs);
+}

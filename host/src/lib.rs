@@ -65,6 +65,9 @@ pub use runtime::cpu_runner::CpuBackend;
 pub use runtime::gpu::{GpuBackend, GpuContext};
 pub use tracer::{Instance, InstancedTracer, Quality, Ray, RayHit, Tracer};
 pub use treelet_core::{Sphere, Triangle};
+/// The wgpu Treelet is built on: an engine that hands Treelet its device
+/// ([`GpuContext::from_wgpu`]) uses this version.
+pub use wgpu;
 
 /// The README's Rust snippets, run as doc tests: what a newcomer copies
 /// first compiles and passes.

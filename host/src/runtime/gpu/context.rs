@@ -119,6 +119,30 @@ fn device_local_bytes(adapter: &wgpu::Adapter) -> Option<u64> {
         .max()
 }
 
+/// A device just opened, and what was found of its adapter.
+struct Opened {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    limits: wgpu::Limits,
+    timestamps: bool,
+    device_memory: Option<u64>,
+    partitioned: bool,
+    cache_path: Option<PathBuf>,
+}
+
+/// The most storage buffers any kernel binds, and the most workgroup
+/// memory any module declares (bytes).
+fn kernel_needs() -> (u32, u32) {
+    static NEEDS: std::sync::OnceLock<(u32, u32)> = std::sync::OnceLock::new();
+    *NEEDS.get_or_init(|| {
+        let buffers = Kernel::all().iter().map(|k| k.bindings().len() + k.split_bindings().len()).max().unwrap_or(0);
+        let modules = shaders::unpack(SHADERS).unwrap_or_default();
+        let workgroup = modules.iter().map(|m| m.workgroup_bytes()).max().unwrap_or(0);
+        (buffers as u32, workgroup as u32)
+    })
+}
+
 /// The device extension of NVIDIA's subgroup partition instruction.
 const PARTITIONED: &std::ffi::CStr = c"VK_NV_shader_subgroup_partitioned";
 
@@ -231,7 +255,7 @@ impl GpuContext {
                  `apt-get install mesa-vulkan-drivers` gives lavapipe)",
             )?;
         let info = adapter.get_info();
-        let needed = wgpu::Features::PASSTHROUGH_SHADERS | wgpu::Features::SHADER_INT64;
+        let needed = Self::required_features();
         let missing = needed - adapter.features();
         if !missing.is_empty() {
             bail!("adapter `{}` lacks features Treelet needs: {missing:?}", info.name);
@@ -262,6 +286,82 @@ impl GpuContext {
             adapter.request_device(&descriptor).await.map(|d| (d, false))
         }
         .with_context(|| format!("could not open adapter `{}`", info.name))?;
+        let opened = Opened { device, queue, info, limits, timestamps, device_memory, partitioned, cache_path };
+        Ok(Self::assemble(opened, start))
+    }
+
+    /// The features a device must have for Treelet's kernels (SPIR-V
+    /// passthrough needs wgpu's experimental features enabled, and Vulkan).
+    pub fn required_features() -> wgpu::Features {
+        wgpu::Features::PASSTHROUGH_SHADERS | wgpu::Features::SHADER_INT64
+    }
+
+    /// `base` with the limits Treelet's kernels need raised to them: storage
+    /// buffers per stage (the most any kernel binds, second parts of split
+    /// buffers included), workgroup memory (the most any module declares)
+    /// and 256 invocations a workgroup. An engine opens its device with
+    /// these (and [`GpuContext::required_features`]) to share it.
+    pub fn required_limits(base: wgpu::Limits) -> wgpu::Limits {
+        let (buffers, workgroup_bytes) = kernel_needs();
+        wgpu::Limits {
+            max_storage_buffers_per_shader_stage: base.max_storage_buffers_per_shader_stage.max(buffers),
+            max_compute_workgroup_storage_size: base.max_compute_workgroup_storage_size.max(workgroup_bytes),
+            max_compute_invocations_per_workgroup: base.max_compute_invocations_per_workgroup.max(256),
+            max_compute_workgroup_size_x: base.max_compute_workgroup_size_x.max(256),
+            ..base
+        }
+    }
+
+    /// Treelet on an engine's own device: `device` and `queue` opened from
+    /// `adapter` (Vulkan) with [`GpuContext::required_features`] and
+    /// [`GpuContext::required_limits`]; an error names each missing feature
+    /// and each limit below what the kernels need. Treelet records its
+    /// dispatches on encoders of its own and submits them to `queue`
+    /// itself; buffers it makes live on `device`, so the engine can bind
+    /// them (and Treelet the engine's: see `Tracer`). Optional features the
+    /// device has are used (timestamps, a pipeline cache); NVIDIA's
+    /// partition instruction is not (wgpu cannot enable its extension on a
+    /// device opened elsewhere), so the sort ranks digits with ballots.
+    pub fn from_wgpu(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Result<Arc<Self>> {
+        let start = Instant::now();
+        let info = adapter.get_info();
+        if info.backend != wgpu::Backend::Vulkan {
+            bail!("device of adapter `{}` runs on {:?}: Treelet's kernels are SPIR-V and need a Vulkan device", info.name, info.backend);
+        }
+        let features = device.features();
+        let missing = Self::required_features() - features;
+        let limits = device.limits();
+        let needed = Self::required_limits(wgpu::Limits::downlevel_defaults());
+        let mut short = Vec::new();
+        let mut check = |name: &str, has: u32, needs: u32| {
+            if has < needs {
+                short.push(format!("{name} is {has}, the kernels need {needs}"));
+            }
+        };
+        check("max_storage_buffers_per_shader_stage", limits.max_storage_buffers_per_shader_stage, needed.max_storage_buffers_per_shader_stage);
+        check("max_compute_workgroup_storage_size", limits.max_compute_workgroup_storage_size, needed.max_compute_workgroup_storage_size);
+        check("max_compute_invocations_per_workgroup", limits.max_compute_invocations_per_workgroup, needed.max_compute_invocations_per_workgroup);
+        check("max_compute_workgroup_size_x", limits.max_compute_workgroup_size_x, needed.max_compute_workgroup_size_x);
+        if !missing.is_empty() || !short.is_empty() {
+            let mut why = Vec::new();
+            if !missing.is_empty() {
+                why.push(format!("it lacks features {missing:?} (open it with GpuContext::required_features(), wgpu's experimental features enabled)"));
+            }
+            if !short.is_empty() {
+                why.push(format!("{} (open it with GpuContext::required_limits(..))", short.join("; ")));
+            }
+            bail!("the device of adapter `{}` cannot run Treelet: {}", info.name, why.join("; "));
+        }
+        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        let cache_path = cache_file(&info).filter(|_| features.contains(wgpu::Features::PIPELINE_CACHE));
+        let device_memory = device_local_bytes(adapter);
+        let opened = Opened { device, queue, info, limits, timestamps, device_memory, partitioned: false, cache_path };
+        Ok(Self::assemble(opened, start))
+    }
+
+    /// The context of a device just opened; `start`: when opening began.
+    fn assemble(opened: Opened, start: Instant) -> Arc<Self> {
+        let Opened { device, queue, info, limits, timestamps, device_memory, partitioned, cache_path } = opened;
         let device_s = start.elapsed().as_secs_f64();
         crate::runtime::timeline::mark("device");
         // Unpacks the modules now, so that a damaged file fails here.
@@ -279,7 +379,7 @@ impl GpuContext {
             };
             DiskCache { cache, path }
         });
-        Ok(Arc::new(Self {
+        Arc::new(Self {
             device,
             queue,
             info,
@@ -287,7 +387,7 @@ impl GpuContext {
             timestamps,
             device_memory,
             subgroup_partitioned: partitioned,
-            pipelines: Mutex::default(), cache, startup, built: Mutex::default() }))
+            pipelines: Mutex::default(), cache, startup, built: Mutex::default() })
     }
 
     /// The pipeline of `kernel`, built the first time it is asked for (the

@@ -101,3 +101,81 @@ mod tests {
         assert_eq!(unpack(whole).map(|m| m.len()).unwrap_or(0), Kernel::all().len(), "one module per kernel");
     }
 }
+
+impl Module {
+    /// Bytes of workgroup memory the module declares (its `Workgroup`
+    /// variables, sizes summed without padding): what a device's
+    /// `max_compute_workgroup_storage_size` must hold for its pipeline.
+    pub fn workgroup_bytes(&self) -> u64 {
+        const OP_TYPE_INT: u32 = 21;
+        const OP_TYPE_FLOAT: u32 = 22;
+        const OP_TYPE_VECTOR: u32 = 23;
+        const OP_TYPE_ARRAY: u32 = 28;
+        const OP_TYPE_STRUCT: u32 = 30;
+        const OP_TYPE_POINTER: u32 = 32;
+        const OP_CONSTANT: u32 = 43;
+        const OP_VARIABLE: u32 = 59;
+        const WORKGROUP: u32 = 4;
+        let words: Vec<u32> = self.spirv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let mut sizes: HashMap<u32, u64> = HashMap::new();
+        let mut constants: HashMap<u32, u64> = HashMap::new();
+        let mut pointees: HashMap<u32, u32> = HashMap::new();
+        let mut total = 0;
+        let mut at = 5;
+        while at < words.len() {
+            let (count, op) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+            if count == 0 || at + count > words.len() {
+                break;
+            }
+            let i = &words[at..at + count];
+            let size = |id: u32| sizes.get(&id).copied().unwrap_or(0);
+            match op {
+                OP_TYPE_INT | OP_TYPE_FLOAT => {
+                    sizes.insert(i[1], i[2] as u64 / 8);
+                }
+                OP_TYPE_VECTOR => {
+                    sizes.insert(i[1], size(i[2]) * i[3] as u64);
+                }
+                OP_TYPE_ARRAY => {
+                    sizes.insert(i[1], size(i[2]) * constants.get(&i[3]).copied().unwrap_or(0));
+                }
+                OP_TYPE_STRUCT => {
+                    sizes.insert(i[1], i[2..].iter().map(|&m| size(m)).sum());
+                }
+                OP_TYPE_POINTER if i[2] == WORKGROUP => {
+                    pointees.insert(i[1], i[3]);
+                }
+                OP_CONSTANT if count >= 4 => {
+                    constants.insert(i[2], i[3] as u64);
+                }
+                OP_VARIABLE if i[3] == WORKGROUP => {
+                    total += pointees.get(&i[1]).map_or(0, |&t| size(t));
+                }
+                _ => {}
+            }
+            at += count;
+        }
+        total
+    }
+}
+
+use std::collections::HashMap;
+
+#[cfg(test)]
+mod workgroup_tests {
+    use super::*;
+
+    /// The reader finds the workgroup arrays the shader declares: the sort's
+    /// tiles, the treelet teams' rows; none in a fill.
+    #[test]
+    fn workgroup_bytes_of_known_kernels() {
+        let fill = module("fill::fill_cs").unwrap();
+        assert_eq!(fill.workgroup_bytes(), 0);
+        let every = unpack(SHADERS).unwrap();
+        let largest = every.iter().map(|m| (m.workgroup_bytes(), m.entry_point)).max().unwrap();
+        assert!(largest.0 >= 4096 && largest.0 <= 65536, "{largest:?}");
+        // Two arrays of 256 words at least (the scan's `a` and `b`).
+        let scan = every.iter().find(|m| m.entry_point == "scan::scan_spine_cs").unwrap();
+        assert!(scan.workgroup_bytes() >= 2048, "{}: {}", scan.entry_point, scan.workgroup_bytes());
+    }
+}
