@@ -347,7 +347,7 @@ fn reinsertion_matches_cpu_and_lowers_sah() {
         let scene = Scene::from_spec(&format!("{spec}:{}", seed % 1000)).unwrap();
         for rounds in [0, 3] {
             let plain = TreeletConfig { rounds, max_leaf: 1, ..Default::default() };
-            let config = TreeletConfig { reinsert: 4, ..plain };
+            let config = TreeletConfig { reinsert: Some(4), reinsert_climb: 0, ..plain };
             let c = run(&mut CpuBackend::new(), &scene, &config);
             let v = validate_primitives(scene.primitives(), &c.nodes, &c.parents, &c.prim_indices);
             assert!(v.is_valid(), "cpu {spec}, rounds {rounds}: {:?}", v.errors);

@@ -57,9 +57,9 @@ enum Command {
         /// Largest leaf the final SAH collapse makes; 1 keeps one primitive per leaf (trbvh, sweep).
         #[arg(long, default_value_t = TreeletConfig::default().max_leaf, value_parser = clap::value_parser!(u32).range(1..=1024))]
         max_leaf: u32,
-        /// Iterations of parallel reinsertion after the rounds (Meister and Bittner 2018: nodes moved where they lower the SAH most; trbvh, hploc).
-        #[arg(long, default_value_t = TreeletConfig::default().reinsert, value_parser = clap::value_parser!(u32).range(0..=64))]
-        reinsert: u32,
+        /// Iterations of parallel reinsertion after the rounds (Meister and Bittner 2018: nodes moved where they lower the SAH most; trbvh, hploc). Default: 2 for trbvh on GPUs, else 0.
+        #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+        reinsert: Option<u32>,
         /// Print one JSON object instead of a summary.
         #[arg(long)]
         json: bool,
@@ -634,7 +634,8 @@ fn run(cli: Cli) -> Result<bool> {
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, reinsert, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
-            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert, ..Default::default() };
+            let defaults = TreeletConfig::default();
+            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert: reinsert.or(defaults.reinsert), ..defaults };
             let on_cpu = matches!(builder, Builder::Sweep | Builder::Reference);
             if on_cpu && device == DeviceChoice::Gpu {
                 anyhow::bail!("the {} builder runs on the CPU only: add --device cpu", builder.name());

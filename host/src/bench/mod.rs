@@ -102,9 +102,9 @@ pub enum BenchCommand {
         gamma: u32,
         #[arg(long, default_value_t = TreeletConfig::default().max_leaf)]
         max_leaf: u32,
-        /// Iterations of parallel reinsertion after the rounds (trbvh, hploc).
-        #[arg(long, default_value_t = TreeletConfig::default().reinsert)]
-        reinsert: u32,
+        /// Iterations of parallel reinsertion after the rounds (trbvh, hploc); default: 2 for trbvh on GPUs, else 0.
+        #[arg(long)]
+        reinsert: Option<u32>,
         /// Primitive counts (the seed's table, then millions).
         #[arg(long, value_delimiter = ',', default_values_t = vec![1000, 10000, 20000, 35000, 50000, 65000, 1_000_000, 4_000_000, 16_000_000])]
         sizes: Vec<usize>,
@@ -605,7 +605,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         }
         BenchCommand::Build { builder, rounds, gamma, max_leaf, reinsert, sizes, device, repeats, json, per_kernel } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
-            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert, ..Default::default() };
+            let defaults = TreeletConfig::default();
+            let config = TreeletConfig { rounds, gamma, max_leaf, reinsert: reinsert.or(defaults.reinsert), ..defaults };
             if matches!(builder, Builder::Sweep | Builder::Reference) {
                 anyhow::bail!("bench build times the device builders (lbvh, trbvh, hploc); time the CPU builders with `treelet build --builder {} --device cpu`", builder.name());
             }

@@ -15,7 +15,8 @@ use crate::runtime::kernels::Kernel;
 
 /// Runs `iterations` iterations over `bvh` in place; returns the number of
 /// moves made in each.
-pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iterations: u32) -> Result<Vec<u32>> {
+/// Searches climb at most `max_climb` ancestors (0: to the root).
+pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iterations: u32, max_climb: u32) -> Result<Vec<u32>> {
     let n = bvh.n;
     if n < 3 || iterations == 0 {
         return Ok(Vec::new());
@@ -30,9 +31,7 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let made = b.zeroed("reinsertion moves made", iterations as u64 * 4)?;
     let unowned = b.upload("reinsertion owners fill", &[FillParams { len: node_count, value: u32::MAX, _pad0: [0; 2] }])?;
     let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
-    // Developers' switch: searches climb at most this many ancestors.
-    let max_climb = std::env::var("TREELET_REINSERT_CLIMB").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
-    // ... and `TREELET_REINSERT_LEAVES=0` moves internal nodes only (nodes
+    // Developers' switch: `TREELET_REINSERT_LEAVES=0` moves internal nodes only (nodes
     // 1 to n - 2 in the LBVH layout: the first n - 2 moves), half the searches.
     let leaves = std::env::var("TREELET_REINSERT_LEAVES").map_or(true, |v| v != "0");
     let searched = if leaves { movers } else { n - 2 };

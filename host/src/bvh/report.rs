@@ -129,7 +129,8 @@ pub fn run_build_with<B: Backend>(
     config: TreeletConfig,
 ) -> Result<(Bvh, BuildReport)> {
     // Treelet rounds: the TRBVH's, or over the H-PLOC tree where asked.
-    let treelets = (builder == Builder::Trbvh || (builder == Builder::Hploc && (config.rounds > 0 || config.reinsert > 0))).then_some(&config);
+    let config = config.resolved(builder, backend.class());
+    let treelets = (builder == Builder::Trbvh || (builder == Builder::Hploc && (config.rounds > 0 || config.reinsert_iterations() > 0))).then_some(&config);
     let hierarchy = match builder {
         Builder::Hploc => Some(lbvh::Hierarchy::Hploc),
         Builder::Lbvh | Builder::Trbvh => None,
@@ -168,7 +169,7 @@ pub fn run_build_with<B: Backend>(
         total_ms += rounds.total();
         ms.insert("treelets".into(), serde_json::json!(per_round.iter().sum::<f64>()));
         ms.insert("collapse".into(), serde_json::json!(rounds.get("collapse")));
-        if config.reinsert > 0 {
+        if config.reinsert_iterations() > 0 {
             ms.insert("reinsert".into(), serde_json::json!(rounds.get("reinsert")));
         }
         round_ms = Some(per_round);

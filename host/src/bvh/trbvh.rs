@@ -37,8 +37,11 @@ pub struct TreeletConfig {
     /// a ray must test small.
     pub max_leaf: u32,
     /// Iterations of parallel reinsertion after the rounds (Meister &
-    /// Bittner 2018, [`crate::bvh::reinsert`]); 0: none.
-    pub reinsert: u32,
+    /// Bittner 2018, [`crate::bvh::reinsert`]); `None`: the builder's and
+    /// device's default ([`TreeletConfig::resolved`]).
+    pub reinsert: Option<u32>,
+    /// How many ancestors a reinsertion search climbs (0: to the root).
+    pub reinsert_climb: u32,
     /// Skip treelets kept in an earlier round under which nothing has
     /// changed since (their DP would keep them again). Off: solve them all
     /// (the same tree, slower; for tests).
@@ -68,8 +71,52 @@ impl Default for TreeletConfig {
                 (n.len() == 3 && n[2] >= 1).then(|| (n[0], n[1], n[2]))
             })
             .unwrap_or((3, 3, 8));
-        let reinsert = std::env::var("TREELET_REINSERT").ok().and_then(|v| v.trim().parse().ok()).unwrap_or(0);
-        Self { rounds, gamma, max_leaf, reinsert, skip_kept: true, verify: false, single_heights: single_invocation_heights() }
+        let env = |name| std::env::var(name).ok().and_then(|v| v.trim().parse::<u32>().ok());
+        let (reinsert, reinsert_climb) = (env("TREELET_REINSERT"), env("TREELET_REINSERT_CLIMB").unwrap_or(REINSERT_CLIMB));
+        Self {
+            rounds,
+            gamma,
+            max_leaf,
+            reinsert,
+            reinsert_climb,
+            skip_kept: true,
+            verify: false,
+            single_heights: single_invocation_heights(),
+        }
+    }
+}
+
+/// Reinsertion iterations the TRBVH gets on GPUs unless told otherwise.
+/// On the H200 (splits 0.3, `docs/results/h200-reinsertion-2026-11-29/`),
+/// two iterations whose searches climb at most 12 ancestors raised the
+/// TRBVH's diffuse rays inside the real-scene suite by 2-8% (the breakfast
+/// room's unchanged), primary rays from the city street by 35%, a scanned
+/// bunny's and a terrain's diffuse rays by 2%, for 0.6-3.1 ms more build
+/// (about 0.4 ms plus 2.5 ns a triangle). CPU devices run the searches too
+/// slowly for it to pay (the CPU runner took 2.5 s for 8 iterations over
+/// 262k triangles), and H-PLOC is the fast build: none there.
+pub const GPU_TRBVH_REINSERT: u32 = 2;
+
+/// Ancestors a reinsertion search climbs by default: 12 kept nearly all of
+/// the unbounded search's gain for 10-40% less time (H200, same results).
+pub const REINSERT_CLIMB: u32 = 12;
+
+impl TreeletConfig {
+    /// This config with its reinsertion settled for a tree of `builder` on
+    /// `class`: as set, else [`GPU_TRBVH_REINSERT`] for the TRBVH on GPUs,
+    /// else none.
+    pub fn resolved(&self, builder: crate::bvh::tree::Builder, class: crate::runtime::backend::DeviceClass) -> Self {
+        let default = if builder == crate::bvh::tree::Builder::Trbvh && class == crate::runtime::backend::DeviceClass::Gpu {
+            GPU_TRBVH_REINSERT
+        } else {
+            0
+        };
+        Self { reinsert: Some(self.reinsert.unwrap_or(default)), ..*self }
+    }
+
+    /// Reinsertion iterations as set (0 where unset: see [`TreeletConfig::resolved`]).
+    pub fn reinsert_iterations(&self) -> u32 {
+        self.reinsert.unwrap_or(0)
     }
 }
 
@@ -225,11 +272,11 @@ fn rounds<B: Backend>(
     if config.verify {
         verify_current(b, &bvh, &scratch, &base)?;
     }
-    if config.reinsert > 0 {
+    if config.reinsert_iterations() > 0 {
         // Moves nodes anywhere: the counts and costs above go stale (the
         // collapse climbs afresh).
         b.stage("reinsert");
-        let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, config.reinsert)?;
+        let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, config.reinsert_iterations(), config.reinsert_climb)?;
         if std::env::var_os("TREELET_PROFILE_REINSERT").is_some() {
             eprintln!("reinsertion: moves made per iteration {made:?}");
         }
@@ -357,7 +404,7 @@ fn collapse_pass<B: Backend>(
 /// question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = collapse_kernels(b);
-    if TreeletConfig::default().reinsert > 0 {
+    if TreeletConfig::default().resolved(crate::bvh::tree::Builder::Trbvh, b.class()).reinsert_iterations() > 0 {
         k.extend(crate::bvh::reinsert::kernels(b));
     }
     k.extend([

@@ -20,7 +20,9 @@ use crate::scene::primitives::Primitives;
 pub enum Builder {
     /// Karras 2012, on the chosen device.
     Lbvh,
-    /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the chosen device.
+    /// The LBVH, then treelet restructuring (Karras & Aila 2013), on the
+    /// chosen device; on GPUs then two iterations of reinsertion (Meister &
+    /// Bittner 2018).
     Trbvh,
     /// H-PLOC (Benthin et al. 2024): the LBVH's Morton order, nearest
     /// neighbours merged within subgroups as the climbs go up, on the
@@ -62,7 +64,8 @@ pub enum Accel {
     None,
     /// Traverse the LBVH (Karras 2012).
     Lbvh,
-    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013).
+    /// Traverse the LBVH after treelet restructuring (Karras & Aila 2013;
+    /// on GPUs then two iterations of reinsertion, Meister & Bittner 2018).
     Trbvh,
     /// Traverse the H-PLOC tree (Benthin et al. 2024).
     Hploc,
@@ -224,7 +227,7 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
             let mut build_ms = times.total();
             if builder == Builder::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
-                let (restructured, times) = trbvh::restructure(b, bvh, &root, &config)?;
+                let (restructured, times) = trbvh::restructure(b, bvh, &root, &config.resolved(builder, b.class()))?;
                 bvh = restructured;
                 build_ms += times.total();
             }
@@ -235,7 +238,8 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
         Builder::Hploc => {
             let (mut bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
             let mut build_ms = times.total();
-            if config.reinsert > 0 {
+            let config = config.resolved(builder, b.class());
+            if config.reinsert_iterations() > 0 {
                 // Reinsertion over H-PLOC's tree, without treelet rounds.
                 let root = trbvh::root_box(b, &bvh)?;
                 let (reinserted, times) = trbvh::restructure(b, bvh, &root, &TreeletConfig { rounds: 0, ..config })?;
@@ -277,9 +281,9 @@ pub fn collapsed_tree<B: Backend>(
         Builder::Sweep | Builder::Reference => bail!("internal: the {} builder runs on the CPU", builder.name()),
     };
     let (bvh, more) = match builder {
-        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 || config.reinsert > 0 => {
+        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 || config.resolved(builder, b.class()).reinsert_iterations() > 0 => {
             let root = trbvh::root_box(b, &bvh)?;
-            trbvh::optimize(b, bvh, &root, config)?
+            trbvh::optimize(b, bvh, &root, &config.resolved(builder, b.class()))?
         }
         Builder::Hploc => {
             b.take_times()?;
