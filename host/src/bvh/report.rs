@@ -129,7 +129,7 @@ pub fn run_build_with<B: Backend>(
     config: TreeletConfig,
 ) -> Result<(Bvh, BuildReport)> {
     // Treelet rounds: the TRBVH's, or over the H-PLOC tree where asked.
-    let config = config.resolved(builder, backend.class());
+    let config = crate::bvh::tree::settled(&config, builder, backend.class());
     let treelets = (builder == Builder::Trbvh || (builder == Builder::Hploc && (config.rounds > 0 || config.reinsert_iterations() > 0))).then_some(&config);
     let hierarchy = match builder {
         Builder::Hploc => Some(lbvh::Hierarchy::Hploc),

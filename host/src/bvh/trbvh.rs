@@ -18,7 +18,7 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::{Aabb, Node};
 
 use crate::bvh::lbvh::DeviceBvh;
-use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::backend::{Backend, DeviceClass, StageTimes};
 use crate::runtime::kernels::Kernel;
 
 /// How the optimization runs; defaults after Karras & Aila 2013.
@@ -38,7 +38,7 @@ pub struct TreeletConfig {
     pub max_leaf: u32,
     /// Iterations of parallel reinsertion after the rounds (Meister &
     /// Bittner 2018, [`crate::bvh::reinsert`]); `None`: the builder's and
-    /// device's default ([`TreeletConfig::resolved`]).
+    /// device's default (see [`trbvh_reinsert`]).
     pub reinsert: Option<u32>,
     /// How many ancestors a reinsertion search climbs (0: to the root).
     pub reinsert_climb: u32,
@@ -60,9 +60,11 @@ pub struct TreeletConfig {
 }
 
 impl Default for TreeletConfig {
-    /// The paper's three rounds, gamma 3 and leaves of at most 8, no
-    /// reinsertion; for developers tuning them,
-    /// `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF` and `TREELET_REINSERT=ITERATIONS`.
+    /// The paper's three rounds, gamma 3 and leaves of at most 8,
+    /// reinsertion as the builder and device call for (searches climbing
+    /// [`REINSERT_CLIMB`] ancestors); for developers tuning them,
+    /// `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF`, `TREELET_REINSERT=ITERATIONS`
+    /// and `TREELET_REINSERT_CLIMB=ANCESTORS`.
     fn default() -> Self {
         let (rounds, gamma, max_leaf) = std::env::var("TREELET_TREELETS")
             .ok()
@@ -101,20 +103,20 @@ pub const GPU_TRBVH_REINSERT: u32 = 2;
 /// the unbounded search's gain for 10-40% less time (H200, same results).
 pub const REINSERT_CLIMB: u32 = 12;
 
+/// Reinsertion iterations the TRBVH gets on `class` unless told
+/// otherwise: [`GPU_TRBVH_REINSERT`] on GPUs, none on CPU devices.
+pub fn trbvh_reinsert(class: DeviceClass) -> u32 {
+    if class == DeviceClass::Gpu { GPU_TRBVH_REINSERT } else { 0 }
+}
+
 impl TreeletConfig {
-    /// This config with its reinsertion settled for a tree of `builder` on
-    /// `class`: as set, else [`GPU_TRBVH_REINSERT`] for the TRBVH on GPUs,
-    /// else none.
-    pub fn resolved(&self, builder: crate::bvh::tree::Builder, class: crate::runtime::backend::DeviceClass) -> Self {
-        let default = if builder == crate::bvh::tree::Builder::Trbvh && class == crate::runtime::backend::DeviceClass::Gpu {
-            GPU_TRBVH_REINSERT
-        } else {
-            0
-        };
+    /// This config with its reinsertion settled: as set, else `default`
+    /// (`crate::bvh::tree` settles it per builder and device).
+    pub fn with_default_reinsert(&self, default: u32) -> Self {
         Self { reinsert: Some(self.reinsert.unwrap_or(default)), ..*self }
     }
 
-    /// Reinsertion iterations as set (0 where unset: see [`TreeletConfig::resolved`]).
+    /// Reinsertion iterations as set (0 where unset: see [`TreeletConfig::with_default_reinsert`]).
     pub fn reinsert_iterations(&self) -> u32 {
         self.reinsert.unwrap_or(0)
     }
@@ -404,7 +406,7 @@ fn collapse_pass<B: Backend>(
 /// question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = collapse_kernels(b);
-    if TreeletConfig::default().resolved(crate::bvh::tree::Builder::Trbvh, b.class()).reinsert_iterations() > 0 {
+    if TreeletConfig::default().with_default_reinsert(trbvh_reinsert(b.class())).reinsert_iterations() > 0 {
         k.extend(crate::bvh::reinsert::kernels(b));
     }
     k.extend([

@@ -227,7 +227,7 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
             let mut build_ms = times.total();
             if builder == Builder::Trbvh {
                 let root = trbvh::root_box(b, &bvh)?;
-                let (restructured, times) = trbvh::restructure(b, bvh, &root, &config.resolved(builder, b.class()))?;
+                let (restructured, times) = trbvh::restructure(b, bvh, &root, &settled(&config, builder, b.class()))?;
                 bvh = restructured;
                 build_ms += times.total();
             }
@@ -238,7 +238,7 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
         Builder::Hploc => {
             let (mut bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
             let mut build_ms = times.total();
-            let config = config.resolved(builder, b.class());
+            let config = settled(&config, builder, b.class());
             if config.reinsert_iterations() > 0 {
                 // Reinsertion over H-PLOC's tree, without treelet rounds.
                 let root = trbvh::root_box(b, &bvh)?;
@@ -264,6 +264,13 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
     })
 }
 
+/// `config` with its reinsertion settled for a tree of `builder` on
+/// `class`: as set, else the TRBVH's default on the device
+/// ([`trbvh::trbvh_reinsert`]), none for other builders.
+pub fn settled(config: &TreeletConfig, builder: Builder, class: crate::runtime::backend::DeviceClass) -> TreeletConfig {
+    config.with_default_reinsert(if builder == Builder::Trbvh { trbvh::trbvh_reinsert(class) } else { 0 })
+}
+
 /// The tree `builder` makes on the device with its leaves collapsed by SAH
 /// as it is traced, and the stage times of the whole build (what `bench
 /// build` and the pareto figure time): the LBVH as built; the LBVH, then
@@ -281,9 +288,9 @@ pub fn collapsed_tree<B: Backend>(
         Builder::Sweep | Builder::Reference => bail!("internal: the {} builder runs on the CPU", builder.name()),
     };
     let (bvh, more) = match builder {
-        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 || config.resolved(builder, b.class()).reinsert_iterations() > 0 => {
+        Builder::Trbvh | Builder::Hploc if builder == Builder::Trbvh || config.rounds > 0 || settled(&config, builder, b.class()).reinsert_iterations() > 0 => {
             let root = trbvh::root_box(b, &bvh)?;
-            trbvh::optimize(b, bvh, &root, &config.resolved(builder, b.class()))?
+            trbvh::optimize(b, bvh, &root, &settled(&config, builder, b.class()))?
         }
         Builder::Hploc => {
             b.take_times()?;
