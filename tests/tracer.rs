@@ -317,9 +317,10 @@ fn tracers_on_one_device_keep_their_own_trees() {
 
 /// An engine's own device: opened by the engine (a wgpu instance of its
 /// own, Treelet's required features and limits), handed to
-/// `GpuContext::from_wgpu`; the tracer on it finds the scan's hits. A
-/// device opened with wgpu's defaults is refused, the missing feature and
-/// the short limit named.
+/// `GpuContext::from_wgpu`; the tracer on it finds the scan's hits, and
+/// writes them into a buffer the engine made on its device (rays written
+/// there by the engine's queue). A device opened with wgpu's defaults is
+/// refused, the missing feature and the short limit named.
 #[test]
 fn tracer_on_an_engines_own_device() {
     use treelet::runtime::gpu::GpuContext;
@@ -345,7 +346,8 @@ fn tracer_on_an_engines_own_device() {
         ..Default::default()
     };
     let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).unwrap();
-    let ctx = GpuContext::from_wgpu(&adapter, device, queue).unwrap();
+    // The engine keeps its handles (wgpu's are shared references).
+    let ctx = GpuContext::from_wgpu(&adapter, device.clone(), queue.clone()).unwrap();
     assert_eq!(ctx.info.name, ours.info.name);
     let b = &mut GpuBackend::new(ctx);
     let seed = fresh_seed();
@@ -356,5 +358,26 @@ fn tracer_on_an_engines_own_device() {
     check("the engine's device", &tracer.closest_hits(b, &rs).unwrap(), &g, &rs);
     let m = moved(&g, &mut rng);
     tracer.refit(b, &m.0, &m.1).unwrap();
-    check("the engine's device, refit", &tracer.closest_hits(b, &rs).unwrap(), &m, &rs);
+    let hits = tracer.closest_hits(b, &rs).unwrap();
+    check("the engine's device, refit", &hits, &m, &rs);
+
+    // The engine's own buffer: rays in, hits out, in place.
+    let data = treelet::tracer::device_rays(&rs).unwrap();
+    let engine_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("the engine's rays"),
+        size: (data.len() * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&engine_buffer, 0, bytemuck::cast_slice(&data));
+    tracer.closest_hits_on_device(b, &engine_buffer, rs.len()).unwrap();
+    let out = b.read::<[f32; 4]>(&engine_buffer, 2 * rs.len()).unwrap();
+    for (k, h) in hits.iter().enumerate() {
+        let (t, prim) = (out[2 * k][0], out[2 * k][1].to_bits());
+        assert_eq!(prim, h.prim, "ray {k}: in the engine's buffer {prim}, from closest_hits {}", h.prim);
+        // Distances from the point at t_min on, as `device_rays` moves the origin there.
+        if h.is_hit() {
+            assert!((t + rs[k].t_min - h.t).abs() <= 1e-3 * h.t.max(1.0), "ray {k}: {t} + {} against {}", rs[k].t_min, h.t);
+        }
+    }
 }
