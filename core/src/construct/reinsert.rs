@@ -156,6 +156,30 @@ fn touched<N: RecordLoad<Node> + ?Sized>(m: &Reinsertion, nodes: &N, parents: &[
     [m.from, parent, sibling, parents[parent as usize], m.to, parents[m.to as usize]]
 }
 
+/// Move `i`, unless `i` is past the moves or its node found none.
+#[inline]
+fn proposed(i: u32, params: &ReinsertParams, moves: &[Reinsertion]) -> Option<Reinsertion> {
+    if params.n < 3 || i >= 2 * params.n - 2 {
+        return None;
+    }
+    let m = moves[i as usize];
+    (m.to != INVALID).then_some(m)
+}
+
+/// Whether the bid on each node of `set` is `bits` (the move's own).
+/// Index loops: rust-gpu compiles no array iterators.
+#[inline]
+fn won_bids(set: &[u32; 6], bids: &[u32], bits: u32) -> bool {
+    let mut k = 0;
+    while k < 6 {
+        if bids[set[k] as usize] != bits {
+            return false;
+        }
+        k += 1;
+    }
+    true
+}
+
 /// Kernel, one invocation per move: bids the move's gain on its nodes
 /// (`bids` zeroed; a positive f32's bits order as the float).
 pub fn bid_kernel<N: RecordLoad<Node> + ?Sized>(
@@ -166,14 +190,7 @@ pub fn bid_kernel<N: RecordLoad<Node> + ?Sized>(
     moves: &[Reinsertion],
     bids: &mut [u32],
 ) {
-    if params.n < 3 || i >= 2 * params.n - 2 {
-        return;
-    }
-    let m = moves[i as usize];
-    if m.to == INVALID {
-        return;
-    }
-    // Index loops: rust-gpu compiles no array iterators.
+    let Some(m) = proposed(i, params, moves) else { return };
     let set = touched(&m, nodes, parents);
     for k in 0..6 {
         atomics::max_device(&mut bids[set[k] as usize], m.gain.to_bits());
@@ -192,19 +209,10 @@ pub fn claim_kernel<N: RecordLoad<Node> + ?Sized>(
     bids: &[u32],
     owners: &mut [u32],
 ) {
-    if params.n < 3 || i >= 2 * params.n - 2 {
-        return;
-    }
-    let m = moves[i as usize];
-    if m.to == INVALID {
-        return;
-    }
+    let Some(m) = proposed(i, params, moves) else { return };
     let set = touched(&m, nodes, parents);
-    let bits = m.gain.to_bits();
-    for k in 0..6 {
-        if bids[set[k] as usize] != bits {
-            return;
-        }
+    if !won_bids(&set, bids, m.gain.to_bits()) {
+        return;
     }
     for k in 0..6 {
         atomics::min_device(&mut owners[set[k] as usize], i);
@@ -226,17 +234,13 @@ pub fn apply_kernel(
     owners: &[u32],
     made: &mut [u32],
 ) {
-    if params.n < 3 || i >= 2 * params.n - 2 {
-        return;
-    }
-    let m = moves[i as usize];
-    if m.to == INVALID {
-        return;
-    }
+    let Some(m) = proposed(i, params, moves) else { return };
     let set = touched(&m, &*nodes, &*parents);
-    let bits = m.gain.to_bits();
+    if !won_bids(&set, bids, m.gain.to_bits()) {
+        return;
+    }
     for k in 0..6 {
-        if bids[set[k] as usize] != bits || owners[set[k] as usize] != i {
+        if owners[set[k] as usize] != i {
             return;
         }
     }
