@@ -335,6 +335,41 @@ fn reinsertion_matches_cpu_and_lowers_sah() {
     use treelet::bvh::validate::validate_primitives;
     use treelet::scene::Scene;
 
+    /// What a user sees: rays from among the primitives, each aimed near a
+    /// random one of them, hit through the tree the very primitive at the
+    /// very distance the scan of every primitive finds.
+    fn hits_equal_the_scan(scene: &Scene, bvh: &Bvh, seed: u64, what: &str) {
+        use glam::Vec3;
+        use rand::{Rng, SeedableRng};
+        use treelet_core::geometry::prims::{Origin, Prims};
+        use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
+        let all = scene.primitives();
+        let prims = Prims::new(all.spheres, all.triangles);
+        // Origins among the primitives (not in the far walls of smallpt's
+        // room, spheres of radius 1e5).
+        let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+        let points = all.spheres.iter().filter(|s| s.radius < 1e3).map(|s| Vec3::from(s.center));
+        let targets: Vec<Vec3> = points
+            .chain(all.triangles.iter().map(|t| (Vec3::from(t.v0) + Vec3::from(t.v1) + Vec3::from(t.v2)) / 3.0))
+            .collect();
+        for &p in &targets {
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let mut hits = 0;
+        for k in 0..2000 {
+            let u = Vec3::new(rng.random(), rng.random(), rng.random());
+            let o = lo + (hi - lo) * u;
+            let target = targets[rng.random_range(0..targets.len())];
+            let jitter = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let d = (target - o + jitter * 0.02 * (hi - lo).length()).normalize_or(Vec3::X);
+            let (through, scan) = (closest_hit_bvh(o, d, Origin::NONE, &prims, &bvh.nodes, &bvh.prim_indices), closest_hit_linear(o, d, Origin::NONE, &prims));
+            assert_eq!((through.prim, through.t), (scan.prim, scan.t), "{what}: ray {k} from {o} along {d}");
+            hits += scan.is_hit() as u32;
+        }
+        assert!(hits > 1000, "{what}: {hits} of 2000 rays hit: the test would prove little");
+    }
+
     fn run<B: Backend>(b: &mut B, scene: &Scene, config: &TreeletConfig) -> Bvh {
         let (dbvh, _) = build_primitives_on_device(b, scene.primitives()).unwrap();
         let rb = root_box(b, &dbvh).unwrap();
@@ -351,6 +386,7 @@ fn reinsertion_matches_cpu_and_lowers_sah() {
             let c = run(&mut CpuBackend::new(), &scene, &config);
             let v = validate_primitives(scene.primitives(), &c.nodes, &c.parents, &c.prim_indices);
             assert!(v.is_valid(), "cpu {spec}, rounds {rounds}: {:?}", v.errors);
+            hits_equal_the_scan(&scene, &c, seed, &format!("cpu {spec}, rounds {rounds}"));
             let after = sah_cost(&c.nodes, SahCosts::KARRAS_AILA);
             let without = sah_cost(&run(&mut CpuBackend::new(), &scene, &plain).nodes, SahCosts::KARRAS_AILA);
             eprintln!("{spec}, rounds {rounds}: SAH {without:.3} -> {after:.3} with reinsertion");
@@ -364,6 +400,7 @@ fn reinsertion_matches_cpu_and_lowers_sah() {
             let g = run(&mut gpu, &scene, &config);
             let v = validate_primitives(scene.primitives(), &g.nodes, &g.parents, &g.prim_indices);
             assert!(v.is_valid(), "gpu {spec}, rounds {rounds}: {:?}", v.errors);
+            hits_equal_the_scan(&scene, &g, seed, &format!("gpu {spec}, rounds {rounds}"));
             if g.nodes != c.nodes || g.parents != c.parents || g.prim_indices != c.prim_indices {
                 let gs = sah_cost(&g.nodes, SahCosts::KARRAS_AILA);
                 let what = format!("{spec}, rounds {rounds}: the GPU's tree differs, SAH gpu {gs} cpu {after}");
