@@ -13,13 +13,15 @@ use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
 
-/// Runs `iterations` iterations over `bvh` in place; returns the number of
-/// moves made in each.
-/// Searches climb at most `max_climb` ancestors (0: to the root).
-pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iterations: u32, max_climb: u32) -> Result<Vec<u32>> {
+/// Runs `iterations` iterations over `bvh` in place, searches climbing at
+/// most `max_climb` ancestors (0: to the root). Returns the buffer of the
+/// moves made in each iteration (u32s), left on the device: reading it
+/// back would wait for the build in its middle ([`moves_made`] does, to
+/// measure).
+pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iterations: u32, max_climb: u32) -> Result<Option<B::Buffer>> {
     let n = bvh.n;
     if n < 3 || iterations == 0 {
-        return Ok(Vec::new());
+        return Ok(None);
     }
     let (node_count, movers) = (2 * n - 1, 2 * n - 2);
     let extent = root_box.extent().max_element();
@@ -47,7 +49,13 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
         b.zero_words(&flags, n - 1)?;
         b.dispatch(refit, &[&p, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
     }
-    b.read::<u32>(&made, iterations as usize)
+    Ok(Some(made))
+}
+
+/// The moves made in each of `iterations` iterations, read back from what
+/// [`reinsert`] returned (waits for the device).
+pub fn moves_made<B: Backend>(b: &mut B, made: Option<&B::Buffer>, iterations: u32) -> Result<Vec<u32>> {
+    made.map_or(Ok(Vec::new()), |m| b.read::<u32>(m, iterations as usize))
 }
 
 /// The kernels [`reinsert`] dispatches on `b` (relaxed refit counters where

@@ -278,8 +278,10 @@ fn rounds<B: Backend>(
         // Moves nodes anywhere: the counts and costs above go stale (the
         // collapse climbs afresh).
         b.stage("reinsert");
-        let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, config.reinsert_iterations(), config.reinsert_climb)?;
+        let iterations = config.reinsert_iterations();
+        let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, iterations, config.reinsert_climb)?;
         if std::env::var_os("TREELET_PROFILE_REINSERT").is_some() {
+            let made = crate::bvh::reinsert::moves_made(b, made.as_ref(), iterations)?;
             eprintln!("reinsertion: moves made per iteration {made:?}");
         }
     }
