@@ -7,12 +7,12 @@
 //!
 //!     cargo run --release -p treelet --example trace_counts -- SCENE [WIDTH HEIGHT] [EX,EY,EZ,TX,TY,TZ]
 //!
-//! Trees: TRBVH (the CPU runner's), with `TREELET_SPLITS` as set.
+//! Trees: TRBVH (the CPU runner's), split as by default or as `TREELET_SPLITS` says.
 use std::cell::Cell;
 
 use anyhow::{Context, Result};
 use treelet::bvh::layout::{wide_nodes, Layout};
-use treelet::bvh::lbvh::split_budget;
+use treelet::bvh::tree::split_budget;
 use treelet::bvh::tree::{binary_tree_split, Accel};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
@@ -58,7 +58,7 @@ fn main() -> Result<()> {
     let camera = scene.camera.camera(w, h);
     let b = &mut CpuBackend::new();
     let builder = Accel::Trbvh.builder()?.context("trbvh")?;
-    let built = binary_tree_split(b, prims_host, builder, split_budget())?;
+    let built = binary_tree_split(b, prims_host, builder, split_budget(builder))?;
     let slots = built.bvh.n as usize;
     let buffers = built.prim_buffers(b, prims_host)?;
     let (bt, _) = built.lay_out(b, Layout::Bvh2, &buffers)?;

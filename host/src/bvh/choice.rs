@@ -69,6 +69,16 @@ impl TreeletTradeOff {
     /// measured and is left as it was (the estimate errs towards the
     /// cheaper build).
     ///
+    /// Since 2026-12-01 the TRBVH and H-PLOC split large triangles first
+    /// (`crate::bvh::tree::DEFAULT_SPLITS`, the LBVH does not); measured on
+    /// the H200 (`docs/results/h200-splits-2026-12-01/`, budget 0.3 against
+    /// none): the TRBVH's build 0.07-0.13 ms longer on scans and terrain,
+    /// 0.26-0.82 ms on the real-scene suite (104k to 1M triangles), about
+    /// 0.2 ms plus 0.8 ns a primitive, added below; rays on terrain within
+    /// 1% (no saving added; inside interiors with large walls they gain up
+    /// to 1.5x, which the estimate leaves out, erring towards the cheaper
+    /// build).
+    ///
     /// The GPU's savings were measured again beside H-PLOC's
     /// ([`TreeletTradeOff::hploc`]), in one call
     /// (`docs/results/h100-hploc/log_choice.txt`): render kernels for the
@@ -78,8 +88,8 @@ impl TreeletTradeOff {
     pub fn of(class: DeviceClass) -> Self {
         match class {
             DeviceClass::Gpu => TreeletTradeOff {
-                extra_build_ms: 1.3 + 0.4,
-                extra_build_ns_per_prim: 6.8 + 1.9,
+                extra_build_ms: 1.3 + 0.4 + 0.2,
+                extra_build_ns_per_prim: 6.8 + 1.9 + 0.8,
                 saved_ns_per_path: 1.51,
                 saved_ns_per_ray: 0.131 + 0.03,
             },
@@ -106,13 +116,15 @@ impl TreeletTradeOff {
     /// random spheres without the leaf collapse, which both trees' layouts
     /// do, 0.17 / 0.23 / 0.42 / 1.24 / 4.55 ms more than the LBVH's at 4 096
     /// / 65 536 / 262 144 / 1M / 4M primitives, about 0.15 ms plus 1.1 ns a
-    /// primitive; terrain:1M in the room as above). Not on CPU devices,
+    /// primitive; terrain:1M in the room as above; with its triangles split
+    /// since 2026-12-01, 0.06-0.43 ms more on the H200, about 0.1 ms plus
+    /// 0.6 ns a primitive, added). Not on CPU devices,
     /// where it is unmeasured: there the choice stays between the other two.
     pub fn hploc(class: DeviceClass) -> Option<Self> {
         match class {
             DeviceClass::Gpu => Some(TreeletTradeOff {
-                extra_build_ms: 0.15,
-                extra_build_ns_per_prim: 1.1,
+                extra_build_ms: 0.15 + 0.1,
+                extra_build_ns_per_prim: 1.1 + 0.6,
                 saved_ns_per_path: 1.03,
                 saved_ns_per_ray: 0.079,
             }),
@@ -221,7 +233,8 @@ mod tests {
     #[test]
     fn hploc_wins_between_the_two_on_a_gpu_only() {
         // A million primitives: the H-PLOC tree pays for itself from about
-        // 16M rays, the treelets (with their reinsertion) beat it from about 110M.
+        // 25M rays, the treelets (with their reinsertion) beat it from about 115M
+        // (both with their split triangles).
         let n = 1_000_000;
         assert_eq!(cheaper_builder(DeviceClass::Gpu, n, Work::Rays(40_000_000)).0, Builder::Hploc);
         assert_eq!(cheaper_builder(DeviceClass::Gpu, n, Work::Rays(10_000_000)).0, Builder::Lbvh);

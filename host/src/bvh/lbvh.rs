@@ -129,7 +129,7 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let ordered = b.ordered_atomics_in_divergent_flow();
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
-    if split_budget() > 0.0 {
+    if split_override().is_some_and(|b| b > 0.0) {
         k.extend(SPLIT_KERNELS);
     }
     k.extend(crate::bvh::sort::kernels(b));
@@ -149,7 +149,7 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
 /// The kernels [`build_primitives_with`] dispatches on `b` for `hierarchy`.
 pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
-    if split_budget() > 0.0 {
+    if split_override().is_some_and(|b| b > 0.0) {
         k.extend(SPLIT_KERNELS);
     }
     k.extend(crate::bvh::sort::kernels(b));
@@ -158,13 +158,14 @@ pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
 }
 
 /// [`build_primitives_on_device`] with the given way of making the hierarchy
-/// (and triangles split as `TREELET_SPLITS` says: [`split_budget`]).
+/// (whole triangles, unless `TREELET_SPLITS` says otherwise: [`split_override`];
+/// the traced trees' default is `crate::bvh::tree::split_budget`'s).
 pub fn build_primitives_with<B: Backend>(
     b: &mut B,
     prims: Primitives,
     hierarchy: Hierarchy,
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
-    build_primitives_split(b, prims, hierarchy, split_budget())
+    build_primitives_split(b, prims, hierarchy, split_override().unwrap_or(0.0))
 }
 
 /// [`build_primitives_with`] over pieces of the triangles: at most
@@ -215,10 +216,12 @@ pub fn build_primitives_split<B: Backend>(
 }
 
 /// Extra references that triangle splitting may add, as a fraction of the
-/// triangles (`treelet_core::construct::presplit`): `TREELET_SPLITS`
-/// (0: no splitting, the default).
-pub fn split_budget() -> f32 {
-    std::env::var("TREELET_SPLITS").ok().and_then(|v| v.parse::<f32>().ok()).filter(|b| b.is_finite() && *b >= 0.0).unwrap_or(0.0)
+/// triangles (`treelet_core::construct::presplit`), where `TREELET_SPLITS`
+/// sets it (0: no splitting) for every build; `None` where it is unset or
+/// not a finite number >= 0 (each builder's default then holds:
+/// `crate::bvh::tree::split_budget`).
+pub fn split_override() -> Option<f32> {
+    std::env::var("TREELET_SPLITS").ok().and_then(|v| v.parse::<f32>().ok()).filter(|b| b.is_finite() && *b >= 0.0)
 }
 
 /// The kernels splitting adds to a build.

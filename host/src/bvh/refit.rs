@@ -29,7 +29,10 @@ pub fn refit<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: Primitives) -> Re
 pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<StageTimes> {
     let n = bvh.n;
     if prims.sphere_count + prims.triangle_count != n {
-        bail!("refit with {} primitives: the tree was built over {n}", prims.sphere_count + prims.triangle_count);
+        // Also a tree over pieces of triangles (more leaf slots than
+        // primitives): its boxes come from the pieces, which this refit
+        // does not make; its `bvh2` layout refits (`refit_bvh2`).
+        bail!("refit with {} primitives: the tree was built over {n} (or over pieces of them: refit its bvh2 layout)", prims.sphere_count + prims.triangle_count);
     }
     if n == 0 {
         return Ok(StageTimes::default());
@@ -70,9 +73,14 @@ pub fn refit_bvh2<B: Backend>(
     let Some(collapsed) = &tree.collapsed else {
         bail!("internal: a {} tree keeps no collapsed tree to refit", tree.layout.name());
     };
+    // Leaf slots: one a primitive, or more where triangles were split
+    // before the build (`treelet_core::construct::presplit`). Each slot is
+    // written from its whole primitive, so a split triangle's leaves get
+    // its whole box: looser than the pieces', still correct. The caller
+    // checks that the primitives are those the tree was built over.
     let n = collapsed.n;
-    if prims.sphere_count + prims.triangle_count != n {
-        bail!("refit with {} primitives: the tree was built over {n}", prims.sphere_count + prims.triangle_count);
+    if prims.sphere_count + prims.triangle_count > n {
+        bail!("refit with {} primitives: the tree has {n} leaf slots", prims.sphere_count + prims.triangle_count);
     }
     b.stage("fit");
     let nodes = collapsed.node_count;

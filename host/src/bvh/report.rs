@@ -148,12 +148,14 @@ pub fn run_build_with<B: Backend>(
     if treelets.is_some() {
         kernels.extend(crate::bvh::trbvh::kernels(backend));
     }
+    let budget = crate::bvh::tree::split_budget(builder);
+    if budget > 0.0 {
+        kernels.extend(lbvh::SPLIT_KERNELS);
+    }
     backend.prepare_kernels(&kernels);
     let start = Instant::now();
-    let (mut device_bvh, times) = match hierarchy {
-        Some(h) => lbvh::build_primitives_with(backend, prims, h)?,
-        None => lbvh::build_primitives_on_device(backend, prims)?,
-    };
+    let hierarchy = hierarchy.unwrap_or_else(|| lbvh::Hierarchy::for_device(backend, prims.len()));
+    let (mut device_bvh, times) = lbvh::build_primitives_split(backend, prims, hierarchy, budget)?;
     let mut bvh = device_bvh.read(backend)?;
     let mut ms: serde_json::Map<String, serde_json::Value> =
         STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
@@ -185,7 +187,7 @@ pub fn run_build_with<B: Backend>(
     }
     let wall_ms = start.elapsed().as_secs_f64() * 1e3;
     // A tree over pieces of triangles has more leaf slots than primitives.
-    let check = if bvh.prim_indices.len() == prims.len() && lbvh::split_budget() == 0.0 {
+    let check = if bvh.prim_indices.len() == prims.len() && budget == 0.0 {
         validate_primitives(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices)
     } else {
         crate::bvh::validate::validate_split(prims, &bvh.nodes, &bvh.parents, &bvh.prim_indices)

@@ -118,7 +118,8 @@ pub fn traced_tree<B: Backend>(
     accel: Accel,
     layout: Layout,
 ) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
-    traced_tree_split(b, all, accel, layout, lbvh::split_budget())
+    let budget = accel.builder()?.map_or(0.0, split_budget);
+    traced_tree_split(b, all, accel, layout, budget)
 }
 
 /// [`traced_tree`] over pieces of the triangles (see [`binary_tree_split`]).
@@ -161,6 +162,9 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
         Builder::Hploc => lbvh::kernels_with(b, lbvh::Hierarchy::Hploc),
         Builder::Sweep | Builder::Reference => Vec::new(),
     };
+    if split_budget(builder) > 0.0 {
+        k.extend(lbvh::SPLIT_KERNELS);
+    }
     k.extend(crate::bvh::layout::kernels(b, layout));
     k.sort();
     k.dedup();
@@ -212,7 +216,29 @@ impl<B: Backend> BuiltTree<B> {
 /// as built, the TRBVH's restructured tree (or the H-PLOC tree) before its leaf collapse, or the
 /// full-sweep tree built on the CPU and uploaded. Starts a new build on `b`.
 pub fn binary_tree<B: Backend>(b: &mut B, all: Primitives, builder: Builder) -> Result<BuiltTree<B>> {
-    binary_tree_split(b, all, builder, lbvh::split_budget())
+    binary_tree_split(b, all, builder, split_budget(builder))
+}
+
+/// Extra references, as a fraction of the triangles, that the traced trees
+/// of the optimizing builders (TRBVH, H-PLOC) split large triangles into
+/// by default (`treelet_core::construct::presplit`). Measured on the H200
+/// (`docs/results/h200-splits-2026-12-01/`): on interiors with large
+/// walls and floors 0.3 gives 1.5x the diffuse rays from inside (the
+/// breakfast room, the staircase) and the same elsewhere within a few
+/// percent; on scans it splits almost nothing, since a triangle gets a
+/// piece more only where its box wastes over three times the mean; 1.0
+/// slows scans and terrain (longer builds, 6-13% fewer rays).
+pub const DEFAULT_SPLITS: f32 = 0.3;
+
+/// The split budget of `builder`'s traced trees: `TREELET_SPLITS` where
+/// set ([`lbvh::split_override`]), else [`DEFAULT_SPLITS`] for the TRBVH and
+/// H-PLOC and none for the LBVH (the fastest build, kept so) and the CPU
+/// builders (which take whole primitives).
+pub fn split_budget(builder: Builder) -> f32 {
+    lbvh::split_override().unwrap_or(match builder {
+        Builder::Trbvh | Builder::Hploc => DEFAULT_SPLITS,
+        Builder::Lbvh | Builder::Sweep | Builder::Reference => 0.0,
+    })
 }
 
 /// [`binary_tree`] over pieces of the triangles, `budget` times the
@@ -283,8 +309,11 @@ pub fn collapsed_tree<B: Backend>(
     config: &TreeletConfig,
 ) -> Result<(lbvh::DeviceBvh<B>, StageTimes)> {
     let (bvh, mut times) = match builder {
-        Builder::Lbvh | Builder::Trbvh => lbvh::build_primitives_on_device(b, all)?,
-        Builder::Hploc => lbvh::build_primitives_with(b, all, lbvh::Hierarchy::Hploc)?,
+        Builder::Lbvh | Builder::Trbvh => {
+            let hierarchy = lbvh::Hierarchy::for_device(b, all.len());
+            lbvh::build_primitives_split(b, all, hierarchy, split_budget(builder))?
+        }
+        Builder::Hploc => lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, split_budget(builder))?,
         Builder::Sweep | Builder::Reference => bail!("internal: the {} builder runs on the CPU", builder.name()),
     };
     let (bvh, more) = match builder {
