@@ -114,7 +114,14 @@ fn decompress_xz(path: &Path, what: &str, bytes: &[u8], max: u64) -> Result<Vec<
 /// Reads `path` as UTF-8 text (see [`read`]); an error names the line of
 /// the first byte that is not text.
 pub fn read_text(path: &Path, what: &str) -> Result<String> {
-    let bytes = read(path, what)?;
+    let mut bytes = read(path, what)?;
+    // A byte-order mark, as some editors on Windows write: not part of the text.
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    if bytes.starts_with(b"\xFF\xFE") || bytes.starts_with(b"\xFE\xFF") {
+        bail!("{what} {}: UTF-16 text; save it as UTF-8", path.display());
+    }
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let line = 1 + e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count();

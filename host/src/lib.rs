@@ -52,6 +52,14 @@
 //! The `treelet` command (`main.rs`, `bench/`) sits on top. The kernels
 //! themselves are in the `treelet-core` crate, which an engine may also use
 //! directly (`no_std`): see its docs for the traversal functions.
+/// Notes on standard error that never panic (see [`console`]); defined
+/// before the modules, so that theirs is this one.
+macro_rules! eprintln {
+    () => { $crate::console::err(format_args!("")) };
+    ($($t:tt)*) => { $crate::console::err(format_args!($($t)*)) };
+}
+
+pub mod console;
 pub mod bvh;
 pub mod input;
 pub mod plot;

@@ -21,6 +21,20 @@ use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
 
+// Output that never panics on a full or closed stream (`treelet::console`);
+// defined before the modules, so that theirs are these.
+macro_rules! println {
+    () => { treelet::console::out(format_args!(""), true) };
+    ($($t:tt)*) => { treelet::console::out(format_args!($($t)*), true) };
+}
+macro_rules! print {
+    ($($t:tt)*) => { treelet::console::out(format_args!($($t)*), false) };
+}
+macro_rules! eprintln {
+    () => { treelet::console::err(format_args!("")) };
+    ($($t:tt)*) => { treelet::console::err(format_args!($($t)*)) };
+}
+
 mod bench;
 #[cfg(test)]
 mod cli_help;
@@ -265,13 +279,35 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     if let Some(report) = &args.report {
         image_io::check_output(report, "--report", &[])?;
     }
+    // Files one render would write over another it reads or writes.
+    let same = |a: &std::path::Path, b: &std::path::Path| {
+        a == b || a.canonicalize().is_ok_and(|a| b.canonicalize().is_ok_and(|b| a == b))
+    };
+    if let (Some(resume), None) = (&args.resume, &part) {
+        if same(resume, &args.out) {
+            anyhow::bail!("--resume {} and --out name the same file: the image would replace the part it continues", resume.display());
+        }
+    }
+    if let Some(report) = &args.report {
+        for (other, what) in [(Some(&args.out), "--out"), (args.resume.as_ref(), "--resume"), (Some(&part_path), "the part beside --out")] {
+            if other.is_some_and(|o| same(report, o)) {
+                anyhow::bail!("--report {} names the same file as {what}: one would replace the other", report.display());
+            }
+        }
+    }
     if args.integrator == IntegratorArg::Auto && part.is_some() {
         anyhow::bail!(
             "--integrator auto with --samples: parts rendered apart must share one integrator, and a pilot on each machine may choose another; name one (nee or caustics)"
         );
     }
-    if args.checkpoint.is_some_and(|s| !(s > 0.0 && s.is_finite())) {
-        anyhow::bail!("--checkpoint {}: seconds between checkpoints must be a positive number", args.checkpoint.unwrap_or(0.0));
+    // A bound, so that the time of the next checkpoint is one a clock holds
+    // (1e19 s overflowed the program's clock, 1e30 its durations).
+    const MAX_CHECKPOINT_S: f64 = 1e9;
+    if args.checkpoint.is_some_and(|s| !(s > 0.0 && s <= MAX_CHECKPOINT_S)) {
+        anyhow::bail!(
+            "--checkpoint {}: seconds between checkpoints must be a positive number, at most {MAX_CHECKPOINT_S:e} (about 31 years)",
+            args.checkpoint.unwrap_or(0.0)
+        );
     }
     if args.devices.as_deref() == Some("list") {
         for (i, name) in GpuContext::adapters().iter().enumerate() {
@@ -631,6 +667,8 @@ fn bound_threads() {
 
 fn run(cli: Cli) -> Result<bool> {
     treelet::input::set_max_input_bytes(cli.max_input_bytes);
+    // A cap that cannot be read is an error before any work, not ignored.
+    treelet::runtime::memory::memory_cap()?;
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, reinsert, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });
@@ -784,7 +822,10 @@ fn main() -> ExitCode {
     bound_threads();
     let cli = Cli::parse();
     treelet::runtime::timeline::mark("arguments");
-    let outcome = run(cli);
+    let mut outcome = run(cli);
+    if let Err(e) = treelet::console::finish() {
+        outcome = outcome.and_then(|_| Err(anyhow::anyhow!("cannot write to standard output: {e}")));
+    }
     // A render stopped by a signal exits as the shell expects of one (128 + SIGINT).
     if STOP.load(Ordering::SeqCst) {
         if let Err(e) = &outcome {

@@ -1041,3 +1041,65 @@ fn bench_placed_traces_a_files_instances() {
     assert!(e.contains("expected a .gltf/.glb or a .json scene file"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Untrusted input and hostile outputs (issue 66): no panic, no replaced
+/// device or part, and a clear message.
+#[test]
+fn hostile_arguments_and_outputs_get_clear_errors() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    // Checkpoints past what a clock holds.
+    for every in ["1e19", "1e30", "inf", "nan"] {
+        let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--checkpoint", every, "--out", &path("c.png")]);
+        assert!(e.contains("--checkpoint") && e.contains("at most"), "{every}: {e}");
+    }
+    // A full standard output: exit 1 and a note, not a panic.
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["build", "--scene", "random:100", "--device", "cpu", "--json"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.code() == Some(1) && err.contains("standard output") && !err.contains("panicked"), "{:?} {err}", out.status);
+    // A full standard error loses the notes only.
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["build", "--scene", "random:100", "--device", "cpu", "--json"])
+        .stderr(full)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{:?}", out.status);
+    // --resume naming --out would replace the part with the image.
+    std::fs::write(dir.join("p.exr"), b"not read").unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--resume", &path("p.exr"), "--out", &path("p.exr")]);
+    assert!(e.contains("--resume") && e.contains("same file"), "{e}");
+    // A memory cap that cannot be read is an error, not ignored.
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["build", "--scene", "random:100", "--device", "cpu"])
+        .env("TREELET_MAX_MEMORY", "lots")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("TREELET_MAX_MEMORY=lots"), "{err}");
+    // A folder that is a file is called a file.
+    std::fs::write(dir.join("afile"), b"x").unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--out", &path("afile/out.png")]);
+    assert!(e.contains("is a file, not a folder"), "{e}");
+    // A report written through a link to a regular file keeps the link.
+    std::fs::write(dir.join("target.json"), b"{}").unwrap();
+    let link = dir.join("report.json");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(dir.join("target.json"), &link).unwrap();
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--out", &path("r.png"), "--report", &path("report.json")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link was replaced by a file");
+    assert!(std::fs::read_to_string(dir.join("target.json")).unwrap().len() > 2, "the report went elsewhere");
+    // A scene file that starts with a byte-order mark reads as without.
+    let scene = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.json")).unwrap();
+    std::fs::write(dir.join("bom.json"), format!("\u{feff}{scene}")).unwrap();
+    let out = treelet(&["render", "--device", "cpu", "--scene", &path("bom.json"), "--width", "8", "--height", "6", "--spp", "1", "--out", &path("bom.png")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::remove_dir_all(&dir).ok();
+}

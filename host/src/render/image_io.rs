@@ -49,8 +49,19 @@ pub fn check_output(path: &Path, what: &str, formats: &[&str]) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    if !dir.is_dir() {
-        bail!("{what} {}: the folder {} does not exist", path.display(), dir.display());
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => bail!("{what} {}: {} is a file, not a folder", path.display(), dir.display()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            bail!("{what} {}: the folder {} does not exist", path.display(), dir.display())
+        }
+        Err(e) => bail!("{what} {}: cannot reach the folder {}: {e}", path.display(), dir.display()),
+    }
+    // A device or a pipe (`/dev/stdout`, `/dev/null`) is written in place
+    // (see `write_atomically`): no probe file beside it, and a pipe is not
+    // opened now (that would wait for a reader).
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+        return Ok(());
     }
     // Whether the folder takes new files: a probe, removed at once.
     let probe = dir.join(format!(".treelet-write-check-{}", std::process::id()));
@@ -67,8 +78,20 @@ pub fn check_output(path: &Path, what: &str, formats: &[&str]) -> Result<()> {
 
 /// Writes a file by `write` into a temporary file beside `path` (with the
 /// same extension), then renames it over `path`: a crash or a failed write
-/// never leaves a half-written file where a good one was.
+/// never leaves a half-written file where a good one was. Where `path`
+/// names something that is not a regular file (a device such as
+/// `/dev/stdout`, a pipe), it is written in place: a rename would replace
+/// the device node or link itself. A link to a regular file keeps being a
+/// link: the file it names is replaced.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return write(path);
+    }
+    let resolved = match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).ok(),
+        _ => None,
+    };
+    let path = resolved.as_deref().unwrap_or(path);
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

@@ -309,7 +309,7 @@ pub fn run(
     let names: Vec<String> = workers.iter().map(|w| w.0.clone()).collect();
     let names_and_workers = workers;
     let mut g = Gather::new(&names, first, (width, height), control.resume.as_ref());
-    let mut checkpoint_due = control.checkpoint.as_ref().map(|(every, _)| start + *every);
+    let mut checkpoint_due = control.checkpoint.as_ref().and_then(|(every, _)| start.checked_add(*every));
     let mut checkpointing = false;
     let mut interrupted = false;
     let jobs: Vec<DeviceJob<'_>> = (0..devices)
@@ -353,7 +353,7 @@ pub fn run(
                         if let Some(sums) = sums {
                             write(done, &sums)?;
                         }
-                        checkpoint_due = Some(Instant::now() + *every);
+                        checkpoint_due = Instant::now().checked_add(*every);
                     }
                 }
             }

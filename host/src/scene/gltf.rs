@@ -39,17 +39,17 @@ pub fn load(path: &Path) -> Result<Scene> {
 pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     let name = path.display().to_string();
     let bytes = crate::input::read(path, "glTF file")?;
-    precheck(&bytes, &name)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
+    // glTF readers may ignore a byte-order mark before the JSON.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    precheck(bytes, &name)?;
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
     let buffers = buffers(&gltf, path.parent().unwrap_or(Path::new(".")), &name)?;
     check_ranges(&gltf.document, &name)?;
     let document = &gltf.document;
     let scene =
         document.default_scene().or_else(|| document.scenes().next()).with_context(|| format!("{name}: no scene"))?;
     let mut out = Loaded { mesh_slots: vec![None; document.meshes().len()], ..Default::default() };
-    for node in scene.nodes() {
-        walk(&node, Mat4::IDENTITY, &buffers, &name, &mut out)?;
-    }
+    walk(document, &scene, &buffers, &name, &mut out)?;
     let placed = out.instances.iter().map(|i| out.meshes[i.mesh as usize].triangles.len() as u64).sum::<u64>();
     if placed == 0 {
         bail!("{name}: the scene has no triangles");
@@ -62,9 +62,12 @@ pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
             "note: {name}: punctual lights (KHR_lights_punctual) are not supported; only emissive materials give light"
         );
     }
-    let camera = match out.camera {
-        Some(c) => c,
-        None => framing(placed_bounds(&out.meshes, &out.instances)),
+    let camera = match (out.camera, out.orthographic) {
+        (Some(c), _) => c,
+        (None, Some(node)) => bail!(
+            "{name}: node {node}: orthographic cameras are not supported (perspective only); remove it to get a camera that frames the scene"
+        ),
+        (None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
     };
     let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new(), placed: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
@@ -106,6 +109,7 @@ fn placed_bounds(meshes: &[SceneMesh], instances: &[SceneInstance]) -> (Vec3, Ve
 /// it exists): every attribute's accessor exists.
 fn precheck(bytes: &[u8], name: &str) -> Result<()> {
     let json = if bytes.starts_with(b"glTF") {
+        check_glb(bytes, name)?;
         gltf::Glb::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid GLB file: {e}"))?.json.into_owned()
     } else {
         bytes.to_vec()
@@ -122,6 +126,40 @@ fn precheck(bytes: &[u8], name: &str) -> Result<()> {
     Ok(())
 }
 
+/// A GLB file's header and chunk lengths against its size, so that a cut
+/// or lying file is called what it is (the `gltf` crate reports "failed to
+/// fill whole buffer", or subtracts past zero on a header length under 12).
+fn check_glb(bytes: &[u8], name: &str) -> Result<()> {
+    let word = |at: usize| bytes.get(at..at + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        bail!("{name}: truncated: {} bytes, where a GLB header takes 12", bytes.len());
+    };
+    if version != 2 {
+        bail!("{name}: GLB version {version}; only version 2 is read");
+    }
+    if length < 20 {
+        bail!("{name}: its GLB header gives a length of {length} bytes, less than a header and one chunk");
+    }
+    if length > bytes.len() {
+        bail!("{name}: truncated: the GLB header says {length} bytes, the file has {}", bytes.len());
+    }
+    let (mut at, mut k) = (12usize, 0);
+    while at < length {
+        let (Some(chunk), Some(kind)) = (word(at), bytes.get(at + 4..at + 8).filter(|_| at + 8 <= length)) else {
+            bail!("{name}: truncated: the header of chunk {k} at byte {at} is cut off");
+        };
+        if k == 0 && kind != b"JSON" {
+            bail!("{name}: the first GLB chunk is not JSON");
+        }
+        if chunk > length - at - 8 {
+            bail!("{name}: truncated or corrupt: chunk {k} says {chunk} bytes, {} remain", length - at - 8);
+        }
+        at += 8 + chunk;
+        k += 1;
+    }
+    Ok(())
+}
+
 /// Every buffer view within its buffer and every accessor within its view,
 /// so that reading them cannot go out of bounds.
 fn check_ranges(document: &gltf::Document, name: &str) -> Result<()> {
@@ -132,6 +170,10 @@ fn check_ranges(document: &gltf::Document, name: &str) -> Result<()> {
         }
     }
     for accessor in document.accessors() {
+        // The crate's iterators count from `count - 1`.
+        if accessor.count() == 0 {
+            bail!("{name}: accessor {}: a count of 0 (glTF asks for at least 1)", accessor.index());
+        }
         let Some(view) = accessor.view() else { continue };
         let element = accessor.size();
         let stride = view.stride().unwrap_or(element);
@@ -157,8 +199,14 @@ struct Loaded {
     mesh_slots: Vec<Option<u32>>,
     instances: Vec<SceneInstance>,
     camera: Option<CameraSpec>,
+    /// The first node with an orthographic camera, if any.
+    orthographic: Option<usize>,
     textured: bool,
 }
+
+/// Deepest node hierarchy read: real scenes nest a few tens of levels; a
+/// chain of a hundred thousand nodes is an attack on the reader.
+const MAX_NODE_DEPTH: usize = 1000;
 
 /// Each buffer's bytes: the `.glb` binary chunk, a base64 data URI, or a
 /// file beside the scene.
@@ -194,11 +242,69 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
     Ok(out)
 }
 
-/// Adds `node` and its children, placed by `parent` times their
-/// transforms: an instance of its mesh (read the first time a node places
-/// it), and the first perspective camera.
-fn walk(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<()> {
-    let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+/// Adds the nodes of `scene` and their children, each placed by its
+/// parent's transform times its own ([`visit`]), depth first in the file's
+/// order, with an explicit stack (a chain of nodes as deep as the file
+/// likes cannot overflow the program's). A node met twice is refused: the
+/// glTF nodes form disjoint trees, and a cycle would never end.
+fn walk(document: &gltf::Document, scene: &gltf::Scene, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<()> {
+    enum Step<'a> {
+        Enter(gltf::Node<'a>, Mat4, usize),
+        Leave(usize),
+    }
+    // 0: not met yet, 1: an ancestor of the node being read, 2: read.
+    let mut state = vec![0u8; document.nodes().len()];
+    let roots: Vec<gltf::Node> = scene.nodes().collect();
+    let mut stack: Vec<Step> = roots.into_iter().rev().map(|n| Step::Enter(n, Mat4::IDENTITY, 1)).collect();
+    while let Some(step) = stack.pop() {
+        let (node, parent, depth) = match step {
+            Step::Leave(i) => {
+                state[i] = 2;
+                continue;
+            }
+            Step::Enter(node, parent, depth) => (node, parent, depth),
+        };
+        let i = node.index();
+        match state[i] {
+            1 => bail!("{name}: node {i} is its own ancestor (the node hierarchy has a cycle)"),
+            2 => bail!("{name}: node {i} is reached twice (it has two parents, or a scene lists it twice); glTF nodes form disjoint trees"),
+            _ => {}
+        }
+        if depth > MAX_NODE_DEPTH {
+            bail!("{name}: node {i} is {depth} levels deep; at most {MAX_NODE_DEPTH} are read");
+        }
+        state[i] = 1;
+        let world = visit(&node, parent, buffers, name, out)?;
+        stack.push(Step::Leave(i));
+        let children: Vec<gltf::Node> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| Step::Enter(c, world, depth + 1)));
+    }
+    Ok(())
+}
+
+/// `node`'s own transform: its matrix, or its translation, rotation and
+/// scale, the rotation a unit quaternion (rounding within 1% is
+/// normalised; anything else is refused, since the `gltf` crate would
+/// make its matrix as it is and scale the mesh by the length squared).
+fn local_transform(node: &gltf::Node, name: &str) -> Result<Mat4> {
+    Ok(match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
+        gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+            let q = glam::Quat::from_array(rotation);
+            let length = q.length();
+            if !(length.is_finite() && (length - 1.0).abs() <= 1e-2) {
+                bail!("{name}: node {}: rotation {rotation:?} is not a unit quaternion (length {length})", node.index());
+            }
+            Mat4::from_scale_rotation_translation(Vec3::from_array(scale), q / length, Vec3::from_array(translation))
+        }
+    })
+}
+
+/// Adds `node`, placed by `parent` times its transform: an instance of its
+/// mesh (read the first time a node places it), and the first perspective
+/// camera. Returns its world transform, its children's parent.
+fn visit(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &mut Loaded) -> Result<Mat4> {
+    let world = parent * local_transform(node, name)?;
     if !world.is_finite() {
         bail!("{name}: node {} has a non-finite transform", node.index());
     }
@@ -219,21 +325,30 @@ fn walk(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: &
         out.instances.push(SceneInstance { mesh: slot, transform: Affine3A::from_mat4(world), material: None });
     }
     if let (None, Some(camera)) = (&out.camera, node.camera()) {
-        if let gltf::camera::Projection::Perspective(p) = camera.projection() {
-            let origin = world.transform_point3(Vec3::ZERO);
-            let direction = world.transform_vector3(-Vec3::Z);
-            out.camera = Some(CameraSpec {
-                origin: origin.into(),
-                direction: direction.into(),
-                near: 0.0,
-                fov: (p.yfov() / 2.0).tan(),
-            });
+        match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => {
+                let origin = world.transform_point3(Vec3::ZERO);
+                let direction = world.transform_vector3(-Vec3::Z);
+                let yfov = p.yfov();
+                if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+                    bail!("{name}: node {}: camera field of view {yfov} radians (it must lie between 0 and pi)", node.index());
+                }
+                if !(direction.length_squared() > 0.0 && direction.is_finite()) {
+                    bail!("{name}: node {}: the camera's transform gives it no direction to look in", node.index());
+                }
+                out.camera = Some(CameraSpec {
+                    origin: origin.into(),
+                    direction: direction.into(),
+                    near: 0.0,
+                    fov: (yfov / 2.0).tan(),
+                });
+            }
+            gltf::camera::Projection::Orthographic(_) => {
+                out.orthographic.get_or_insert(node.index());
+            }
         }
     }
-    for child in node.children() {
-        walk(&child, world, buffers, name, out)?;
-    }
-    Ok(())
+    Ok(world)
 }
 
 /// A glTF mesh's triangles in its own space, every primitive's in order,
@@ -245,6 +360,15 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], name: &str, out: &mut Loade
         let at = format!("{name}: mesh {} primitive {}", mesh.index(), primitive.index());
         if primitive.mode() != gltf::mesh::Mode::Triangles {
             bail!("{at}: {:?} primitives are not supported (triangles only)", primitive.mode());
+        }
+        // The crate reads positions as three f32 and indices as unsigned
+        // integers whatever the accessors say (and panics on other index
+        // types): what it reads must be what they hold.
+        use gltf::accessor::{DataType, Dimensions};
+        let positions = primitive.get(&gltf::Semantic::Positions).with_context(|| format!("{at}: no positions"))?;
+        check_accessor(&positions, &at, "POSITION", &[DataType::F32], Dimensions::Vec3)?;
+        if let Some(indices) = primitive.indices() {
+            check_accessor(&indices, &at, "indices", &[DataType::U8, DataType::U16, DataType::U32], Dimensions::Scalar)?;
         }
         let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
         let positions: Vec<[f32; 3]> = reader.read_positions().with_context(|| format!("{at}: no positions"))?.collect();
@@ -270,6 +394,25 @@ fn read_mesh(mesh: &gltf::Mesh, buffers: &[Vec<u8>], name: &str, out: &mut Loade
     }
     let label = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), |n| format!("mesh {} `{n}`", mesh.index()));
     Ok(SceneMesh { name: format!("{name}: {label}"), triangles, materials })
+}
+
+/// That accessor `a` (a primitive's `role`) holds `dims` of one of `types`
+/// in a buffer view (quantized or sparse data, or none, is not read).
+fn check_accessor(a: &gltf::Accessor, at: &str, role: &str, types: &[gltf::accessor::DataType], dims: gltf::accessor::Dimensions) -> Result<()> {
+    if !types.contains(&a.data_type()) || a.dimensions() != dims || a.normalized() {
+        bail!(
+            "{at}: the {role} accessor {} holds {:?} of {:?}{}; Treelet reads {dims:?} of {}",
+            a.index(),
+            a.dimensions(),
+            a.data_type(),
+            if a.normalized() { ", normalized" } else { "" },
+            types.iter().map(|t| format!("{t:?}")).collect::<Vec<_>>().join(" or ")
+        );
+    }
+    if a.view().is_none() {
+        bail!("{at}: the {role} accessor {} has no buffer view", a.index());
+    }
+    Ok(())
 }
 
 /// The path tracer's material for a glTF material (see the module doc).
@@ -457,12 +600,95 @@ mod tests {
                 document(&data_uri(), 4, 6).replace(r#""count": 4, "type": "VEC3""#, r#""count": 5, "type": "VEC3""#),
                 "accessor 0 reaches past",
             ),
+            // Index and position accessors of types the crate does not read
+            // as they are (float indices made it panic).
+            ("floatindices.gltf", document(&data_uri(), 4, 3).replace("5123", "5126"), "indices accessor 1 holds Scalar of F32"),
+            ("signedindices.gltf", document(&data_uri(), 4, 6).replace("5123", "5122"), "indices accessor 1 holds Scalar of I16"),
+            ("bytepositions.gltf", document(&data_uri(), 4, 6).replace("5126", "5121"), "POSITION accessor 0 holds Vec3 of U8"),
+            ("emptyaccessor.gltf", document(&data_uri(), 4, 0), "accessor 1: a count of 0"),
+            // Node hierarchies that are not trees, or too deep to walk.
+            ("selfchild.gltf", document(&data_uri(), 4, 6).replace(r#""children": [1]"#, r#""children": [0]"#), "node 0 is its own ancestor"),
+            (
+                "cycle.gltf",
+                document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2], "mesh": 0"#, r#""scale": [2, 2, 2], "mesh": 0, "children": [0]"#),
+                "node 0 is its own ancestor",
+            ),
+            ("twoparents.gltf", document(&data_uri(), 4, 6).replace(r#""nodes": [0, 2]"#, r#""nodes": [0, 2, 1]"#), "node 1 is reached twice"),
+            ("deep.gltf", deep_chain(100_000), "levels deep"),
+            // A rotation that is no rotation; a camera Treelet cannot make.
+            ("quaternion.gltf", document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [10, 0, 0, 0]"#), "not a unit quaternion"),
+            (
+                "orthographic.gltf",
+                document(&data_uri(), 4, 6).replace(
+                    r#"{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}"#,
+                    r#"{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}"#,
+                ),
+                "node 2: orthographic cameras are not supported",
+            ),
         ];
         for (file, text, expected) in cases {
             let path = d.join(file);
             std::fs::write(&path, text).unwrap();
             let e = format!("{:#}", load(&path).unwrap_err());
             assert!(e.contains(expected) && e.contains(file), "{file}: {e}");
+        }
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    /// The square under a chain of `depth` nodes.
+    fn deep_chain(depth: usize) -> String {
+        let nodes: Vec<String> = (0..depth)
+            .map(|k| if k + 1 < depth { format!(r#"{{"children": [{}]}}"#, k + 1) } else { r#"{"mesh": 0}"#.to_string() })
+            .collect();
+        let text = document(&data_uri(), 4, 6);
+        let start = text.find("\"nodes\": [\n").unwrap();
+        let end = start + text[start..].find("],\n  \"cameras\"").unwrap() + 1;
+        let text = format!("{}\"nodes\": [{}]{}", &text[..start], nodes.join(","), &text[end..]);
+        text.replace(r#""scenes": [{"nodes": [0, 2]}]"#, r#""scenes": [{"nodes": [0]}]"#)
+    }
+
+    #[test]
+    fn a_slightly_unnormalised_rotation_is_normalised() {
+        let d = dir();
+        let path = d.join("rounded.gltf");
+        let text = document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [0, 0, 0, 1.001]"#);
+        std::fs::write(&path, text).unwrap();
+        let s = load(&path).unwrap();
+        assert_eq!(s.triangles[0], Triangle::new([10.0, 0.0, 0.0], [11.0, 0.0, 0.0], [11.0, 1.0, 0.0]));
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    /// A GLB cut anywhere, or whose lengths lie, is called truncated or
+    /// corrupt, never read past its end.
+    #[test]
+    fn cut_glb_files_are_called_truncated() {
+        let d = dir();
+        let json = document("", 4, 6).replace(r#""uri": "", "#, "");
+        let mut json = json.into_bytes();
+        json.resize(json.len().div_ceil(4) * 4, b' ');
+        let bin = square_buffer();
+        let mut glb = Vec::new();
+        glb.extend(b"glTF");
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        glb.extend((json.len() as u32).to_le_bytes());
+        glb.extend(b"JSON");
+        glb.extend(&json);
+        glb.extend((bin.len() as u32).to_le_bytes());
+        glb.extend(b"BIN\0");
+        glb.extend(&bin);
+        let path = d.join("cut.glb");
+        for cut in [10, 16, 12 + 8 + json.len() / 2, 12 + 8 + json.len() + 4, glb.len() - 7] {
+            std::fs::write(&path, &glb[..cut]).unwrap();
+            let e = format!("{:#}", load(&path).unwrap_err());
+            assert!(e.contains("truncated") && e.contains("cut.glb"), "cut at {cut}: {e}");
+        }
+        for (length, expected) in [(8u32, "less than a header"), (u32::MAX, "truncated")] {
+            let mut lying = glb.clone();
+            lying[8..12].copy_from_slice(&length.to_le_bytes());
+            std::fs::write(&path, &lying).unwrap();
+            let e = format!("{:#}", load(&path).unwrap_err());
+            assert!(e.contains(expected), "length {length}: {e}");
         }
         std::fs::remove_dir_all(&d).ok();
     }
