@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// run of every kernel peaked at 22 GB of memory (issue 69). The split
 /// follows the SPIR-V's size: about 1.1 to 2.6 MB of modules per group.
 #[cfg(feature = "rebuild-shaders")]
-const GROUPS: [&str; 5] = ["kernels", "render-linear", "render-bvh2", "render-bvh2-light", "render-cwbvh"];
+const GROUPS: [&str; 6] = ["kernels", "render-linear", "render-bvh2", "render-bvh2-light", "render-bvh4", "render-cwbvh"];
 
 #[cfg(feature = "rebuild-shaders")]
 fn rebuild() -> Result<(), Box<dyn std::error::Error>> {

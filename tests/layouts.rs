@@ -1,4 +1,4 @@
-//! The traversal layouts (`classic`, `bvh2`, `cwbvh`): every layout of every
+//! The traversal layouts (`classic`, `bvh2`, `bvh4`, `cwbvh`): every layout of every
 //! tree (LBVH, TRBVH, sweep) finds exactly the scan's closest hit, distance
 //! and primitive, on random, mesh and stiff scenes, for rays from outside,
 //! from inside, along the axes and leaving a surface; each layout passes
@@ -13,13 +13,14 @@ use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
 use treelet::bvh::tree::{binary_tree_split, traced_tree, Accel};
 use treelet::scene::{random_spheres, Scene};
-use treelet::bvh::validate_layout::{validate_bvh2, validate_bvh2_split, validate_wide, validate_wide_split};
-use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, Node, Sphere, WideNode};
+use treelet::bvh::validate_layout::{validate_bvh2, validate_bvh2_split, validate_bvh4, validate_bvh4_split, validate_wide, validate_wide_split};
+use treelet_core::geometry::buffers::{Bvh2Node, Bvh4Node, LeafPrim, Node, Sphere, WideNode};
 use treelet_core::geometry::features::ALL;
 use treelet_core::geometry::prims::{Origin, Prims};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::rng::BounceRng;
 use treelet_core::trace::bvh2::closest_hit_bvh2;
+use treelet_core::trace::bvh4::closest_hit_bvh4;
 use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
 use treelet_core::trace::cwbvh::closest_hit_cwbvh;
 use treelet_core::trace::hit::Hit;
@@ -28,6 +29,7 @@ use treelet_core::trace::hit::Hit;
 enum HostTree {
     Classic(Vec<Node>, Vec<u32>),
     Bvh2(Vec<Bvh2Node>, Vec<LeafPrim>),
+    Bvh4(Vec<Bvh4Node>, Vec<LeafPrim>),
     Wide(Vec<WideNode>, Vec<LeafPrim>),
 }
 
@@ -35,6 +37,7 @@ fn read<B: Backend>(b: &mut B, tree: &TracedTree<B>, n: usize) -> HostTree {
     match tree.layout {
         Layout::Classic => HostTree::Classic(b.read(&tree.nodes, tree.node_count as usize).unwrap(), b.read(&tree.prims, n).unwrap()),
         Layout::Bvh2 => HostTree::Bvh2(b.read(&tree.nodes, tree.node_count as usize).unwrap(), b.read(&tree.prims, n).unwrap()),
+        Layout::Bvh4 => HostTree::Bvh4(b.read(&tree.nodes, tree.node_count as usize).unwrap(), b.read(&tree.prims, n).unwrap()),
         _ => HostTree::Wide(wide_nodes(b, tree).unwrap(), b.read(&tree.prims, n).unwrap()),
     }
 }
@@ -49,6 +52,7 @@ impl HostTree {
         match self {
             HostTree::Classic(nodes, idx) => closest_hit_bvh(o, d, from, prims, nodes, idx),
             HostTree::Bvh2(nodes, leaf) => closest_hit_bvh2::<ALL>(o, d, from, prims, nodes, leaf),
+            HostTree::Bvh4(nodes, leaf) => closest_hit_bvh4::<ALL>(o, d, from, prims, nodes, leaf),
             HostTree::Wide(nodes, leaf) => closest_hit_cwbvh::<ALL>(o, d, from, prims, nodes, leaf),
         }
     }
@@ -57,6 +61,7 @@ impl HostTree {
         let v = match self {
             HostTree::Classic(..) => return, // the binary validator's business (tests/invariants.rs)
             HostTree::Bvh2(nodes, leaf) => validate_bvh2(prims, nodes, leaf),
+            HostTree::Bvh4(nodes, leaf) => validate_bvh4(prims, nodes, leaf),
             HostTree::Wide(nodes, leaf) => validate_wide(prims, nodes, leaf),
         };
         assert!(v.is_valid(), "{:?}", v.errors);
@@ -169,6 +174,7 @@ impl HostTree {
         let v = match self {
             HostTree::Classic(..) => return,
             HostTree::Bvh2(nodes, leaf) => validate_bvh2_split(prims, nodes, leaf),
+            HostTree::Bvh4(nodes, leaf) => validate_bvh4_split(prims, nodes, leaf),
             HostTree::Wide(nodes, leaf) => validate_wide_split(prims, nodes, leaf),
         };
         assert!(v.is_valid(), "{what}: {:?}", v.errors);
@@ -190,7 +196,7 @@ fn split_trees_trace_like_the_scan(what: &str, spheres: &[Sphere], triangles: &[
     let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 600);
     let gpu = treelet_tests::gpu();
     for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc] {
-        for layout in [Layout::Classic, Layout::Bvh2, Layout::Cwbvh] {
+        for layout in Layout::ALL {
             let cpu = build_split(&mut CpuBackend::new(), prims, accel, layout, 0.5);
             let mut trees = vec![("CPU runner", cpu.0)];
             assert!(!splits || cpu.1 > prims.len(), "{what}, {accel:?}: no triangle was split");
@@ -384,6 +390,20 @@ fn validators_catch_corruption() {
     let mut bad = leaf.clone();
     bad[1].prim = bad[0].prim;
     assert!(validate_bvh2(prims, &nodes, &bad).errors.iter().any(|e| e.contains("stored")));
+    let HostTree::Bvh4(nodes, leaf) = build(b, prims, Accel::Trbvh, Layout::Bvh4) else { unreachable!() };
+    assert!(validate_bvh4(prims, &nodes, &leaf).is_valid());
+    let four = |mutate: &dyn Fn(&mut Vec<Bvh4Node>), needle: &str| {
+        let mut n = nodes.clone();
+        mutate(&mut n);
+        let v = validate_bvh4(prims, &n, &leaf);
+        assert!(v.errors.iter().any(|e| e.contains(needle)), "expected `{needle}` in {:?}", v.errors);
+    };
+    four(&|n| n[0].hi_z[0] -= 1.0, "does not contain");
+    four(&|n| n[0].lo_x[1] = f32::INFINITY, "empty on some axes only");
+    // A slot dropped: its primitives are then stored nowhere.
+    four(&|n| (n[0].lo_x[0], n[0].lo_y[0], n[0].lo_z[0], n[0].hi_x[0], n[0].hi_y[0], n[0].hi_z[0], n[0].count[0]) = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1), "stored 0 times");
+    // Two slots naming one internal node.
+    four(&|n| (n[0].child[1], n[0].count[1]) = (n[0].child[0], n[0].count[0]), "reached twice");
 }
 
 /// The GPU lays out the trees the CPU runner does: the same buffers where
@@ -401,7 +421,7 @@ fn gpu_layouts_equal_cpu() {
         let scene = prims.as_core();
         let bounds = prims.boxes().iter().fold(treelet_core::Aabb::EMPTY, |a, b| a.union(b));
         let probes = rays(&scene, bounds.lo(), bounds.hi(), seed, 300);
-        for layout in [Layout::Bvh2, Layout::Cwbvh] {
+        for layout in [Layout::Bvh2, Layout::Bvh4, Layout::Cwbvh] {
             let g = build(&mut GpuBackend::new(ctx.clone()), prims, Accel::Trbvh, layout);
             let c = build(&mut CpuBackend::new(), prims, Accel::Trbvh, layout);
             g.validate(prims);
@@ -411,6 +431,9 @@ fn gpu_layouts_equal_cpu() {
                 }
                 (HostTree::Bvh2(gn, gl), HostTree::Bvh2(cn, cl)) if fused => {
                     assert!(gn == cn && gl == cl, "{what}: GPU and CPU two-box trees differ");
+                }
+                (HostTree::Bvh4(gn, gl), HostTree::Bvh4(cn, cl)) if fused => {
+                    assert!(gn == cn && gl == cl, "{what}: GPU and CPU 4-wide trees differ");
                 }
                 _ => {}
             }
@@ -526,7 +549,7 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
     use treelet::bvh::layout::Layout;
     for scene in [treelet::scene::cornell(), treelet::scene::random_scene("random:3000", 3000, 7), treelet::scene::mesh_scene("terrain", &treelet::scene::terrain(5000))] {
         for accel in [Accel::None, Accel::Lbvh, Accel::Trbvh, Accel::Hploc] {
-            for layout in [Layout::Classic, Layout::Bvh2, Layout::Cwbvh] {
+            for layout in Layout::ALL {
                 let settings = RenderSettings {
                     width: 16,
                     height: 12,

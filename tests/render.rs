@@ -252,12 +252,14 @@ fn cast_kernels_match_cpu() {
     let kernels = [
         (&room, Layout::Classic, Kernel::Cast(Method::Classic, false)),
         (&room, Layout::Bvh2, Kernel::Cast(Method::Bvh2, false)),
+        (&room, Layout::Bvh4, Kernel::Cast(Method::Bvh4, false)),
         (&room, Layout::Cwbvh, Kernel::Cast(Method::Cwbvh, false)),
         (&room, Layout::Cwbvh, Kernel::CastWideWorkgroupStack),
         // The kernels compiled for triangles alone, on the mesh alone.
         (&alone, Layout::Classic, Kernel::Cast(Method::Classic, false)),
         (&alone, Layout::Classic, Kernel::Cast(Method::Classic, true)),
         (&alone, Layout::Bvh2, Kernel::Cast(Method::Bvh2, true)),
+        (&alone, Layout::Bvh4, Kernel::Cast(Method::Bvh4, true)),
         (&alone, Layout::Cwbvh, Kernel::Cast(Method::Cwbvh, true)),
     ];
     let reference = |scene: &Scene| cast(&mut CpuBackend::new(), scene, Layout::Classic, kernels[0].2, (64, 48));

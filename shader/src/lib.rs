@@ -34,6 +34,8 @@ pub mod bounds;
 #[cfg(feature = "kernels")]
 pub mod bvh2;
 #[cfg(feature = "kernels")]
+pub mod bvh4;
+#[cfg(feature = "kernels")]
 pub mod cwbvh;
 #[cfg(feature = "kernels")]
 pub mod depth;
@@ -51,7 +53,7 @@ pub mod multisplit;
 pub mod radix_tree;
 #[cfg(feature = "kernels")]
 pub mod reinsert;
-#[cfg(any(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-cwbvh"))]
+#[cfg(any(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-bvh4", feature = "render-cwbvh"))]
 pub mod render;
 #[cfg(feature = "kernels")]
 pub mod scan;

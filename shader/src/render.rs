@@ -1,7 +1,7 @@
 // Built in groups (this crate's features, one rust-gpu run each; see
 // host/build.rs): a group leaves the others' imports and macros unused.
 #![cfg_attr(
-    not(all(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-cwbvh")),
+    not(all(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-bvh4", feature = "render-cwbvh")),
     allow(unused_imports, unused_macros)
 )]
 use spirv_std::glam::{UVec3, Vec4};
@@ -16,6 +16,7 @@ use treelet_core::render::caustics::light_paths;
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel, tiled_pixel};
 use treelet_core::render::lights::Light;
 use treelet_core::trace::bvh2::{Bvh2Tree, Level};
+use treelet_core::trace::bvh4::Bvh4Tree;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::placed::PlacedScene;
@@ -112,12 +113,16 @@ macro_rules! render_entry_points {
                 render_kernel!(camera whole linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
                 #[cfg(feature = "render-bvh2")]
                 render_kernel!(camera bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                #[cfg(feature = "render-bvh4")]
+                render_kernel!(camera whole bvh4_cs, Vec4, Vec4, Bvh4Tree::new, 0 $(| $f)*);
                 #[cfg(feature = "render-cwbvh")]
                 render_kernel!(camera whole cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
                 #[cfg(feature = "render-linear")]
                 render_kernel!(light whole light_linear_cs, Node, u32, Scan::new, 0 $(| $f)*);
                 #[cfg(feature = "render-bvh2-light")]
                 render_kernel!(light light_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, 0 $(| $f)*);
+                #[cfg(feature = "render-bvh4")]
+                render_kernel!(light whole light_bvh4_cs, Vec4, Vec4, Bvh4Tree::new, 0 $(| $f)*);
                 #[cfg(feature = "render-cwbvh")]
                 render_kernel!(light whole light_cwbvh_cs, Vec4, Vec4, WideTree::new, 0 $(| $f)*);
             }
@@ -184,12 +189,16 @@ macro_rules! cast_kernel {
 cast_kernel!(whole cast_classic_cs, Node, u32, ClassicTree::new, ALL);
 #[cfg(feature = "render-bvh2")]
 cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
+#[cfg(feature = "render-bvh4")]
+cast_kernel!(whole cast_bvh4_cs, Vec4, Vec4, Bvh4Tree::new, ALL);
 #[cfg(feature = "render-cwbvh")]
 cast_kernel!(whole cast_cwbvh_cs, Vec4, Vec4, WideTree::new, ALL);
 #[cfg(feature = "render-linear")]
 cast_kernel!(whole cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
 #[cfg(feature = "render-bvh2")]
 cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
+#[cfg(feature = "render-bvh4")]
+cast_kernel!(whole cast_bvh4_triangles_cs, Vec4, Vec4, Bvh4Tree::new, TRIANGLES);
 #[cfg(feature = "render-cwbvh")]
 cast_kernel!(whole cast_cwbvh_triangles_cs, Vec4, Vec4, WideTree::new, TRIANGLES);
 

@@ -470,6 +470,31 @@ pub struct Bvh2Node {
 }
 const _: () = assert!(core::mem::size_of::<Bvh2Node>() == 64);
 
+/// A 4-wide node of full-precision boxes, made from the [`Bvh2Node`]
+/// layout ([`crate::layouts::bvh4`]): the children of a two-box node's
+/// children. repr(C), Pod, 128 bytes, one cache line; the boxes by axis
+/// and side (`lo_x[k]` is child `k`'s lower x), so that the GPU reads the
+/// node in eight 16-byte loads.
+///
+/// Child `k` is the internal node `child[k]` where `count[k] == 0`, a leaf
+/// of the `count[k]` [`LeafPrim`]s from `child[k]` on otherwise; an unused
+/// slot is a leaf of one primitive behind an inverted infinite box, which no
+/// ray meets.
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct Bvh4Node {
+    pub lo_x: [f32; 4],
+    pub hi_x: [f32; 4],
+    pub lo_y: [f32; 4],
+    pub hi_y: [f32; 4],
+    pub lo_z: [f32; 4],
+    pub hi_z: [f32; 4],
+    pub child: [u32; 4],
+    pub count: [u32; 4],
+}
+const _: () = assert!(core::mem::size_of::<Bvh4Node>() == 128);
+
 /// A node of the compressed 8-wide BVH (Ylitie, Karras & Laine 2017,
 /// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
 /// BVHs"). repr(C), Pod, 80 bytes.

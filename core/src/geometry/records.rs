@@ -12,7 +12,7 @@
 //! the CPU runner as records; the tests below check both give the same
 //! bytes.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, MeshRecord, Node, PlacedMesh, WideNode};
+use crate::geometry::buffers::{Bvh2Node, Bvh4Node, InstanceRecord, LeafPrim, MeshRecord, Node, PlacedMesh, WideNode};
 use crate::gpu::unchecked::{at, put};
 use glam::Vec4;
 
@@ -58,6 +58,21 @@ impl RecordStore<Bvh2Node> for [Vec4] {
         put(self, 4 * i + 1, vector(n.left_max, n.right));
         put(self, 4 * i + 2, vector(n.right_min, n.left_count));
         put(self, 4 * i + 3, vector(n.right_max, n.right_count));
+    }
+}
+
+impl RecordStore<Bvh4Node> for [Vec4] {
+    #[inline]
+    fn store(&mut self, i: usize, n: &Bvh4Node) {
+        let bits = |w: [u32; 4]| Vec4::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3]));
+        put(self, 8 * i, Vec4::from_array(n.lo_x));
+        put(self, 8 * i + 1, Vec4::from_array(n.hi_x));
+        put(self, 8 * i + 2, Vec4::from_array(n.lo_y));
+        put(self, 8 * i + 3, Vec4::from_array(n.hi_y));
+        put(self, 8 * i + 4, Vec4::from_array(n.lo_z));
+        put(self, 8 * i + 5, Vec4::from_array(n.hi_z));
+        put(self, 8 * i + 6, bits(n.child));
+        put(self, 8 * i + 7, bits(n.count));
     }
 }
 
@@ -130,6 +145,23 @@ impl RecordLoad<Bvh2Node> for [Vec4] {
         let (right_min, left_count) = parts(at(self, 4 * i + 2));
         let (right_max, right_count) = parts(at(self, 4 * i + 3));
         Bvh2Node { left_min, left, left_max, right, right_min, left_count, right_max, right_count }
+    }
+}
+
+impl RecordLoad<Bvh4Node> for [Vec4] {
+    #[inline]
+    fn load(&self, i: usize) -> Bvh4Node {
+        let bits = |v: Vec4| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits(), v.w.to_bits()];
+        Bvh4Node {
+            lo_x: at(self, 8 * i).to_array(),
+            hi_x: at(self, 8 * i + 1).to_array(),
+            lo_y: at(self, 8 * i + 2).to_array(),
+            hi_y: at(self, 8 * i + 3).to_array(),
+            lo_z: at(self, 8 * i + 4).to_array(),
+            hi_z: at(self, 8 * i + 5).to_array(),
+            child: bits(at(self, 8 * i + 6)),
+            count: bits(at(self, 8 * i + 7)),
+        }
     }
 }
 
@@ -240,21 +272,26 @@ mod tests {
         let more: Vec<u32> = (0..20).map(|k| 0x27d4_eb2fu32.wrapping_mul(k + 3)).collect();
         same_bytes(*bytemuck::from_bytes::<WideNode>(bytemuck::cast_slice(&more)), 5);
         same_bytes(*bytemuck::from_bytes::<InstanceRecord>(bytemuck::cast_slice(&words)), 4);
+        let wide4: Vec<u32> = (0..32).map(|k| 0x1656_67b1u32.wrapping_mul(k + 5) >> 2).collect();
+        same_bytes(*bytemuck::from_bytes::<Bvh4Node>(bytemuck::cast_slice(&wide4)), 8);
     }
 
     #[test]
     fn both_forms_read_the_same_records() {
-        let words: Vec<u32> = (0..24).map(|k| 0x85eb_ca6bu32.wrapping_mul(k + 7) >> 1).collect();
+        let words: Vec<u32> = (0..32).map(|k| 0x85eb_ca6bu32.wrapping_mul(k + 7) >> 1).collect();
         let vectors: Vec<Vec4> = words
             .chunks(4)
             .map(|w| Vec4::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3])))
             .collect();
         let nodes: &[Bvh2Node] = bytemuck::cast_slice(&words[..16]);
-        let leaf_prims: &[LeafPrim] = bytemuck::cast_slice(&words);
+        let leaf_prims: &[LeafPrim] = bytemuck::cast_slice(&words[..24]);
         let loaded: Bvh2Node = vectors[..].load(0);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&nodes[0]));
         let loaded: LeafPrim = vectors[..].load(1);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&leaf_prims[1]));
+        let four: &[Bvh4Node] = bytemuck::cast_slice(&words);
+        let loaded: Bvh4Node = vectors[..].load(0);
+        assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&four[0]));
         let wide: &[WideNode] = bytemuck::cast_slice(&words[..20]);
         let loaded: WideNode = vectors[..].load(0);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&wide[0]));

@@ -6,6 +6,8 @@
 //! - [`classic`]: the scan of every primitive, and the seed's 32-byte
 //!   nodes with a stack;
 //! - [`bvh2`]: two-box binary nodes, nearer child first (Aila & Laine 2009);
+//! - [`bvh4`]: the same tree as 4-wide nodes of full-precision boxes, half
+//!   the steps;
 //! - [`cwbvh`]: compressed 8-wide nodes with node and primitive groups
 //!   (Ylitie, Karras & Laine 2017).
 //!
@@ -17,6 +19,7 @@
 //! Every layout finds exactly the scan's closest hit: ties go to the lower
 //! primitive index ([`hit::Hit::is_beaten_by`]).
 pub mod bvh2;
+pub mod bvh4;
 pub mod classic;
 pub mod cwbvh;
 pub mod hit;

@@ -5,7 +5,7 @@
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::geometry::aabb::Aabb;
-use treelet_core::geometry::buffers::{Bvh2Node, LayoutParams, LeafPrim, WideNode};
+use treelet_core::geometry::buffers::{Bvh2Node, Bvh4Node, LayoutParams, LeafPrim, WideNode};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::layouts::cwbvh_build::{WIDE_NODE_COST, WIDE_PRIM_COST};
 use treelet_core::trace::hit::STACK_DEPTH;
@@ -34,6 +34,9 @@ pub enum Layout {
     /// Binary nodes that hold both children's boxes (Aila & Laine 2009);
     /// primitives in leaf order.
     Bvh2,
+    /// 4-wide nodes of full-precision boxes, made from bvh2's (each node's
+    /// grandchildren as its children); primitives in leaf order.
+    Bvh4,
     /// Compressed 8-wide nodes, child boxes quantized to bytes (Ylitie,
     /// Karras & Laine 2017); primitives in leaf order.
     Cwbvh,
@@ -41,7 +44,7 @@ pub enum Layout {
 
 impl Layout {
     /// The layouts a tree can be traced in, `auto` aside.
-    pub const ALL: [Layout; 3] = [Layout::Classic, Layout::Bvh2, Layout::Cwbvh];
+    pub const ALL: [Layout; 4] = [Layout::Classic, Layout::Bvh2, Layout::Bvh4, Layout::Cwbvh];
 
     /// What `auto` stands for on `device`: the layout that rendered fastest
     /// there (`treelet render --layout L --report F`, render-kernel time;
@@ -65,6 +68,7 @@ impl Layout {
             Layout::Auto => "auto",
             Layout::Classic => "classic",
             Layout::Bvh2 => "bvh2",
+            Layout::Bvh4 => "bvh4",
             Layout::Cwbvh => "cwbvh",
         }
     }
@@ -74,6 +78,7 @@ impl Layout {
         match self {
             Layout::Classic => Method::Classic,
             Layout::Bvh2 => Method::Bvh2,
+            Layout::Bvh4 => Method::Bvh4,
             Layout::Cwbvh => Method::Cwbvh,
             Layout::Auto => panic!("internal: a layout must be resolved for its device first"),
         }
@@ -169,7 +174,11 @@ pub fn lay_out<B: Backend>(
                 });
             }
             b.stage("layout");
-            bvh2(b, &collapsed, prims)
+            let two = bvh2(b, &collapsed, prims)?;
+            if layout == Layout::Bvh4 {
+                return bvh4(b, two);
+            }
+            Ok(two)
         }
     }
 }
@@ -235,7 +244,22 @@ pub fn kernels<B: Backend>(b: &B, layout: Layout) -> Vec<Kernel> {
         // Classic and bvh2 collapse the tree's leaves first (classic only when it has leaves to collapse).
         Layout::Classic | Layout::Auto => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth]].concat(),
         Layout::Bvh2 => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth, Kernel::Bvh2Nodes, Kernel::LeafPrims]].concat(),
+        Layout::Bvh4 => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth, Kernel::Bvh2Nodes, Kernel::LeafPrims, Kernel::Bvh4Nodes]]
+            .concat(),
     }
+}
+
+/// The 4-wide layout made from a tree in the two-box one
+/// (`treelet_core::layouts::bvh4`): a node for each of its nodes, the
+/// same leaf primitives. The walk's stack holds what a tree of the depth
+/// the two-box layout admits needs (`treelet_core::trace::bvh4::BVH4_STACK_ENTRIES`).
+fn bvh4<B: Backend>(b: &mut B, two: TracedTree<B>) -> Result<TracedTree<B>> {
+    let bytes = two.node_count as u64 * std::mem::size_of::<Bvh4Node>() as u64;
+    check_fits(b, "4-wide nodes", bytes)?;
+    let nodes = b.scratch("4-wide nodes", bytes)?;
+    let p = b.upload("4-wide params", &[LayoutParams { nodes: two.node_count, ..Default::default() }])?;
+    b.dispatch(Kernel::Bvh4Nodes, &[&p, &two.nodes, &nodes], groups_for(two.node_count, WORKGROUP_SIZE));
+    Ok(TracedTree { layout: Layout::Bvh4, nodes, prims: two.prims, node_count: two.node_count, collapsed: None })
 }
 
 /// The two-box binary layout of a collapsed tree (depth-first order).

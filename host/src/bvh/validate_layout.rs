@@ -5,7 +5,7 @@
 //! node stores for each child (for cwbvh, the dequantized bytes) contains
 //! it; that every primitive is stored exactly once and exactly as the scene
 //! has it; and that every node is reached exactly once from the root.
-use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, WideNode};
+use treelet_core::geometry::buffers::{Bvh2Node, Bvh4Node, LeafPrim, WideNode};
 
 use crate::bvh::validate::{primitive_box, Validation};
 use crate::scene::primitives::Primitives;
@@ -349,5 +349,74 @@ fn validate_bvh2_tree(prims: Primitives, nodes: &[Bvh2Node], leaf_prims: &[LeafP
             c.err(format!("node {i} reached {s} times"));
         }
     }
+    c.finish()
+}
+
+/// Checks a 4-wide BVH of full-precision boxes (root 0) over `prims`; see
+/// the module doc. Its node array also holds nodes no walk reaches (the
+/// two-box layout's odd levels, `treelet_core::layouts::bvh4`): every node
+/// is reached at most once, and every primitive exactly once.
+pub fn validate_bvh4(prims: Primitives, nodes: &[Bvh4Node], leaf_prims: &[LeafPrim]) -> Validation {
+    validate_bvh4_tree(prims, nodes, leaf_prims, false)
+}
+
+/// [`validate_bvh4`] for a tree over pieces of triangles (see
+/// [`validate_bvh2_split`]).
+pub fn validate_bvh4_split(prims: Primitives, nodes: &[Bvh4Node], leaf_prims: &[LeafPrim]) -> Validation {
+    validate_bvh4_tree(prims, nodes, leaf_prims, true)
+}
+
+fn validate_bvh4_tree(prims: Primitives, nodes: &[Bvh4Node], leaf_prims: &[LeafPrim], split: bool) -> Validation {
+    let mut c = Check::new(prims, split);
+    if nodes.is_empty() {
+        c.err("no nodes".into());
+        return c.finish();
+    }
+    let mut seen_node = vec![0u32; nodes.len()];
+    fn visit(c: &mut Check, nodes: &[Bvh4Node], leaf_prims: &[LeafPrim], i: usize, seen: &mut [u32], depth: u32) -> Box3 {
+        let Some(node) = nodes.get(i) else {
+            c.err(format!("node index {i} out of range ({})", nodes.len()));
+            return EMPTY;
+        };
+        seen[i] += 1;
+        if seen[i] > 1 {
+            c.err(format!("node {i} reached twice"));
+            return EMPTY;
+        }
+        if depth > 64 {
+            c.err(format!("node {i} is deeper than 64 levels"));
+            return EMPTY;
+        }
+        let mut total = EMPTY;
+        for k in 0..4 {
+            let (lo, hi) = ([node.lo_x[k], node.lo_y[k], node.lo_z[k]], [node.hi_x[k], node.hi_y[k], node.hi_z[k]]);
+            let (index, count) = (node.child[k], node.count[k]);
+            let at = format!("node {i} slot {k}");
+            // A slot no ray reaches: an empty box on every axis.
+            if (0..3).any(|a| lo[a] > hi[a]) {
+                if !(0..3).all(|a| lo[a] > hi[a]) || count == 0 {
+                    c.err(format!("{at}: box {lo:?}..{hi:?} is empty on some axes only, or names an internal node"));
+                }
+                continue;
+            }
+            let exact = if count == 0 {
+                visit(c, nodes, leaf_prims, index as usize, seen, depth + 1)
+            } else if c.pieces.is_some() {
+                c.leaf_of_pieces(leaf_prims, index..index + count, (lo, hi), &at)
+            } else {
+                let mut b = EMPTY;
+                for j in 0..count {
+                    b = union(b, c.leaf(leaf_prims, (index + j) as usize, &at));
+                }
+                b
+            };
+            if (0..3).any(|a| lo[a] > exact.0[a] || hi[a] < exact.1[a]) && exact.0[0] <= exact.1[0] {
+                c.err(format!("{at}: box {lo:?}..{hi:?} does not contain {:?}..{:?}", exact.0, exact.1));
+            }
+            total = union(total, exact);
+        }
+        total
+    }
+    visit(&mut c, nodes, leaf_prims, 0, &mut seen_node, 0);
     c.finish()
 }

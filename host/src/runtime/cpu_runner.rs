@@ -20,6 +20,7 @@ use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
 use treelet_core::render::lights::Light;
 use treelet_core::render::variants::VARIANTS;
 use treelet_core::trace::bvh2::{Bvh2Tree, Level};
+use treelet_core::trace::bvh4::Bvh4Tree;
 use treelet_core::trace::placed::PlacedScene;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
@@ -850,6 +851,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
             }
         }
+        (Kernel::Bvh4Nodes, [p, nodes, out]) => {
+            let p: treelet_core::LayoutParams = params(p);
+            let (nodes, out) = (view::<treelet_core::Bvh2Node>(nodes), view::<treelet_core::Bvh4Node>(out));
+            for id in ids(groups) {
+                treelet_core::layouts::bvh4::bvh4_node_kernel(id, p.nodes, nodes, out);
+            }
+        }
         (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {
             let p: treelet_core::LayoutParams = params(p);
             let (nodes, parents, deepest) = (view::<treelet_core::Node>(nodes), view(parents), view(deepest));
@@ -941,6 +949,11 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                         SceneRefs::new(&p, spheres, triangles, materials, Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
                     cast_variant(tri, &p, &scene, rays, groups);
                 }
+                Kernel::Cast(Method::Bvh4, tri) => {
+                    let scene =
+                        SceneRefs::new(&p, spheres, triangles, materials, Bvh4Tree::new(view::<treelet_core::Bvh4Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
+                    cast_variant(tri, &p, &scene, rays, groups);
+                }
                 Kernel::Cast(Method::Cwbvh, tri) => {
                     let scene =
                         SceneRefs::new(&p, spheres, triangles, materials, WideTree::new(view::<treelet_core::WideNode>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]));
@@ -970,6 +983,10 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
                 Method::Bvh2 => {
                     let tree = Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
+                    render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
+                }
+                Method::Bvh4 => {
+                    let tree = Bvh4Tree::new(view::<treelet_core::Bvh4Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
                     render_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, accum, groups)
                 }
                 Method::Cwbvh => {
@@ -1037,6 +1054,10 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 Method::Classic => panic!("no light paths through the seed's layout"),
                 Method::Bvh2 => {
                     let tree = Bvh2Tree::new(view::<treelet_core::Bvh2Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
+                    light_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, splats, groups)
+                }
+                Method::Bvh4 => {
+                    let tree = Bvh4Tree::new(view::<treelet_core::Bvh4Node>(nodes) as &[_], view::<treelet_core::LeafPrim>(prims) as &[_]);
                     light_all(v, &p, &SceneRefs::new(&p, spheres, triangles, materials, tree), lights, splats, groups)
                 }
                 Method::Cwbvh => {

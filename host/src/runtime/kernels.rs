@@ -18,6 +18,7 @@ pub enum Method {
     Scan,
     Classic,
     Bvh2,
+    Bvh4,
     Cwbvh,
 }
 
@@ -28,6 +29,7 @@ impl Method {
             Method::Scan => "linear",
             Method::Classic => "classic",
             Method::Bvh2 => "bvh2",
+            Method::Bvh4 => "bvh4",
             Method::Cwbvh => "cwbvh",
         }
     }
@@ -40,7 +42,7 @@ impl Method {
         !matches!(self, Method::Classic)
     }
 
-    pub const ALL: [Method; 4] = [Method::Scan, Method::Classic, Method::Bvh2, Method::Cwbvh];
+    pub const ALL: [Method; 5] = [Method::Scan, Method::Classic, Method::Bvh2, Method::Bvh4, Method::Cwbvh];
 }
 
 /// Entry point of render kernel `(method, variant)`, as the shader crate
@@ -191,6 +193,8 @@ pub enum Kernel {
     Bvh2Nodes,
     /// Primitives in leaf order.
     LeafPrims,
+    /// The 4-wide layout from the two-box one.
+    Bvh4Nodes,
     /// The depth of a tree (each leaf climbs; the deepest counts).
     TreeDepth,
     /// The compressed wide BVH: SAH DP over the binary tree (bottom up).
@@ -237,7 +241,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 72] = [
+    const FIXED: [Kernel; 75] = [
         Kernel::Fill,
         Kernel::CopyWords,
         Kernel::CastInstances,
@@ -298,6 +302,7 @@ impl Kernel {
         Kernel::Collapse,
         Kernel::Bvh2Nodes,
         Kernel::LeafPrims,
+        Kernel::Bvh4Nodes,
         Kernel::TreeDepth,
         Kernel::WideDp,
         Kernel::WideDpRelaxed,
@@ -306,9 +311,11 @@ impl Kernel {
         Kernel::WideEmit,
         Kernel::Cast(Method::Classic, false),
         Kernel::Cast(Method::Bvh2, false),
+        Kernel::Cast(Method::Bvh4, false),
         Kernel::Cast(Method::Cwbvh, false),
         Kernel::Cast(Method::Classic, true),
         Kernel::Cast(Method::Bvh2, true),
+        Kernel::Cast(Method::Bvh4, true),
         Kernel::Cast(Method::Cwbvh, true),
     ];
 
@@ -398,6 +405,7 @@ impl Kernel {
             Kernel::Collapse => "treelet::collapse_cs",
             Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
             Kernel::LeafPrims => "bvh2::leaf_prims_cs",
+            Kernel::Bvh4Nodes => "bvh4::bvh4_nodes_cs",
             Kernel::TreeDepth => "depth::tree_depth_cs",
             Kernel::WideDp => "cwbvh::wide_dp_cs",
             Kernel::WideDpRelaxed => "cwbvh::wide_dp_relaxed_cs",
@@ -412,9 +420,11 @@ impl Kernel {
             Kernel::Light(method, v) => render_entry_point(method, v, true),
             Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
             Kernel::Cast(Method::Bvh2, false) => "render::cast_bvh2_cs",
+            Kernel::Cast(Method::Bvh4, false) => "render::cast_bvh4_cs",
             Kernel::Cast(Method::Cwbvh, false) => "render::cast_cwbvh_cs",
             Kernel::Cast(Method::Classic, true) => "render::cast_classic_triangles_cs",
             Kernel::Cast(Method::Bvh2, true) => "render::cast_bvh2_triangles_cs",
+            Kernel::Cast(Method::Bvh4, true) => "render::cast_bvh4_triangles_cs",
             Kernel::Cast(Method::Cwbvh, true) => "render::cast_cwbvh_triangles_cs",
             Kernel::Cast(Method::Scan, _) => panic!("no cast kernel scans"),
             Kernel::CastWideWorkgroupStack => "render::cast_cwbvh_workgroup_cs",
@@ -536,6 +546,7 @@ impl Kernel {
             Kernel::ReinsertRefit | Kernel::ReinsertRefitRelaxed => &[Read, ReadWrite, Read, ReadWrite],
             Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
+            Kernel::Bvh4Nodes => &[Read, Read, ReadWrite],
             Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
             Kernel::TreeDepth => &[Read, Read, Read, ReadWrite],
             Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
