@@ -288,6 +288,24 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             anyhow::bail!("--resume {} and --out name the same file: the image would replace the part it continues", resume.display());
         }
     }
+    // Samples a stopped render left where this one would write its own (a
+    // checkpoint beside --out, or an unfinished part at --out): written over
+    // without resuming them, they would be lost.
+    if part_path.exists() && !args.resume.as_ref().is_some_and(|r| same(r, &part_path)) {
+        let unfinished = match parts::read_part(&part_path) {
+            // Beside --out, a part is always one a render did not finish (a
+            // finished render removes it); at --out, one short of its plan.
+            Ok((info, _)) => part.is_none() || info.samples.end < info.planned_end,
+            Err(_) => false,
+        };
+        if unfinished {
+            anyhow::bail!(
+                "{} holds the samples of a render that did not finish: continue it with `--resume {}` and the same options, or delete it to start again",
+                part_path.display(),
+                part_path.display()
+            );
+        }
+    }
     if let Some(report) = &args.report {
         for (other, what) in [(Some(&args.out), "--out"), (args.resume.as_ref(), "--resume"), (Some(&part_path), "the part beside --out")] {
             if other.is_some_and(|o| same(report, o)) {

@@ -703,6 +703,12 @@ fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && err.contains("samples 0.."), "{err}");
     assert!(!std::path::Path::new(&p("img.png")).exists(), "a killed render wrote no image");
+    // Running the command again without --resume would write over the
+    // checkpoint: refused, saying how to continue.
+    let before = std::fs::read(p("img.part.exr")).unwrap();
+    let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "16", "--checkpoint", "0.2", "--out", &p("img.png")]);
+    assert!(e.contains("did not finish") && e.contains("--resume"), "{e}");
+    assert_eq!(std::fs::read(p("img.part.exr")).unwrap(), before, "the checkpoint was touched");
 
     let o = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "256", "--checkpoint", "0.01", "--out", &p("done.png")]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -156,6 +156,13 @@ struct MaterialSpec {
     ior: f32,
 }
 
+/// Indices of refraction a glass may have (relative ones below 1 included:
+/// a bubble of air in water is 0.75).
+const MIN_IOR: f32 = 0.01;
+const MAX_IOR: f32 = 100.0;
+/// The widest camera: half-height `tan(89.95 degrees)` at unit distance.
+const MAX_FOV: f32 = 1146.0;
+
 fn default_ior() -> f32 {
     1.5
 }
@@ -226,8 +233,11 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
                 m.emission
             );
         }
-        if kind == GLASS && m.ior <= 0.0 {
-            bail!("scene file {name}: material `{key}` has index of refraction {} (must be positive)", m.ior);
+        if kind == GLASS && !(m.ior >= MIN_IOR && m.ior <= MAX_IOR) {
+            bail!(
+                "scene file {name}: material `{key}` has index of refraction {} (it must lie between {MIN_IOR} and {MAX_IOR}; past that, refraction's arithmetic overflows into NaN pixels)",
+                m.ior
+            );
         }
         let ior = if kind == GLASS { m.ior } else { 0.0 }; // meaningful for glass alone
         materials.insert(key.clone(), Material { emission: m.emission, kind, color: m.color, ior });
@@ -332,10 +342,17 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     }
     let c = &file.camera;
     if c.origin.iter().chain(&c.direction).chain([&c.near, &c.fov]).any(|v| !v.is_finite())
-        || c.direction.iter().all(|&v| v == 0.0)
+        || glam::Vec3::from_array(c.direction).normalize_or_zero() == glam::Vec3::ZERO
         || c.fov <= 0.0
     {
         bail!("scene file {name}: the camera needs a finite origin, a non-zero direction and a positive fov");
+    }
+    // Cameras that would render black, or from behind their origin.
+    if c.fov > MAX_FOV {
+        bail!("scene file {name}: camera fov {} (the half-height of the image at unit distance) is past {MAX_FOV}, a view of 179.9 degrees", c.fov);
+    }
+    if c.near < 0.0 {
+        bail!("scene file {name}: camera near {}: rays would start behind the camera (use 0 or more)", c.near);
     }
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
@@ -367,6 +384,26 @@ mod tests {
         let e = parse(&scene(r#"{"type": "diffuse", "color": [0, 0, 0], "emission": [1e30, 0, 0]}"#), "b.json").unwrap_err().to_string();
         assert!(e.contains("b.json") && e.contains("emission"), "{e}");
         assert!(parse(&scene(r#"{"type": "diffuse", "color": [1, 1, 1], "emission": [1e6, 0, 0]}"#), "c.json").is_ok());
+        // Glass whose index overflows refraction's arithmetic (NaN pixels).
+        let e = parse(&scene(r#"{"type": "glass", "color": [1, 1, 1], "ior": 1e30}"#), "d.json").unwrap_err().to_string();
+        assert!(e.contains("d.json") && e.contains("index of refraction"), "{e}");
+        assert!(parse(&scene(r#"{"type": "glass", "color": [1, 1, 1], "ior": 0.75}"#), "e.json").is_ok());
+    }
+
+    #[test]
+    fn cameras_that_would_render_black_or_backwards_are_errors() {
+        let scene = |camera: &str| {
+            format!(r#"{{"camera": {camera}, "materials": {{"m": {{"type": "diffuse", "color": [1, 1, 1]}}}}, "spheres": [{{"center": [0,0,5], "radius": 1, "material": "m"}}]}}"#)
+        };
+        for (camera, expected) in [
+            (r#"{"origin": [0,0,0], "direction": [0,0,1], "fov": 1e38}"#, "fov"),
+            (r#"{"origin": [0,0,0], "direction": [0,0,1], "near": -1}"#, "behind the camera"),
+            (r#"{"origin": [0,0,0], "direction": [0,0,1e-30]}"#, "non-zero direction"),
+        ] {
+            let e = parse(&scene(camera), "cam.json").unwrap_err().to_string();
+            assert!(e.contains("cam.json") && e.contains(expected), "{camera}: {e}");
+        }
+        assert!(parse(&scene(r#"{"origin": [0,0,0], "direction": [0,0,1e-3], "fov": 2}"#), "ok.json").is_ok());
     }
 
     #[test]
