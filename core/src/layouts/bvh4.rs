@@ -1,8 +1,9 @@
 //! The 4-wide layout of full-precision boxes ([`Bvh4Node`]), made from the
-//! `bvh2` layout ([`crate::layouts::bvh2`]) by taking each two-box node's
-//! grandchildren as its four children: a child that is a leaf stays one
-//! child, an internal child gives its own two. So a walk from the root
-//! meets every other level of the binary tree: about half the steps, each
+//! `bvh2` layout ([`crate::layouts::bvh2`]): each two-box node's two
+//! children, then twice the internal child of the largest surface area
+//! replaced by its own two (the greedy collapse of wide BVH builders: the
+//! children rays meet most are opened first). So a walk from the root
+//! skips most levels of the binary tree: about half the steps, each
 //! testing four boxes instead of two, with no decoding (the compressed
 //! 8-wide layout spends about 40 instructions a child on its quantized
 //! boxes, which made it slower than `bvh2` on the H200:
@@ -11,11 +12,11 @@
 //! nodes the best trade of steps against work per step on GPUs.
 //!
 //! One kernel without atomics, [`bvh4_node_kernel`]: node `i` of the `bvh2`
-//! layout becomes node `i` here, its children's internal children keeping
-//! their `bvh2` indices. A walk reaches only the nodes at even depths of the
-//! binary tree; the others are written and never read (twice the nodes'
-//! memory, none of it in the cache: each node is one 128-byte line). The
-//! leaf primitives are the `bvh2` layout's, shared.
+//! layout becomes node `i` here, the internal nodes among its children
+//! keeping their `bvh2` indices. A walk reaches only some of the nodes;
+//! the others are written and never read (up to twice the nodes' memory,
+//! none of it in the cache: each node is one 128-byte line). The leaf
+//! primitives are the `bvh2` layout's, shared.
 use crate::geometry::buffers::{Bvh2Node, Bvh4Node};
 use crate::geometry::records::{RecordLoad, RecordStore};
 
@@ -58,9 +59,10 @@ impl Bvh4Node {
 }
 
 /// Kernel, one invocation per node `i` of a `bvh2` layout of `node_count`
-/// nodes: its [`Bvh4Node`] at `i` (see the module doc). Slots 0 and 1 come
-/// from the left child (itself if a leaf, else its two children), 2 and 3
-/// from the right.
+/// nodes: its [`Bvh4Node`] at `i` (see the module doc): its two children in
+/// slots 0 and 1, then, twice, the internal child of the largest half area
+/// (the first such slot on ties) replaced by its left child, its right
+/// child in the next free slot.
 pub fn bvh4_node_kernel<N: RecordLoad<Bvh2Node> + ?Sized, O: RecordStore<Bvh4Node> + ?Sized>(
     i: u32,
     node_count: u32,
@@ -72,22 +74,39 @@ pub fn bvh4_node_kernel<N: RecordLoad<Bvh2Node> + ?Sized, O: RecordStore<Bvh4Nod
     }
     let n = nodes.load(i as usize);
     let mut w = Bvh4Node::EMPTY;
-    take(&mut w, 0, n.left_min, n.left_max, n.left, n.left_count, nodes);
-    take(&mut w, 2, n.right_min, n.right_max, n.right, n.right_count, nodes);
+    w.set(0, n.left_min, n.left_max, n.left, n.left_count);
+    w.set(1, n.right_min, n.right_max, n.right, n.right_count);
+    let mut used = 2usize;
+    while used < 4 {
+        let mut open = usize::MAX;
+        let mut largest = -1.0f32;
+        let mut k = 0;
+        while k < used {
+            if w.count[k] == 0 {
+                let (lo, hi) = w.slot_box(k);
+                let a = half_area(lo, hi);
+                if a > largest {
+                    (open, largest) = (k, a);
+                }
+            }
+            k += 1;
+        }
+        if open == usize::MAX {
+            break;
+        }
+        let c = nodes.load(w.child[open] as usize);
+        w.set(open, c.left_min, c.left_max, c.left, c.left_count);
+        w.set(used, c.right_min, c.right_max, c.right, c.right_count);
+        used += 1;
+    }
     out.store(i as usize, &w);
 }
 
-/// One child of a two-box node into slots `k` and `k + 1`: a leaf as it is
-/// (slot `k`), an internal node as its own two children.
+/// Half the surface area of the box `lo..hi` (0 for an empty or flat one).
 #[inline]
-fn take<N: RecordLoad<Bvh2Node> + ?Sized>(w: &mut Bvh4Node, k: usize, lo: [f32; 3], hi: [f32; 3], child: u32, count: u32, nodes: &N) {
-    if count > 0 {
-        w.set(k, lo, hi, child, count);
-    } else {
-        let c = nodes.load(child as usize);
-        w.set(k, c.left_min, c.left_max, c.left, c.left_count);
-        w.set(k + 1, c.right_min, c.right_max, c.right, c.right_count);
-    }
+fn half_area(lo: [f32; 3], hi: [f32; 3]) -> f32 {
+    let (x, y, z) = ((hi[0] - lo[0]).max(0.0), (hi[1] - lo[1]).max(0.0), (hi[2] - lo[2]).max(0.0));
+    x * y + y * z + z * x
 }
 
 #[cfg(test)]
@@ -110,7 +129,7 @@ mod tests {
     }
 
     #[test]
-    fn grandchildren_become_children_and_leaves_stay_one_slot() {
+    fn the_largest_internal_children_are_opened_and_leaves_stay_one_slot() {
         // Root 0: left internal (node 1: two leaves), right a leaf of 3 at 7.
         let nodes: Vec<Bvh2Node> = std::vec![two(0.0, (1, 0), (7, 3)), two(10.0, (0, 2), (2, 5))];
         let mut out = std::vec![Bvh4Node::default(); 2];
@@ -118,12 +137,22 @@ mod tests {
             bvh4_node_kernel(i, 2, &nodes[..], &mut out[..]);
         }
         let root = out[0];
-        assert_eq!((root.child, root.count), ([0, 2, 7, 0], [2, 5, 3, 1]));
+        assert_eq!((root.child, root.count), ([0, 7, 2, 0], [2, 3, 5, 1]));
         assert_eq!(root.slot_box(0), ([10.0; 3], [11.0; 3]));
-        assert_eq!(root.slot_box(1), ([12.0; 3], [13.0; 3]));
-        assert_eq!(root.slot_box(2), ([2.0; 3], [3.0; 3]));
+        assert_eq!(root.slot_box(1), ([2.0; 3], [3.0; 3]));
+        assert_eq!(root.slot_box(2), ([12.0; 3], [13.0; 3]));
         assert_eq!(root.slot_box(3), ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]));
-        // Node 1 (odd depth, never walked) is written all the same.
-        assert_eq!((out[1].child, out[1].count), ([0, 0, 2, 0], [2, 1, 5, 1]));
+        // Node 1 (never walked from the root) is written all the same.
+        assert_eq!((out[1].child, out[1].count), ([0, 2, 0, 0], [2, 5, 1, 1]));
+        // Three internal levels: the larger of the two internal children is
+        // opened first, then the largest of what is left.
+        let deep: Vec<Bvh2Node> = std::vec![two(0.0, (1, 0), (2, 0)), two(0.0, (0, 1), (1, 1)), two(0.0, (2, 1), (3, 1))];
+        let mut out = std::vec![Bvh4Node::default(); 3];
+        for i in 0..3 {
+            bvh4_node_kernel(i, 3, &deep[..], &mut out[..]);
+        }
+        // Node 0's right child (box 2..3, half area 3) is as large as its
+        // left (0..1, half area 3): the first, node 1, opens, then node 2.
+        assert_eq!((out[0].child, out[0].count), ([0, 2, 1, 3], [1, 1, 1, 1]));
     }
 }

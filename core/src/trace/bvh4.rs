@@ -17,10 +17,11 @@ use crate::gpu::unchecked::{get, scratch, set};
 use crate::trace::bvh2::leaf;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
 
-/// Stack entries of the walk: a step pushes at most three, and the walk
-/// goes down two binary levels a step, so a tree the depth check admits
-/// (`STACK_DEPTH + 1` levels) needs at most `3 (STACK_DEPTH / 2 + 1)`.
-pub const BVH4_STACK_ENTRIES: usize = 3 * (STACK_DEPTH / 2 + 1);
+/// Stack entries of the walk: a step pushes at most three, and goes down
+/// at least one binary level (a node's children are its descendants), so a
+/// tree the depth check admits (internal nodes at most `STACK_DEPTH - 1`
+/// levels deep) needs at most `3 STACK_DEPTH`.
+pub const BVH4_STACK_ENTRIES: usize = 3 * STACK_DEPTH;
 
 /// A tree in this layout: its nodes and the `bvh2` layout's leaf
 /// primitives, as records or as the 16-byte vectors of their bytes (see
