@@ -465,6 +465,12 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     };
     let result = treelet::render::devices::render_on_devices(&list, &scene, &settings, reference.as_ref(), control, on_pass)?;
     bar.finish_and_clear();
+    // A NaN or infinite pixel is a wrong image, whatever made it: said, not
+    // left for the user to find.
+    let bad = result.image.pixels.iter().filter(|p| !p.iter().all(|v| v.is_finite())).count();
+    if bad > 0 {
+        eprintln!("warning: {bad} of {} pixels are NaN or infinite (a material or light out of range?)", result.image.pixels.len());
+    }
     let done = result.samples.clone();
     let write_start = std::time::Instant::now();
     match (&result.stopped, &part) {
