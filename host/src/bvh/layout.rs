@@ -22,8 +22,8 @@ use crate::scene::primitives::Primitives;
 pub enum Layout {
     /// The fastest measured on the device: bvh2 on GPUs and on the CPU
     /// runner, cwbvh on CPU Vulkan adapters (lavapipe); a render of 256
-    /// samples per pixel or more on a Vulkan device times bvh2, bvh4 and
-    /// cwbvh first and keeps the fastest.
+    /// samples per pixel or more on a Vulkan device times both first and
+    /// keeps the faster.
     // (Plain words: this is `--layout auto`'s help. The code is `resolve`
     // and `render::variant::PILOT_MIN_SPP`; a test in main.rs holds them
     // to this text.)

@@ -116,15 +116,15 @@ pub fn prepare_pipelines<B: Backend>(b: &mut B, scene: &Scene, settings: &Render
     b.prepare_kernels(&kernels);
 }
 
-/// The layouts a pilot times (see [`pilots_layout`]): `bvh4` traces
-/// diffuse rays inside interiors 2-6% faster than `bvh2` on the H200 and
-/// coherent ones up to 20% slower (`docs/results/h200-bvh4-2026-12-01/`),
-/// so which renders faster depends on the scene and the path's bounces.
-const PILOT_LAYOUTS: [Layout; 3] = [Layout::Bvh2, Layout::Bvh4, Layout::Cwbvh];
+/// The layouts a pilot times (see [`pilots_layout`]). Not `bvh4`: its
+/// render kernels ran 7-9% slower than `bvh2`'s on the H200 (terrain and
+/// the city in smallpt's room), and a pilot that timed it never kept it
+/// (`docs/results/h200-bvh4-2026-12-01/`).
+const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
 
 
 /// Whether a render with `settings` following `plan` on a device of
-/// `class` times each of [`PILOT_LAYOUTS`] before it starts (see [`PILOT_MIN_SPP`]).
+/// `class` times both of [`PILOT_LAYOUTS`] before it starts (see [`PILOT_MIN_SPP`]).
 pub fn pilots_layout(settings: &RenderSettings, plan: &Plan, class: DeviceClass) -> bool {
     settings.layout == Layout::Auto
         && !plan.placed
@@ -348,7 +348,7 @@ fn dispatch_placed<B: Backend>(
 
 /// Builds `plan`'s tree once, lays it out in each of [`PILOT_LAYOUTS`],
 /// renders one sample of every pixel through each into a scratch buffer
-/// (GPU timestamps), and keeps the fastest, saying so in `plan`.
+/// (GPU timestamps), and keeps the faster, saying so in `plan`.
 fn faster_layout<B: Backend>(
     b: &mut B,
     all: Primitives,
@@ -379,7 +379,7 @@ fn faster_layout<B: Backend>(
     let (_, layout_ms, tree, layout) = best.context("the pilot timed no layout")?;
     plan.layout = layout;
     plan.layout_reason = format!(
-        "the fastest of one sample per pixel through each layout, timed before the render ({}; at {PILOT_MIN_SPP} spp or more, see `treelet::render::variant::PILOT_MIN_SPP`)",
+        "the faster of one sample per pixel through each layout, timed before the render ({}; at {PILOT_MIN_SPP} spp or more, see `treelet::render::variant::PILOT_MIN_SPP`)",
         measured.join(", ")
     );
     Ok((tree, buffers, built.build_ms + layout_ms))

@@ -255,7 +255,7 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
                 DeviceClass::CpuAdapter => "CPU Vulkan adapters (lavapipe)",
                 DeviceClass::CpuRunner => "the CPU runner",
             };
-            let pilot = if class != DeviceClass::CpuRunner { format!("; renders of {} spp or more time the bvh2, bvh4 and cwbvh layouts first and keep the fastest", PILOT_MIN_SPP) } else { String::new() };
+            let pilot = if class != DeviceClass::CpuRunner { format!("; renders of {} spp or more time both layouts first and keep the faster", PILOT_MIN_SPP) } else { String::new() };
             (chosen, format!("the layout that renders fastest on {on}, as measured (see `treelet::bvh::layout::Layout::resolve`){pilot}"))
         }
         other => (other, "as asked (--layout)".to_string()),
