@@ -7,7 +7,7 @@
 //! has to enter the node: on scenes whose triangles span many sizes it
 //! predicts trace speed better than the SAH, which sees no overlap at all.
 //!
-//! Where triangles are split into several leaves ([`super::lbvh::split_budget`]),
+//! Where triangles are split into several leaves ([`super::tree::split_budget`]),
 //! the part of a triangle in a node's subtree is the sum of its parts in
 //! the boxes of the leaves under the node that hold it (the pieces' boxes
 //! overlap by their padding alone). Triangles and parallelograms count;

@@ -124,7 +124,7 @@ const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
 
 
 /// Whether a render with `settings` following `plan` on a device of
-/// `class` times both of [`PILOT_LAYOUTS`] before it starts (see [`PILOT_MIN_SPP`]).
+/// `class` times both layouts it pilots (`bvh2`, `cwbvh`) before it starts (see [`PILOT_MIN_SPP`]).
 pub fn pilots_layout(settings: &RenderSettings, plan: &Plan, class: DeviceClass) -> bool {
     settings.layout == Layout::Auto
         && !plan.placed
