@@ -514,6 +514,26 @@ mod tests {
         )
     }
 
+    /// The square as a GLB file: a header, the JSON chunk (padded with
+    /// spaces), the BIN chunk; and the JSON chunk's length.
+    fn square_glb() -> (Vec<u8>, usize) {
+        let json = document("", 4, 6).replace(r#""uri": "", "#, "");
+        let mut json = json.into_bytes();
+        json.resize(json.len().div_ceil(4) * 4, b' ');
+        let bin = square_buffer(); // 60 bytes, a multiple of 4
+        let mut glb = Vec::new();
+        glb.extend(b"glTF");
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        glb.extend((json.len() as u32).to_le_bytes());
+        glb.extend(b"JSON");
+        glb.extend(&json);
+        glb.extend((bin.len() as u32).to_le_bytes());
+        glb.extend(b"BIN\0");
+        glb.extend(&bin);
+        (glb, json.len())
+    }
+
     fn data_uri() -> String {
         format!(
             "data:application/octet-stream;base64,{}",
@@ -555,20 +575,7 @@ mod tests {
         std::fs::write(&external, document("square.bin", 4, 6)).unwrap();
         check_scene(&load(&external).unwrap());
         // GLB: a header, the JSON chunk (padded with spaces), the BIN chunk.
-        let json = document("", 4, 6).replace(r#""uri": "", "#, "");
-        let mut json = json.into_bytes();
-        json.resize(json.len().div_ceil(4) * 4, b' ');
-        let bin = square_buffer(); // 60 bytes, a multiple of 4
-        let mut glb = Vec::new();
-        glb.extend(b"glTF");
-        glb.extend(2u32.to_le_bytes());
-        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-        glb.extend((json.len() as u32).to_le_bytes());
-        glb.extend(b"JSON");
-        glb.extend(&json);
-        glb.extend((bin.len() as u32).to_le_bytes());
-        glb.extend(b"BIN\0");
-        glb.extend(&bin);
+        let (glb, _) = square_glb();
         let binary = d.join("square.glb");
         std::fs::write(&binary, glb).unwrap();
         check_scene(&Scene::from_spec(binary.to_str().unwrap()).unwrap());
@@ -663,22 +670,9 @@ mod tests {
     #[test]
     fn cut_glb_files_are_called_truncated() {
         let d = dir();
-        let json = document("", 4, 6).replace(r#""uri": "", "#, "");
-        let mut json = json.into_bytes();
-        json.resize(json.len().div_ceil(4) * 4, b' ');
-        let bin = square_buffer();
-        let mut glb = Vec::new();
-        glb.extend(b"glTF");
-        glb.extend(2u32.to_le_bytes());
-        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-        glb.extend((json.len() as u32).to_le_bytes());
-        glb.extend(b"JSON");
-        glb.extend(&json);
-        glb.extend((bin.len() as u32).to_le_bytes());
-        glb.extend(b"BIN\0");
-        glb.extend(&bin);
+        let (glb, json_len) = square_glb();
         let path = d.join("cut.glb");
-        for cut in [10, 16, 12 + 8 + json.len() / 2, 12 + 8 + json.len() + 4, glb.len() - 7] {
+        for cut in [10, 16, 12 + 8 + json_len / 2, 12 + 8 + json_len + 4, glb.len() - 7] {
             std::fs::write(&path, &glb[..cut]).unwrap();
             let e = format!("{:#}", load(&path).unwrap_err());
             assert!(e.contains("truncated") && e.contains("cut.glb"), "cut at {cut}: {e}");
