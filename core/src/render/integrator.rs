@@ -46,12 +46,14 @@ use crate::trace::hit::{ClosestHit, Hit, Query};
 
 /// Hard cap on path length.
 pub const MAX_BOUNCES: u32 = 512;
-/// Field of view of smallpt: the image plane half-height at unit distance.
+/// Field of view of smallpt: the full height of the image plane at unit
+/// distance (its rays span `-fov/2..fov/2` up and down: 28.8 degrees).
 pub const SMALLPT_FOV: f32 = 0.5135;
 
 impl Camera {
-    /// A camera at `origin` looking along `dir`, `fov` being the half-height of
-    /// the image plane at unit distance (smallpt: 0.5135). "Up" is +y.
+    /// A camera at `origin` looking along `dir`, `fov` being the full height
+    /// of the image plane at unit distance, `2 tan(vertical angle / 2)`
+    /// (smallpt: 0.5135). "Up" is +y.
     pub fn look(origin: Vec3, dir: Vec3, near: f32, fov: f32, width: u32, height: u32) -> Camera {
         let dir = dir.normalize();
         let side = if dir.cross(Vec3::Y).length_squared() > 1e-12 { dir.cross(Vec3::Y) } else { Vec3::X };

@@ -160,7 +160,8 @@ struct MaterialSpec {
 /// a bubble of air in water is 0.75).
 const MIN_IOR: f32 = 0.01;
 const MAX_IOR: f32 = 100.0;
-/// The widest camera: half-height `tan(89.95 degrees)` at unit distance.
+/// The widest camera: an image plane `2 tan(89.9 degrees)` high at unit
+/// distance (`fov` is the full height: see `Camera::look`).
 const MAX_FOV: f32 = 1146.0;
 
 fn default_ior() -> f32 {
@@ -349,7 +350,7 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     }
     // Cameras that would render black, or from behind their origin.
     if c.fov > MAX_FOV {
-        bail!("scene file {name}: camera fov {} (the half-height of the image at unit distance) is past {MAX_FOV}, a view of 179.9 degrees", c.fov);
+        bail!("scene file {name}: camera fov {} (the height of the image plane at unit distance) is past {MAX_FOV}, a view of 179.8 degrees", c.fov);
     }
     if c.near < 0.0 {
         bail!("scene file {name}: camera near {}: rays would start behind the camera (use 0 or more)", c.near);

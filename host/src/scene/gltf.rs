@@ -340,7 +340,10 @@ fn visit(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: 
                     origin: origin.into(),
                     direction: direction.into(),
                     near: 0.0,
-                    fov: (yfov / 2.0).tan(),
+                    // `fov` is the image plane's full height at unit
+                    // distance (`Camera::look`); glTF's `yfov` the whole
+                    // vertical angle.
+                    fov: 2.0 * (yfov / 2.0).tan(),
                 });
             }
             gltf::camera::Projection::Orthographic(_) => {
@@ -451,8 +454,10 @@ fn material(m: &gltf::Material, at: &str, out: &mut Loaded) -> Result<Material> 
 /// looking down -z at its centre, the box filling about the image.
 fn framing((lo, hi): (Vec3, Vec3)) -> CameraSpec {
     let (center, half) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
+    // An image plane 0.5 high at unit distance: the box's front face, at
+    // 4.4 times its half-size, fills it with a margin of a tenth.
     let fov = 0.5;
-    let distance = half.x.max(half.y) / fov + half.z;
+    let distance = 1.1 * half.x.max(half.y) / (fov / 2.0) + half.z;
     CameraSpec { origin: (center + Vec3::Z * distance.max(1e-3)).into(), direction: [0.0, 0.0, -1.0], near: 0.0, fov }
 }
 
@@ -561,7 +566,50 @@ mod tests {
         assert_eq!(s.materials[4].kind, MIRROR);
         assert_eq!(s.camera.origin, [0.0, 0.0, 9.0]);
         assert_eq!(s.camera.direction, [0.0, 0.0, -1.0]);
-        assert!((s.camera.fov - 0.5f32.tan()).abs() < 1e-6);
+        assert!((s.camera.fov - 2.0 * 0.5f32.tan()).abs() < 1e-6);
+    }
+
+    /// Where a glTF camera puts things in the picture: the camera at
+    /// (0, 0, 9) looking down -z with `yfov` 1 radian sees the point half a
+    /// radian above its axis on the image's top edge (it saw it a quarter
+    /// of the way down when the loader passed the plane's half-height).
+    #[test]
+    fn a_gltf_camera_sees_its_whole_vertical_field_of_view() {
+        let d = dir();
+        let path = d.join("camera.gltf");
+        std::fs::write(&path, document(&data_uri(), 4, 6)).unwrap();
+        let s = load(&path).unwrap();
+        let (w, h) = (64, 100);
+        let camera = s.camera.camera(w, h);
+        let up_angle = |y: u32| {
+            let (_, dir) = camera.primary_ray(w / 2, y, 0, w, h, (0.5, 0.5));
+            dir.y.atan2(-dir.z)
+        };
+        // Pixel centres: the top row's half a pixel below the edge.
+        let pixel = 1.0 / h as f32;
+        assert!((up_angle(h - 1) - 0.5).abs() < pixel, "top row at {} radians", up_angle(h - 1));
+        assert!((up_angle(0) + 0.5).abs() < pixel, "bottom row at {} radians", up_angle(0));
+        assert!(up_angle(h / 2).abs() < pixel);
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    /// A file without a camera is framed whole: the rays of the image's
+    /// edges pass outside the box's front face, those near its centre
+    /// inside.
+    #[test]
+    fn the_default_framing_shows_the_whole_box() {
+        let (lo, hi) = (Vec3::new(-1.0, -2.0, -0.5), Vec3::new(3.0, 2.0, 0.5));
+        let camera = framing((lo, hi)).camera(100, 100);
+        let front_at = |x: u32, y: u32| {
+            let (o, dir) = camera.primary_ray(x, y, 0, 100, 100, (0.5, 0.5));
+            o + dir * ((hi.z - o[2]) / dir.z)
+        };
+        for (x, y) in [(0, 50), (99, 50), (50, 0), (50, 99)] {
+            let p = front_at(x, y);
+            assert!(p.x <= lo.x || p.x >= hi.x || p.y <= lo.y || p.y >= hi.y, "pixel ({x}, {y}) lands inside the box at {p}");
+        }
+        let p = front_at(50, 50);
+        assert!(p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y);
     }
 
     #[test]
