@@ -7,7 +7,9 @@
 //!
 //!     cargo run --release -p treelet --example trace_counts -- SCENE [WIDTH HEIGHT] [EX,EY,EZ,TX,TY,TZ]
 //!
-//! Trees: TRBVH (the CPU runner's), split as by default or as `TREELET_SPLITS` says.
+//! Trees: TRBVH, split as by default or as `TREELET_SPLITS` says, built by
+//! the CPU runner, or on the GPU with `TREELET_COUNTS_DEVICE=gpu` (the
+//! counts are still made on the CPU, over the GPU's tree).
 use std::cell::Cell;
 
 use anyhow::{Context, Result};
@@ -16,6 +18,7 @@ use treelet::bvh::tree::split_budget;
 use treelet::bvh::tree::{binary_tree_split, Accel};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
+use treelet::runtime::gpu::{GpuBackend, GpuContext};
 use treelet::scene::Scene;
 use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, WideNode};
 use treelet_core::geometry::features::ALL;
@@ -42,6 +45,16 @@ impl<T: Copy> RecordLoad<T> for Counted<'_, T> {
 }
 
 fn main() -> Result<()> {
+    if std::env::var("TREELET_COUNTS_DEVICE").is_ok_and(|d| d == "gpu") {
+        let ctx = GpuContext::new()?;
+        println!("trees built on {}", ctx.info.name);
+        count(&mut GpuBackend::new(ctx))
+    } else {
+        count(&mut CpuBackend::new())
+    }
+}
+
+fn count<B: Backend>(b: &mut B) -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let spec = args.first().context("usage: trace_counts SCENE [WIDTH HEIGHT] [EX,EY,EZ,TX,TY,TZ]")?;
     let (w, h) = match (args.get(1), args.get(2)) {
@@ -56,7 +69,6 @@ fn main() -> Result<()> {
     let prims_host = scene.primitives();
     let prims = Prims::new(&scene.spheres, &scene.triangles);
     let camera = scene.camera.camera(w, h);
-    let b = &mut CpuBackend::new();
     let builder = Accel::Trbvh.builder()?.context("trbvh")?;
     let built = binary_tree_split(b, prims_host, builder, split_budget(builder))?;
     let slots = built.bvh.n as usize;
