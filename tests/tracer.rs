@@ -381,3 +381,150 @@ fn tracer_on_an_engines_own_device() {
         }
     }
 }
+
+/// A random indexed mesh as an engine keeps it: `v` vertices of 7 words
+/// (a position, then four words of the engine's own, which must not be
+/// read as coordinates) after 4 words, and `n` triangles of random indices
+/// (some repeat a vertex: degenerate triangles, which nothing hits);
+/// returns the vertex words, the indices, and the triangles they make.
+fn engine_mesh(rng: &mut impl Rng, v: usize, n: usize) -> (Vec<u32>, Vec<u32>, Vec<Triangle>) {
+    let points: Vec<[f32; 3]> = (0..v).map(|_| [rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32), rng.random_range(0.0..100.0f32)]).collect();
+    let mut words = vec![0x7FC0_0000u32; 4]; // NaN before the first vertex
+    for p in &points {
+        words.extend(p.map(f32::to_bits));
+        words.extend([0x7F80_0000, 0xFFFF_FFFF, 0x7FC0_0000, 1]); // inf, NaN, NaN, 1e-45
+    }
+    // Indices near each other, so triangles are small, as a mesh's are.
+    let indices: Vec<u32> = (0..n)
+        .flat_map(|_| {
+            let a = rng.random_range(0..v as u32);
+            let mut near = || (a + rng.random_range(0..8)).min(v as u32 - 1);
+            [a, near(), near()]
+        })
+        .collect();
+    let tris = indices.chunks(3).map(|t| Triangle::new(points[t[0] as usize], points[t[1] as usize], points[t[2] as usize])).collect();
+    (words, indices, tris)
+}
+
+/// u16 indices packed two a word, after `pad` halves.
+fn halves(indices: &[u32], pad: usize) -> Vec<u32> {
+    let mut h: Vec<u32> = vec![0xABCD; pad];
+    h.extend(indices);
+    h.resize(h.len().div_ceil(2) * 2, 0);
+    h.chunks(2).map(|p| p[0] | p[1] << 16).collect()
+}
+
+/// An engine's mesh in its own buffers (`Tracer::build_from_buffers`):
+/// strided vertices with words of the engine's own between them; `u32`
+/// indices, `u16` indices at an odd half, no index buffer, and indices in
+/// the vertex buffer itself; on the CPU runner and the GPU, with random
+/// rays, each against the scan of the triangles the host assembles from
+/// the same words; then moved and refit from the buffers. Bad buffers are
+/// refused by name.
+#[test]
+fn tracer_from_an_engines_buffers() {
+    use treelet::tracer::{IndexBuffer, IndexFormat, MeshBuffers};
+    let seed = fresh_seed();
+    let mut backends: Vec<Box<dyn FnMut(u64)>> = vec![Box::new(|seed| engine_buffers(&mut CpuBackend::new(), seed))];
+    if let Some(ctx) = gpu() {
+        backends.push(Box::new(move |seed| engine_buffers(&mut GpuBackend::new(ctx.clone()), seed)));
+    }
+    for run in &mut backends {
+        run(seed);
+    }
+
+    fn engine_buffers<B: Backend>(b: &mut B, seed: u64) {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let (v, n) = (3000, 2000);
+        let (words, indices, tris) = engine_mesh(&mut rng, v, n);
+        let rs = rays(&mut rng, 2000);
+        let adapter = b.adapter();
+        let what = |case: &str| format!("{adapter} seed {seed}: {case}");
+        let vertices = b.upload("engine vertices", &words).unwrap();
+        let u32s = b.upload("engine u32 indices", &indices).unwrap();
+        let u16s = b.upload("engine u16 indices", &halves(&indices, 3)).unwrap();
+        // An engine's buffers stay its own: out of the backend's pool.
+        b.keep(&[&vertices, &u32s, &u16s]);
+        let mesh = |indices, vertices, vertex_count| engine_buffers_of::<B>(indices, vertices, vertex_count, n);
+        let g: Geometry = (vec![], tris.clone());
+        for (case, index) in [
+            ("u32 indices", Some(IndexBuffer { buffer: &u32s, offset: 0, format: IndexFormat::U32 })),
+            ("u16 indices", Some(IndexBuffer { buffer: &u16s, offset: 6, format: IndexFormat::U16 })),
+        ] {
+            let tracer = Tracer::build_from_buffers(b, &mesh(index, &vertices, v), Quality::High).unwrap();
+            check(&what(case), &tracer.closest_hits(b, &rs).unwrap(), &g, &rs);
+        }
+        // Indices after the vertices, in the vertex buffer itself.
+        let mut both = words.clone();
+        let index_offset = both.len() as u64 * 4;
+        both.extend(&indices);
+        let both = b.upload("engine vertices and indices", &both).unwrap();
+        b.keep(&[&both]);
+        let one = mesh(Some(IndexBuffer { buffer: &both, offset: index_offset, format: IndexFormat::U32 }), &both, v);
+        let tracer = Tracer::build_from_buffers(b, &one, Quality::Fast).unwrap();
+        check(&what("indices in the vertex buffer"), &tracer.closest_hits(b, &rs).unwrap(), &g, &rs);
+
+        // No index buffer: three vertices a triangle; then moved, refit from the buffer.
+        let mut unindexed = words[..4].to_vec();
+        for k in &indices {
+            unindexed.extend_from_slice(&words[4 + 7 * *k as usize..11 + 7 * *k as usize]);
+        }
+        let buffer = b.upload("engine triangle soup", &unindexed).unwrap();
+        b.keep(&[&buffer]);
+        let mut tracer = Tracer::build_from_buffers(b, &mesh(None, &buffer, 3 * n), Quality::Balanced).unwrap();
+        check(&what("no index buffer"), &tracer.closest_hits(b, &rs).unwrap(), &g, &rs);
+        let shift = [rng.random_range(-5.0..5.0f32), rng.random_range(-5.0..5.0f32), rng.random_range(-5.0..5.0f32)];
+        let mut moved_words = unindexed.clone();
+        for k in 0..3 * n {
+            for c in 0..3 {
+                let w = &mut moved_words[4 + 7 * k + c];
+                *w = (f32::from_bits(*w) + shift[c]).to_bits();
+            }
+        }
+        let moved_tris: Vec<Triangle> = moved_words[4..]
+            .chunks(21)
+            .map(|t| {
+                let p = |k: usize| [f32::from_bits(t[7 * k]), f32::from_bits(t[7 * k + 1]), f32::from_bits(t[7 * k + 2])];
+                Triangle::new(p(0), p(1), p(2))
+            })
+            .collect();
+        let moved_buffer = b.upload("engine triangle soup, moved", &moved_words).unwrap();
+        b.keep(&[&moved_buffer]);
+        tracer.refit_from_buffers(b, &mesh(None, &moved_buffer, 3 * n)).unwrap();
+        check(&what("no index buffer, refit"), &tracer.closest_hits(b, &rs).unwrap(), &(vec![], moved_tris), &rs);
+
+        // Refused, by name.
+        let mut bad_index = indices.clone();
+        bad_index[3 * 17 + 1] = v as u32 + 5;
+        let bad_index = b.upload("bad indices", &bad_index).unwrap();
+        let mut nan = words.clone();
+        nan[4 + 7 * indices[3 * 29 + 2] as usize + 1] = f32::NAN.to_bits();
+        let nan = b.upload("NaN vertex", &nan).unwrap();
+        let short = b.upload("short index buffer", &indices[..3 * n - 2]).unwrap();
+        b.keep(&[&bad_index, &nan, &short]);
+        let u32_index = |buffer| Some(IndexBuffer { buffer, offset: 0, format: IndexFormat::U32 });
+        let cases = [
+            (mesh(u32_index(&bad_index), &vertices, v), "triangle 17 names a vertex past the 3000 vertices".to_string()),
+            (mesh(u32_index(&u32s), &nan, v), format!("triangle {} has a coordinate that is not finite", first_user(&indices, indices[3 * 29 + 2]))),
+            (MeshBuffers { vertex_stride: 10, ..mesh(u32_index(&u32s), &vertices, v) }, "vertex stride 10".to_string()),
+            (mesh(u32_index(&u32s), &vertices, v + 10), "past the vertex buffer's".to_string()),
+            (mesh(u32_index(&short), &vertices, v), "past the index buffer's".to_string()),
+            (mesh(None, &vertices, v), "need 6000 vertices, not 3000".to_string()),
+        ];
+        for (m, expected) in cases {
+            let e = format!("{:#}", Tracer::build_from_buffers(b, &m, Quality::Fast).err().expect(&expected));
+            assert!(e.contains(&expected), "{}: expected {expected:?}, got {e}", b.adapter());
+        }
+    }
+
+    /// The mesh of `n` triangles with the test's vertex layout (7 words a
+    /// vertex after 4).
+    fn engine_buffers_of<'a, B: Backend>(indices: Option<IndexBuffer<'a, B>>, vertices: &'a B::Buffer, vertex_count: usize, n: usize) -> MeshBuffers<'a, B> {
+        MeshBuffers { vertices, vertex_offset: 16, vertex_stride: 28, vertex_count: vertex_count as u32, indices, triangle_count: n as u32 }
+    }
+
+    /// The first triangle that uses vertex `k`.
+    fn first_user(indices: &[u32], k: u32) -> usize {
+        indices.iter().position(|&i| i == k).unwrap() / 3
+    }
+}

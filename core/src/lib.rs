@@ -66,7 +66,7 @@ pub mod trace;
 
 pub use geometry::aabb::Aabb;
 pub use geometry::buffers::{
-    BuildParams, Bvh2Node, Bvh4Node, Camera, CopyParams, FillParams, InstanceRecord, LayoutParams, LeafPrim, Material, Node, RenderParams, ScanParams, SplitParams,
+    BuildParams, Bvh2Node, Bvh4Node, Camera, CopyParams, FillParams, GatherParams, InstanceRecord, LayoutParams, LeafPrim, Material, Node, RenderParams, ScanParams, SplitParams,
     SortParams, Sphere, WideNode, INVALID, LEAF_BIT,
 };
 pub use geometry::triangle::Triangle;

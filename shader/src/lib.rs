@@ -44,6 +44,8 @@ pub mod fill;
 #[cfg(feature = "kernels")]
 pub mod fit;
 #[cfg(feature = "kernels")]
+pub mod gather;
+#[cfg(feature = "kernels")]
 pub mod morton;
 #[cfg(feature = "kernels")]
 pub mod presplit;

@@ -175,6 +175,25 @@ pub struct CopyParams {
 }
 const _: () = assert!(core::mem::size_of::<CopyParams>() == 16);
 
+/// Parameters of [`crate::geometry::gather::gather_triangles_kernel`]:
+/// where an engine's mesh lies in its buffers (offsets and stride in
+/// bytes, multiples of 4; `index_offset` of 2 for `u16` indices).
+#[repr(C)]
+#[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+#[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
+pub struct GatherParams {
+    pub triangles: u32,
+    /// Vertices in the vertex buffer: indices must lie below.
+    pub vertices: u32,
+    pub vertex_offset: u32,
+    pub vertex_stride: u32,
+    pub index_offset: u32,
+    /// 2 (`u16`), 4 (`u32`) or 0 (no index buffer: vertices `3k..3k + 3`).
+    pub index_bytes: u32,
+    pub _pad: [u32; 2],
+}
+const _: () = assert!(core::mem::size_of::<GatherParams>() == 32);
+
 /// Surface kinds of smallpt.
 pub const DIFFUSE: u32 = 0;
 pub const MIRROR: u32 = 1;

@@ -196,11 +196,27 @@ pub fn build_primitives_split<B: Backend>(
         };
         return Ok((bvh, b.take_times()?));
     }
-    let mut params = BuildParams { spheres: prims.spheres.len() as u32, ..Default::default() };
     let spheres = upload_or_placeholder(b, "spheres", prims.spheres)?;
     let triangles = upload_or_placeholder(b, "triangles", prims.triangles)?;
-    if budget > 0.0 && !prims.triangles.is_empty() && n > 1 {
-        let (mut bvh, times) = build_split(b, prims, hierarchy, budget, &spheres, &triangles)?;
+    build_uploaded_split(b, (spheres, triangles), (prims.spheres.len() as u32, prims.triangles.len() as u32), hierarchy, budget)
+}
+
+/// [`build_primitives_split`] over primitives already on the device
+/// (`spheres`, `triangles`: buffers, counts; an engine's mesh gathered from
+/// its own buffers), after `b.begin_build()` and with at least one
+/// primitive. The tree keeps the buffers as its `prims`.
+pub fn build_uploaded_split<B: Backend>(
+    b: &mut B,
+    (spheres, triangles): (B::Buffer, B::Buffer),
+    (sphere_count, triangle_count): (u32, u32),
+    hierarchy: Hierarchy,
+    budget: f32,
+) -> Result<(DeviceBvh<B>, StageTimes)> {
+    let n = sphere_count + triangle_count;
+    anyhow::ensure!(n >= 1 && n <= MAX_PRIMITIVES, "{n} primitives: the build takes 1 to {MAX_PRIMITIVES}");
+    let mut params = BuildParams { spheres: sphere_count, ..Default::default() };
+    if budget > 0.0 && triangle_count > 0 && n > 1 {
+        let (mut bvh, times) = build_split(b, (sphere_count, triangle_count), hierarchy, budget, &spheres, &triangles)?;
         bvh.prims = Some((spheres, triangles));
         return Ok((bvh, times));
     }
@@ -236,7 +252,7 @@ pub const SPLIT_KERNELS: [Kernel; 7] =
 /// of references (leaf slots), a primitive's index may appear in several.
 fn build_split<B: Backend>(
     b: &mut B,
-    prims: Primitives,
+    (sphere_count, triangle_count): (u32, u32),
     hierarchy: Hierarchy,
     budget: f32,
     spheres: &B::Buffer,
@@ -244,10 +260,10 @@ fn build_split<B: Backend>(
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
     use treelet_core::construct::presplit::PRIORITY_TILE;
     use treelet_core::geometry::buffers::{CopyParams, SplitParams};
-    let n = prims.len() as u32;
+    let n = sphere_count + triangle_count;
     b.stage("split");
     // The primitives' centroid bounds: the Morton grid the pieces follow.
-    let params = BuildParams { n, spheres: prims.spheres.len() as u32, ..Default::default() };
+    let params = BuildParams { n, spheres: sphere_count, ..Default::default() };
     let p = b.upload("build params", &[params])?;
     let prim_boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let bounds = b.upload("centroid bounds", &BOUNDS_START)?;
@@ -269,7 +285,7 @@ fn build_split<B: Backend>(
     let partials = b.scratch("split priority sums", tiles as u64 * 4)?;
     b.dispatch(Kernel::SplitPriority, &[&sp, triangles, &priorities, &partials], tiles);
     let sum: f64 = b.read::<f32>(&partials, tiles as usize)?.iter().map(|&s| s as f64).sum();
-    let extra = (budget as f64 * prims.triangles.len() as f64).min((MAX_PRIMITIVES - n) as f64);
+    let extra = (budget as f64 * triangle_count as f64).min((MAX_PRIMITIVES - n) as f64);
     split.scale = if sum > 0.0 && sum.is_finite() { (extra / sum) as f32 } else { 0.0 };
     // Pieces per primitive, scanned into offsets; the total after the last.
     let sp = b.upload("split params", &[split])?;

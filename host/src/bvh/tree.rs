@@ -247,33 +247,10 @@ pub fn split_budget(builder: Builder) -> f32 {
 pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builder, budget: f32) -> Result<BuiltTree<B>> {
     let config = TreeletConfig::default();
     Ok(match builder {
-        Builder::Lbvh | Builder::Trbvh => {
-            let hierarchy = lbvh::Hierarchy::for_device(b, all.len());
-            let (mut bvh, times) = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
-            let mut build_ms = times.total();
-            if builder == Builder::Trbvh {
-                let root = trbvh::root_box(b, &bvh)?;
-                let (restructured, times) = trbvh::restructure(b, bvh, &root, &settled(&config, builder, b.class()))?;
-                bvh = restructured;
-                build_ms += times.total();
-            }
-            // The LBVH is traced as built (one primitive per leaf).
-            let max_leaf = if builder == Builder::Trbvh { config.max_leaf } else { 1 };
-            BuiltTree { bvh, max_leaf, build_ms }
-        }
-        Builder::Hploc => {
-            let (mut bvh, times) = lbvh::build_primitives_split(b, all, lbvh::Hierarchy::Hploc, budget)?;
-            let mut build_ms = times.total();
-            let config = settled(&config, builder, b.class());
-            if config.reinsert_iterations() > 0 {
-                // Reinsertion over H-PLOC's tree, without treelet rounds.
-                let root = trbvh::root_box(b, &bvh)?;
-                let (reinserted, times) = trbvh::restructure(b, bvh, &root, &TreeletConfig { rounds: 0, ..config })?;
-                bvh = reinserted;
-                build_ms += times.total();
-            }
-            // Leaves collapsed by SAH when laid out, as the TRBVH's.
-            BuiltTree { bvh, max_leaf: config.max_leaf, build_ms }
+        Builder::Lbvh | Builder::Trbvh | Builder::Hploc => {
+            let hierarchy = hierarchy_of(b, builder, all.len());
+            let lbvh = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
+            optimize_built(b, builder, lbvh)?
         }
         Builder::Sweep => {
             let build = std::time::Instant::now();
@@ -287,6 +264,57 @@ pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builde
             b.begin_build();
             BuiltTree { bvh: lbvh::DeviceBvh::upload(b, &tree)?, max_leaf: config.max_leaf, build_ms }
         }
+    })
+}
+
+/// [`binary_tree_split`] over primitives already on the device (an
+/// engine's mesh gathered from its own buffers), after `b.begin_build()`:
+/// the device's builders only (the sweep and the reference take the host's
+/// primitives).
+pub fn binary_tree_uploaded<B: Backend>(b: &mut B, prims: &PrimBuffers<B>, builder: Builder, budget: f32) -> Result<BuiltTree<B>> {
+    match builder {
+        Builder::Lbvh | Builder::Trbvh | Builder::Hploc => {
+            let counts = (prims.sphere_count, prims.triangle_count);
+            let hierarchy = hierarchy_of(b, builder, (counts.0 + counts.1) as usize);
+            let lbvh = lbvh::build_uploaded_split(b, (prims.spheres.clone(), prims.triangles.clone()), counts, hierarchy, budget)?;
+            optimize_built(b, builder, lbvh)
+        }
+        Builder::Sweep | Builder::Reference => bail!("the {} builder runs on the CPU over the host's primitives", builder.name()),
+    }
+}
+
+/// The hierarchy step of a device builder's LBVH.
+fn hierarchy_of<B: Backend>(b: &B, builder: Builder, n: usize) -> lbvh::Hierarchy {
+    if builder == Builder::Hploc { lbvh::Hierarchy::Hploc } else { lbvh::Hierarchy::for_device(b, n) }
+}
+
+/// A device builder's tree from its LBVH (or H-PLOC tree): the LBVH traced
+/// as built; the TRBVH's treelet rounds (and reinsertion on GPUs); H-PLOC's
+/// tree with reinsertion where configured.
+fn optimize_built<B: Backend>(b: &mut B, builder: Builder, (mut bvh, times): (lbvh::DeviceBvh<B>, StageTimes)) -> Result<BuiltTree<B>> {
+    let config = TreeletConfig::default();
+    let mut build_ms = times.total();
+    Ok(match builder {
+        Builder::Trbvh => {
+            let root = trbvh::root_box(b, &bvh)?;
+            let (restructured, times) = trbvh::restructure(b, bvh, &root, &settled(&config, builder, b.class()))?;
+            build_ms += times.total();
+            BuiltTree { bvh: restructured, max_leaf: config.max_leaf, build_ms }
+        }
+        Builder::Hploc => {
+            let config = settled(&config, builder, b.class());
+            if config.reinsert_iterations() > 0 {
+                // Reinsertion over H-PLOC's tree, without treelet rounds.
+                let root = trbvh::root_box(b, &bvh)?;
+                let (reinserted, times) = trbvh::restructure(b, bvh, &root, &TreeletConfig { rounds: 0, ..config })?;
+                bvh = reinserted;
+                build_ms += times.total();
+            }
+            // Leaves collapsed by SAH when laid out, as the TRBVH's.
+            BuiltTree { bvh, max_leaf: config.max_leaf, build_ms }
+        }
+        // The LBVH is traced as built (one primitive per leaf).
+        _ => BuiltTree { bvh, max_leaf: 1, build_ms },
     })
 }
 

@@ -95,11 +95,21 @@ pub trait Backend: Send {
     /// bindings' worth: kernels bind large buffers in two parts, see
     /// `treelet_core::geometry::split`).
     fn max_buffer_bytes(&self) -> u64;
+    /// Largest buffer one storage binding holds, in bytes.
+    fn max_binding_bytes(&self) -> u64 {
+        self.max_buffer_bytes()
+    }
     /// The device's own memory, in bytes, where it has one apart from the
     /// host's and says how large (Vulkan's largest device-local heap).
     fn device_memory_bytes(&self) -> Option<u64> {
         None
     }
+    /// The size of `buffer` in bytes (an engine's buffer, to check what it
+    /// says it holds against).
+    fn buffer_bytes(&self, buffer: &Self::Buffer) -> u64;
+    /// Whether `a` and `b` are the same buffer (kernels bind a buffer once:
+    /// the CPU runner borrows each binding mutably).
+    fn same_buffer(&self, a: &Self::Buffer, b: &Self::Buffer) -> bool;
     /// A buffer holding `data`.
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
     /// A buffer of at least `bytes` bytes whose contents are undefined

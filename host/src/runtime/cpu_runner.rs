@@ -347,6 +347,12 @@ impl Backend for CpuBackend {
     fn adapter(&self) -> String {
         "cpu".into()
     }
+    fn buffer_bytes(&self, buffer: &CpuBuffer) -> u64 {
+        buffer.borrow().len() as u64 * 8
+    }
+    fn same_buffer(&self, a: &CpuBuffer, b: &CpuBuffer) -> bool {
+        Rc::ptr_eq(a, b)
+    }
     fn device_kind(&self) -> &'static str {
         "cpu"
     }
@@ -416,6 +422,13 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (src, dst) = (view::<u32>(src), view::<u32>(dst));
             for id in ids(groups) {
                 fill::copy_words_kernel(id, &p, src, dst);
+            }
+        }
+        (Kernel::GatherTriangles, [p, vertices, indices, out, flags]) => {
+            let p: treelet_core::GatherParams = params(p);
+            let (vertices, indices, out, flags) = (view::<u32>(vertices), view::<u32>(indices), view(out), view::<u32>(flags));
+            for id in ids(groups) {
+                treelet_core::geometry::gather::gather_triangles_kernel(id, &p, vertices, indices, out, flags);
             }
         }
         (Kernel::CastInstances, [p, instances, nodes, leaves, spheres, triangles, rays]) => {

@@ -229,6 +229,9 @@ pub enum Kernel {
     CastWideWorkgroupStack,
     /// Words copied from one buffer into another.
     CopyWords,
+    /// An engine's mesh gathered from its vertex and index buffers into
+    /// triangles (`treelet_core::geometry::gather`).
+    GatherTriangles,
     /// An engine's rays through an instanced scene (a top-level tree over
     /// instances of meshes, `bvh2` layout at both levels).
     CastInstances,
@@ -241,9 +244,10 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 75] = [
+    const FIXED: [Kernel; 76] = [
         Kernel::Fill,
         Kernel::CopyWords,
+        Kernel::GatherTriangles,
         Kernel::CastInstances,
         Kernel::InstanceBounds,
         Kernel::TopLevelNodes,
@@ -347,6 +351,7 @@ impl Kernel {
         match self {
             Kernel::Fill => "fill::fill_cs",
             Kernel::CopyWords => "fill::copy_words_cs",
+            Kernel::GatherTriangles => "gather::gather_triangles_cs",
             Kernel::CastInstances => "render::cast_instances_cs",
             Kernel::InstanceBounds => "bounds::instance_bounds_cs",
             Kernel::TopLevelNodes => "bvh2::top_level_nodes_cs",
@@ -487,6 +492,7 @@ impl Kernel {
         match self {
             Kernel::Fill => &[Read, ReadWrite],
             Kernel::CopyWords => &[Read, Read, ReadWrite],
+            Kernel::GatherTriangles => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
             Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite, Read, ReadWrite],

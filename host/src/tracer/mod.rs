@@ -18,12 +18,16 @@
 //! ```
 //!
 //! Meshes placed many times with transforms (instancing, a top-level tree
-//! over bottom-level trees): [`InstancedTracer`]. Files: `primitives.rs`
-//! ([`Tracer`]), `instances.rs`, `rays.rs` (rays, hits, device batches).
+//! over bottom-level trees): [`InstancedTracer`]. An engine's mesh in its
+//! own vertex and index buffers: [`Tracer::build_from_buffers`]. Files:
+//! `primitives.rs` ([`Tracer`]), `engine_mesh.rs` ([`MeshBuffers`]),
+//! `instances.rs`, `rays.rs` (rays, hits, device batches).
+mod engine_mesh;
 mod instances;
 mod primitives;
 mod rays;
 
+pub use engine_mesh::{IndexBuffer, IndexFormat, MeshBuffers};
 pub use instances::{Instance, InstancedTracer};
 pub use primitives::{Quality, Tracer};
 pub use rays::{batch_slots, device_rays, Ray, RayHit};

@@ -6,11 +6,12 @@ use treelet_core::gpu::workgroup::groups_for;
 use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
+use super::engine_mesh::{gather, MeshBuffers};
 use super::rays::{batch_dims, check_rays, hit_record, read_batch, Ray, RayHit};
 use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::{refit_bvh2, refit_uploaded};
-use crate::bvh::tree::{binary_tree, Builder, BuiltTree};
+use crate::bvh::tree::{binary_tree, binary_tree_uploaded, split_budget, Builder, BuiltTree};
 use crate::runtime::backend::{Backend, DeviceClass};
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
@@ -91,6 +92,55 @@ impl<B: Backend> Tracer<B> {
         Ok(tracer)
     }
 
+    /// Builds the tree over an engine's mesh in its own buffers on `b`'s
+    /// device ([`MeshBuffers`]: a vertex buffer, an optional index buffer),
+    /// gathered into Treelet's triangles on the device: nothing goes
+    /// through the host but the two-word check of what the buffers hold
+    /// (indices past the vertices, coordinates that are not finite: an
+    /// error names the first such triangle). Triangle `t` of the mesh is
+    /// primitive `t` of the hits. Its kernels are submitted and waited for
+    /// on `b`'s queue (the engine's, for a [`GpuContext::from_wgpu`](crate::runtime::gpu::GpuContext::from_wgpu)
+    /// context): work the engine recorded into its own encoders is not
+    /// seen unless submitted before.
+    pub fn build_from_buffers(b: &mut B, mesh: &MeshBuffers<B>, quality: Quality) -> Result<Self> {
+        b.begin_build();
+        let prims = gather(b, mesh)?;
+        let n = prims.triangle_count as usize;
+        let built = if n == 0 {
+            None
+        } else {
+            let builder = match quality.builder(b.class(), n) {
+                // The CPU builders take host primitives: the device's best instead.
+                Builder::Sweep | Builder::Reference => Builder::Trbvh,
+                builder => builder,
+            };
+            Some(binary_tree_uploaded(b, &prims, builder, split_budget(builder))?)
+        };
+        let mut tracer = Tracer { built, prims, tree: None, counts: (0, n), update_ms: 0.0, refit_state: None };
+        let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
+        tracer.update_ms = build_ms + tracer.lay_out(b)?;
+        tracer.keep_buffers(b);
+        Ok(tracer)
+    }
+
+    /// [`Tracer::refit`] from an engine's buffers: the mesh of
+    /// [`Tracer::build_from_buffers`] moved (the same triangle count and
+    /// vertex indices), gathered again on the device and the tree refit
+    /// there.
+    pub fn refit_from_buffers(&mut self, b: &mut B, mesh: &MeshBuffers<B>) -> Result<()> {
+        if (0, mesh.triangle_count as usize) != self.counts {
+            bail!(
+                "refit with {} triangles: the tree was built over {} spheres and {} triangles (build a new one)",
+                mesh.triangle_count,
+                self.counts.0,
+                self.counts.1
+            );
+        }
+        b.begin_build();
+        let prims = gather(b, mesh)?;
+        self.refit_with(b, prims)
+    }
+
     /// Moves the primitives: the same counts, in the same order, at new
     /// places. The tree keeps its shape and gets new boxes bottom-up, written
     /// into its layout in place (its leaves' primitives too: see
@@ -114,7 +164,13 @@ impl<B: Backend> Tracer<B> {
         // every frame does not make the pool grow.
         b.begin_build();
         // Uploaded once, for the refit and for tracing.
-        self.prims = PrimBuffers::upload(b, all)?;
+        let prims = PrimBuffers::upload(b, all)?;
+        self.refit_with(b, prims)
+    }
+
+    /// The refit of the tree over `prims` (on the device, the same counts).
+    fn refit_with(&mut self, b: &mut B, prims: PrimBuffers<B>) -> Result<()> {
+        self.prims = prims;
         self.update_ms = match (&self.tree, &self.built) {
             // The layout's boxes and primitives rewritten in place.
             (Some(tree), _) if tree.collapsed.is_some() => refit_bvh2(b, tree, &self.prims, &mut self.refit_state)?.total(),
@@ -199,14 +255,15 @@ impl<B: Backend> Tracer<B> {
     /// (0 for a sphere), and `rays[2k + 1]` (the unit geometric normal, 0:
     /// the bits of instance 0); for a miss (inf, bits of `u32::MAX`, 0, 0)
     /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`](crate::tracer::batch_slots)`(count)` such pairs; pairs past
-    /// `count` must be zero. Submitted, not waited for.
+    /// `count` must be zero. Recorded, not submitted: on a GPU, submitted at
+    /// the backend's next flush ([`GpuBackend::submit`](crate::runtime::gpu::GpuBackend::submit), a read).
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_RAYS)
     }
 
     /// [`Tracer::occluded`] on rays already on the device, laid out as for
     /// [`Tracer::closest_hits_on_device`]: `rays[2k]` becomes (1 if
-    /// occluded else 0, 0, 0, 0). Submitted, not waited for.
+    /// occluded else 0, 0, 0, 0). Recorded, as [`Tracer::closest_hits_on_device`].
     pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
         self.cast_on_device(b, rays, count, CAST_OCCLUDED)
     }

@@ -113,6 +113,16 @@ impl GpuBackend {
         self.used.iter().map(|(k, _)| k.1).sum::<u64>() + self.free.iter().map(|(k, v)| k.1 * v.len() as u64).sum::<u64>()
     }
 
+    /// Submits the kernels recorded so far to the device's queue and waits
+    /// for them (their stage times are kept for the next `take_times`). An
+    /// engine sharing the device calls it before submitting work of its own
+    /// that reads what they wrote: dispatches such as
+    /// `Tracer::closest_hits_on_device` are recorded, and submitted only at
+    /// such a flush (this, a read, `take_times`).
+    pub fn submit(&mut self) -> Result<()> {
+        self.flush()
+    }
+
     pub fn context(&self) -> &Arc<GpuContext> {
         &self.ctx
     }
@@ -240,6 +250,12 @@ impl Backend for GpuBackend {
     fn adapter(&self) -> String {
         self.ctx.info.name.clone()
     }
+    fn buffer_bytes(&self, buffer: &wgpu::Buffer) -> u64 {
+        buffer.size()
+    }
+    fn same_buffer(&self, a: &wgpu::Buffer, b: &wgpu::Buffer) -> bool {
+        a == b
+    }
     fn device_kind(&self) -> &'static str {
         "gpu"
     }
@@ -265,6 +281,9 @@ impl Backend for GpuBackend {
     }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_buffer_bytes()
+    }
+    fn max_binding_bytes(&self) -> u64 {
+        self.ctx.max_binding_bytes()
     }
     fn device_memory_bytes(&self) -> Option<u64> {
         match (self.ctx.device_memory, self.memory_cap) {

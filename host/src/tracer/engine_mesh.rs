@@ -1,0 +1,154 @@
+//! An engine's mesh where the engine keeps it: positions in its vertex
+//! buffer (any offset and stride), triangles as `u16` or `u32` indices in
+//! its index buffer, or three vertices a triangle without one. Gathered
+//! on the device into the triangles a tree is built over and traced
+//! against (`Kernel::GatherTriangles`, `treelet_core::geometry::gather`),
+//! with no copy through the host; what the engine's buffers say is checked
+//! first (sizes, alignment), and what they hold by the gather (indices
+//! past the vertices, coordinates that are not finite), the first bad
+//! triangle named.
+use anyhow::{bail, ensure, Result};
+use treelet_core::geometry::buffers::{CopyParams, GatherParams, Sphere};
+use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
+
+use crate::bvh::layout::PrimBuffers;
+use crate::runtime::backend::Backend;
+use crate::runtime::kernels::Kernel;
+use crate::scene::primitives::MAX_PRIMITIVES;
+
+/// The integer type of an index buffer's entries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndexFormat {
+    U16,
+    U32,
+}
+
+impl IndexFormat {
+    fn bytes(self) -> u64 {
+        match self {
+            IndexFormat::U16 => 2,
+            IndexFormat::U32 => 4,
+        }
+    }
+}
+
+/// An engine's index buffer: three entries a triangle from `offset` (bytes,
+/// a multiple of the entry's size).
+pub struct IndexBuffer<'a, B: Backend> {
+    pub buffer: &'a B::Buffer,
+    pub offset: u64,
+    pub format: IndexFormat,
+}
+
+/// An engine's mesh in its own buffers (on a GPU, `wgpu::Buffer`s made
+/// with `BufferUsages::STORAGE` on the device the tracer's backend uses):
+/// vertex `k`'s position is three f32 at byte `vertex_offset + k *
+/// vertex_stride` of `vertices` (both multiples of 4; the stride at least
+/// 12), triangle `t` is vertices `indices[3t..3t + 3]`, or `3t..3t + 3`
+/// without an index buffer.
+pub struct MeshBuffers<'a, B: Backend> {
+    pub vertices: &'a B::Buffer,
+    pub vertex_offset: u64,
+    pub vertex_stride: u64,
+    pub vertex_count: u32,
+    pub indices: Option<IndexBuffer<'a, B>>,
+    pub triangle_count: u32,
+}
+
+impl<B: Backend> MeshBuffers<'_, B> {
+    /// Checks what the mesh says against its buffers; the gather's
+    /// parameters (the index offset made relative to `index_base` bytes, where
+    /// the index words are bound from).
+    fn params(&self, b: &B, index_base: u64) -> Result<GatherParams> {
+        let (n, v) = (self.triangle_count as u64, self.vertex_count as u64);
+        ensure!(n <= MAX_PRIMITIVES as u64, "engine mesh: {n} triangles: at most {MAX_PRIMITIVES} are supported");
+        ensure!(
+            self.vertex_stride >= 12 && self.vertex_stride % 4 == 0 && self.vertex_offset % 4 == 0,
+            "engine mesh: vertex stride {} and offset {} (bytes) must be multiples of 4, the stride at least 12 (three f32)",
+            self.vertex_stride,
+            self.vertex_offset
+        );
+        let vertex_bytes = b.buffer_bytes(self.vertices);
+        let vertex_end = if v == 0 { 0 } else { self.vertex_offset + (v - 1) * self.vertex_stride + 12 };
+        ensure!(
+            vertex_end <= vertex_bytes,
+            "engine mesh: {v} vertices of stride {} from byte {} reach byte {vertex_end}, past the vertex buffer's {vertex_bytes} bytes",
+            self.vertex_stride,
+            self.vertex_offset
+        );
+        ensure!(vertex_end <= u32::MAX as u64, "engine mesh: the vertices reach byte {vertex_end}: at most 4 GiB are read");
+        fits_binding(b, "vertex buffer", vertex_bytes)?;
+        fits_binding(b, "triangles gathered", n * 48)?;
+        let (index_offset, index_bytes) = match &self.indices {
+            None => {
+                ensure!(v >= 3 * n, "engine mesh: {n} triangles without an index buffer need {} vertices, not {v}", 3 * n);
+                (0, treelet_core::geometry::gather::NO_INDICES)
+            }
+            Some(i) => {
+                let size = i.format.bytes();
+                ensure!(i.offset % size == 0, "engine mesh: index offset {} is not a multiple of the {size}-byte entries", i.offset);
+                let end = i.offset + 3 * n * size;
+                let bytes = b.buffer_bytes(i.buffer);
+                ensure!(end <= bytes, "engine mesh: {n} triangles of {size}-byte indices from byte {} reach byte {end}, past the index buffer's {bytes} bytes", i.offset);
+                fits_binding(b, "index buffer", bytes)?;
+                ((i.offset - index_base) as u32, size as u32)
+            }
+        };
+        Ok(GatherParams {
+            triangles: self.triangle_count,
+            vertices: self.vertex_count,
+            vertex_offset: self.vertex_offset as u32,
+            vertex_stride: self.vertex_stride as u32,
+            index_offset,
+            index_bytes,
+            _pad: [0; 2],
+        })
+    }
+}
+
+/// The mesh's triangles gathered into a buffer of Treelet's on `b` (taken
+/// from its pool: call after `b.begin_build()`), checked: an error names
+/// the first triangle with an index past the vertices, or with a
+/// coordinate that is not finite (one read back of two words, which waits
+/// for the gather).
+pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>) -> Result<PrimBuffers<B>> {
+    let n = mesh.triangle_count;
+    let spheres = b.upload("no spheres", &[Sphere::default()])?;
+    let triangles = b.scratch("engine triangles", (n as u64).max(1) * 48)?;
+    if n == 0 {
+        return Ok(PrimBuffers { spheres, triangles, sphere_count: 0, triangle_count: 0 });
+    }
+    b.stage("gather");
+    // Bound once each: an index buffer that is the vertex buffer has its
+    // index words copied out first (a kernel binds a buffer once).
+    let (indices, index_base) = match &mesh.indices {
+        None => (b.upload("no indices", &[0u32])?, 0),
+        Some(i) if b.same_buffer(i.buffer, mesh.vertices) => {
+            let first = i.offset / 4;
+            let words = (i.offset + 3 * n as u64 * i.format.bytes()).div_ceil(4) - first;
+            let copy = b.upload("copy params", &[CopyParams { len: words as u32, src_offset: first as u32, dst_offset: 0, _pad0: 0 }])?;
+            let own = b.scratch("engine indices", words * 4)?;
+            b.dispatch(Kernel::CopyWords, &[&copy, i.buffer, &own], groups_for(words as u32, WORKGROUP_SIZE));
+            (own, first * 4)
+        }
+        Some(i) => (i.buffer.clone(), 0),
+    };
+    let p = b.upload("gather params", &[mesh.params(b, index_base)?])?;
+    let flags = b.upload("gather flags", &[u32::MAX; 2])?;
+    b.dispatch(Kernel::GatherTriangles, &[&p, mesh.vertices, &indices, &triangles, &flags], groups_for(n, WORKGROUP_SIZE));
+    let flags = b.read::<u32>(&flags, 2)?;
+    if flags[0] != u32::MAX {
+        bail!("engine mesh: triangle {} names a vertex past the {} vertices", flags[0], mesh.vertex_count);
+    }
+    if flags[1] != u32::MAX {
+        bail!("engine mesh: triangle {} has a coordinate that is not finite (or an extent past f32's range)", flags[1]);
+    }
+    Ok(PrimBuffers { spheres, triangles, sphere_count: 0, triangle_count: n })
+}
+
+/// The gather binds each buffer whole.
+fn fits_binding<B: Backend>(b: &B, what: &str, bytes: u64) -> Result<()> {
+    let max = b.max_binding_bytes();
+    ensure!(bytes <= max, "engine mesh: the {what} ({bytes} bytes) is larger than one binding of `{}` holds ({max} bytes)", b.adapter());
+    Ok(())
+}
