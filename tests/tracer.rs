@@ -419,11 +419,13 @@ fn halves(indices: &[u32], pad: usize) -> Vec<u32> {
 /// indices, `u16` indices at an odd half, no index buffer, and indices in
 /// the vertex buffer itself; on the CPU runner and the GPU, with random
 /// rays, each against the scan of the triangles the host assembles from
-/// the same words; then moved and refit from the buffers. Bad buffers are
-/// refused by name.
+/// the same words; then moved and refit from the buffers; an instanced
+/// scene of such meshes against the same scene built from the host's
+/// triangles, before and after a mesh's refit. Bad buffers are refused by
+/// name.
 #[test]
 fn tracer_from_an_engines_buffers() {
-    use treelet::tracer::{IndexBuffer, IndexFormat, MeshBuffers};
+    use treelet::tracer::{IndexBuffer, IndexFormat, Instance, InstancedTracer, MeshBuffers};
     let seed = fresh_seed();
     let mut backends: Vec<Box<dyn FnMut(u64)>> = vec![Box::new(|seed| engine_buffers(&mut CpuBackend::new(), seed))];
     if let Some(ctx) = gpu() {
@@ -491,7 +493,33 @@ fn tracer_from_an_engines_buffers() {
         let moved_buffer = b.upload("engine triangle soup, moved", &moved_words).unwrap();
         b.keep(&[&moved_buffer]);
         tracer.refit_from_buffers(b, &mesh(None, &moved_buffer, 3 * n)).unwrap();
-        check(&what("no index buffer, refit"), &tracer.closest_hits(b, &rs).unwrap(), &(vec![], moved_tris), &rs);
+        let moved: Geometry = (vec![], moved_tris.clone());
+        check(&what("no index buffer, refit"), &tracer.closest_hits(b, &rs).unwrap(), &moved, &rs);
+
+        // Instanced: the indexed mesh and the moved soup, placed five times,
+        // from the buffers against the same scene built from host triangles
+        // (which tests/instances.rs checks against the flattened scan).
+        let placed: Vec<Instance> = (0..5u32)
+            .map(|k| {
+                let (s, c) = (k as f32 * 0.7).sin_cos();
+                Instance { mesh: k % 2, transform: [[c, 0.0, s, 30.0 * k as f32 - 60.0], [0.0, 1.0, 0.0, 5.0 * k as f32], [-s, 0.0, c, 10.0]] }
+            })
+            .collect();
+        let meshes = [mesh(Some(IndexBuffer { buffer: &u16s, offset: 6, format: IndexFormat::U16 }), &vertices, v), mesh(None, &buffer, 3 * n)];
+        let mut from_buffers = InstancedTracer::build_from_buffers(b, &meshes, &placed, Quality::High).unwrap();
+        let mut from_host = InstancedTracer::build(b, &[&tris, &tris], &placed, Quality::High).unwrap();
+        let same = |case: &str, a: &[RayHit], h: &[RayHit]| {
+            let hits = a.iter().filter(|x| x.is_hit()).count();
+            assert!(hits > a.len() / 20, "{}: only {hits} hits", what(case));
+            for (k, (x, y)) in a.iter().zip(h).enumerate() {
+                assert_eq!((x.prim, x.instance), (y.prim, y.instance), "{}: ray {k}: from buffers {x:?}, from the host {y:?}", what(case));
+                assert!(x.t == y.t || (x.t - y.t).abs() <= 1e-5 * y.t.max(1.0), "{}: ray {k}: {x:?} against {y:?}", what(case));
+            }
+        };
+        same("instanced", &from_buffers.closest_hits(b, &rs).unwrap(), &from_host.closest_hits(b, &rs).unwrap());
+        from_buffers.refit_mesh_from_buffers(b, 1, &mesh(None, &moved_buffer, 3 * n)).unwrap();
+        from_host.refit_mesh(b, 1, &moved_tris).unwrap();
+        same("instanced, mesh 1 refit", &from_buffers.closest_hits(b, &rs).unwrap(), &from_host.closest_hits(b, &rs).unwrap());
 
         // Refused, by name.
         let mut bad_index = indices.clone();

@@ -28,6 +28,7 @@ use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 use treelet_core::trace::hit::STACK_DEPTH;
 
+use super::engine_mesh::MeshBuffers;
 use super::primitives::{Quality, Tracer};
 use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
 use crate::bvh::lbvh;
@@ -149,6 +150,35 @@ impl<B: Backend> InstancedTracer<B> {
             trees.push(tracer);
             bounds.push(mesh_bounds(triangles));
         }
+        Self::from_trees(b, trees, bounds, instances, update_ms)
+    }
+
+    /// [`Self::build`] over meshes in an engine's own buffers (see
+    /// [`Tracer::build_from_buffers`]): mesh `k` is `meshes[k]`, gathered
+    /// and built on the device; each mesh's box is read from its tree's root
+    /// (64 bytes a mesh).
+    pub fn build_from_buffers(b: &mut B, meshes: &[MeshBuffers<B>], instances: &[Instance], quality: Quality) -> Result<Self> {
+        if meshes.len() > u32::MAX as usize {
+            bail!("{} meshes: at most {} are supported", meshes.len(), u32::MAX);
+        }
+        let mut trees = Vec::with_capacity(meshes.len());
+        let mut bounds = Vec::with_capacity(meshes.len());
+        let mut update_ms = 0.0;
+        for (m, mesh) in meshes.iter().enumerate() {
+            if mesh.triangle_count == 0 {
+                bail!("mesh {m} has no triangles: every instanced mesh needs one");
+            }
+            let tracer = Tracer::build_from_buffers(b, mesh, quality).with_context(|| format!("mesh {m}"))?;
+            update_ms += tracer.last_update_ms();
+            bounds.push(tracer.layout_bounds(b)?);
+            trees.push(tracer);
+        }
+        Self::from_trees(b, trees, bounds, instances, update_ms)
+    }
+
+    /// The scene over meshes whose trees are built: their layouts gathered,
+    /// then the top level over `instances`.
+    fn from_trees(b: &mut B, trees: Vec<Tracer<B>>, bounds: Vec<[[f64; 3]; 2]>, instances: &[Instance], update_ms: f64) -> Result<Self> {
         let gathered = gather(b, &trees, &bounds, top_nodes_for(instances.len()))?;
         let no_spheres = b.upload("no spheres", &[treelet_core::Sphere::default()])?;
         let no_instances = b.zeroed("no instances", 64)?;
@@ -226,8 +256,26 @@ impl<B: Backend> InstancedTracer<B> {
         };
         only_triangles(triangles).with_context(|| format!("mesh {mesh}"))?;
         tracer.refit(b, &[], triangles).with_context(|| format!("mesh {mesh}"))?;
-        let refit_ms = tracer.last_update_ms();
-        self.bounds[mesh] = mesh_bounds(triangles);
+        self.after_mesh_refit(b, mesh, mesh_bounds(triangles))
+    }
+
+    /// [`Self::refit_mesh`] from an engine's buffers (see
+    /// [`Tracer::refit_from_buffers`]); the mesh's new box is read from its
+    /// tree's root.
+    pub fn refit_mesh_from_buffers(&mut self, b: &mut B, mesh: usize, buffers: &MeshBuffers<B>) -> Result<()> {
+        let Some(tracer) = self.meshes.get_mut(mesh) else {
+            bail!("refit of mesh {mesh}: there are {} meshes", self.meshes.len());
+        };
+        tracer.refit_from_buffers(b, buffers).with_context(|| format!("mesh {mesh}"))?;
+        let bounds = tracer.layout_bounds(b)?;
+        self.after_mesh_refit(b, mesh, bounds)
+    }
+
+    /// After mesh `mesh`'s tree was refit (its new box `bounds`): its part
+    /// of the gathered buffers, and the top level.
+    fn after_mesh_refit(&mut self, b: &mut B, mesh: usize, bounds: [[f64; 3]; 2]) -> Result<()> {
+        let refit_ms = self.meshes[mesh].last_update_ms();
+        self.bounds[mesh] = bounds;
         let nodes = self.meshes[mesh].tree.as_ref().map_or(0, |t| t.node_count);
         if nodes == self.gathered.node_counts[mesh] {
             copy_mesh(b, &self.meshes[mesh], &self.gathered, mesh)?;

@@ -199,6 +199,24 @@ impl<B: Backend> Tracer<B> {
         b.keep(&kept);
     }
 
+    /// The box of the tree's primitives, read from its layout's root (one
+    /// node, 64 bytes): what an instanced scene needs of a mesh that is in
+    /// an engine's buffers. An empty box for a tracer without primitives.
+    pub(super) fn layout_bounds(&self, b: &mut B) -> Result<[[f64; 3]; 2]> {
+        let mut bounds = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+        let Some(tree) = &self.tree else { return Ok(bounds) };
+        let root: treelet_core::Bvh2Node = b.read(&tree.nodes, 1)?[0];
+        // A one-leaf tree's second child is an empty (inverted) box.
+        let children = [(root.left_min, root.left_max), (root.right_min, root.right_max)];
+        for (lo, hi) in children.into_iter().filter(|(lo, hi)| lo[0] <= hi[0]) {
+            for k in 0..3 {
+                bounds[0][k] = bounds[0][k].min(lo[k] as f64);
+                bounds[1][k] = bounds[1][k].max(hi[k] as f64);
+            }
+        }
+        Ok(bounds)
+    }
+
     /// Device time of the last [`Tracer::build`] or [`Tracer::refit`], in
     /// ms: the tree's build or refit and its layout for tracing (GPU
     /// timestamps where the device has them; wall clock on the CPU runner).
