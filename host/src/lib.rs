@@ -30,6 +30,50 @@
 //! # anyhow::Ok(())
 //! ```
 //!
+//! ### On the engine's own GPU device
+//!
+//! An engine opens its wgpu device with the features and limits Treelet
+//! needs, hands it over ([`GpuContext::from_wgpu`] names anything missing),
+//! and keeps its mesh in its own buffers: the tree is built from them on
+//! the device ([`tracer::MeshBuffers`], [`Tracer::build_from_buffers`]),
+//! rays are traced in a buffer of its own, in place
+//! ([`Tracer::closest_hits_on_device`]), and [`GpuBackend::submit`] puts
+//! Treelet's recorded kernels on the shared queue before the engine's own
+//! work that reads the hits. `examples/engine_frames.rs` is a whole frame
+//! loop.
+//!
+//! ```no_run
+//! use treelet::tracer::{IndexBuffer, IndexFormat, MeshBuffers};
+//! use treelet::{wgpu, GpuBackend, GpuContext, Quality, Tracer};
+//! # fn engine(adapter: &wgpu::Adapter, vertices: &wgpu::Buffer, indices: &wgpu::Buffer, rays: &wgpu::Buffer) -> anyhow::Result<()> {
+//! let descriptor = wgpu::DeviceDescriptor {
+//!     required_features: GpuContext::required_features(),
+//!     required_limits: GpuContext::required_limits(adapter.limits()),
+//!     // SAFETY: Treelet's kernels are SPIR-V passed through, validated by the driver.
+//!     experimental_features: unsafe { wgpu::ExperimentalFeatures::enabled() },
+//!     ..Default::default()
+//! };
+//! let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
+//! // ... the engine makes `vertices`, `indices` and `rays` on `device` (usage STORAGE) ...
+//! let b = &mut GpuBackend::new(GpuContext::from_wgpu(adapter, device.clone(), queue.clone())?);
+//! // 32-byte vertices with the position first; u32 indices.
+//! let mesh = MeshBuffers::<GpuBackend> {
+//!     vertices,
+//!     vertex_offset: 0,
+//!     vertex_stride: 32,
+//!     vertex_count: 10_000,
+//!     indices: Some(IndexBuffer { buffer: indices, offset: 0, format: IndexFormat::U32 }),
+//!     triangle_count: 19_602,
+//! };
+//! let mut tracer = Tracer::build_from_buffers(b, &mesh, Quality::Fast)?;
+//! // Each frame: the mesh moved in its buffers; rays written as `device_rays` lays them out.
+//! tracer.refit_from_buffers(b, &mesh)?;
+//! tracer.closest_hits_on_device(b, rays, 1920 * 1080)?;
+//! b.submit()?;
+//! // ... the engine's passes read the hits from `rays` ...
+//! # Ok(()) }
+//! ```
+//!
 //! ## The folders, bottom to top
 //!
 //! Each folder depends only on the ones above it in this list
@@ -80,5 +124,5 @@ pub use wgpu;
 /// The README's Rust snippets, run as doc tests: what a newcomer copies
 /// first compiles and passes.
 #[cfg(doctest)]
-#[doc = include_str!("../../README.md")]
+#[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;

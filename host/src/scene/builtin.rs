@@ -7,9 +7,9 @@ use super::model::Scene;
 
 /// Name, and the text of `scenes/<name>.json`. None names a mesh file.
 pub const BUILT_IN: [(&str, &str); 3] = [
-    ("room_disk", include_str!("../../../scenes/room_disk.json")),
-    ("cornell_diffuse", include_str!("../../../scenes/cornell_diffuse.json")),
-    ("cornell_mirrors", include_str!("../../../scenes/cornell_mirrors.json")),
+    ("room_disk", include_str!("../../scenes/room_disk.json")),
+    ("cornell_diffuse", include_str!("../../scenes/cornell_diffuse.json")),
+    ("cornell_mirrors", include_str!("../../scenes/cornell_mirrors.json")),
 ];
 
 /// The built-in scene file called `name`, parsed; `None` for other names.
