@@ -206,6 +206,7 @@ pub fn parse_in(text: &str, name: &str, dir: &Path) -> Result<Scene> {
 
 /// [`parse_in`] with the instances kept.
 pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<InstancedScene> {
+    super::json_keys::check(text.as_bytes()).map_err(|e| anyhow::anyhow!("scene file {name}: {e}"))?;
     let file: SceneFile = serde_json::from_str(text)
         .map_err(|e| anyhow::anyhow!("scene file {name}: line {}, column {}: {e}", e.line(), e.column()))?;
     let mut materials = BTreeMap::new();
@@ -405,6 +406,16 @@ mod tests {
             assert!(e.contains("cam.json") && e.contains(expected), "{camera}: {e}");
         }
         assert!(parse(&scene(r#"{"origin": [0,0,0], "direction": [0,0,1e-3], "fov": 2}"#), "ok.json").is_ok());
+    }
+
+    /// A material named twice rendered with the second silently.
+    #[test]
+    fn a_key_named_twice_is_an_error() {
+        let text = "{\"camera\": {\"origin\": [0,0,0], \"direction\": [0,0,1]}, \"materials\": {\"m\": {\"type\": \"diffuse\", \"color\": [1, 1, 1]},\n \"m\": {\"type\": \"mirror\", \"color\": [1, 1, 1]}},\n \"spheres\": [{\"center\": [0,0,5], \"radius\": 1, \"material\": \"m\"}]}";
+        let e = parse(text, "twice.json").unwrap_err().to_string();
+        assert!(e.contains("twice.json") && e.contains("\"m\" appears twice") && e.contains("line 2"), "{e}");
+        let once = text.replace("\n \"m\": {\"type\": \"mirror\"", "\n \"n\": {\"type\": \"mirror\"");
+        parse(&once, "once.json").unwrap();
     }
 
     #[test]

@@ -114,6 +114,7 @@ fn precheck(bytes: &[u8], name: &str) -> Result<()> {
     } else {
         bytes.to_vec()
     };
+    super::json_keys::check(&json).map_err(|e| anyhow!("{name}: {e}"))?;
     let root: gltf::json::Root =
         gltf::json::deserialize::from_slice(&json).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -670,6 +671,12 @@ mod tests {
             ),
             ("twoparents.gltf", document(&data_uri(), 4, 6).replace(r#""nodes": [0, 2]"#, r#""nodes": [0, 2, 1]"#), "node 1 is reached twice"),
             ("deep.gltf", deep_chain(100_000), "levels deep"),
+            // The last of two keys would win silently.
+            (
+                "twokeys.gltf",
+                document(&data_uri(), 4, 6).replace(r#""scenes": [{"nodes": [0, 2]}]"#, r#""scenes": [{"nodes": [0, 2], "nodes": [0]}]"#),
+                "the key \"nodes\" appears twice",
+            ),
             // A rotation that is no rotation; a camera Treelet cannot make.
             ("quaternion.gltf", document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [10, 0, 0, 0]"#), "not a unit quaternion"),
             (

@@ -14,6 +14,7 @@ pub mod city;
 pub mod file;
 pub mod gltf;
 pub mod instanced;
+pub mod json_keys;
 pub mod mesh;
 pub mod model;
 pub mod placed;
