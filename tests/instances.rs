@@ -272,13 +272,13 @@ fn instanced_tracer_rejects_bad_input_by_name() {
     let err = |r: anyhow::Result<InstancedTracer<CpuBackend>>| format!("{:#}", r.err().expect("an error"));
     let at = |k: u32| Instance::translated(k, [0.0, 0.0, 1.0]);
     let e = err(InstancedTracer::build(b, &[&tri], &[at(0), at(3)], Quality::Fast));
-    assert!(e.contains("instance 1 places mesh 3, but there are 1 meshes"), "{e}");
+    assert!(e.contains("instances[1] places mesh 3, but there are 1 meshes"), "{e}");
     let flat = Instance { mesh: 0, transform: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]] };
     let e = err(InstancedTracer::build(b, &[&tri], &[at(0), flat], Quality::Fast));
-    assert!(e.contains("instance 1") && e.contains("singular"), "{e}");
+    assert!(e.contains("instances[1]") && e.contains("singular"), "{e}");
     let nan = Instance { mesh: 0, transform: [[f32::NAN, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
     let e = err(InstancedTracer::build(b, &[&tri], &[nan], Quality::Fast));
-    assert!(e.contains("instance 0") && e.contains("non-finite"), "{e}");
+    assert!(e.contains("instances[0]") && e.contains("non-finite"), "{e}");
     let e = err(InstancedTracer::build(b, &[&tri, &[]], &[at(0)], Quality::Fast));
     assert!(e.contains("mesh 1 has no triangles"), "{e}");
     let bad = [Triangle::new([0.0, f32::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])];

@@ -69,7 +69,7 @@ fn render_bad_input_names_the_problem() {
     )
     .unwrap();
     let e = stderr_of(&["render", "--device", "cpu", "--scene", unknown.to_str().unwrap()]);
-    assert!(e.contains("sphere 0") && e.contains("unknown material `gold`"), "{e}");
+    assert!(e.contains("spheres[0]") && e.contains("unknown material `gold`"), "{e}");
 
     let nan = dir.join("nan.json");
     std::fs::write(

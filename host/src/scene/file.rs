@@ -252,7 +252,7 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     for (i, s) in file.spheres.iter().enumerate() {
         let m = materials
             .get(&s.material)
-            .with_context(|| format!("scene file {name}: sphere {i} uses unknown material `{}`", s.material))?;
+            .with_context(|| format!("scene file {name}: spheres[{i}] uses unknown material `{}`", s.material))?;
         spheres.push(Sphere::new(s.center, s.radius));
         sphere_materials.push(*m);
     }
@@ -263,16 +263,16 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     for (i, mesh) in file.meshes.iter().enumerate() {
         let m = materials
             .get(&mesh.material)
-            .with_context(|| format!("scene file {name}: mesh {i} uses unknown material `{}`", mesh.material))?;
+            .with_context(|| format!("scene file {name}: meshes[{i}] uses unknown material `{}`", mesh.material))?;
         if !mesh.placement.is_finite() {
-            bail!("scene file {name}: mesh {i} has a non-finite transform");
+            bail!("scene file {name}: meshes[{i}] has a non-finite transform");
         }
         let path = dir.join(&mesh.path);
         let label = path.display().to_string();
         let slot = match meshes.iter().position(|s| s.name == label) {
             Some(slot) => slot as u32,
             None => {
-                let loaded = super::mesh::load(&path).with_context(|| format!("scene file {name}: mesh {i}"))?;
+                let loaded = super::mesh::load(&path).with_context(|| format!("scene file {name}: meshes[{i}]"))?;
                 let materials = vec![*m; loaded.len()];
                 meshes.push(SceneMesh { name: label, triangles: loaded, materials });
                 meshes.len() as u32 - 1
@@ -280,22 +280,22 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
         };
         if let Some(key) = &mesh.name {
             if names.insert(key, (slot, *m)).is_some() {
-                bail!("scene file {name}: mesh {i}: a mesh is already named `{key}`");
+                bail!("scene file {name}: meshes[{i}]: a mesh is already named `{key}`");
             }
         }
         instances.push(SceneInstance { mesh: slot, transform: mesh.placement.transform(), material: Some(*m) });
     }
     for (i, instance) in file.instances.iter().enumerate() {
         let &(slot, named) = names.get(instance.mesh.as_str()).with_context(|| {
-            format!("scene file {name}: instance {i} places `{}`, which no mesh is named", instance.mesh)
+            format!("scene file {name}: instances[{i}] places `{}`, which no mesh is named", instance.mesh)
         })?;
         if !instance.placement.is_finite() {
-            bail!("scene file {name}: instance {i} has a non-finite transform");
+            bail!("scene file {name}: instances[{i}] has a non-finite transform");
         }
         let material = match &instance.material {
             Some(key) => *materials
                 .get(key)
-                .with_context(|| format!("scene file {name}: instance {i} uses unknown material `{key}`"))?,
+                .with_context(|| format!("scene file {name}: instances[{i}] uses unknown material `{key}`"))?,
             None => named, // the material of the mesh entry that named it
 
         };
@@ -306,20 +306,20 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     for (i, d) in file.disks.iter().enumerate() {
         let m = materials
             .get(&d.material)
-            .with_context(|| format!("scene file {name}: disk {i} uses unknown material `{}`", d.material))?;
+            .with_context(|| format!("scene file {name}: disks[{i}] uses unknown material `{}`", d.material))?;
         if d.center.iter().chain(&d.normal).any(|v| !v.is_finite()) {
-            bail!("scene file {name}: disk {i} has a non-finite centre or normal");
+            bail!("scene file {name}: disks[{i}] has a non-finite centre or normal");
         }
         let n = glam::Vec3::from_array(d.normal);
         if !(n.length() > 0.0) || !n.normalize().is_finite() {
-            bail!("scene file {name}: disk {i} has normal {:?}, which gives no direction", d.normal);
+            bail!("scene file {name}: disks[{i}] has normal {:?}, which gives no direction", d.normal);
         }
         if !(d.radius > 0.0 && d.radius.is_finite()) {
-            bail!("scene file {name}: disk {i} has radius {} (must be positive and finite)", d.radius);
+            bail!("scene file {name}: disks[{i}] has radius {} (must be positive and finite)", d.radius);
         }
         let disk = treelet_core::geometry::triangle::Triangle::disk(d.center, d.normal, d.radius);
         if !disk.aabb().extent().is_finite() {
-            bail!("scene file {name}: disk {i}: its bounding box overflows f32 (centre {:?}, radius {})", d.center, d.radius);
+            bail!("scene file {name}: disks[{i}]: its bounding box overflows f32 (centre {:?}, radius {})", d.center, d.radius);
         }
         triangles.push(disk);
         triangle_materials.push(*m);
@@ -327,17 +327,17 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     for (i, p) in file.parallelograms.iter().enumerate() {
         let m = materials
             .get(&p.material)
-            .with_context(|| format!("scene file {name}: parallelogram {i} uses unknown material `{}`", p.material))?;
+            .with_context(|| format!("scene file {name}: parallelograms[{i}] uses unknown material `{}`", p.material))?;
         if p.corner.iter().chain(p.edges.iter().flatten()).any(|v| !v.is_finite()) {
-            bail!("scene file {name}: parallelogram {i} has a non-finite corner or edge");
+            bail!("scene file {name}: parallelograms[{i}] has a non-finite corner or edge");
         }
         let [e1, e2] = p.edges.map(glam::Vec3::from_array);
         if !(e1.cross(e2).length() > 0.0) {
-            bail!("scene file {name}: parallelogram {i} has edges {:?} and {:?}, which span no area", p.edges[0], p.edges[1]);
+            bail!("scene file {name}: parallelograms[{i}] has edges {:?} and {:?}, which span no area", p.edges[0], p.edges[1]);
         }
         let shape = treelet_core::geometry::triangle::Triangle::parallelogram(p.corner, p.edges[0], p.edges[1]);
         if !shape.aabb().extent().is_finite() || !shape.area().is_finite() {
-            bail!("scene file {name}: parallelogram {i}: its size overflows f32 (corner {:?}, edges {:?})", p.corner, p.edges);
+            bail!("scene file {name}: parallelograms[{i}]: its size overflows f32 (corner {:?}, edges {:?})", p.corner, p.edges);
         }
         triangles.push(shape);
         triangle_materials.push(*m);
@@ -465,23 +465,23 @@ mod tests {
         let base = r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "disks": ["#;
         let case = |disk: &str| format!("{:#}", parse(&format!("{base}{disk}]}}"), "d.json").unwrap_err());
         let e = case(r#"{"center": [0,0,5], "normal": [0,0,0], "radius": 1, "material": "w"}"#);
-        assert!(e.contains("d.json") && e.contains("disk 0") && e.contains("normal"), "{e}");
+        assert!(e.contains("d.json") && e.contains("disks[0]") && e.contains("normal"), "{e}");
         let e = case(r#"{"center": [0,0,5], "normal": [0,0,1], "radius": -1, "material": "w"}"#);
-        assert!(e.contains("disk 0") && e.contains("radius -1"), "{e}");
+        assert!(e.contains("disks[0]") && e.contains("radius -1"), "{e}");
         let e = case(r#"{"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "w"}, {"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "x"}"#);
-        assert!(e.contains("disk 1 uses unknown material `x`"), "{e}");
+        assert!(e.contains("disks[1] uses unknown material `x`"), "{e}");
         let e = case(r#"{"center": [3e38,0,5], "normal": [1,1,0], "radius": 3e38, "material": "w"}"#);
-        assert!(e.contains("disk 0") && e.contains("overflows"), "{e}");
+        assert!(e.contains("disks[0]") && e.contains("overflows"), "{e}");
         assert!(parse(&format!("{base}{}]}}", r#"{"center": [0,0,5], "normal": [0,0,1], "radius": 1, "material": "w"}"#), "ok.json").is_ok());
 
         let base = base.replace("\"disks\"", "\"parallelograms\"");
         let case = |p: &str| format!("{:#}", parse(&format!("{base}{p}]}}"), "p.json").unwrap_err());
         let e = case(r#"{"corner": [0,0,5], "edges": [[1,0,0], [2,0,0]], "material": "w"}"#);
-        assert!(e.contains("p.json") && e.contains("parallelogram 0") && e.contains("span no area"), "{e}");
+        assert!(e.contains("p.json") && e.contains("parallelograms[0]") && e.contains("span no area"), "{e}");
         let e = case(r#"{"corner": [0,0,5], "edges": [[1,0,0], [0,1,0]], "material": "w"}, {"corner": [0,0,5], "edges": [[1,0,0], [0,"x",0]], "material": "w"}"#);
         assert!(e.contains("p.json: line 1"), "{e}");
         let e = case(r#"{"corner": [0,0,5], "edges": [[3e38,0,0], [0,3e38,0]], "material": "w"}"#);
-        assert!(e.contains("parallelogram 0") && e.contains("overflows"), "{e}");
+        assert!(e.contains("parallelograms[0]") && e.contains("overflows"), "{e}");
         let scene = parse(&format!("{base}{}]}}", r#"{"corner": [0,0,5], "edges": [[2,0,0], [0,3,0]], "material": "w"}"#), "ok.json").unwrap();
         assert_eq!((scene.triangles.len(), scene.triangles[0].area()), (1, 6.0));
     }
@@ -492,9 +492,9 @@ mod tests {
         let base = r#"{"camera": {"origin": [0,0,0], "direction": [0,0,1]}, "materials": {"w": {"type": "diffuse", "color": [1,1,1]}}, "meshes": ["#;
         let case = |mesh: &str| parse_in(&format!("{base}{mesh}]}}"), "m.json", dir).unwrap_err();
         let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "gold"}"#));
-        assert!(e.contains("mesh 0 uses unknown material `gold`"), "{e}");
+        assert!(e.contains("meshes[0] uses unknown material `gold`"), "{e}");
         let e = format!("{:#}", case(r#"{"path": "missing.obj", "material": "w"}"#));
-        assert!(e.contains("mesh 0") && e.contains("missing.obj"), "{e}");
+        assert!(e.contains("meshes[0]") && e.contains("missing.obj"), "{e}");
         let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "w", "scale": [3e38, 3e38, 3e38], "translate": [3e38, 0, 0]}"#));
         assert!(e.contains("after the mesh transforms"), "{e}");
         let e = format!("{:#}", case(r#"{"path": "pyramid.obj", "material": "w", "spin": 3}"#));
@@ -512,11 +512,11 @@ mod tests {
         let named = r#"{"path": "pyramid.obj", "material": "w", "name": "p"}"#;
         let err = |text: String| format!("{:#}", parse_instanced_in(&text, "i.json", dir).unwrap_err());
         let e = err(file(named, r#"{"mesh": "q"}"#));
-        assert!(e.contains("i.json") && e.contains("instance 0 places `q`, which no mesh is named"), "{e}");
+        assert!(e.contains("i.json") && e.contains("instances[0] places `q`, which no mesh is named"), "{e}");
         let e = err(file(named, r#"{"mesh": "p"}, {"mesh": "p", "material": "gold"}"#));
-        assert!(e.contains("instance 1 uses unknown material `gold`"), "{e}");
+        assert!(e.contains("instances[1] uses unknown material `gold`"), "{e}");
         let e = err(file(&format!("{named}, {named}"), ""));
-        assert!(e.contains("mesh 1: a mesh is already named `p`"), "{e}");
+        assert!(e.contains("meshes[1]: a mesh is already named `p`"), "{e}");
         let e = err(file(named, r#"{"mesh": "p", "turn": 3}"#));
         assert!(e.contains("line 1") && e.contains("turn"), "{e}");
         // The same file under two mesh entries is read once; copies keep

@@ -391,9 +391,9 @@ impl<B: Backend> InstancedTracer<B> {
             .enumerate()
             .map(|(k, i)| {
                 if i.mesh as usize >= self.meshes.len() {
-                    bail!("instance {k} places mesh {}, but there are {} meshes", i.mesh, self.meshes.len());
+                    bail!("instances[{k}] places mesh {}, but there are {} meshes", i.mesh, self.meshes.len());
                 }
-                check_transform(&i.transform).with_context(|| format!("instance {k}"))?;
+                check_transform(&i.transform).with_context(|| format!("instances[{k}]"))?;
                 Ok(PlacedMesh { world_from_object: i.transform, mesh: i.mesh, _pad: [0; 3] })
             })
             .collect()
