@@ -42,3 +42,36 @@ fn malformed_scene_names() {
         assert!(e.contains(needle), "`{spec}`: {e}");
     }
 }
+
+/// One OBJ polygon of many vertices, fanned into triangles that all cross
+/// its centre: every triangle overlaps nearly every node box, so counting
+/// the end-point overlap is quadratic (20 000 vertices took 77 s). The
+/// load and build stay linear; the EPO is counted within a budget of box
+/// visits and reported as not counted past it.
+#[test]
+fn a_huge_polygon_builds_without_an_unbounded_metric() {
+    let dir = std::env::temp_dir().join(format!("treelet-polygon-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("polygon.obj");
+    let n = 6000;
+    let mut text = String::new();
+    for k in 0..n {
+        let a = k as f32 / n as f32 * std::f32::consts::TAU;
+        text.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+    }
+    text.push('f');
+    for k in 1..=n {
+        text.push_str(&format!(" {k}"));
+    }
+    text.push('\n');
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::from_spec(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.triangles.len(), n - 2, "a fan of n - 2 triangles");
+    let (_, report) = treelet::bvh::report::run_build(&mut treelet::runtime::cpu_runner::CpuBackend::new(), &scene, None).unwrap();
+    assert!(report.valid && report.epo.is_none(), "valid {}, EPO {:?}", report.valid, report.epo);
+    // A scene of separate triangles gets its EPO.
+    let scattered = treelet::scene::random_scene("scattered", 2000, 3);
+    let (_, report) = treelet::bvh::report::run_build(&mut treelet::runtime::cpu_runner::CpuBackend::new(), &scattered, None).unwrap();
+    assert!(report.epo.is_some_and(|e| e.is_finite() && e >= 0.0), "{:?}", report.epo);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -664,7 +664,8 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
 fn print_summary(r: &BuildReport) {
     println!("scene      {} ({} primitives)", r.scene, r.primitives);
     println!("device     {} ({})", r.device, r.adapter);
-    println!("builder    {}: {} nodes, {} leaves, {} references, SAH {:.3}, EPO {:.3}", r.builder, r.nodes, r.leaves, r.references, r.sah_cost, r.epo);
+    let epo = r.epo.map_or("not counted (the triangles overlap too many boxes)".to_string(), |e| format!("{e:.3}"));
+    println!("builder    {}: {} nodes, {} leaves, {} references, SAH {:.3}, EPO {epo}", r.builder, r.nodes, r.leaves, r.references, r.sah_cost);
     if let (Some(before), Some(after)) = (r.sah_before, r.sah_after) {
         println!("treelets   SAH {before:.3} -> {after:.3} ({:.1}% lower)", 100.0 * (1.0 - after / before));
     }

@@ -30,7 +30,9 @@ pub struct BuildReport {
     pub sah_cost: f64,
     /// End-point overlap with the same constants ([`crate::bvh::epo`]): on
     /// scenes of mixed triangle sizes, a better predictor of trace speed.
-    pub epo: f64,
+    /// `None` (JSON `null`) where the triangles overlap too many boxes for
+    /// it to be counted in bounded time.
+    pub epo: Option<f64>,
     pub valid: bool,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<String>,
