@@ -55,6 +55,27 @@ pub fn epo(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u
         }
     }
     let first_triangle = prims.spheres.len();
+    // A thousand triangles spread over the list first, each walk cut off
+    // at 16 times the budget's mean: where their mean is past the budget,
+    // the whole count would be too (a polygon fanned around one point is
+    // found in a few million visits instead of the full budget's).
+    let step = (prims.triangles.len() / 1024).max(1);
+    let sampled: Vec<u64> = (0..prims.triangles.len())
+        .step_by(step)
+        .collect::<Vec<_>>()
+        .par_iter()
+        .map(|&t| {
+            let cut = 16 * EPO_VISITS_PER_TRIANGLE;
+            let walked = std::sync::atomic::AtomicU64::new(0);
+            for v in triangles_of(&prims.triangles[t]) {
+                overlap_of(v, &leaves_of[first_triangle + t], nodes, parents, costs, (&walked, cut));
+            }
+            walked.load(std::sync::atomic::Ordering::Relaxed).min(cut)
+        })
+        .collect();
+    if !sampled.is_empty() && sampled.iter().sum::<u64>() / sampled.len() as u64 > EPO_VISITS_PER_TRIANGLE {
+        return None;
+    }
     let (overlap, area) = prims
         .triangles
         .par_iter()
@@ -69,9 +90,6 @@ pub fn epo(prims: Primitives, nodes: &[Node], parents: &[u32], prim_indices: &[u
             sums
         })
         .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-    if std::env::var_os("TREELET_EPO_VISITS").is_some() {
-        eprintln!("EPO: {} node visits for {} triangles", visits.load(std::sync::atomic::Ordering::Relaxed), prims.triangles.len());
-    }
     if visits.load(std::sync::atomic::Ordering::Relaxed) > budget {
         return None;
     }
