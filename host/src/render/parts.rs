@@ -58,6 +58,21 @@ impl PartInfo {
 
 const PREFIX: &str = "treelet.";
 
+/// FNV-1a (64 bits) of the sums' bits, as 16 hex digits: written in a
+/// part's header and checked on reading, so that a part damaged on disk
+/// or on the way (one flipped byte merged into negative pixels) is an
+/// error, not a wrong image.
+fn sums_checksum(sums: &[[f32; 4]]) -> String {
+    use std::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    for s in sums {
+        for v in s {
+            h.write_u32(v.to_bits());
+        }
+    }
+    format!("{:016x}", h.finish())
+}
+
 /// Writes `sums` (one per pixel, image order) as a part, atomically.
 pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()> {
     let (w, h) = (info.width as usize, info.height as usize);
@@ -79,6 +94,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
     put("first_sample", AttributeValue::Text(Text::from(info.samples.start.to_string().as_str())));
     put("last_sample", AttributeValue::Text(Text::from(info.samples.end.to_string().as_str())));
     put("planned_last_sample", AttributeValue::Text(Text::from(info.planned_end.to_string().as_str())));
+    put("sums_checksum", AttributeValue::Text(Text::from(sums_checksum(sums).as_str())));
     let layer = Layer::new(
         (w, h),
         attributes,
@@ -150,7 +166,15 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
     if info.samples.is_empty() {
         bail!("{}: its sample range {}..{} is empty", path.display(), info.samples.start, info.samples.end);
     }
-    Ok((info, image.layer_data.channel_data.pixels.1))
+    let sums = image.layer_data.channel_data.pixels.1;
+    // Parts written before the checksum was recorded have none to check.
+    if other.contains_key(&Text::from(format!("{PREFIX}sums_checksum").as_str())) {
+        let (recorded, found) = (field("sums_checksum")?, sums_checksum(&sums));
+        if recorded != found {
+            bail!("{}: its pixel sums do not match the checksum in its header ({found}, not {recorded}): the file was damaged after it was written", path.display());
+        }
+    }
+    Ok((info, sums))
 }
 
 /// Reads an image to be scored (`compare`, `render --reference`): a part
@@ -263,6 +287,53 @@ mod tests {
         assert!(back.differs_from(&info).is_none());
         let why = back.differs_from(&PartInfo { sampler: "independent".into(), ..info }).expect("two samplers differ");
         assert!(why.contains("sampler sobol") && why.contains("independent"), "{why}");
+    }
+
+    /// Every byte of a part flipped in turn: each damaged file
+    /// is refused (by the checksum, or as a broken EXR), never read as other
+    /// sums; a part whose header records another checksum is named damaged.
+    #[test]
+    fn a_damaged_part_is_refused() {
+        let dir = std::env::temp_dir().join(format!("treelet-part-damaged-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("part.exr");
+        let info = PartInfo {
+            scene: "cornell".into(),
+            scene_hash: "0".into(),
+            width: 5,
+            height: 4,
+            seed: 1,
+            integrator: "nee".into(),
+            sampler: "sobol".into(),
+            samples: 0..4,
+            planned_end: 4,
+        };
+        let sums: Vec<[f32; 4]> = (0..20).map(|k| [k as f32 * 0.37, 1.0 + k as f32, 2.5, k as f32 * k as f32]).collect();
+        write_part(&path, &info, &sums).unwrap();
+        let good = std::fs::read(&path).unwrap();
+        assert_eq!(read_part(&path).unwrap().1, sums);
+        // Header and data alike: a flip may leave the sums as they were
+        // (a byte of the scene's name), never make other sums.
+        let mut refused = 0;
+        for at in 0..good.len() {
+            let mut bad = good.clone();
+            bad[at] ^= 0x10;
+            std::fs::write(&path, &bad).unwrap();
+            match read_part(&path) {
+                Err(_) => refused += 1,
+                Ok((_, back)) => assert_eq!(back, sums, "byte {at} flipped was read as other sums"),
+            }
+        }
+        assert!(refused > 0);
+        // A header recording another checksum.
+        let recorded = sums_checksum(&sums);
+        let at = good.windows(recorded.len()).position(|w| w == recorded.as_bytes()).unwrap();
+        let mut bad = good.clone();
+        bad[at] = if bad[at] == b'0' { b'1' } else { b'0' };
+        std::fs::write(&path, &bad).unwrap();
+        let e = format!("{:#}", read_part(&path).unwrap_err());
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(e.contains("part.exr") && e.contains("damaged"), "{e}");
     }
 
     /// A header whose data window asks for more pixels than the file holds:
