@@ -288,6 +288,8 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             anyhow::bail!("--resume {} and --out name the same file: the image would replace the part it continues", resume.display());
         }
     }
+    // One render at a time writes --out and the part beside it.
+    let _lock = treelet::render::lock::OutputLock::take(&args.out)?;
     // Samples a stopped render left where this one would write its own (a
     // checkpoint beside --out, or an unfinished part at --out): written over
     // without resuming them, they would be lost.

@@ -684,7 +684,9 @@ fn an_interrupted_render_keeps_its_samples_and_resumes_bit_for_bit() {
 /// `--checkpoint` writes the samples done as it goes: a render killed
 /// outright (SIGKILL: no chance to write anything) leaves its last
 /// checkpoint, which merges into an image; a render that completes removes
-/// its checkpoint, and no temporary file is left behind.
+/// its checkpoint, and no temporary file is left behind. While a render
+/// runs, another of the same `--out` is refused; the killed one's lock is
+/// taken over.
 #[test]
 fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
     let dir = std::env::temp_dir().join(format!("treelet-cli-checkpoint-{}", std::process::id()));
@@ -697,6 +699,10 @@ fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(2500));
+    // A second render of the same --out while the first runs: refused,
+    // naming the first (the two wrote over each other's checkpoint).
+    let e = stderr_of(&["render", "--device", "cpu", "--width", "8", "--height", "8", "--spp", "16", "--out", &p("img.png")]);
+    assert!(e.contains("being rendered by another treelet") && e.contains(&format!("pid {}", child.id())), "{e}");
     child.kill().unwrap();
     child.wait().unwrap();
     let o = treelet(&["merge", &p("img.part.exr"), "--out", &p("merged.png")]);

@@ -18,11 +18,13 @@
 //! | `sums.rs` | per-pixel sums, their image, the error measures |
 //! | `outcome.rs` | what a render gives back |
 //! | `parts.rs` | parts of a render as EXR files, and merging them |
+//! | `lock.rs` | the lock beside `--out` for the life of a render |
 //! | `image_io.rs` | reading and writing images |
 pub mod devices;
 pub mod dispatch_size;
 pub mod image_io;
 pub mod integrator_choice;
+pub mod lock;
 pub mod outcome;
 pub mod parts;
 pub mod placed;
