@@ -730,6 +730,28 @@ fn checkpoints_survive_a_kill_and_go_when_the_render_completes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Under an address-space limit (`ulimit -v`, as batch systems set), a
+/// render whose memory estimate is past the room left is refused before it
+/// starts, naming the estimate (the limit was not counted: such a render
+/// ran, then aborted when an allocation failed).
+#[test]
+fn an_address_space_limit_is_counted() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-ulimit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("big.png");
+    let command = format!(
+        "ulimit -v 3000000 && exec '{}' render --device cpu --width 7000 --height 7000 --spp 1 --out '{}'",
+        env!("CARGO_BIN_EXE_treelet"),
+        out.display()
+    );
+    let o = Command::new("bash").args(["-c", &command]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("this render needs about") && err.contains("available") && !err.contains("panicked"), "{err}");
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Runs `treelet args` with `env`, killed after `seconds`: a hang fails the
 /// test instead of blocking it.
 fn treelet_within(seconds: u64, env: &[(&str, &str)], args: &[&str]) -> std::process::Output {

@@ -59,14 +59,28 @@ fn machine_available_bytes() -> Option<u64> {
     let mut sys = sysinfo::System::new();
     sys.refresh_memory();
     let available = sys.available_memory();
-    // A cgroup's limit (a container, a Slurm job) is what this process may use.
-    let limit = sys.cgroup_limits().map(|c| c.free_memory);
+    // A cgroup's limit (a container, a Slurm job) is what this process may
+    // use; and `ulimit -v` (RLIMIT_AS) bounds its address space, which an
+    // allocation past it fails to grow (an abort, after the work).
+    let limits = [sys.cgroup_limits().map(|c| c.free_memory), address_space_room()];
+    let limit = limits.into_iter().flatten().min();
     match (available, limit) {
         (0, None) => None,
         (a, Some(l)) if a > 0 => Some(a.min(l)),
         (0, Some(l)) => Some(l),
         (a, _) => Some(a),
     }
+}
+
+/// Room left under the address-space limit (`ulimit -v`): the soft limit
+/// of `/proc/self/limits` less the process's size now (`VmSize` of
+/// `/proc/self/status`); `None` where there is no limit or no `/proc`.
+fn address_space_room() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let soft = limits.lines().find(|l| l.starts_with("Max address space"))?.split_whitespace().nth(3)?.parse::<u64>().ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let size_kb = status.lines().find(|l| l.starts_with("VmSize:"))?.split_whitespace().nth(1)?.parse::<u64>().ok()?;
+    Some(soft.saturating_sub(size_kb * 1024))
 }
 
 /// Bytes as people read them: `1.5 GiB`.
