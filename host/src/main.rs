@@ -841,11 +841,25 @@ impl Drop for OpenDevices {
     }
 }
 
+/// Past a file-size limit (`ulimit -f`, as batch systems set) the kernel
+/// kills a writer with SIGXFSZ, leaving its temporary file and no word of
+/// why; ignored, the write fails with EFBIG instead, which the writers
+/// report (naming the file) after removing their temporary file.
+fn ignore_file_size_signal() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_IGN, before any thread
+    // starts; no handler runs.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
 fn main() -> ExitCode {
     // The process's clock (as near as `main` knows), for wall times.
     treelet::runtime::timeline::start();
     // Before any thread starts (the library also does it when it opens Vulkan).
     treelet::runtime::gpu::quiet_mesa_runtime_dir();
+    ignore_file_size_signal();
     bound_threads();
     let cli = Cli::parse();
     treelet::runtime::timeline::mark("arguments");

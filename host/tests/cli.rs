@@ -752,6 +752,28 @@ fn an_address_space_limit_is_counted() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Past a file-size limit (`ulimit -f`) a render's write fails with an
+/// error naming the file, and leaves no temporary file (SIGXFSZ killed it,
+/// exit 153, its temporary file left behind).
+#[test]
+fn a_file_size_limit_is_a_write_error() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-fsize-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("x.exr");
+    let command = format!(
+        "ulimit -f 20 && exec '{}' render --device cpu --width 256 --height 256 --spp 1 --out '{}'",
+        env!("CARGO_BIN_EXE_treelet"),
+        out.display()
+    );
+    let o = Command::new("bash").args(["-c", &command]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("x.exr") && err.contains("File too large"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Runs `treelet args` with `env`, killed after `seconds`: a hang fails the
 /// test instead of blocking it.
 fn treelet_within(seconds: u64, env: &[(&str, &str)], args: &[&str]) -> std::process::Output {
