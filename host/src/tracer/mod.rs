@@ -21,13 +21,16 @@
 //! over bottom-level trees): [`InstancedTracer`]. An engine's mesh in its
 //! own vertex and index buffers: [`Tracer::build_from_buffers`]. Files:
 //! `primitives.rs` ([`Tracer`]), `engine_mesh.rs` ([`MeshBuffers`]),
-//! `instances.rs`, `rays.rs` (rays, hits, device batches).
+//! `instances.rs`, `queries.rs` ([`RayQueries`], what both tracers
+//! answer), `rays.rs` (rays, hits, device batches).
 mod engine_mesh;
 mod instances;
 mod primitives;
+mod queries;
 mod rays;
 
 pub use engine_mesh::{IndexBuffer, IndexFormat, MeshBuffers};
 pub use instances::{Instance, InstancedTracer};
 pub use primitives::{Quality, Tracer};
+pub use queries::RayQueries;
 pub use rays::{batch_slots, device_rays, Ray, RayHit};
