@@ -93,7 +93,7 @@
 //!   render parts;
 //! - [`tracer`]: the engine API re-exported above.
 //!
-//! The `treelet` command (`main.rs`, `bench/`) sits on top. The kernels
+//! The `treelet` command (`cli/`: `main.rs`, `bench/`) sits on top. The kernels
 //! themselves are in the `treelet-core` crate, which an engine may also use
 //! directly (`no_std`): see its docs for the traversal functions.
 /// Notes on standard error that never panic (see [`console`]); defined

@@ -19,7 +19,7 @@ use treelet::runtime::device::Device;
 
 /// CUB's sort times on the H100 (`peers/cub`), a reference series of
 /// graph 2.5 and 3.5.
-const CUB_SORT_H100: &str = include_str!("../../data/cub_sort_h100.jsonl");
+const CUB_SORT_H100: &str = include_str!("../../../data/cub_sort_h100.jsonl");
 
 
 pub fn run(figure: Figure, suite: &Suite) -> Result<()> {
