@@ -34,8 +34,9 @@ pub enum Layout {
     /// Binary nodes that hold both children's boxes (Aila & Laine 2009);
     /// primitives in leaf order.
     Bvh2,
-    /// 4-wide nodes of full-precision boxes, made from bvh2's (each node's
-    /// grandchildren as its children); primitives in leaf order.
+    /// 4-wide nodes of full-precision boxes, made from bvh2's (a node's two
+    /// children, then twice the internal child of largest area opened);
+    /// primitives in leaf order.
     Bvh4,
     /// Compressed 8-wide nodes, child boxes quantized to bytes (Ylitie,
     /// Karras & Laine 2017); primitives in leaf order.
