@@ -20,7 +20,7 @@ use syn::visit::{self, Visit};
 
 /// Floors of core's top-level folders (`core/src/<folder>/`); a file may import files of its floor or lower.
 const CORE_FLOORS: &[(&str, u32)] =
-    &[("gpu", 0), ("geometry", 1), ("construct", 2), ("layouts", 3), ("trace", 4), ("render", 5)];
+    &[("gpu", 0), ("geometry", 1), ("construct", 2), ("layouts", 3), ("trace", 4), ("render", 5), ("registry", 6)];
 
 /// Floors of the host library's top-level folders; a top-level file (`tracer.rs`) is a folder named by its stem.
 /// The engine API (`tracer`) sits below the renderer, which traces a scene's

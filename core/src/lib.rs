@@ -61,6 +61,7 @@ pub mod construct;
 pub mod geometry;
 pub mod gpu;
 pub mod layouts;
+pub mod registry;
 pub mod render;
 pub mod trace;
 

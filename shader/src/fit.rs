@@ -5,67 +5,6 @@ use treelet_core::gpu::workgroup::{linear_id, WG};
 use treelet_core::geometry::split::SplitMut;
 use treelet_core::{Aabb, Node};
 
-/// A bottom-up fit entry point; `$ordered` as in
-/// `treelet_core::construct::fit::fit_kernel` (acquire-release counters for GPUs,
-/// relaxed for CPU adapters: see `treelet_core::gpu::atomics::add_device_acq_rel`).
-macro_rules! fit_kernel {
-    ($name:ident, $ordered:literal) => {
-        #[spirv(compute(threads(256)))]
-        pub fn $name(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] sorted_prims: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] prim_boxes: &[Aabb],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] parents: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] flags: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] nodes_hi: &mut [Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            treelet_core::construct::fit::fit_kernel::<$ordered>(id, params.n, sorted_prims, prim_boxes, &mut SplitMut::new(nodes, nodes_hi), parents, flags);
-        }
-    };
-}
-
-/// Hierarchy and bounds in one bottom-up pass (Apetrei 2014); `$ordered` as
-/// for `fit_kernel!`.
-macro_rules! agglomerate_kernel {
-    ($name:ident, $ordered:literal) => {
-        #[spirv(compute(threads(256)))]
-        pub fn $name(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] sorted_prims: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] prim_boxes: &[Aabb],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] nodes: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] parents: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] ends: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] nodes_hi: &mut [Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            let n = params.n;
-            treelet_core::construct::agglomerate::agglomerate_kernel::<$ordered>(
-                id,
-                n,
-                keys,
-                sorted_prims,
-                prim_boxes,
-                &mut SplitMut::new(nodes, nodes_hi),
-                parents,
-                ends,
-            );
-        }
-    };
-}
-
-fit_kernel!(fit_cs, true);
-fit_kernel!(fit_relaxed_cs, false);
-agglomerate_kernel!(agglomerate_cs, true);
-agglomerate_kernel!(agglomerate_relaxed_cs, false);
-
 /// One step of `treelet_core::construct::agglomerate_subgroup`, its
 /// number a constant (so the driver keeps only that step's branch), then
 /// its subgroup operation.
@@ -94,7 +33,7 @@ fn agglomerate_step<const STEP: u32>(
 /// The agglomerative build's lowest levels, merged within each subgroup
 /// (`treelet_core::construct::agglomerate_subgroup`): the start, the rounds
 /// (each round's nine steps unrolled), then the clusters left queued for
-/// [`climb_queued_cs`].
+/// `climb_queued_cs` (`per_invocation`).
 #[spirv(compute(threads(256)))]
 #[allow(clippy::too_many_arguments)]
 pub fn agglomerate_subgroup_cs(
@@ -140,38 +79,10 @@ pub fn agglomerate_subgroup_cs(
     agglomerate_step::<12>(id, lane, size, n, i, nodes, parents, ends, queue, queued, &mut me, &mut io);
 }
 
-/// The climbs of the clusters [`agglomerate_subgroup_cs`] queued; `$ordered`
-/// as for `fit_kernel!`.
-macro_rules! climb_queued_kernel {
-    ($name:ident, $ordered:literal) => {
-        #[spirv(compute(threads(256)))]
-        #[allow(clippy::too_many_arguments)]
-        pub fn $name(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] ends: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] queue: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] queued: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] nodes_hi: &mut [Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            treelet_core::construct::agglomerate_subgroup::climb_queued_kernel::<$ordered>(
-                id, params.n, keys, &mut SplitMut::new(nodes, nodes_hi), parents, ends, queue, queued,
-            );
-        }
-    };
-}
-
-climb_queued_kernel!(climb_queued_cs, true);
-climb_queued_kernel!(climb_queued_relaxed_cs, false);
-
 /// H-PLOC (`treelet_core::construct::hploc`) over the sorted keys: the
 /// steps in the order `hploc_schedule!` gives, each followed by its
-/// subgroup operation; `ORDERED` as for `fit_kernel!`.
+/// subgroup operation; `ORDERED` as for the fit (`treelet_core::construct::fit::fit_kernel`:
+/// acquire-release counters on GPUs, relaxed on CPU adapters).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn hploc<const ORDERED: bool>(
@@ -222,7 +133,7 @@ fn hploc<const ORDERED: bool>(
     treelet_core::hploc_schedule!(step, io.output, me.more());
 }
 
-/// The H-PLOC entry points; `$ordered` as for `fit_kernel!`.
+/// The H-PLOC entry points; `$ordered` as for `hploc`.
 macro_rules! hploc_kernel {
     ($name:ident, $ordered:literal) => {
         #[spirv(compute(threads(256)))]

@@ -6,8 +6,7 @@ use treelet_core::construct::{bounds, presplit};
 use treelet_core::geometry::buffers::{BuildParams, SplitParams};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
-use treelet_core::Sphere;
-use treelet_core::gpu::workgroup::{WG, linear_group, linear_id};
+use treelet_core::gpu::workgroup::{WG, linear_group};
 
 /// Each primitive's priority, and their sum per workgroup.
 #[spirv(compute(threads(256)))]
@@ -30,38 +29,6 @@ pub fn split_priority_cs(
     });
 }
 
-/// Pieces per primitive.
-#[spirv(compute(threads(256)))]
-pub fn split_count_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SplitParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] priorities: &[f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] counts: &mut [u32],
-) {
-    presplit::count_kernel(linear_id(gid.x, gid.y, groups.x), params, priorities, counts);
-}
-
-/// Each primitive's pieces: boxes and primitive indices.
-#[spirv(compute(threads(256)))]
-#[allow(clippy::too_many_arguments)]
-pub fn split_emit_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SplitParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] triangles: &[Triangle],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] offsets: &[u32],
-    // Two 16-byte vectors per box (see `treelet_core::geometry::records`).
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] ref_boxes: &mut [Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] ref_prims: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles_hi: &[Triangle],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    let triangles = Split::new(triangles, triangles_hi);
-    presplit::emit_kernel(id, params, spheres, triangles, offsets, ref_boxes, ref_prims);
-}
-
 /// The pieces' boxes as the build's, and their centroid bounds.
 #[spirv(compute(threads(256)))]
 pub fn split_bounds_cs(
@@ -81,14 +48,3 @@ pub fn split_bounds_cs(
     });
 }
 
-/// Each leaf slot's reference becomes its primitive.
-#[spirv(compute(threads(256)))]
-pub fn split_remap_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &BuildParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] ref_prims: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values: &mut [u32],
-) {
-    presplit::remap_kernel(linear_id(gid.x, gid.y, groups.x), params.n, ref_prims, values);
-}

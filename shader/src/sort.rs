@@ -28,21 +28,6 @@ pub fn sort_histogram_cs(
     });
 }
 
-/// After a sort of the high digits: each run of ties ordered by the low
-/// digits (`treelet_core::construct::sort_ties`).
-#[spirv(compute(threads(256)))]
-pub fn sort_settle_ties_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &mut [u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] values: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] sort_state: &mut [u32],
-) {
-    let id = treelet_core::gpu::workgroup::linear_id(gid.x, gid.y, groups.x);
-    treelet_core::construct::sort_ties::settle_ties_kernel(id, params, keys, values, sort_state);
-}
-
 #[spirv(compute(threads(256)))]
 pub fn sort_offsets_cs(
     #[spirv(local_invocation_index)] lid: u32,

@@ -1,66 +1,11 @@
-use spirv_std::glam::{UVec3, Vec4};
+use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::construct::collapse::collapse_kernel;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_init_climb_kernel, treelet_init_kernel, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
+use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
-use treelet_core::geometry::split::{Split, SplitMut};
+use treelet_core::geometry::split::SplitMut;
 use treelet_core::gpu::subgroup::subgroup_barrier;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
-
-/// Per-node counts, costs and heights, bottom up, in two kernels (the
-/// lowest levels, then the queued climbs); `$ordered`: acquire-release
-/// counters (GPUs), else relaxed (CPU adapters: lavapipe).
-macro_rules! treelet_init_kernels {
-    ($name:ident, $climb:ident, $ordered:literal) => {
-        #[spirv(compute(threads(256)))]
-        #[allow(clippy::too_many_arguments)]
-        pub fn $name(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] nodes_hi: &[Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            let summaries = (counts, costs, heights, tree_leaves);
-            treelet_init_kernel::<$ordered, _>(id, params, &Split::new(nodes, nodes_hi), parents, flags, summaries, queue, queued);
-        }
-
-        #[spirv(compute(threads(256)))]
-        #[allow(clippy::too_many_arguments)]
-        pub fn $climb(
-            #[spirv(global_invocation_id)] gid: UVec3,
-            #[spirv(num_workgroups)] groups: UVec3,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] flags: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] tree_leaves: &mut [u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] queue: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] queued: &[u32],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] nodes_hi: &[Node],
-        ) {
-            let id = linear_id(gid.x, gid.y, groups.x);
-            let summaries = (counts, costs, heights, tree_leaves);
-            treelet_init_climb_kernel::<$ordered, _>(id, params, &Split::new(nodes, nodes_hi), parents, flags, summaries, queue, queued);
-        }
-    };
-}
-
-treelet_init_kernels!(treelet_init_cs, treelet_init_climb_cs, true);
-treelet_init_kernels!(treelet_init_relaxed_cs, treelet_init_climb_relaxed_cs, false);
 
 /// Counts treelet roots per height (a local histogram per workgroup first).
 #[spirv(compute(threads(256)))]
@@ -152,29 +97,6 @@ pub fn treelet_restructure_cs(
         };
     }
     phases!(0 1 2 3 4 5 6 7 8);
-}
-
-/// The final SAH leaf collapse and depth-first compaction, one invocation per primitive.
-#[spirv(compute(threads(256)))]
-pub fn collapse_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] nodes: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] parents: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] counts: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] tree_leaves: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] prims: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] out_nodes: &mut [Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] out_parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] out_prims: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] nodes_hi: &[Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] out_nodes_hi: &mut [Vec4],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    let nodes = Split::new(nodes, nodes_hi);
-    let out_nodes = &mut SplitMut::new(out_nodes, out_nodes_hi);
-    collapse_kernel(id, params.n, &nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims);
 }
 
 /// Restructures the treelets of one height, one invocation each (heights

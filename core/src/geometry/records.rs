@@ -14,7 +14,9 @@
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{Bvh2Node, Bvh4Node, InstanceRecord, LeafPrim, MeshRecord, Node, PlacedMesh, WideNode};
 use crate::gpu::unchecked::{at, put};
-use glam::Vec4;
+/// The 16-byte vector records are read and written as on the GPU (also
+/// named by the kernel registry, `crate::registry`).
+pub use glam::Vec4;
 
 /// A buffer of `T` records, bound as records or as 16-byte vectors.
 pub trait RecordStore<T> {

@@ -25,10 +25,7 @@ use treelet_core::trace::placed::PlacedScene;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
-use treelet_core::construct::{
-    agglomerate, bounds, collapse, fill, fit, morton, presplit, primitive_boxes, radix_tree, reinsert, scan, sort, treelet_kernels,
-};
-use treelet_core::layouts::{bvh2, cwbvh_build};
+use treelet_core::construct::{bounds, presplit, scan, sort, treelet_kernels};
 
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::{Kernel, Method};
@@ -407,30 +404,74 @@ impl Backend for CpuBackend {
     }
 }
 
+/// A binding of a registered kernel as its call takes it: a shared or a
+/// mutable view of the buffer's words.
+macro_rules! cpu_view {
+    (read, $b:ident, $t:ty) => {
+        let $b: &[$t] = view($b);
+    };
+    (write, $b:ident, $t:ty) => {
+        let $b: &mut [$t] = view($b);
+    };
+}
+
+/// A buffer the GPU binds in two parts, bound whole.
+macro_rules! cpu_whole {
+    (read, $b:ident, $hi:ident) => {
+        let $b = Split::whole($b);
+    };
+    (write, $b:ident, $hi:ident) => {
+        #[allow(unused_mut)]
+        let mut $b = SplitMut::whole($b);
+    };
+}
+
+/// The element type the CPU views a binding as (`as` in the registry).
+macro_rules! cpu_type {
+    ($t:ty) => {
+        $t
+    };
+    ($t:ty, $cpu:ty) => {
+        $cpu
+    };
+}
+
+// The registry's kernels (`treelet_core::registry`): each one's call, made
+// from its one declaration, for every invocation.
+macro_rules! run_registered {
+    ($(
+        $(#[doc = $doc:expr])*
+        $name:ident = $entry:ident($params:ty) {
+            $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
+        } |$id:ident, $p:ident| $call:expr;
+    )*) => {
+        /// Runs `kernel` if it is one of the registry's (and says whether it was).
+        fn run_registered(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) -> bool {
+            match kernel {
+                $(Kernel::$name => {
+                    let [params_words, $($b),*] = b else { panic!("{kernel:?}: wrong number of bindings") };
+                    let params_value: $params = params(params_words);
+                    let $p = &params_value;
+                    $(cpu_view!($access, $b, cpu_type!($t $(, $cpu)?));)*
+                    $($(cpu_whole!($access, $b, $hi);)?)*
+                    for $id in ids(groups) {
+                        $call;
+                    }
+                    true
+                })*
+                _ => false,
+            }
+        }
+    };
+}
+treelet_core::per_invocation_kernels!(run_registered);
+
 /// Calls the core function of `kernel` for every invocation of the dispatch.
 fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: u32) {
+    if run_registered(kernel, b, groups) {
+        return;
+    }
     match (kernel, b) {
-        (Kernel::Fill, [p, data]) => {
-            let p: treelet_core::FillParams = params(p);
-            let data = view(data);
-            for id in ids(groups) {
-                fill::fill_kernel(id, &p, data);
-            }
-        }
-        (Kernel::CopyWords, [p, src, dst]) => {
-            let p: treelet_core::CopyParams = params(p);
-            let (src, dst) = (view::<u32>(src), view::<u32>(dst));
-            for id in ids(groups) {
-                fill::copy_words_kernel(id, &p, src, dst);
-            }
-        }
-        (Kernel::GatherTriangles, [p, vertices, indices, out, flags]) => {
-            let p: treelet_core::GatherParams = params(p);
-            let (vertices, indices, out, flags) = (view::<u32>(vertices), view::<u32>(indices), view(out), view::<u32>(flags));
-            for id in ids(groups) {
-                treelet_core::geometry::gather::gather_triangles_kernel(id, &p, vertices, indices, out, flags);
-            }
-        }
         (Kernel::CastInstances, [p, instances, nodes, leaves, spheres, triangles, rays]) => {
             use treelet_core::{Bvh2Node, LeafPrim};
             let p: treelet_core::RenderParams = params(p);
@@ -457,21 +498,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
-        (Kernel::TopLevelNodes, [p, nodes, prim_indices, out, parents, deepest]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, prim_indices) = (view::<treelet_core::Node>(nodes), view(prim_indices));
-            let (out, parents, deepest) = (view::<treelet_core::Bvh2Node>(out), view(parents), view(deepest));
-            for id in ids(groups) {
-                bvh2::top_level_kernel(id, p.n, nodes, parents, prim_indices, out, deepest);
-            }
-        }
-        (Kernel::PrimitiveBoxes, [p, spheres, triangles, boxes]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (spheres, triangles, boxes) = (view(spheres), view(triangles), view::<treelet_core::Aabb>(boxes));
-            for id in ids(groups) {
-                primitive_boxes::primitive_boxes_kernel(id, p.n, p.spheres, spheres, &Split::whole(triangles), boxes);
-            }
-        }
         (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, bounds_words]) => {
             let p: treelet_core::BuildParams = params(p);
             let (spheres, triangles) = (view(spheres), view(triangles));
@@ -483,13 +509,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
         }
-        (Kernel::Morton, [p, boxes, keys, values, slots, zeroed]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (boxes, keys, values, slots, zeroed) = (view(boxes), view(keys), view(values), view(slots), view(zeroed));
-            for id in ids(groups) {
-                morton::morton_kernel(id, &p, boxes, keys, values, slots, zeroed);
-            }
-        }
         (Kernel::SplitPriority, [p, triangles, priorities, partials]) => {
             let p: treelet_core::SplitParams = params(p);
             let (triangles, priorities, partials) = (view(triangles), view(priorities), view(partials));
@@ -499,22 +518,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 presplit::priority_phase(phase, lid, g, &p, triangles, priorities, partials, &mut shared)
             });
         }
-        (Kernel::SplitCount, [p, priorities, counts]) => {
-            let p: treelet_core::SplitParams = params(p);
-            let (priorities, counts) = (view(priorities), view(counts));
-            for id in ids(groups) {
-                presplit::count_kernel(id, &p, priorities, counts);
-            }
-        }
-        (Kernel::SplitEmit, [p, spheres, triangles, offsets, ref_boxes, ref_prims]) => {
-            let p: treelet_core::SplitParams = params(p);
-            let (spheres, triangles, offsets) = (view(spheres), view(triangles), view(offsets));
-            let (ref_boxes, ref_prims) = (view::<Aabb>(ref_boxes), view(ref_prims));
-            let triangles = Split::whole(triangles);
-            for id in ids(groups) {
-                presplit::emit_kernel(id, &p, spheres, triangles, offsets, ref_boxes, ref_prims);
-            }
-        }
         (Kernel::SplitBounds, [p, ref_boxes, boxes, bounds_words]) => {
             let p: treelet_core::BuildParams = params(p);
             let (ref_boxes, boxes, bounds_words) = (view::<Aabb>(ref_boxes), view::<Aabb>(boxes), view(bounds_words));
@@ -523,13 +526,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
                 bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
             });
-        }
-        (Kernel::SplitRemap, [p, ref_prims, values]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (ref_prims, values) = (view(ref_prims), view(values));
-            for id in ids(groups) {
-                presplit::remap_kernel(id, p.n, ref_prims, values);
-            }
         }
         (Kernel::SortHistogram, [p, keys, sort_state]) => {
             let p: treelet_core::SortParams = params(p);
@@ -546,13 +542,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             workgroups(groups, sort::OFFSETS_PHASES, |g, phase, lid| {
                 sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
             });
-        }
-        (Kernel::SortSettleTies, [p, keys, values, sort_state]) => {
-            let p: treelet_core::SortParams = params(p);
-            let (keys, values, sort_state) = (view(keys), view(values), view(sort_state));
-            for id in ids(groups) {
-                treelet_core::construct::sort_ties::settle_ties_kernel(id, &p, keys, values, sort_state);
-            }
         }
         (Kernel::Multisplit, [p, keys, ranks, counts, sizes]) => {
             let p: treelet_core::SortParams = params(p);
@@ -642,52 +631,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 scan::scan_downsweep_phase(phase, lid, g, &p, data, partials, &mut a, &mut b)
             });
         }
-        (Kernel::RadixTree, [p, keys, nodes, parents]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (keys, nodes, parents) = (view(keys), view(nodes), view(parents));
-            for id in ids(groups) {
-                radix_tree::radix_tree_kernel(id, p.n, keys, &mut SplitMut::whole(nodes), parents);
-            }
-        }
-        (Kernel::Fit | Kernel::FitRelaxed, [p, prims, boxes, nodes, parents, flags]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (prims, boxes, nodes) = (view(prims), view(boxes), view(nodes));
-            let (parents, flags) = (view(parents), view(flags));
-            for id in ids(groups) {
-                fit::fit_kernel::<true>(id, p.n, prims, boxes, &mut SplitMut::whole(nodes), parents, flags);
-            }
-        }
-        (Kernel::RefitState, [p, nodes, parents, state]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, state) = (view::<treelet_core::Node>(nodes), view(parents), view(state));
-            for id in ids(groups) {
-                bvh2::refit_state_kernel(id, p.nodes, nodes, parents, state);
-            }
-        }
-        (Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed, [p, prim_indices, spheres, triangles, nodes, parents, state, out_prims, out_nodes]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
-            let (nodes, parents, state) = (view::<treelet_core::Node>(nodes), view(parents), view(state));
-            let (out_prims, out_nodes) = (view::<treelet_core::LeafPrim>(out_prims), view::<f32>(out_nodes));
-            let prims = treelet_core::geometry::prims::Prims {
-                spheres,
-                sphere_count: p.spheres,
-                triangles: Split::whole(triangles),
-                triangle_count: p.n - p.spheres,
-            };
-            let mut out_nodes = SplitMut::whole(out_nodes);
-            for id in ids(groups) {
-                bvh2::refit_kernel::<true, _, _>(id, p.n, p.nodes, &prims, prim_indices, nodes, parents, state, out_prims, &mut out_nodes);
-            }
-        }
-        (Kernel::Agglomerate | Kernel::AgglomerateRelaxed, [p, keys, prims, boxes, nodes, parents, ends]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (keys, prims, boxes, nodes) = (view(keys), view(prims), view(boxes), view(nodes));
-            let (parents, ends) = (view(parents), view(ends));
-            for id in ids(groups) {
-                agglomerate::agglomerate_kernel::<true>(id, p.n, keys, prims, boxes, &mut SplitMut::whole(nodes), parents, ends);
-            }
-        }
         (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, ends, queue, queued]) => {
             use treelet_core::construct::agglomerate_subgroup::*;
             let p: treelet_core::BuildParams = params(p);
@@ -716,92 +659,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     let inputs = (&*keys, &*prims, &*boxes);
                     hploc_subgroup_on_cpu(g, base, subgroup_size, settings, inputs, &mut SplitMut::whole(nodes), parents, ends, lists, sh);
                 }
-            }
-        }
-        (Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed, [p, keys, nodes, parents, ends, queue, queued]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (keys, nodes, parents, ends) = (view(keys), view(nodes), view(parents), view(ends));
-            let (queue, queued) = (view(queue), view(queued));
-            for id in ids(groups) {
-                treelet_core::construct::agglomerate_subgroup::climb_queued_kernel::<true>(
-                    id, p.n, keys, &mut SplitMut::whole(nodes), parents, ends, queue, queued,
-                );
-            }
-        }
-        (
-            Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed,
-            [p, nodes, parents, flags, counts, costs, heights, tree_leaves, queue, queued],
-        ) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
-            let (counts, costs, heights, tree_leaves) = (view(counts), view(costs), view(heights), view(tree_leaves));
-            let (queue, queued) = (view(queue), view(queued));
-            // The first kernel climbs from the leaves, the second from its queues.
-            let first = matches!(kernel, Kernel::TreeletInit | Kernel::TreeletInitRelaxed);
-            for id in ids(groups) {
-                let summaries = (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves);
-                if first {
-                    treelet_kernels::treelet_init_kernel::<true, [treelet_core::Node]>(id, &p, nodes, parents, flags, summaries, queue, queued);
-                } else {
-                    treelet_kernels::treelet_init_climb_kernel::<true, [treelet_core::Node]>(id, &p, nodes, parents, flags, summaries, queue, queued);
-                }
-            }
-        }
-        (Kernel::ReinsertSearch, [p, nodes, parents, moves]) => {
-            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
-            let (nodes, parents, moves) = (view::<treelet_core::Node>(nodes), view(parents), view(moves));
-            for id in ids(groups) {
-                reinsert::search_kernel(id, &p, nodes, parents, moves);
-            }
-        }
-        (Kernel::ReinsertBid, [p, nodes, parents, moves, bids]) => {
-            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
-            let (nodes, parents, moves, bids) = (view::<treelet_core::Node>(nodes), view(parents), view(moves), view(bids));
-            for id in ids(groups) {
-                reinsert::bid_kernel(id, &p, nodes, parents, moves, bids);
-            }
-        }
-        (Kernel::ReinsertClaim, [p, nodes, parents, moves, bids, owners]) => {
-            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
-            let (nodes, parents, moves) = (view::<treelet_core::Node>(nodes), view(parents), view(moves));
-            let (bids, owners) = (view(bids), view(owners));
-            for id in ids(groups) {
-                reinsert::claim_kernel(id, &p, nodes, parents, moves, bids, owners);
-            }
-        }
-        (Kernel::ReinsertApply, [p, nodes, parents, moves, bids, owners, made]) => {
-            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
-            let (nodes, parents, moves) = (&mut SplitMut::whole(view::<treelet_core::Node>(nodes)), view(parents), view(moves));
-            let (bids, owners, made) = (view(bids), view(owners), view(made));
-            for id in ids(groups) {
-                reinsert::apply_kernel(id, &p, nodes, parents, moves, bids, owners, made);
-            }
-        }
-        (Kernel::ReinsertRefit | Kernel::ReinsertRefitRelaxed, [p, nodes, parents, flags]) => {
-            let p: treelet_core::geometry::buffers::ReinsertParams = params(p);
-            let (nodes, parents, flags) = (&mut SplitMut::whole(view::<treelet_core::Node>(nodes)), view(parents), view(flags));
-            for id in ids(groups) {
-                fit::refit_nodes_kernel::<true>(id, p.n, nodes, parents, flags);
-            }
-        }
-        (Kernel::Collapse, [p, nodes, parents, counts, tree_leaves, prims, out_nodes, out_parents, out_prims]) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (nodes, parents, counts, tree_leaves) = (view::<treelet_core::Node>(nodes), view(parents), view(counts), view(tree_leaves));
-            let (prims, out_nodes, out_parents, out_prims) =
-                (view(prims), view::<treelet_core::Node>(out_nodes), view(out_parents), view(out_prims));
-            for id in ids(groups) {
-                collapse::collapse_kernel(
-                    id,
-                    p.n,
-                    nodes,
-                    parents,
-                    counts,
-                    tree_leaves,
-                    prims,
-                    out_nodes,
-                    out_parents,
-                    out_prims,
-                );
             }
         }
         (Kernel::TreeletHistogram, [p, counts, heights, level_counts]) => {
@@ -855,96 +712,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
             for id in ids(groups) {
                 treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);
-            }
-        }
-        (Kernel::Bvh2Nodes, [p, nodes, parents, out]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, out) = (view::<treelet_core::Node>(nodes), view(parents), view::<treelet_core::Bvh2Node>(out));
-            for id in ids(groups) {
-                bvh2::bvh2_node_kernel(id, p.nodes, nodes, parents, out);
-            }
-        }
-        (Kernel::Bvh4Nodes, [p, nodes, out]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, out) = (view::<treelet_core::Bvh2Node>(nodes), view::<treelet_core::Bvh4Node>(out));
-            for id in ids(groups) {
-                treelet_core::layouts::bvh4::bvh4_node_kernel(id, p.nodes, nodes, out);
-            }
-        }
-        (Kernel::TreeDepth, [p, nodes, parents, deepest]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, deepest) = (view::<treelet_core::Node>(nodes), view(parents), view(deepest));
-            for id in ids(groups) {
-                treelet_core::layouts::depth::leaf_depth_kernel(id, p.nodes, nodes, parents, deepest);
-            }
-        }
-        (Kernel::LeafPrims, [p, prim_indices, spheres, triangles, out]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (prim_indices, spheres, triangles, out) =
-                (view(prim_indices), view(spheres), view(triangles), view::<treelet_core::LeafPrim>(out));
-            for id in ids(groups) {
-                bvh2::leaf_prims_kernel(id, p.n, p.spheres, prim_indices, spheres, Split::whole(triangles), out);
-            }
-        }
-        (Kernel::WideDp | Kernel::WideDpRelaxed, [p, nodes, parents, flags, counts, costs, decisions]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, flags) = (view(nodes), view(parents), view(flags));
-            let (counts, costs, decisions) = (view(counts), view(costs), view(decisions));
-            for id in ids(groups) {
-                cwbvh_build::wide_dp_kernel::<true>(id, &p, nodes, parents, flags, counts, costs, decisions);
-            }
-        }
-        (Kernel::WideCount, [p, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, parents, counts, decisions) = (view(nodes), view(parents), view(counts), view(decisions));
-            let (is_wide, child_counts, prim_counts) = (view(is_wide), view(child_counts), view(prim_counts));
-            for id in ids(groups) {
-                cwbvh_build::wide_count_kernel(
-                    id,
-                    &p,
-                    nodes,
-                    parents,
-                    counts,
-                    decisions,
-                    is_wide,
-                    child_counts,
-                    prim_counts,
-                );
-            }
-        }
-        (Kernel::WidePlace, [p, nodes, decisions, is_wide, child_offsets, positions, slots]) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, decisions, is_wide) = (view(nodes), view(decisions), view(is_wide));
-            let (child_offsets, positions, slots) = (view(child_offsets), view(positions), view(slots));
-            for id in ids(groups) {
-                cwbvh_build::wide_place_kernel(id, &p, nodes, decisions, is_wide, child_offsets, positions, slots);
-            }
-        }
-        (
-            Kernel::WideEmit,
-            [p, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles, out_nodes, out_prims],
-        ) => {
-            let p: treelet_core::LayoutParams = params(p);
-            let (nodes, slots, is_wide) = (view(nodes), view(slots), view(is_wide));
-            let (child_offsets, prim_offsets, positions) = (view(child_offsets), view(prim_offsets), view(positions));
-            let (prim_indices, spheres, triangles) = (view(prim_indices), view(spheres), view(triangles));
-            let (out_nodes, out_prims) = (view::<treelet_core::WideNode>(out_nodes), view::<treelet_core::LeafPrim>(out_prims));
-            for id in ids(groups) {
-                cwbvh_build::wide_emit_kernel(
-                    id,
-                    &p,
-                    nodes,
-                    slots,
-                    is_wide,
-                    child_offsets,
-                    prim_offsets,
-                    positions,
-                    prim_indices,
-                    spheres,
-                    Split::whole(triangles),
-                    out_nodes,
-                    out_prims,
-                );
             }
         }
         (Kernel::Cast(..) | Kernel::CastWideWorkgroupStack, [p, spheres, materials, nodes, prims, rays, triangles]) => {

@@ -1,6 +1,9 @@
 //! The table of kernels: one entry per compute entry point of the shader
 //! crate, with its bindings. The GPU backend builds one pipeline per entry;
 //! the CPU runner matches on the same enum to call the same core function.
+//! The kernels of the registry (`treelet_core::registry`) get their variant
+//! and facts from their one declaration there; the rest are written out
+//! below.
 
 /// How a kernel uses one storage binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,31 +79,52 @@ fn render_entry_point(method: Method, variant: u8, light: bool) -> &'static str 
     &names[(light as usize * Method::ALL.len() + m) * VARIANTS.len() + variant as usize]
 }
 
-/// Every compute kernel of Treelet.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Kernel {
-    Fill,
-    PrimitiveBoxes,
+/// A registered kernel's facts, as `treelet_core::registry` declares them.
+#[derive(Clone, Copy, Debug)]
+pub struct Registration {
+    pub entry_point: &'static str,
+    /// The bindings' accesses, binding 0 (the parameter struct) first.
+    pub bindings: &'static [Access],
+    /// Their binding numbers as declared (`0, 1, 2, ...`: the tests check).
+    pub numbers: &'static [u32],
+    /// The bindings bound in two parts, in the order of their second parts.
+    pub split: &'static [usize],
+    /// The second parts' binding numbers (`bindings.len() + k`: the tests check).
+    pub second_parts: &'static [u32],
+}
+
+macro_rules! access {
+    (read) => {
+        Read
+    };
+    (write) => {
+        ReadWrite
+    };
+}
+
+// The enum: the kernels written out by hand below, then every kernel of
+// the registry (`treelet_core::per_invocation_kernels!`), with their facts.
+macro_rules! kernel_table {
+    ($(
+        $(#[doc = $doc:expr])*
+        $name:ident = $entry:ident($params:ty) {
+            $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
+        } |$id:ident, $p:ident| $call:expr;
+    )*) => {
+        /// Every compute kernel of Treelet.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Kernel {
     /// [`Kernel::PrimitiveBoxes`] fused with the centroid bounds.
     PrimitiveBounds,
-    Morton,
     /// Triangle splitting (`treelet_core::construct::presplit`): each
     /// primitive's priority and their sums per workgroup.
     SplitPriority,
-    /// Triangle splitting: pieces per primitive.
-    SplitCount,
-    /// Triangle splitting: each primitive's pieces, boxes and primitive.
-    SplitEmit,
     /// Triangle splitting: the pieces' boxes as the build's, with their centroid bounds.
     SplitBounds,
-    /// Triangle splitting: leaf slots name primitives instead of pieces.
-    SplitRemap,
     /// Radix sort: digit counts of every pass.
     SortHistogram,
     /// Radix sort: where each digit starts, per pass.
     SortOffsets,
-    /// Sort: runs of keys tied in their high digits ordered by their low ones.
-    SortSettleTies,
     /// Radix sort: one pass (one sweep with decoupled look-back).
     SortOnesweep,
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
@@ -131,42 +155,14 @@ pub enum Kernel {
     ScanReduce,
     ScanSpine,
     ScanDownsweep,
-    RadixTree,
-    Fit,
-    /// [`Kernel::Fit`] with a relaxed counter, for CPU adapters.
-    FitRelaxed,
-    /// The state a `bvh2` layout's refit climbs on (counters, node indices,
-    /// the leaf each primitive slot starts), made once per tree.
-    RefitState,
-    /// A `bvh2` layout's refit in place: its leaf primitives, and its boxes
-    /// bottom-up over its collapsed tree.
-    RefitLeaves,
-    /// [`Kernel::RefitLeaves`] with relaxed counters, for CPU adapters.
-    RefitLeavesRelaxed,
-    /// Hierarchy and boxes in one bottom-up pass (Apetrei 2014).
-    Agglomerate,
-    /// [`Kernel::Agglomerate`] with relaxed exchanges, for CPU adapters.
-    AgglomerateRelaxed,
     /// The agglomerative build's lowest levels merged within each subgroup,
     /// the rest queued for [`Kernel::ClimbQueued`].
     AgglomerateSubgroup,
-    /// The climbs of the queued clusters, as [`Kernel::Agglomerate`]'s.
-    ClimbQueued,
-    /// [`Kernel::ClimbQueued`] with relaxed exchanges, for CPU adapters.
-    ClimbQueuedRelaxed,
     /// H-PLOC (Benthin et al. 2024): nearest-neighbour clusters merged
     /// within subgroups as the climbs go up.
     Hploc,
     /// [`Kernel::Hploc`] with relaxed exchanges, for CPU adapters.
     HplocRelaxed,
-    /// Treelet optimization: per-node counts, costs, heights (bottom up).
-    TreeletInit,
-    /// [`Kernel::TreeletInit`] with relaxed counters, for CPU adapters.
-    TreeletInitRelaxed,
-    /// The climbs [`Kernel::TreeletInit`] queued.
-    TreeletInitClimb,
-    /// [`Kernel::TreeletInitClimb`] with relaxed counters, for CPU adapters.
-    TreeletInitClimbRelaxed,
     /// Treelet optimization: count treelet roots per height.
     TreeletHistogram,
     /// Treelet optimization: list treelet roots by height.
@@ -175,38 +171,6 @@ pub enum Kernel {
     TreeletRestructure,
     /// Treelet optimization: restructure the treelets of one height, one invocation each.
     TreeletRestructureSingle,
-    /// Reinsertion (Meister & Bittner 2018): each node's best move.
-    ReinsertSearch,
-    /// Reinsertion: moves bid their gains on their nodes.
-    ReinsertBid,
-    /// Reinsertion: moves that won every bid claim their nodes.
-    ReinsertClaim,
-    /// Reinsertion: the moves that hold all their nodes are made.
-    ReinsertApply,
-    /// Reinsertion: boxes refit from the leaves after the moves.
-    ReinsertRefit,
-    /// [`Kernel::ReinsertRefit`] with relaxed counters, for CPU adapters.
-    ReinsertRefitRelaxed,
-    /// SAH leaf collapse and depth-first compaction into fresh arrays.
-    Collapse,
-    /// The two-box binary layout from a collapsed tree.
-    Bvh2Nodes,
-    /// Primitives in leaf order.
-    LeafPrims,
-    /// The 4-wide layout from the two-box one.
-    Bvh4Nodes,
-    /// The depth of a tree (each leaf climbs; the deepest counts).
-    TreeDepth,
-    /// The compressed wide BVH: SAH DP over the binary tree (bottom up).
-    WideDp,
-    /// [`Kernel::WideDp`] with relaxed counters, for CPU adapters.
-    WideDpRelaxed,
-    /// The compressed wide BVH: which nodes are wide nodes, their children's counts.
-    WideCount,
-    /// The compressed wide BVH: indices of wide nodes.
-    WidePlace,
-    /// The compressed wide BVH: nodes and leaf primitives.
-    WideEmit,
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
@@ -227,41 +191,46 @@ pub enum Kernel {
     Cast(Method, bool),
     /// [`Kernel::Cast`] through the wide BVH with the top of the stack in workgroup memory.
     CastWideWorkgroupStack,
-    /// Words copied from one buffer into another.
-    CopyWords,
-    /// An engine's mesh gathered from its vertex and index buffers into
-    /// triangles (`treelet_core::geometry::gather`).
-    GatherTriangles,
     /// An engine's rays through an instanced scene (a top-level tree over
     /// instances of meshes, `bvh2` layout at both levels).
     CastInstances,
     /// An instanced scene's top level: each instance's record and world
     /// box, and the first pass of their centroid bounds.
     InstanceBounds,
-    /// An instanced scene's top level in the two-box layout, from its LBVH
-    /// as built (leaves refer to instances).
-    TopLevelNodes,
+    $($(#[doc = $doc])* $name,)*
+        }
+
+        impl Kernel {
+            /// The kernels of the registry.
+            pub const REGISTERED: &'static [Kernel] = &[$(Kernel::$name),*];
+
+            /// The facts of a kernel of the registry (`None` for the others).
+            pub fn registration(self) -> Option<Registration> {
+                match self {
+                    $(Kernel::$name => Some(Registration {
+                        entry_point: concat!("per_invocation::", stringify!($entry)),
+                        bindings: &[Read, $(access!($access)),*],
+                        numbers: &[0, $($binding),*],
+                        split: &[$($([$binding, $hi_binding][0],)?)*],
+                        second_parts: &[$($($hi_binding,)?)*],
+                    }),)*
+                    _ => None,
+                }
+            }
+        }
+    };
 }
+treelet_core::per_invocation_kernels!(kernel_table);
 
 impl Kernel {
-    const FIXED: [Kernel; 76] = [
-        Kernel::Fill,
-        Kernel::CopyWords,
-        Kernel::GatherTriangles,
+    const FIXED: [Kernel; 36] = [
         Kernel::CastInstances,
         Kernel::InstanceBounds,
-        Kernel::TopLevelNodes,
-        Kernel::PrimitiveBoxes,
         Kernel::PrimitiveBounds,
-        Kernel::Morton,
         Kernel::SplitPriority,
-        Kernel::SplitCount,
-        Kernel::SplitEmit,
         Kernel::SplitBounds,
-        Kernel::SplitRemap,
         Kernel::SortHistogram,
         Kernel::SortOffsets,
-        Kernel::SortSettleTies,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
@@ -276,43 +245,13 @@ impl Kernel {
         Kernel::ScanReduce,
         Kernel::ScanSpine,
         Kernel::ScanDownsweep,
-        Kernel::RadixTree,
-        Kernel::Fit,
-        Kernel::FitRelaxed,
-        Kernel::RefitState,
-        Kernel::RefitLeaves,
-        Kernel::RefitLeavesRelaxed,
-        Kernel::Agglomerate,
-        Kernel::AgglomerateRelaxed,
         Kernel::AgglomerateSubgroup,
-        Kernel::ClimbQueued,
-        Kernel::ClimbQueuedRelaxed,
         Kernel::Hploc,
         Kernel::HplocRelaxed,
-        Kernel::TreeletInit,
-        Kernel::TreeletInitRelaxed,
-        Kernel::TreeletInitClimb,
-        Kernel::TreeletInitClimbRelaxed,
         Kernel::TreeletHistogram,
         Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
         Kernel::TreeletRestructureSingle,
-        Kernel::ReinsertSearch,
-        Kernel::ReinsertBid,
-        Kernel::ReinsertClaim,
-        Kernel::ReinsertApply,
-        Kernel::ReinsertRefit,
-        Kernel::ReinsertRefitRelaxed,
-        Kernel::Collapse,
-        Kernel::Bvh2Nodes,
-        Kernel::LeafPrims,
-        Kernel::Bvh4Nodes,
-        Kernel::TreeDepth,
-        Kernel::WideDp,
-        Kernel::WideDpRelaxed,
-        Kernel::WideCount,
-        Kernel::WidePlace,
-        Kernel::WideEmit,
         Kernel::Cast(Method::Classic, false),
         Kernel::Cast(Method::Bvh2, false),
         Kernel::Cast(Method::Bvh4, false),
@@ -327,6 +266,7 @@ impl Kernel {
     pub fn all() -> Vec<Kernel> {
         let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::geometry::features::ALL).unwrap() as u8;
         let mut all = Self::FIXED.to_vec();
+        all.extend_from_slice(Self::REGISTERED);
         all.push(Kernel::CastWideWorkgroupStack);
         all.push(Kernel::RenderPlaced);
         all.push(Kernel::RenderPlacedCaustics);
@@ -348,24 +288,17 @@ impl Kernel {
 
     /// Name of the entry point in the shader crate (`<module>::<name>`).
     pub fn entry_point(self) -> &'static str {
+        if let Some(r) = self.registration() {
+            return r.entry_point;
+        }
         match self {
-            Kernel::Fill => "fill::fill_cs",
-            Kernel::CopyWords => "fill::copy_words_cs",
-            Kernel::GatherTriangles => "gather::gather_triangles_cs",
             Kernel::CastInstances => "render::cast_instances_cs",
             Kernel::InstanceBounds => "bounds::instance_bounds_cs",
-            Kernel::TopLevelNodes => "bvh2::top_level_nodes_cs",
-            Kernel::PrimitiveBoxes => "scene::primitive_boxes_cs",
             Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
-            Kernel::Morton => "morton::morton_cs",
             Kernel::SplitPriority => "presplit::split_priority_cs",
-            Kernel::SplitCount => "presplit::split_count_cs",
-            Kernel::SplitEmit => "presplit::split_emit_cs",
             Kernel::SplitBounds => "presplit::split_bounds_cs",
-            Kernel::SplitRemap => "presplit::split_remap_cs",
             Kernel::SortHistogram => "sort::sort_histogram_cs",
             Kernel::SortOffsets => "sort::sort_offsets_cs",
-            Kernel::SortSettleTies => "sort::sort_settle_ties_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
@@ -380,43 +313,13 @@ impl Kernel {
             Kernel::ScanReduce => "scan::scan_reduce_cs",
             Kernel::ScanSpine => "scan::scan_spine_cs",
             Kernel::ScanDownsweep => "scan::scan_downsweep_cs",
-            Kernel::RadixTree => "radix_tree::radix_tree_cs",
-            Kernel::Fit => "fit::fit_cs",
-            Kernel::FitRelaxed => "fit::fit_relaxed_cs",
-            Kernel::RefitState => "bvh2::refit_state_cs",
-            Kernel::RefitLeaves => "bvh2::refit_cs",
-            Kernel::RefitLeavesRelaxed => "bvh2::refit_relaxed_cs",
-            Kernel::Agglomerate => "fit::agglomerate_cs",
-            Kernel::AgglomerateRelaxed => "fit::agglomerate_relaxed_cs",
             Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
-            Kernel::ClimbQueued => "fit::climb_queued_cs",
-            Kernel::ClimbQueuedRelaxed => "fit::climb_queued_relaxed_cs",
             Kernel::Hploc => "fit::hploc_cs",
             Kernel::HplocRelaxed => "fit::hploc_relaxed_cs",
-            Kernel::TreeletInit => "treelet::treelet_init_cs",
-            Kernel::TreeletInitRelaxed => "treelet::treelet_init_relaxed_cs",
-            Kernel::TreeletInitClimb => "treelet::treelet_init_climb_cs",
-            Kernel::TreeletInitClimbRelaxed => "treelet::treelet_init_climb_relaxed_cs",
             Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
             Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
             Kernel::TreeletRestructureSingle => "treelet::treelet_restructure_single_cs",
-            Kernel::ReinsertSearch => "reinsert::reinsert_search_cs",
-            Kernel::ReinsertBid => "reinsert::reinsert_bid_cs",
-            Kernel::ReinsertClaim => "reinsert::reinsert_claim_cs",
-            Kernel::ReinsertApply => "reinsert::reinsert_apply_cs",
-            Kernel::ReinsertRefit => "reinsert::reinsert_refit_cs",
-            Kernel::ReinsertRefitRelaxed => "reinsert::reinsert_refit_relaxed_cs",
-            Kernel::Collapse => "treelet::collapse_cs",
-            Kernel::Bvh2Nodes => "bvh2::bvh2_nodes_cs",
-            Kernel::LeafPrims => "bvh2::leaf_prims_cs",
-            Kernel::Bvh4Nodes => "bvh4::bvh4_nodes_cs",
-            Kernel::TreeDepth => "depth::tree_depth_cs",
-            Kernel::WideDp => "cwbvh::wide_dp_cs",
-            Kernel::WideDpRelaxed => "cwbvh::wide_dp_relaxed_cs",
-            Kernel::WideCount => "cwbvh::wide_count_cs",
-            Kernel::WidePlace => "cwbvh::wide_place_cs",
-            Kernel::WideEmit => "cwbvh::wide_emit_cs",
             Kernel::Render(method, v) => render_entry_point(method, v, false),
             Kernel::RenderPlaced => "render::render_placed_cs",
             Kernel::RenderPlacedCaustics => "render::render_placed_caustics_cs",
@@ -433,6 +336,7 @@ impl Kernel {
             Kernel::Cast(Method::Cwbvh, true) => "render::cast_cwbvh_triangles_cs",
             Kernel::Cast(Method::Scan, _) => panic!("no cast kernel scans"),
             Kernel::CastWideWorkgroupStack => "render::cast_cwbvh_workgroup_cs",
+            _ => unreachable!("{self:?} is registered"),
         }
     }
 
@@ -441,27 +345,15 @@ impl Kernel {
     /// part from the split on (`treelet_core::geometry::split`) as binding
     /// `bindings().len() + k` for the `k`-th of them, with the same access.
     pub fn split_bindings(self) -> &'static [usize] {
+        if let Some(r) = self.registration() {
+            return r.split;
+        }
         match self {
-            Kernel::PrimitiveBoxes | Kernel::PrimitiveBounds | Kernel::RadixTree | Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[2],
-            Kernel::Fit | Kernel::FitRelaxed => &[3],
+            Kernel::PrimitiveBounds => &[2],
             Kernel::SplitPriority => &[1],
-            Kernel::SplitEmit => &[2],
-            Kernel::RefitState => &[1],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[3, 4, 7, 8],
-            Kernel::Agglomerate | Kernel::AgglomerateRelaxed | Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
-            Kernel::TreeletInit | Kernel::TreeletInitRelaxed | Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed | Kernel::TreeDepth => &[1],
-            Kernel::Collapse => &[1, 6],
-            Kernel::ReinsertSearch
-            | Kernel::ReinsertBid
-            | Kernel::ReinsertClaim
-            | Kernel::ReinsertApply
-            | Kernel::ReinsertRefit
-            | Kernel::ReinsertRefitRelaxed => &[1],
+            Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletRestructure => &[3],
             Kernel::TreeletRestructureSingle => &[2],
-            Kernel::Bvh2Nodes => &[1, 3],
-            Kernel::LeafPrims => &[3, 4],
-            Kernel::WideEmit => &[9],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
             Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
@@ -489,27 +381,20 @@ impl Kernel {
 
     /// Bindings in order; binding 0 is always the parameter struct.
     pub fn bindings(self) -> &'static [Access] {
+        if let Some(r) = self.registration() {
+            return r.bindings;
+        }
         match self {
-            Kernel::Fill => &[Read, ReadWrite],
-            Kernel::CopyWords => &[Read, Read, ReadWrite],
-            Kernel::GatherTriangles => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
             Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::TopLevelNodes => &[Read, Read, Read, ReadWrite, Read, ReadWrite],
-            Kernel::PrimitiveBoxes => &[Read, Read, Read, ReadWrite],
             Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::Morton => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SplitPriority => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::SplitCount => &[Read, Read, ReadWrite],
-            Kernel::SplitEmit => &[Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::SplitBounds => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::SplitRemap => &[Read, Read, ReadWrite],
             Kernel::SortHistogram => &[Read, Read, ReadWrite],
             Kernel::ScanReduce => &[Read, Read, ReadWrite],
             Kernel::ScanSpine => &[Read, ReadWrite],
             Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
             Kernel::SortOffsets => &[Read, ReadWrite],
-            Kernel::SortSettleTies => &[Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortOnesweep
             | Kernel::SortOnesweepSmall
             | Kernel::SortOnesweepScanned
@@ -521,22 +406,8 @@ impl Kernel {
             | Kernel::SortMultisplitMediumPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RadixTree => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::Fit | Kernel::FitRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::RefitState => &[Read, Read, Read, ReadWrite],
-            Kernel::RefitLeaves | Kernel::RefitLeavesRelaxed => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::Agglomerate | Kernel::AgglomerateRelaxed => {
-                &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite]
-            }
             Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::ClimbQueued | Kernel::ClimbQueuedRelaxed => &[Read, Read, ReadWrite, ReadWrite, ReadWrite, Read, Read],
             Kernel::Hploc | Kernel::HplocRelaxed => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::TreeletInit | Kernel::TreeletInitRelaxed => {
-                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
-            }
-            Kernel::TreeletInitClimb | Kernel::TreeletInitClimbRelaxed => {
-                &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, Read, Read]
-            }
             Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
             Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::TreeletRestructure => {
@@ -545,24 +416,33 @@ impl Kernel {
             Kernel::TreeletRestructureSingle => {
                 &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
-            Kernel::ReinsertSearch => &[Read, Read, Read, ReadWrite],
-            Kernel::ReinsertBid => &[Read, Read, Read, Read, ReadWrite],
-            Kernel::ReinsertClaim => &[Read, Read, Read, Read, Read, ReadWrite],
-            Kernel::ReinsertApply => &[Read, ReadWrite, ReadWrite, Read, Read, Read, ReadWrite],
-            Kernel::ReinsertRefit | Kernel::ReinsertRefitRelaxed => &[Read, ReadWrite, Read, ReadWrite],
-            Kernel::Collapse => &[Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::Bvh2Nodes => &[Read, Read, Read, ReadWrite],
-            Kernel::Bvh4Nodes => &[Read, Read, ReadWrite],
-            Kernel::LeafPrims => &[Read, Read, Read, Read, ReadWrite],
-            Kernel::TreeDepth => &[Read, Read, Read, ReadWrite],
-            Kernel::WideDp | Kernel::WideDpRelaxed => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::WideCount => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::WidePlace => &[Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::WideEmit => &[Read, Read, Read, Read, Read, Read, Read, Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
             // The render's, then the copies' (`render::render_placed_cs`).
             Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
             Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
+            _ => unreachable!("{self:?} is registered"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registry writes binding numbers out (the shader's attributes
+    /// take literals): they must be the order the host binds in, and the
+    /// second parts of split buffers must follow, in order.
+    #[test]
+    fn registered_bindings_are_numbered_as_bound() {
+        assert!(!Kernel::REGISTERED.is_empty());
+        for &k in Kernel::REGISTERED {
+            let r = k.registration().unwrap();
+            let n = r.bindings.len() as u32;
+            assert_eq!(r.numbers, (0..n).collect::<Vec<_>>(), "{k:?}: bindings out of order");
+            assert_eq!(r.second_parts, (n..n + r.split.len() as u32).collect::<Vec<_>>(), "{k:?}: second parts out of order");
+            assert!(r.split.iter().all(|&i| i > 0 && i < n as usize), "{k:?}: a split binding out of range");
+            assert!(Kernel::all().contains(&k) && !Kernel::FIXED.contains(&k), "{k:?}");
+            assert_eq!(k.entry_point(), r.entry_point);
         }
     }
 }

@@ -169,7 +169,7 @@ mod workgroup_tests {
     /// tiles, the treelet teams' rows; none in a fill.
     #[test]
     fn workgroup_bytes_of_known_kernels() {
-        let fill = module("fill::fill_cs").unwrap();
+        let fill = module("per_invocation::fill_cs").unwrap();
         assert_eq!(fill.workgroup_bytes(), 0);
         let every = unpack(SHADERS).unwrap();
         let largest = every.iter().map(|m| (m.workgroup_bytes(), m.entry_point)).max().unwrap();
