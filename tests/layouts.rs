@@ -11,7 +11,8 @@ use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
-use treelet::bvh::tree::{binary_tree_split, traced_tree, Accel};
+use treelet::bvh::tree::{binary_tree_split, split_budget, traced_tree_with, Accel};
+use treelet::bvh::trbvh::{TreeletConfig, GPU_TRBVH_REINSERT};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::validate_layout::{validate_bvh2, validate_bvh2_split, validate_bvh4, validate_bvh4_split, validate_wide, validate_wide_split};
 use treelet_core::geometry::buffers::{Bvh2Node, Bvh4Node, LeafPrim, Node, Sphere, WideNode};
@@ -42,8 +43,17 @@ fn read<B: Backend>(b: &mut B, tree: &TracedTree<B>, n: usize) -> HostTree {
     }
 }
 
+/// The tree `accel` makes with the settings of a GPU's on any device: the
+/// TRBVH reinserts on GPUs and not on the CPU runner by default, so trees
+/// compared between the two are made alike.
+fn traced<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> TracedTree<B> {
+    let config = TreeletConfig { reinsert: Some(GPU_TRBVH_REINSERT), ..TreeletConfig::default() };
+    let budget = accel.builder().unwrap().map_or(0.0, split_budget);
+    traced_tree_with(b, prims, accel, layout, budget, &config).unwrap().0
+}
+
 fn build<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> HostTree {
-    let (tree, _, _) = traced_tree(b, prims, accel, layout).unwrap();
+    let tree = traced(b, prims, accel, layout);
     read(b, &tree, prims.len())
 }
 
@@ -504,7 +514,7 @@ fn bvh2_refit_in_place_fits_the_moved_primitives() {
 /// counters otherwise than it found them would misplace the last refit's
 /// boxes).
 fn refit_in_place<B: Backend>(b: &mut B, prims: Primitives, moved: Primitives, accel: Accel) -> HostTree {
-    let (tree, _, _) = traced_tree(b, prims, accel, Layout::Bvh2).unwrap();
+    let tree = traced(b, prims, accel, Layout::Bvh2);
     assert!(tree.collapsed.is_some(), "a bvh2 layout keeps its collapsed tree");
     let mut counters = None;
     for frame in [moved, prims, moved] {

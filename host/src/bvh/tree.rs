@@ -130,6 +130,21 @@ pub fn traced_tree_split<B: Backend>(
     layout: Layout,
     budget: f32,
 ) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
+    traced_tree_with(b, all, accel, layout, budget, &TreeletConfig::default())
+}
+
+/// [`traced_tree_split`] with the optimizing builders' settings given
+/// (`config`'s reinsertion as set, else the device's default: the TRBVH
+/// reinserts on GPUs, not on the CPU runner; so a CPU tree that is to equal
+/// a GPU's sets it).
+pub fn traced_tree_with<B: Backend>(
+    b: &mut B,
+    all: Primitives,
+    accel: Accel,
+    layout: Layout,
+    budget: f32,
+    config: &TreeletConfig,
+) -> Result<(TracedTree<B>, PrimBuffers<B>, f64)> {
     let Some(builder) = accel.builder()? else {
         let buffers = PrimBuffers::upload(b, all)?;
         let tree = TracedTree {
@@ -141,7 +156,7 @@ pub fn traced_tree_split<B: Backend>(
         };
         return Ok((tree, buffers, 0.0));
     };
-    let built = binary_tree_split(b, all, builder, budget)?;
+    let built = binary_tree_with(b, all, builder, budget, config)?;
     let buffers = built.prim_buffers(b, all)?;
     let (tree, layout_ms) = built.lay_out(b, layout, &buffers)?;
     Ok((tree, buffers, built.build_ms + layout_ms))
@@ -245,12 +260,22 @@ pub fn split_budget(builder: Builder) -> f32 {
 /// triangles more at most (0: none; see `treelet_core::construct::presplit`;
 /// the sweep takes whole primitives).
 pub fn binary_tree_split<B: Backend>(b: &mut B, all: Primitives, builder: Builder, budget: f32) -> Result<BuiltTree<B>> {
-    let config = TreeletConfig::default();
+    binary_tree_with(b, all, builder, budget, &TreeletConfig::default())
+}
+
+/// [`binary_tree_split`] with the optimizing builders' settings given (see
+/// [`traced_tree_with`]).
+pub fn binary_tree_with<B: Backend>(b: &mut B, all: Primitives, builder: Builder, budget: f32, config: &TreeletConfig) -> Result<BuiltTree<B>> {
     Ok(match builder {
         Builder::Lbvh | Builder::Trbvh | Builder::Hploc => {
             let hierarchy = hierarchy_of(b, builder, all.len());
             let lbvh = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
-            optimize_built(b, builder, lbvh)?
+            let built = optimize_built(b, builder, lbvh, config)?;
+            if !too_deep_after_reinsertion(b, builder, config, &built)? {
+                return Ok(built);
+            }
+            let lbvh = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
+            optimize_built(b, builder, lbvh, &TreeletConfig { reinsert: Some(0), ..*config })?
         }
         Builder::Sweep => {
             let build = std::time::Instant::now();
@@ -276,8 +301,15 @@ pub fn binary_tree_uploaded<B: Backend>(b: &mut B, prims: &PrimBuffers<B>, build
         Builder::Lbvh | Builder::Trbvh | Builder::Hploc => {
             let counts = (prims.sphere_count, prims.triangle_count);
             let hierarchy = hierarchy_of(b, builder, (counts.0 + counts.1) as usize);
-            let lbvh = lbvh::build_uploaded_split(b, (prims.spheres.clone(), prims.triangles.clone()), counts, hierarchy, budget)?;
-            optimize_built(b, builder, lbvh)
+            let build = |b: &mut B| lbvh::build_uploaded_split(b, (prims.spheres.clone(), prims.triangles.clone()), counts, hierarchy, budget);
+            let config = TreeletConfig::default();
+            let lbvh = build(b)?;
+            let built = optimize_built(b, builder, lbvh, &config)?;
+            if !too_deep_after_reinsertion(b, builder, &config, &built)? {
+                return Ok(built);
+            }
+            let lbvh = build(b)?;
+            optimize_built(b, builder, lbvh, &TreeletConfig { reinsert: Some(0), ..config })
         }
         Builder::Sweep | Builder::Reference => bail!("the {} builder runs on the CPU over the host's primitives", builder.name()),
     }
@@ -291,18 +323,22 @@ fn hierarchy_of<B: Backend>(b: &B, builder: Builder, n: usize) -> lbvh::Hierarch
 /// A device builder's tree from its LBVH (or H-PLOC tree): the LBVH traced
 /// as built; the TRBVH's treelet rounds (and reinsertion on GPUs); H-PLOC's
 /// tree with reinsertion where configured.
-fn optimize_built<B: Backend>(b: &mut B, builder: Builder, (mut bvh, times): (lbvh::DeviceBvh<B>, StageTimes)) -> Result<BuiltTree<B>> {
-    let config = TreeletConfig::default();
+fn optimize_built<B: Backend>(
+    b: &mut B,
+    builder: Builder,
+    (mut bvh, times): (lbvh::DeviceBvh<B>, StageTimes),
+    config: &TreeletConfig,
+) -> Result<BuiltTree<B>> {
     let mut build_ms = times.total();
     Ok(match builder {
         Builder::Trbvh => {
             let root = trbvh::root_box(b, &bvh)?;
-            let (restructured, times) = trbvh::restructure(b, bvh, &root, &settled(&config, builder, b.class()))?;
+            let (restructured, times) = trbvh::restructure(b, bvh, &root, &settled(config, builder, b.class()))?;
             build_ms += times.total();
             BuiltTree { bvh: restructured, max_leaf: config.max_leaf, build_ms }
         }
         Builder::Hploc => {
-            let config = settled(&config, builder, b.class());
+            let config = settled(config, builder, b.class());
             if config.reinsert_iterations() > 0 {
                 // Reinsertion over H-PLOC's tree, without treelet rounds.
                 let root = trbvh::root_box(b, &bvh)?;
@@ -316,6 +352,19 @@ fn optimize_built<B: Backend>(b: &mut B, builder: Builder, (mut bvh, times): (lb
         // The LBVH is traced as built (one primitive per leaf).
         _ => BuiltTree { bvh, max_leaf: 1, build_ms },
     })
+}
+
+/// Whether `built` was reinserted and came out deeper than the traversal
+/// stack (found on the device: one word read back). Reinsertion can chain a
+/// tree of coincident boxes (2 000 triangles of one box, `tests/layouts.rs`'s
+/// stiff scenes) past it, where the tree before it was shallow: such a
+/// build is made again without reinsertion.
+fn too_deep_after_reinsertion<B: Backend>(b: &mut B, builder: Builder, config: &TreeletConfig, built: &BuiltTree<B>) -> Result<bool> {
+    if settled(config, builder, b.class()).reinsert_iterations() == 0 {
+        return Ok(false);
+    }
+    let deepest = crate::bvh::layout::tree_depth(b, &built.bvh)?;
+    Ok(deepest as usize + 1 > treelet_core::trace::hit::STACK_DEPTH)
 }
 
 /// `config` with its reinsertion settled for a tree of `builder` on
