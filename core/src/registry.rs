@@ -42,6 +42,11 @@
 //!   whole.
 //! - The call: what each invocation runs, with `id` and `params` (`&Params`)
 //!   and the bindings by name.
+//! - `Name / NameRelaxed = name_cs / name_relaxed_cs(...)`: two kernels of
+//!   one declaration, whose call reads the constant `ORDERED`: `true` in the
+//!   first (acquire-release atomics, for GPUs), `false` in the second
+//!   (relaxed, for CPU adapters such as lavapipe: see
+//!   [`crate::gpu::atomics`]).
 //!
 //! The macro hands the entries to a macro of the caller's (`$callback`),
 //! which makes what its side needs of them.
@@ -50,7 +55,7 @@
 #[macro_export]
 macro_rules! per_invocation_kernels {
     ($callback:ident) => {
-        $callback! {
+        $crate::__kernel_pairs! { $callback []
             /// Fills a buffer's words with a value.
             Fill = fill_cs($crate::geometry::buffers::FillParams) {
                 1 data: write [u32],
@@ -89,62 +94,33 @@ macro_rules! per_invocation_kernels {
 
             /// Bottom-up fit of the radix tree's boxes: a climb from each leaf,
             /// the second to arrive at a node goes on (`construct::fit`).
-            Fit = fit_cs($crate::geometry::buffers::BuildParams) {
+            Fit / FitRelaxed = fit_cs / fit_relaxed_cs($crate::geometry::buffers::BuildParams) {
                 1 sorted_prims: read [u32],
                 2 prim_boxes: read [$crate::geometry::aabb::Aabb],
                 3 nodes: write [$crate::geometry::buffers::Node] | 6 nodes_hi,
                 4 parents: write [u32],
                 5 flags: write [u32],
-            } |id, params| $crate::construct::fit::fit_kernel::<true>(id, params.n, sorted_prims, prim_boxes, &mut nodes, parents, flags);
-
-            /// `Fit` with a relaxed counter, for CPU adapters.
-            FitRelaxed = fit_relaxed_cs($crate::geometry::buffers::BuildParams) {
-                1 sorted_prims: read [u32],
-                2 prim_boxes: read [$crate::geometry::aabb::Aabb],
-                3 nodes: write [$crate::geometry::buffers::Node] | 6 nodes_hi,
-                4 parents: write [u32],
-                5 flags: write [u32],
-            } |id, params| $crate::construct::fit::fit_kernel::<false>(id, params.n, sorted_prims, prim_boxes, &mut nodes, parents, flags);
+            } |id, params| $crate::construct::fit::fit_kernel::<ORDERED>(id, params.n, sorted_prims, prim_boxes, &mut nodes, parents, flags);
 
             /// Hierarchy and boxes in one bottom-up pass (Apetrei 2014).
-            Agglomerate = agglomerate_cs($crate::geometry::buffers::BuildParams) {
+            Agglomerate / AgglomerateRelaxed = agglomerate_cs / agglomerate_relaxed_cs($crate::geometry::buffers::BuildParams) {
                 1 keys: read [u64],
                 2 sorted_prims: read [u32],
                 3 prim_boxes: read [$crate::geometry::aabb::Aabb],
                 4 nodes: write [$crate::geometry::buffers::Node] | 7 nodes_hi,
                 5 parents: write [u32],
                 6 ends: write [u32],
-            } |id, params| $crate::construct::agglomerate::agglomerate_kernel::<true>(id, params.n, keys, sorted_prims, prim_boxes, &mut nodes, parents, ends);
-
-            /// `Agglomerate` with relaxed exchanges, for CPU adapters.
-            AgglomerateRelaxed = agglomerate_relaxed_cs($crate::geometry::buffers::BuildParams) {
-                1 keys: read [u64],
-                2 sorted_prims: read [u32],
-                3 prim_boxes: read [$crate::geometry::aabb::Aabb],
-                4 nodes: write [$crate::geometry::buffers::Node] | 7 nodes_hi,
-                5 parents: write [u32],
-                6 ends: write [u32],
-            } |id, params| $crate::construct::agglomerate::agglomerate_kernel::<false>(id, params.n, keys, sorted_prims, prim_boxes, &mut nodes, parents, ends);
+            } |id, params| $crate::construct::agglomerate::agglomerate_kernel::<ORDERED>(id, params.n, keys, sorted_prims, prim_boxes, &mut nodes, parents, ends);
 
             /// The climbs of the clusters the subgroup agglomeration queued.
-            ClimbQueued = climb_queued_cs($crate::geometry::buffers::BuildParams) {
+            ClimbQueued / ClimbQueuedRelaxed = climb_queued_cs / climb_queued_relaxed_cs($crate::geometry::buffers::BuildParams) {
                 1 keys: read [u64],
                 2 nodes: write [$crate::geometry::buffers::Node] | 7 nodes_hi,
                 3 parents: write [u32],
                 4 ends: write [u32],
                 5 queue: read [u32],
                 6 queued: read [u32],
-            } |id, params| $crate::construct::agglomerate_subgroup::climb_queued_kernel::<true>(id, params.n, keys, &mut nodes, parents, ends, queue, queued);
-
-            /// `ClimbQueued` with relaxed exchanges, for CPU adapters.
-            ClimbQueuedRelaxed = climb_queued_relaxed_cs($crate::geometry::buffers::BuildParams) {
-                1 keys: read [u64],
-                2 nodes: write [$crate::geometry::buffers::Node] | 7 nodes_hi,
-                3 parents: write [u32],
-                4 ends: write [u32],
-                5 queue: read [u32],
-                6 queued: read [u32],
-            } |id, params| $crate::construct::agglomerate_subgroup::climb_queued_kernel::<false>(id, params.n, keys, &mut nodes, parents, ends, queue, queued);
+            } |id, params| $crate::construct::agglomerate_subgroup::climb_queued_kernel::<ORDERED>(id, params.n, keys, &mut nodes, parents, ends, queue, queued);
 
             /// Triangle splitting: each primitive's pieces, boxes and primitive.
             SplitEmit = split_emit_cs($crate::geometry::buffers::SplitParams) {
@@ -216,21 +192,14 @@ macro_rules! per_invocation_kernels {
             } |id, params| $crate::construct::reinsert::apply_kernel(id, params, &mut nodes, parents, moves, bids, owners, made);
 
             /// Reinsertion: boxes refit from the leaves after the moves.
-            ReinsertRefit = reinsert_refit_cs($crate::geometry::buffers::ReinsertParams) {
+            ReinsertRefit / ReinsertRefitRelaxed = reinsert_refit_cs / reinsert_refit_relaxed_cs($crate::geometry::buffers::ReinsertParams) {
                 1 nodes: write [$crate::geometry::buffers::Node] | 4 nodes_hi,
                 2 parents: read [u32],
                 3 flags: write [u32],
-            } |id, params| $crate::construct::fit::refit_nodes_kernel::<true>(id, params.n, &mut nodes, parents, flags);
-
-            /// `ReinsertRefit` with relaxed counters, for CPU adapters.
-            ReinsertRefitRelaxed = reinsert_refit_relaxed_cs($crate::geometry::buffers::ReinsertParams) {
-                1 nodes: write [$crate::geometry::buffers::Node] | 4 nodes_hi,
-                2 parents: read [u32],
-                3 flags: write [u32],
-            } |id, params| $crate::construct::fit::refit_nodes_kernel::<false>(id, params.n, &mut nodes, parents, flags);
+            } |id, params| $crate::construct::fit::refit_nodes_kernel::<ORDERED>(id, params.n, &mut nodes, parents, flags);
 
             /// Treelet optimization: per-node counts, costs, heights (bottom up).
-            TreeletInit = treelet_init_cs($crate::geometry::buffers::TreeletParams) {
+            TreeletInit / TreeletInitRelaxed = treelet_init_cs / treelet_init_relaxed_cs($crate::geometry::buffers::TreeletParams) {
                 1 nodes: read [$crate::geometry::buffers::Node] | 10 nodes_hi,
                 2 parents: read [u32],
                 3 flags: write [u32],
@@ -240,23 +209,10 @@ macro_rules! per_invocation_kernels {
                 7 tree_leaves: write [u32],
                 8 queue: write [u32],
                 9 queued: write [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_kernel::<true, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
-
-            /// `TreeletInit` with relaxed counters, for CPU adapters.
-            TreeletInitRelaxed = treelet_init_relaxed_cs($crate::geometry::buffers::TreeletParams) {
-                1 nodes: read [$crate::geometry::buffers::Node] | 10 nodes_hi,
-                2 parents: read [u32],
-                3 flags: write [u32],
-                4 counts: write [u32],
-                5 costs: write [f32],
-                6 heights: write [u32],
-                7 tree_leaves: write [u32],
-                8 queue: write [u32],
-                9 queued: write [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_kernel::<false, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
+            } |id, params| $crate::construct::treelet_kernels::treelet_init_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
 
             /// The climbs `TreeletInit` queued.
-            TreeletInitClimb = treelet_init_climb_cs($crate::geometry::buffers::TreeletParams) {
+            TreeletInitClimb / TreeletInitClimbRelaxed = treelet_init_climb_cs / treelet_init_climb_relaxed_cs($crate::geometry::buffers::TreeletParams) {
                 1 nodes: read [$crate::geometry::buffers::Node] | 10 nodes_hi,
                 2 parents: read [u32],
                 3 flags: write [u32],
@@ -266,20 +222,7 @@ macro_rules! per_invocation_kernels {
                 7 tree_leaves: write [u32],
                 8 queue: read [u32],
                 9 queued: read [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_climb_kernel::<true, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
-
-            /// `TreeletInitClimb` with relaxed counters, for CPU adapters.
-            TreeletInitClimbRelaxed = treelet_init_climb_relaxed_cs($crate::geometry::buffers::TreeletParams) {
-                1 nodes: read [$crate::geometry::buffers::Node] | 10 nodes_hi,
-                2 parents: read [u32],
-                3 flags: write [u32],
-                4 counts: write [u32],
-                5 costs: write [f32],
-                6 heights: write [u32],
-                7 tree_leaves: write [u32],
-                8 queue: read [u32],
-                9 queued: read [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_climb_kernel::<false, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
+            } |id, params| $crate::construct::treelet_kernels::treelet_init_climb_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
 
             /// SAH leaf collapse and depth-first compaction into fresh arrays.
             Collapse = collapse_cs($crate::geometry::buffers::TreeletParams) {
@@ -295,7 +238,7 @@ macro_rules! per_invocation_kernels {
 
             /// A `bvh2` layout's refit in place: its leaf primitives, and its boxes
             /// bottom-up over its collapsed tree.
-            RefitLeaves = refit_cs($crate::geometry::buffers::LayoutParams) {
+            RefitLeaves / RefitLeavesRelaxed = refit_cs / refit_relaxed_cs($crate::geometry::buffers::LayoutParams) {
                 1 prim_indices: read [u32],
                 2 spheres: read [$crate::geometry::buffers::Sphere],
                 3 triangles: read [$crate::geometry::triangle::Triangle] | 9 triangles_hi,
@@ -304,23 +247,7 @@ macro_rules! per_invocation_kernels {
                 6 state: write [u32],
                 7 out_prims: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::LeafPrim] | 11 out_prims_hi,
                 8 out_nodes: write [f32] | 12 out_nodes_hi,
-            } |id, params| $crate::layouts::bvh2::refit_kernel::<true, _, _>(
-                id, params.n, params.nodes,
-                &$crate::geometry::prims::Prims { spheres, sphere_count: params.spheres, triangles, triangle_count: params.n - params.spheres },
-                prim_indices, &nodes, parents, state, &mut out_prims, &mut out_nodes,
-            );
-
-            /// `RefitLeaves` with relaxed counters, for CPU adapters.
-            RefitLeavesRelaxed = refit_relaxed_cs($crate::geometry::buffers::LayoutParams) {
-                1 prim_indices: read [u32],
-                2 spheres: read [$crate::geometry::buffers::Sphere],
-                3 triangles: read [$crate::geometry::triangle::Triangle] | 9 triangles_hi,
-                4 nodes: read [$crate::geometry::buffers::Node] | 10 nodes_hi,
-                5 parents: read [u32],
-                6 state: write [u32],
-                7 out_prims: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::LeafPrim] | 11 out_prims_hi,
-                8 out_nodes: write [f32] | 12 out_nodes_hi,
-            } |id, params| $crate::layouts::bvh2::refit_kernel::<false, _, _>(
+            } |id, params| $crate::layouts::bvh2::refit_kernel::<ORDERED, _, _>(
                 id, params.n, params.nodes,
                 &$crate::geometry::prims::Prims { spheres, sphere_count: params.spheres, triangles, triangle_count: params.n - params.spheres },
                 prim_indices, &nodes, parents, state, &mut out_prims, &mut out_nodes,
@@ -373,24 +300,14 @@ macro_rules! per_invocation_kernels {
             } |id, params| $crate::layouts::depth::leaf_depth_kernel(id, params.nodes, &nodes, parents, deepest);
 
             /// The compressed wide BVH: SAH DP over the binary tree (bottom up).
-            WideDp = wide_dp_cs($crate::geometry::buffers::LayoutParams) {
+            WideDp / WideDpRelaxed = wide_dp_cs / wide_dp_relaxed_cs($crate::geometry::buffers::LayoutParams) {
                 1 nodes: read [$crate::geometry::buffers::Node],
                 2 parents: read [u32],
                 3 flags: write [u32],
                 4 counts: write [u32],
                 5 costs: write [f32],
                 6 decisions: write [u32],
-            } |id, params| $crate::layouts::cwbvh_build::wide_dp_kernel::<true>(id, params, nodes, parents, flags, counts, costs, decisions);
-
-            /// `WideDp` with relaxed counters, for CPU adapters.
-            WideDpRelaxed = wide_dp_relaxed_cs($crate::geometry::buffers::LayoutParams) {
-                1 nodes: read [$crate::geometry::buffers::Node],
-                2 parents: read [u32],
-                3 flags: write [u32],
-                4 counts: write [u32],
-                5 costs: write [f32],
-                6 decisions: write [u32],
-            } |id, params| $crate::layouts::cwbvh_build::wide_dp_kernel::<false>(id, params, nodes, parents, flags, counts, costs, decisions);
+            } |id, params| $crate::layouts::cwbvh_build::wide_dp_kernel::<ORDERED>(id, params, nodes, parents, flags, counts, costs, decisions);
 
             /// The compressed wide BVH: which nodes are wide nodes, their children's counts.
             WideCount = wide_count_cs($crate::geometry::buffers::LayoutParams) {
@@ -430,5 +347,35 @@ macro_rules! per_invocation_kernels {
                 6 slots: write [u32],
             } |id, params| $crate::layouts::cwbvh_build::wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions, slots);
         }
+    };
+}
+
+/// Hands [`per_invocation_kernels!`](crate::per_invocation_kernels)' entries
+/// to the callback, each ordered/relaxed pair made two entries (with
+/// `ORDERED` defined for each call).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __kernel_pairs {
+    ($callback:ident [$($done:tt)*]) => {
+        $callback! { $($done)* }
+    };
+    ($callback:ident [$($done:tt)*]
+        $(#[doc = $doc:expr])*
+        $name:ident / $relaxed:ident = $entry:ident / $relaxed_entry:ident($params:ty) { $($bindings:tt)* } |$id:ident, $p:ident| $call:expr;
+        $($rest:tt)*
+    ) => {
+        $crate::__kernel_pairs! { $callback [$($done)*
+            $(#[doc = $doc])*
+            $name = $entry($params) { $($bindings)* } |$id, $p| { const ORDERED: bool = true; $call };
+            #[doc = concat!("`", stringify!($name), "` with relaxed atomics, for CPU adapters (lavapipe).")]
+            $relaxed = $relaxed_entry($params) { $($bindings)* } |$id, $p| { const ORDERED: bool = false; $call };
+        ] $($rest)* }
+    };
+    ($callback:ident [$($done:tt)*]
+        $(#[doc = $doc:expr])*
+        $name:ident = $entry:ident($params:ty) { $($bindings:tt)* } |$id:ident, $p:ident| $call:expr;
+        $($rest:tt)*
+    ) => {
+        $crate::__kernel_pairs! { $callback [$($done)* $(#[doc = $doc])* $name = $entry($params) { $($bindings)* } |$id, $p| $call;] $($rest)* }
     };
 }
