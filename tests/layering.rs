@@ -181,6 +181,12 @@ impl Collector<'_> {
                         segs.push(next.to_string());
                         i += 3;
                     }
+                    // `$crate::name!(..)`: a `#[macro_export]` macro, which Rust puts at the
+                    // crate root whatever file defines it; its only path, so no edge.
+                    if matches!(toks.get(i + 1), Some(TokenTree::Punct(p)) if p.as_char() == '!') {
+                        i += 1;
+                        continue;
+                    }
                     let open_end = colons(i + 1); // `crate::{..}`, `super::*`, `x::<T>`
                                                   // A bare `self` is a receiver; `crate::{..}` alone would wrongly look like a root re-export.
                     if segs.len() > 1 || (open_end && segs[0] != "crate") {
@@ -397,6 +403,20 @@ fn reports_cycle() {
     // The root is a node like any other: `crate::Y` in a.rs closes a cycle through lib.rs's re-export.
     assert!(v.iter().any(|m| m.starts_with("[cycle] src/lib.rs -> src/low/a.rs -> src/lib.rs")), "{v:#?}");
     assert!(v.iter().any(|m| m.starts_with("[root re-export] src/low/a.rs:3: `crate::Y`")), "{v:#?}");
+}
+
+/// A macro a macro body calls through `$crate::name!` lives at the root by
+/// Rust's rule (`#[macro_export]`): not a re-export to report.
+#[test]
+fn exported_macros_are_named_from_the_root() {
+    let v = check_tree(
+        "macros",
+        &[
+            ("src/lib.rs", "mod low;"),
+            ("src/low/mod.rs", "#[macro_export]\nmacro_rules! a { () => { $crate::b!() }; }\n#[macro_export]\nmacro_rules! b { () => {}; }"),
+        ],
+    );
+    assert!(v.is_empty(), "{v:#?}");
 }
 
 #[test]
