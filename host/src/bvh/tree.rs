@@ -269,13 +269,7 @@ pub fn binary_tree_with<B: Backend>(b: &mut B, all: Primitives, builder: Builder
     Ok(match builder {
         Builder::Lbvh | Builder::Trbvh | Builder::Hploc => {
             let hierarchy = hierarchy_of(b, builder, all.len());
-            let lbvh = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
-            let built = optimize_built(b, builder, lbvh, config)?;
-            if !too_deep_after_reinsertion(b, builder, config, &built)? {
-                return Ok(built);
-            }
-            let lbvh = lbvh::build_primitives_split(b, all, hierarchy, budget)?;
-            optimize_built(b, builder, lbvh, &TreeletConfig { reinsert: Some(0), ..*config })?
+            built_within_stack(b, builder, config, |b| lbvh::build_primitives_split(b, all, hierarchy, budget))?
         }
         Builder::Sweep => {
             let build = std::time::Instant::now();
@@ -302,14 +296,7 @@ pub fn binary_tree_uploaded<B: Backend>(b: &mut B, prims: &PrimBuffers<B>, build
             let counts = (prims.sphere_count, prims.triangle_count);
             let hierarchy = hierarchy_of(b, builder, (counts.0 + counts.1) as usize);
             let build = |b: &mut B| lbvh::build_uploaded_split(b, (prims.spheres.clone(), prims.triangles.clone()), counts, hierarchy, budget);
-            let config = TreeletConfig::default();
-            let lbvh = build(b)?;
-            let built = optimize_built(b, builder, lbvh, &config)?;
-            if !too_deep_after_reinsertion(b, builder, &config, &built)? {
-                return Ok(built);
-            }
-            let lbvh = build(b)?;
-            optimize_built(b, builder, lbvh, &TreeletConfig { reinsert: Some(0), ..config })
+            built_within_stack(b, builder, &TreeletConfig::default(), build)
         }
         Builder::Sweep | Builder::Reference => bail!("the {} builder runs on the CPU over the host's primitives", builder.name()),
     }
@@ -354,17 +341,27 @@ fn optimize_built<B: Backend>(
     })
 }
 
-/// Whether `built` was reinserted and came out deeper than the traversal
-/// stack (found on the device: one word read back). Reinsertion can chain a
+/// `builder`'s tree from the LBVH (or H-PLOC tree) `build` makes, optimized
+/// as `config` says, within the traversal stack: reinsertion can chain a
 /// tree of coincident boxes (2 000 triangles of one box, `tests/layouts.rs`'s
-/// stiff scenes) past it, where the tree before it was shallow: such a
-/// build is made again without reinsertion.
-fn too_deep_after_reinsertion<B: Backend>(b: &mut B, builder: Builder, config: &TreeletConfig, built: &BuiltTree<B>) -> Result<bool> {
-    if settled(config, builder, b.class()).reinsert_iterations() == 0 {
-        return Ok(false);
+/// stiff scenes) past it where the tree before it was shallow, so a
+/// reinserted tree found too deep (on the device: one word read back) is
+/// made again without reinsertion.
+fn built_within_stack<B: Backend>(
+    b: &mut B,
+    builder: Builder,
+    config: &TreeletConfig,
+    mut build: impl FnMut(&mut B) -> Result<(lbvh::DeviceBvh<B>, StageTimes)>,
+) -> Result<BuiltTree<B>> {
+    let lbvh = build(b)?;
+    let built = optimize_built(b, builder, lbvh, config)?;
+    if settled(config, builder, b.class()).reinsert_iterations() == 0
+        || crate::bvh::layout::tree_depth(b, &built.bvh)? as usize + 1 <= treelet_core::trace::hit::STACK_DEPTH
+    {
+        return Ok(built);
     }
-    let deepest = crate::bvh::layout::tree_depth(b, &built.bvh)?;
-    Ok(deepest as usize + 1 > treelet_core::trace::hit::STACK_DEPTH)
+    let lbvh = build(b)?;
+    optimize_built(b, builder, lbvh, &TreeletConfig { reinsert: Some(0), ..*config })
 }
 
 /// `config` with its reinsertion settled for a tree of `builder` on
