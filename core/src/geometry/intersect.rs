@@ -137,9 +137,18 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
 /// infinity, so `(plane - origin) * inverse` is never NaN (never `0 * inf`)
 /// and its sign is exact. That alone would make a ray lying exactly in a
 /// box's far face leave the slab at `t = 0`, so far distances on such an
-/// axis get `+f32::MAX` added: the ray then stays in the slab unless it lies
-/// more than `t_max / f32::MAX` outside it (a harmless false accept below
-/// that). Near distances need nothing: a ray in a near face enters at 0.
+/// axis get a bias `b` added: the ray stays in the slab for every
+/// `t <= b`, and a box that lies `e` beside it passes the test on that
+/// axis when `e < b / f32::MAX`. [`SlabRay::new`] sets `b = f32::MAX`,
+/// right for every box but a window of one unit: an axis-parallel ray
+/// (an engine's ray straight down, a diffuse bounce along an axis-aligned
+/// wall's normal) then entered every box within a unit of it, 15 630
+/// nodes and leaf primitives against a median of 21 for a diffuse ray
+/// inside the staircase scene. [`SlabRay::within`] lowers `b` to twice the
+/// distance at which the ray leaves the tree's root box, past which no box
+/// of the tree can be met: the window shrinks to that distance over
+/// `f32::MAX` (under `1e-36` for a scene of a hundred units). Near
+/// distances need nothing: a ray in a near face enters at 0.
 #[derive(Clone, Copy)]
 pub struct SlabRay {
     pub o: [f32; 3],
@@ -164,16 +173,71 @@ impl SlabRay {
         }
         SlabRay { o: o.to_array(), inv, far_bias }
     }
+
+    /// Whether the ray runs parallel to an axis (see the type's doc).
+    #[inline]
+    pub fn is_parallel(&self) -> bool {
+        self.far_bias[0] != 0.0 || self.far_bias[1] != 0.0 || self.far_bias[2] != 0.0
+    }
+
+    /// The ray with the far bias of its parallel axes cut down to twice the
+    /// distance at which it leaves the box `lo..hi` (the root's: every box
+    /// it will be tested against lies inside), so that it no longer enters
+    /// boxes up to a unit beside it (see the type's doc). A ray with no
+    /// parallel axis is returned as it is.
+    ///
+    /// Why twice is enough: a box inside the root that the ray meets is
+    /// entered, by the other axes' near distances, no later than the ray
+    /// leaves the root, and those distances are computed within a few ulps;
+    /// the bias only has to stay above them.
+    #[inline]
+    pub fn within(self, lo: [f32; 3], hi: [f32; 3]) -> SlabRay {
+        if !self.is_parallel() {
+            return self;
+        }
+        let mut exit = f32::MAX;
+        for k in 0..3 {
+            if self.far_bias[k] == 0.0 {
+                let far = if self.inv[k] >= 0.0 { hi[k] } else { lo[k] };
+                exit = exit.min((far - self.o[k]) * self.inv[k]);
+            }
+        }
+        // Past f32::MAX / 2 the bias stays f32::MAX; a ray that leaves the
+        // root behind its origin meets nothing past 0 and gets 0.
+        let bias = if exit <= f32::MAX / 2.0 { (2.0 * exit).max(0.0) } else { f32::MAX };
+        let mut ray = self;
+        for k in 0..3 {
+            if ray.far_bias[k] != 0.0 {
+                ray.far_bias[k] = bias;
+            }
+        }
+        ray
+    }
 }
 
-/// How much a slab test widens its far distance (Ize, "Robust BVH Ray
-/// Traversal", 2013: `1 + 2γ(3)`, three roundings of `(plane - o) * inv`),
-/// so that rounding never culls a box the ray touches.
-pub const FAR_WIDENING: f32 = 1.000_000_4;
+/// How much a slab test widens its far distance, and a traversal the
+/// closest hit so far it culls boxes by ([`crate::trace::hit::Hit::reach`]):
+/// `1 + 2^-14`. Two reasons:
+/// * rounding: Ize ("Robust BVH Ray Traversal", 2013) needs `1 + 2γ(3)`
+///   (about `1 + 2^-22`) for three roundings of `(plane - o) * inv`, so that
+///   no box the ray touches is culled;
+/// * ties: a ray through a vertex or edge that several primitives share
+///   hits them all at one distance, and the lowest index must win, as in
+///   the scan ([`crate::trace::hit::Hit::is_beaten_by`]); the winner's box
+///   is entered exactly at that distance, but the slab test computes the
+///   entry apart from the primitive test's distance, and it may round a
+///   few ulps above it. (Rays along an axis through a mesh's vertices lost
+///   such ties in every layout.)
+///
+/// (Folding the two into one multiply of the clipped far distance, as
+/// `ray_box` does, made the `bvh2` walk 1-3% slower on the H200 than a
+/// multiply a node: docs/results/h200-axis-rays-2026-12-02.)
+pub const FAR_WIDENING: f32 = 1.0 + 1.0 / 16384.0;
 
-/// The interval `[near, far]` (far widened by [`FAR_WIDENING`]) over which
-/// the ray is inside the box `lo..hi`, clipped to `0..=t_max`; the ray
-/// meets the box where `near <= far`.
+/// The interval `[near, far]` over which the ray is inside the box
+/// `lo..hi` (far widened by [`FAR_WIDENING`]), clipped to `0..=t_max`; the
+/// ray meets the box where `near <= far`. Traversals pass the closest hit's
+/// [`reach`](crate::trace::hit::Hit::reach) for `t_max`.
 #[inline]
 pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], ray: &SlabRay, t_max: f32) -> (f32, f32) {
     let t = |k: usize| {
@@ -189,14 +253,13 @@ pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], ray: &SlabRay, t_max: f32) -> (
 /// Slab test of a node's box against a ray, hits between 0 and `t_max`.
 /// An axis the ray runs parallel to (zero in `inv_d`) admits every `t` when
 /// the origin lies within the slab, boundaries included, and none otherwise.
-/// The far distance is widened by `1 + 2γ(3)` (Ize, "Robust BVH Ray
-/// Traversal", 2013) so that rounding never culls a box the ray touches.
+/// The far distance, `t_max` included, is widened by [`FAR_WIDENING`].
 #[inline]
 pub fn ray_box(node: &Node, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
     // Arrays, not `Vec3` indexing (which rust-gpu lowers to pointer phis).
     let (lo, hi, o, inv_d) = (node.min, node.max, o.to_array(), inv_d.to_array());
     let mut near = 0.0f32;
-    let mut far = t_max;
+    let mut far = t_max * FAR_WIDENING;
     for k in 0..3 {
         if inv_d[k] == 0.0 {
             if o[k] < lo[k] || o[k] > hi[k] {
@@ -361,6 +424,48 @@ mod tests {
             let t = ray_sphere(p - n * eps, -n, c, 5.0, 0.0);
             assert!((t - 10.0).abs() < 1e-3, "inward ray {k}: {t}");
         }
+    }
+
+    /// A ray along z, parallel to x and y: lying in a box's far face it
+    /// stays in the box at any distance the root allows, while a box half a
+    /// unit beside it, which the bias of `f32::MAX` let through, is culled.
+    #[test]
+    fn parallel_rays_within_the_root() {
+        let meets = |ray: &SlabRay, lo: [f32; 3], hi: [f32; 3]| {
+            let (near, far) = slab_interval(lo, hi, ray, MISS);
+            near <= far
+        };
+        for scale in [1e-30f32, 1e-3, 1.0, 1e6, 1e30] {
+            let root = ([-4.0 * scale, -4.0 * scale, -4.0 * scale], [4.0 * scale, 4.0 * scale, 4.0 * scale]);
+            // The box's far faces in x and y hold the ray; it is entered at
+            // about 7 scale (from z = -4) and left at 8.
+            let (lo, hi) = ([0.0, 0.0, 3.0 * scale], [scale, scale, 4.0 * scale]);
+            for d in [Vec3::Z, -Vec3::Z] {
+                let o = Vec3::new(scale, scale, -4.0 * scale * d.z);
+                let (lo, hi) = if d.z > 0.0 { (lo, hi) } else { ([lo[0], lo[1], -hi[2]], [hi[0], hi[1], -lo[2]]) };
+                let ray = SlabRay::new(o, d);
+                assert!(ray.is_parallel());
+                let ray = ray.within(root.0, root.1);
+                assert!(meets(&ray, lo, hi), "scale {scale}, d {d}: the ray lies in the box's faces");
+                // Boxes half a unit of scale beside it in x, on either side
+                // (the ray at x = scale): culled now; at scale 1 the one on
+                // the side of x's far plane (by the sign of d.x, ±0) passed
+                // with the bias of f32::MAX.
+                let below = ([-scale, lo[1], lo[2]], [0.5 * scale, hi[1], hi[2]]);
+                let above = ([1.5 * scale, lo[1], lo[2]], [2.5 * scale, hi[1], hi[2]]);
+                for (b, side) in [(below, "below"), (above, "above")] {
+                    assert!(!meets(&ray, b.0, b.1), "scale {scale}, d {d}: the box {side} the ray");
+                }
+                if scale == 1.0 {
+                    let unbounded = SlabRay::new(o, d);
+                    assert!(meets(&unbounded, below.0, below.1) || meets(&unbounded, above.0, above.1), "the old bias");
+                }
+            }
+        }
+        // No parallel axis: unchanged.
+        let ray = SlabRay::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
+        assert!(!ray.is_parallel());
+        assert_eq!(ray.within([-1.0; 3], [1.0; 3]).far_bias, [0.0; 3]);
     }
 
     #[test]

@@ -163,7 +163,11 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     // The bases of the nodes and leaf primitives of the mesh the walk is
     // in (0 in the top level), and the ray in its space.
     let (mut node_base, mut leaf_base) = (0u32, 0u32);
-    let (mut slabs, mut ray, mut at_ray) = (SlabRay::new(o, d), WatertightRay::new(o, d), (o, d, from));
+    // A plain walk bounds the far bias of an axis the ray runs parallel to
+    // by the root's box (`slab_ray`); the instanced walk does not yet (the
+    // check cost its kernel 8 registers: docs/results/h200-axis-rays-2026-12-02).
+    let slabs = if INSTANCED { SlabRay::new(o, d) } else { slab_ray(o, d, trees.nodes, 0) };
+    let (mut slabs, mut ray, mut at_ray) = (slabs, WatertightRay::new(o, d), (o, d, from));
     // Entries: node index and the entry distance it was pushed with; below
     // `floor`, the top level's (`usize::MAX` while in the top level).
     // `STACK` words: two a level of depth, for both levels when
@@ -198,8 +202,9 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             node = 0;
         }
         let n = trees.nodes.load((node_base + node) as usize);
-        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, hit.t);
-        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, hit.t);
+        let reach = hit.reach();
+        let (ln, lf) = slab_interval(n.left_min, n.left_max, &slabs, reach);
+        let (rn, rf) = slab_interval(n.right_min, n.right_max, &slabs, reach);
         let (mut go_left, mut go_right) = (ln <= lf, rn <= rf);
         // Leaves are tested at once; only internal children are walked.
         let before = hit;
@@ -246,7 +251,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
                     break;
                 }
                 top_len -= 1;
-                if f32::from_bits(get(&stack, 2 * top_len + 1)) <= hit.t {
+                if f32::from_bits(get(&stack, 2 * top_len + 1)) <= hit.reach() {
                     next = get(&stack, 2 * top_len);
                 }
             }
@@ -256,6 +261,27 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
             node = next;
         }
     }
+}
+
+/// The slab ray of `(o, d)` for the tree whose root is node `root`:
+/// [`SlabRay::within`] its box, which a ray parallel to an axis needs (one
+/// more load of the root, for those rays only: loading it for every ray
+/// cost short rays up to a fifth of their speed, and loading it once before
+/// a loop that loads each next node at its end cost 5-20%, both measured).
+/// Without it, a ray straight down a city of blocks entered 90 times the
+/// nodes of one tilted by a thousandth (`tests/layouts.rs`).
+#[inline]
+fn slab_ray(o: Vec3, d: Vec3, nodes: &(impl RecordLoad<Bvh2Node> + ?Sized), root: u32) -> SlabRay {
+    let slabs = SlabRay::new(o, d);
+    if !slabs.is_parallel() {
+        return slabs;
+    }
+    let r = nodes.load(root as usize);
+    let (a, b) = (r.left_min, r.right_min);
+    let lo = [a[0].min(b[0]), a[1].min(b[1]), a[2].min(b[2])];
+    let (a, b) = (r.left_max, r.right_max);
+    let hi = [a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])];
+    slabs.within(lo, hi)
 }
 
 /// Words at the end of an instanced walk's stack: the world ray (origin,

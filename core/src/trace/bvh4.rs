@@ -105,17 +105,32 @@ pub fn trace_bvh4<const F: u32>(
     if prims.count() == 0 {
         return hit;
     }
-    let (slabs, ray, at_ray) = (SlabRay::new(o, d), WatertightRay::new(o, d), (o, d, from));
+    let mut slabs = SlabRay::new(o, d);
+    if slabs.is_parallel() {
+        // See `SlabRay::within`: the root's box, the union of its slots'.
+        let r = nodes.load(0);
+        let (mut lo, mut hi) = r.slot_box(0);
+        let mut k = 1;
+        while k < 4 {
+            let (l, h) = r.slot_box(k);
+            lo = [lo[0].min(l[0]), lo[1].min(l[1]), lo[2].min(l[2])];
+            hi = [hi[0].max(h[0]), hi[1].max(h[1]), hi[2].max(h[2])];
+            k += 1;
+        }
+        slabs = slabs.within(lo, hi);
+    }
+    let (ray, at_ray) = (WatertightRay::new(o, d), (o, d, from));
     // Entries: node index and the entry distance it was pushed with.
     let mut stack = scratch::<u32, { 2 * BVH4_STACK_ENTRIES }>();
     let mut top = 0usize;
     let mut node = 0u32;
     loop {
         let n = nodes.load(node as usize);
-        let s0 = slab_interval(n.slot_box(0).0, n.slot_box(0).1, &slabs, hit.t);
-        let s1 = slab_interval(n.slot_box(1).0, n.slot_box(1).1, &slabs, hit.t);
-        let s2 = slab_interval(n.slot_box(2).0, n.slot_box(2).1, &slabs, hit.t);
-        let s3 = slab_interval(n.slot_box(3).0, n.slot_box(3).1, &slabs, hit.t);
+        let reach = hit.reach();
+        let s0 = slab_interval(n.slot_box(0).0, n.slot_box(0).1, &slabs, reach);
+        let s1 = slab_interval(n.slot_box(1).0, n.slot_box(1).1, &slabs, reach);
+        let s2 = slab_interval(n.slot_box(2).0, n.slot_box(2).1, &slabs, reach);
+        let s3 = slab_interval(n.slot_box(3).0, n.slot_box(3).1, &slabs, reach);
         // Leaves are tested at once, in slot order; only internal children
         // are walked.
         if s0.0 <= s0.1 && n.count[0] > 0 {
@@ -133,10 +148,11 @@ pub fn trace_bvh4<const F: u32>(
         if query.done(&hit) {
             return hit;
         }
-        let mut c0 = candidate(n.child[0], n.count[0], s0, hit.t);
-        let mut c1 = candidate(n.child[1], n.count[1], s1, hit.t);
-        let mut c2 = candidate(n.child[2], n.count[2], s2, hit.t);
-        let mut c3 = candidate(n.child[3], n.count[3], s3, hit.t);
+        let reach = hit.reach();
+        let mut c0 = candidate(n.child[0], n.count[0], s0, reach);
+        let mut c1 = candidate(n.child[1], n.count[1], s1, reach);
+        let mut c2 = candidate(n.child[2], n.count[2], s2, reach);
+        let mut c3 = candidate(n.child[3], n.count[3], s3, reach);
         // Five exchanges sort four.
         order(&mut c0, &mut c1);
         order(&mut c2, &mut c3);
@@ -154,7 +170,7 @@ pub fn trace_bvh4<const F: u32>(
             let mut next = u32::MAX;
             while next == u32::MAX && top > 0 {
                 top -= 1;
-                if f32::from_bits(get(&stack, 2 * top + 1)) <= hit.t {
+                if f32::from_bits(get(&stack, 2 * top + 1)) <= hit.reach() {
                     next = get(&stack, 2 * top);
                 }
             }

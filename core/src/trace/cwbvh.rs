@@ -269,8 +269,8 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
             let x = Axis::new(n.lo_x, n.hi_x, n.exp_imask & 0xFF, n.origin[0], o.x, inv[0]);
             let y = Axis::new(n.lo_y, n.hi_y, (n.exp_imask >> 8) & 0xFF, n.origin[1], o.y, inv[1]);
             let z = Axis::new(n.lo_z, n.hi_z, (n.exp_imask >> 16) & 0xFF, n.origin[2], o.z, inv[2]);
-            let mask = hit_bits(&x, &y, &z, n.meta[0], 0, oct_inv4, hit.t)
-                | hit_bits(&x, &y, &z, n.meta[1], 1, oct_inv4, hit.t);
+            let reach = hit.reach();
+            let mask = hit_bits(&x, &y, &z, n.meta[0], 0, oct_inv4, reach) | hit_bits(&x, &y, &z, n.meta[1], 1, oct_inv4, reach);
             node_base = n.child_base;
             node_hits = (mask & 0xFF00_0000) | (n.exp_imask >> 24);
             prim_base = n.prim_base;

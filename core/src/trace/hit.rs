@@ -117,4 +117,15 @@ impl Hit {
     pub fn is_beaten_by(&self, t: f32, prim: u32) -> bool {
         t < self.t || (t == self.t && t != MISS && prim < self.prim)
     }
+
+    /// How far a traversal still enters boxes: this hit's distance widened
+    /// as a slab test widens it
+    /// ([`FAR_WIDENING`](crate::geometry::intersect::FAR_WIDENING): for
+    /// ties between primitives that share an edge or vertex), for the tests
+    /// that compare a box's entry with the hit (a child pushed, a cwbvh
+    /// node's children); infinite for no hit.
+    #[inline]
+    pub fn reach(&self) -> f32 {
+        self.t * crate::geometry::intersect::FAR_WIDENING
+    }
 }
