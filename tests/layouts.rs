@@ -11,7 +11,7 @@ use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::{wide_nodes, Layout, TracedTree};
 use treelet::scene::primitives::Primitives;
-use treelet::bvh::tree::{binary_tree_split, split_budget, traced_tree_with, Accel};
+use treelet::bvh::tree::{binary_tree_split, binary_tree_with, split_budget, Accel};
 use treelet::bvh::trbvh::{TreeletConfig, GPU_TRBVH_REINSERT};
 use treelet::scene::{random_spheres, Scene};
 use treelet::bvh::validate_layout::{validate_bvh2, validate_bvh2_split, validate_bvh4, validate_bvh4_split, validate_wide, validate_wide_split};
@@ -24,7 +24,7 @@ use treelet_core::trace::bvh2::closest_hit_bvh2;
 use treelet_core::trace::bvh4::closest_hit_bvh4;
 use treelet_core::trace::classic::{closest_hit_bvh, closest_hit_linear};
 use treelet_core::trace::cwbvh::closest_hit_cwbvh;
-use treelet_core::trace::hit::Hit;
+use treelet_core::trace::hit::{Hit, Query};
 
 /// A laid-out tree, read back.
 enum HostTree {
@@ -46,15 +46,25 @@ fn read<B: Backend>(b: &mut B, tree: &TracedTree<B>, n: usize) -> HostTree {
 /// The tree `accel` makes with the settings of a GPU's on any device: the
 /// TRBVH reinserts on GPUs and not on the CPU runner by default, so trees
 /// compared between the two are made alike.
-fn traced<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> TracedTree<B> {
+/// Also the tree's leaf slots: more than the primitives where the builder
+/// split large triangles (by default, within [`split_budget`]).
+fn traced<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> (TracedTree<B>, usize) {
     let config = TreeletConfig { reinsert: Some(GPU_TRBVH_REINSERT), ..TreeletConfig::default() };
-    let budget = accel.builder().unwrap().map_or(0.0, split_budget);
-    traced_tree_with(b, prims, accel, layout, budget, &config).unwrap().0
+    let builder = accel.builder().unwrap().unwrap();
+    let built = binary_tree_with(b, prims, builder, split_budget(builder), &config).unwrap();
+    let buffers = built.prim_buffers(b, prims).unwrap();
+    let (tree, _) = built.lay_out(b, layout, &buffers).unwrap();
+    (tree, built.bvh.n as usize)
+}
+
+/// The tree [`traced`] makes, read back, and its leaf slots.
+fn build_counted<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> (HostTree, usize) {
+    let (tree, slots) = traced(b, prims, accel, layout);
+    (read(b, &tree, slots), slots)
 }
 
 fn build<B: Backend>(b: &mut B, prims: Primitives, accel: Accel, layout: Layout) -> HostTree {
-    let tree = traced(b, prims, accel, layout);
-    read(b, &tree, prims.len())
+    build_counted(b, prims, accel, layout).0
 }
 
 impl HostTree {
@@ -91,16 +101,31 @@ fn primitive_centre(prims: &Prims, p: u32) -> Vec3 {
     }
 }
 
+/// Primitive `p`'s box (a sphere's as its centre plus and minus its radius,
+/// as the builders bound it).
+fn primitive_box(prims: &Prims, p: u32) -> (Vec3, Vec3) {
+    if p < prims.sphere_count {
+        let b = prims.spheres[p as usize].aabb();
+        (b.lo(), b.hi())
+    } else {
+        let t = prims.triangle(p - prims.sphere_count);
+        let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
+        (a.min(b).min(c), a.max(b).max(c))
+    }
+}
+
 /// Rays that probe a scene of bounds `lo..hi`: from outside through it,
-/// from inside, exactly along an axis, and leaving the surface a scan hit
-/// (`Origin` set, as the renderer's bounces are). Each with the scan's hit.
+/// from inside, exactly along an axis (from outside, and through a
+/// primitive's corner, so lying in the faces of the boxes around it), and
+/// leaving the surface a scan hit (`Origin` set, as the renderer's bounces
+/// are). Each with the scan's hit.
 fn rays(prims: &Prims, lo: Vec3, hi: Vec3, seed: u32, count: u32) -> Vec<(Vec3, Vec3, Origin, Hit)> {
     let (center, size) = ((lo + hi) * 0.5, (hi - lo).max_element().max(1e-30));
     let mut out = Vec::new();
     for i in 0..count {
         let r = BounceRng::new(seed, i, 0, 0);
         let target = lo + (hi - lo) * vec3(&r, 0);
-        let (o, d) = match i % 4 {
+        let (o, d) = match i % 5 {
             0 => {
                 let d = (vec3(&r, 3) - 0.5).normalize_or(Vec3::X);
                 (target - d * (2.0 * size), d)
@@ -113,6 +138,23 @@ fn rays(prims: &Prims, lo: Vec3, hi: Vec3, seed: u32, count: u32) -> Vec<(Vec3, 
                 d[axis] = if r.uniform(10) < 0.5 { -1.0 } else { 1.0 };
                 let d = Vec3::from_array(d);
                 (target - d * (2.0 * size), d)
+            }
+            4 => {
+                // Along an axis through a random primitive's box corner: the
+                // ray lies in faces of the boxes that hold it (a far face
+                // once made the slab test's distance 0 on that axis).
+                let p = ((r.uniform(13) * prims.count() as f32) as u32).min(prims.count() - 1);
+                let (plo, phi) = primitive_box(prims, p);
+                let corner = Vec3::select(glam::BVec3::new(r.uniform(14) < 0.5, r.uniform(15) < 0.5, r.uniform(16) < 0.5), plo, phi);
+                let axis = (r.uniform(9) * 3.0) as usize % 3;
+                let mut d = [0.0f32; 3];
+                d[axis] = if r.uniform(10) < 0.5 { -1.0 } else { 1.0 };
+                let d = Vec3::from_array(d);
+                // From outside the scene on that axis, keeping the corner's
+                // other two coordinates exactly.
+                let mut o = corner.to_array();
+                o[axis] = if d[axis] > 0.0 { lo[axis] - size } else { hi[axis] + size };
+                (Vec3::from_array(o), d)
             }
             _ => {
                 // At a random primitive's centre, from outside the scene.
@@ -151,8 +193,13 @@ fn every_layout_traces_like_the_scan(what: &str, spheres: &[Sphere], triangles: 
     let b = &mut CpuBackend::new();
     for accel in [Accel::Lbvh, Accel::Trbvh, Accel::Hploc, Accel::Sweep] {
         for layout in Layout::ALL {
-            let tree = build(b, prims, accel, layout);
-            tree.validate(prims);
+            // Split trees (large triangles in pieces) by their own validator.
+            let (tree, slots) = build_counted(b, prims, accel, layout);
+            if slots > prims.len() {
+                tree.validate_split(prims, what);
+            } else {
+                tree.validate(prims);
+            }
             for (k, &(o, d, from, scan)) in probes.iter().enumerate() {
                 let hit = tree.trace(o, d, from, &scene);
                 assert!(
@@ -359,6 +406,104 @@ fn stiff_scenes() {
     every_layout_traces_like_the_scan("identical centres", &same, &[], seed);
 }
 
+/// `n` x `n` axis-aligned boxes on a grid of `step` (each `0.8 step` wide,
+/// of heights from `step` to `3 step`), their five faces as triangles, on a
+/// ground quad: walls and roofs in planes that many boxes share, as in
+/// architectural scenes, which axis-parallel rays lie in.
+fn blocks(n: usize, step: f32) -> Vec<Triangle> {
+    let mut out = Vec::new();
+    let mut quad = |a: [f32; 3], b: [f32; 3], c: [f32; 3], d: [f32; 3]| {
+        out.push(Triangle::new(a, b, c));
+        out.push(Triangle::new(a, c, d));
+    };
+    let size = n as f32 * step;
+    quad([0.0, 0.0, 0.0], [size, 0.0, 0.0], [size, 0.0, size], [0.0, 0.0, size]);
+    for i in 0..n {
+        for j in 0..n {
+            let (x0, z0) = (i as f32 * step, j as f32 * step);
+            let (x1, z1) = (x0 + 0.75 * step, z0 + 0.75 * step);
+            let y = step * (1 + (i * 7 + j * 3) % 3) as f32;
+            quad([x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]);
+            quad([x0, 0.0, z0], [x1, 0.0, z0], [x1, y, z0], [x0, y, z0]);
+            quad([x0, 0.0, z1], [x1, 0.0, z1], [x1, y, z1], [x0, y, z1]);
+            quad([x0, 0.0, z0], [x0, 0.0, z1], [x0, y, z1], [x0, y, z0]);
+            quad([x1, 0.0, z0], [x1, 0.0, z1], [x1, y, z1], [x1, y, z0]);
+        }
+    }
+    out
+}
+
+#[test]
+fn axis_aligned_blocks() {
+    let seed = treelet_tests::fresh_seed() as u32;
+    // Steps of a power of two keep every plane exact at every scale.
+    for (step, what) in [(0.25f32, "blocks"), (0.25 * 2f32.powi(32), "blocks near 1e10"), (0.25 * 2f32.powi(-32), "blocks near 1e-9")] {
+        every_layout_traces_like_the_scan(what, &[], &blocks(12, step), seed);
+    }
+}
+
+/// A node load counter over a slice (the traversals read through
+/// `RecordLoad`).
+struct Counted<'a, T> {
+    records: &'a [T],
+    loads: &'a std::cell::Cell<u64>,
+}
+
+impl<T: Copy> treelet_core::geometry::records::RecordLoad<T> for Counted<'_, T> {
+    fn load(&self, i: usize) -> T {
+        self.loads.set(self.loads.get() + 1);
+        self.records[i]
+    }
+}
+
+/// A ray straight down (two direction components exactly zero, as an
+/// engine's ground query) does about the work of one tilted by a
+/// thousandth, in the binary layouts: it once entered every box within a
+/// unit of it beside, a few hundred of these blocks.
+#[test]
+fn axis_parallel_rays_do_no_more_work_than_tilted_ones() {
+    let triangles = blocks(40, 0.05);
+    let prims = Primitives { spheres: &[], triangles: &triangles };
+    let scene = Prims::new(&[], &triangles);
+    let b = &mut CpuBackend::new();
+    let seed = treelet_tests::fresh_seed() as u32;
+    for layout in [Layout::Bvh2, Layout::Bvh4] {
+        let tree = build(b, prims, Accel::Trbvh, layout);
+        let (straight, tilted) = (std::cell::Cell::new(0u64), std::cell::Cell::new(0u64));
+        for i in 0..400 {
+            let r = BounceRng::new(seed, i, 0, 0);
+            let o = Vec3::new(0.1 + 1.8 * r.uniform(0), 0.5, 0.1 + 1.8 * r.uniform(1));
+            for (d, loads) in [(Vec3::NEG_Y, &straight), (Vec3::new(1e-3, -1.0, 1e-3).normalize(), &tilted)] {
+                let hit = match &tree {
+                    HostTree::Bvh2(nodes, leaf) => treelet_core::trace::bvh2::trace_bvh2::<ALL>(
+                        o,
+                        d,
+                        Origin::NONE,
+                        Query::CLOSEST,
+                        &scene,
+                        &Counted { records: nodes, loads },
+                        &leaf[..],
+                    ),
+                    HostTree::Bvh4(nodes, leaf) => treelet_core::trace::bvh4::trace_bvh4::<ALL>(
+                        o,
+                        d,
+                        Origin::NONE,
+                        Query::CLOSEST,
+                        &scene,
+                        &Counted { records: nodes, loads },
+                        &leaf[..],
+                    ),
+                    _ => unreachable!(),
+                };
+                let scan = closest_hit_linear(o, d, Origin::NONE, &scene);
+                assert!(hit.t == scan.t && hit.prim == scan.prim, "{}: ray {i} along {d}", layout.name());
+            }
+        }
+        let (s, t) = (straight.get() as f64 / 400.0, tilted.get() as f64 / 400.0);
+        assert!(s <= 1.5 * t + 4.0, "{}: {s:.1} nodes a ray straight down against {t:.1} tilted", layout.name());
+    }
+}
+
 #[test]
 fn tiny_scenes() {
     let seed = treelet_tests::fresh_seed() as u32;
@@ -514,7 +659,7 @@ fn bvh2_refit_in_place_fits_the_moved_primitives() {
 /// counters otherwise than it found them would misplace the last refit's
 /// boxes).
 fn refit_in_place<B: Backend>(b: &mut B, prims: Primitives, moved: Primitives, accel: Accel) -> HostTree {
-    let tree = traced(b, prims, accel, Layout::Bvh2);
+    let (tree, _) = traced(b, prims, accel, Layout::Bvh2);
     assert!(tree.collapsed.is_some(), "a bvh2 layout keeps its collapsed tree");
     let mut counters = None;
     for frame in [moved, prims, moved] {
