@@ -85,8 +85,12 @@ fn count<B: Backend>(b: &mut B) -> Result<()> {
     let mut disagreements = 0;
     for pass in 0..2 {
         let before: Vec<u64> = counts.iter().map(Cell::get).collect();
+        // bvh2 steps (nodes + leaf primitives) of each ray, by pixel, for
+        // the spread: a warp runs as long as its longest ray.
+        let mut steps = vec![0u64; (w * h) as usize];
         for y in 0..h {
             for x in 0..w {
+                let at = counts[0].get() + counts[1].get();
                 let (o, d) = camera.primary_ray(x, h - 1 - y, 0, w, h, (0.5, 0.5));
                 let (o, d, from) = if pass == 0 {
                     (o, d, Origin::NONE)
@@ -125,9 +129,11 @@ fn count<B: Backend>(b: &mut B) -> Result<()> {
                     &mut [0u32; 1],
                     0,
                 );
+                steps[(y * w + x) as usize] = counts[0].get() + counts[1].get() - at;
                 disagreements += (a.t != c.t || a.prim != c.prim) as u32;
             }
         }
+        print_spread(&steps, w, h);
         let per = |k: usize| (counts[k].get() - before[k]) as f64 / rays[pass].max(1) as f64;
         let name = if pass == 0 { "primary" } else { "diffuse" };
         println!(
@@ -143,4 +149,33 @@ fn count<B: Backend>(b: &mut B) -> Result<()> {
     }
     println!("hits that differ between the layouts: {disagreements} (must be 0)");
     Ok(())
+}
+
+/// Percentiles of the bvh2 steps a ray, and how busy a warp's lanes are
+/// in tiles of 8x4 pixels (the mean over the tile's rays against its
+/// longest: the share of lane-steps doing work if a warp were one tile).
+fn print_spread(steps: &[u64], w: u32, h: u32) {
+    let mut sorted: Vec<u64> = steps.iter().copied().filter(|&s| s > 0).collect();
+    sorted.sort_unstable();
+    if sorted.is_empty() {
+        return;
+    }
+    let q = |f: f64| sorted[((sorted.len() - 1) as f64 * f) as usize];
+    let (mut sum, mut max_sum) = (0u64, 0u64);
+    for ty in 0..h / 4 {
+        for tx in 0..w / 8 {
+            let tile = (0..32).map(|k| steps[((ty * 4 + k / 8) * w + tx * 8 + k % 8) as usize]);
+            sum += tile.clone().sum::<u64>();
+            max_sum += 32 * tile.max().unwrap_or(0);
+        }
+    }
+    println!(
+        "          bvh2 steps a ray: median {}, 90% {}, 99% {}, 99.9% {}, max {}; lanes busy in 8x4 tiles {:.0}%",
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(0.999),
+        sorted[sorted.len() - 1],
+        100.0 * sum as f64 / max_sum.max(1) as f64
+    );
 }
