@@ -30,6 +30,11 @@
 //! # anyhow::Ok(())
 //! ```
 //!
+//! An engine that has no use for the `treelet` command depends on the
+//! crate with `default-features = false`: the feature `cli` (on by default)
+//! brings in clap and the command line's parsing of the option types
+//! ([`Accel`](bvh::tree::Accel), [`Layout`](bvh::layout::Layout) and the rest).
+//!
 //! ### On the engine's own GPU device
 //!
 //! An engine opens its wgpu device with the features and limits Treelet

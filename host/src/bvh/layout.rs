@@ -17,7 +17,8 @@ use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
 
 /// How a tree is stored for traversal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Layout {
     /// The fastest measured on the device: bvh2 on GPUs and on the CPU

@@ -15,7 +15,8 @@ use crate::scene::primitives::Primitives;
 /// Which BVH builder: the one type for `treelet build --builder`,
 /// `treelet bench build --builder`, a render's `--accel` (through
 /// [`Accel::builder`]) and the engine API's `Quality`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Builder {
     /// Karras 2012, on the chosen device.
@@ -50,7 +51,8 @@ impl Builder {
 }
 
 /// How closest hits are found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Accel {
     /// A linear scan for scenes below a measured size; above it lbvh,

@@ -9,7 +9,8 @@ use crate::bvh::tree::{tree_host_bytes, Accel};
 use crate::runtime::backend::DeviceClass;
 
 /// How radiance is estimated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Integrator {
     /// smallpt's: emitters count only where a path hits them.
@@ -56,7 +57,8 @@ impl Integrator {
 }
 
 /// Where camera paths draw their sample points (`--sampler`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Sampler {
     /// Every number an independent hash of (seed, pixel, sample, bounce,

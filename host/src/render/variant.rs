@@ -126,7 +126,8 @@ pub fn describe(bits: u32) -> String {
 }
 
 /// Which render kernel to run.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum KernelChoice {
     /// The smallest variant compiled for the scene's features.

@@ -9,7 +9,8 @@ use anyhow::{Context, Result};
 use crate::runtime::gpu::GpuContext;
 
 /// Where work runs (`--device`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum DeviceChoice {
     /// The first GPU; the CPU runner when there is none (a Vulkan adapter
     /// on CPU cores, such as lavapipe, is slower than the CPU runner there).
