@@ -101,17 +101,10 @@ fn primitive_centre(prims: &Prims, p: u32) -> Vec3 {
     }
 }
 
-/// Primitive `p`'s box (a sphere's as its centre plus and minus its radius,
-/// as the builders bound it).
+/// Primitive `p`'s box, as the builders bound it.
 fn primitive_box(prims: &Prims, p: u32) -> (Vec3, Vec3) {
-    if p < prims.sphere_count {
-        let b = prims.spheres[p as usize].aabb();
-        (b.lo(), b.hi())
-    } else {
-        let t = prims.triangle(p - prims.sphere_count);
-        let (a, b, c) = (Vec3::from_array(t.v0), Vec3::from_array(t.v1), Vec3::from_array(t.v2));
-        (a.min(b).min(c), a.max(b).max(c))
-    }
+    let b = if p < prims.sphere_count { prims.spheres[p as usize].aabb() } else { prims.triangle(p - prims.sphere_count).aabb() };
+    (b.lo(), b.hi())
 }
 
 /// Rays that probe a scene of bounds `lo..hi`: from outside through it,
