@@ -127,15 +127,24 @@ fn hit_bits(x: &Axis, y: &Axis, z: &Axis, meta: u32, word: usize, oct_inv4: u32,
     let is_internal = (meta & (meta << 1)) & 0x1010_1010;
     let bit_index = (meta ^ (oct_inv4 & byte_masks(is_internal << 3))) & 0x1F1F_1F1F;
     let child_bits = (meta >> 5) & 0x0707_0707;
-    let mut mask = 0u32;
-    let mut shift = 0u32;
-    while shift < 32 {
-        if child_hit(x, y, z, word, shift, t_max) {
-            mask |= ((child_bits >> shift) & 0xFF) << ((bit_index >> shift) & 0x1F);
-        }
-        shift += 8;
+    // Written out rather than looped: each byte's shift is then a
+    // constant, whatever the driver makes of a loop.
+    child_mask(x, y, z, word, 0, child_bits, bit_index, t_max)
+        | child_mask(x, y, z, word, 8, child_bits, bit_index, t_max)
+        | child_mask(x, y, z, word, 16, child_bits, bit_index, t_max)
+        | child_mask(x, y, z, word, 24, child_bits, bit_index, t_max)
+}
+
+/// Child `(word, shift)`'s hit bits if the ray meets its box, else 0.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn child_mask(x: &Axis, y: &Axis, z: &Axis, word: usize, shift: u32, child_bits: u32, bit_index: u32, t_max: f32) -> u32 {
+    let bits = ((child_bits >> shift) & 0xFF) << ((bit_index >> shift) & 0x1F);
+    if child_hit(x, y, z, word, shift, t_max) {
+        bits
+    } else {
+        0
     }
-    mask
 }
 
 /// A tree in this layout: nodes (root 0) and leaf primitives.
