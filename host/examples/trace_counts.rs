@@ -45,6 +45,8 @@ impl<T: Copy> RecordLoad<T> for Counted<'_, T> {
 }
 
 fn main() -> Result<()> {
+    // The TREELET_* knobs (TREELET_SPLITS among them), as the command takes them.
+    let _ = treelet::tuning::Tuning::from_env()?.install();
     if std::env::var("TREELET_COUNTS_DEVICE").is_ok_and(|d| d == "gpu") {
         let ctx = GpuContext::new()?;
         println!("trees built on {}", ctx.info.name);

@@ -116,6 +116,7 @@ pub mod render;
 pub mod runtime;
 pub mod scene;
 pub mod tracer;
+pub mod tuning;
 
 pub use runtime::backend::Backend;
 pub use runtime::cpu_runner::CpuBackend;

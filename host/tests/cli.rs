@@ -1134,14 +1134,17 @@ fn hostile_arguments_and_outputs_get_clear_errors() {
     std::fs::write(dir.join("p.exr"), b"not read").unwrap();
     let e = stderr_of(&["render", "--device", "cpu", "--resume", &path("p.exr"), "--out", &path("p.exr")]);
     assert!(e.contains("--resume") && e.contains("same file"), "{e}");
-    // A memory cap that cannot be read is an error, not ignored.
-    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
-        .args(["build", "--scene", "random:100", "--device", "cpu"])
-        .env("TREELET_MAX_MEMORY", "lots")
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("TREELET_MAX_MEMORY=lots"), "{err}");
+    // A memory cap, or any other TREELET_* knob, that cannot be read is an
+    // error that names it, not a knob ignored.
+    for (name, value) in [("TREELET_MAX_MEMORY", "lots"), ("TREELET_SPLITS", "-1"), ("TREELET_SORT_TILES", "huge"), ("TREELET_TREELETS", "3,3")] {
+        let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+            .args(["build", "--scene", "random:100", "--device", "cpu"])
+            .env(name, value)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.code() == Some(1) && err.contains(&format!("{name}={value}: ")), "{err}");
+    }
     // A folder that is a file is called a file.
     std::fs::write(dir.join("afile"), b"x").unwrap();
     let e = stderr_of(&["render", "--device", "cpu", "--out", &path("afile/out.png")]);

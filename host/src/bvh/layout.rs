@@ -210,13 +210,7 @@ pub fn tree_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<u32> {
 /// The wide DP's cost model: the defaults, or for developers tuning it,
 /// `TREELET_WIDE_COSTS=NODE,PRIM`.
 fn wide_costs() -> (f32, f32) {
-    std::env::var("TREELET_WIDE_COSTS")
-        .ok()
-        .and_then(|v| {
-            let (a, b) = v.split_once(',')?;
-            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
-        })
-        .unwrap_or((WIDE_NODE_COST, WIDE_PRIM_COST))
+    crate::tuning::Tuning::current().wide_costs.unwrap_or((WIDE_NODE_COST, WIDE_PRIM_COST))
 }
 
 fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -> LayoutParams {

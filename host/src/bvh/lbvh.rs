@@ -232,12 +232,12 @@ pub fn build_uploaded_split<B: Backend>(
 }
 
 /// Extra references that triangle splitting may add, as a fraction of the
-/// triangles (`treelet_core::construct::presplit`), where `TREELET_SPLITS`
-/// sets it (0: no splitting) for every build; `None` where it is unset or
-/// not a finite number >= 0 (each builder's default then holds:
-/// `crate::bvh::tree::split_budget`).
+/// triangles (`treelet_core::construct::presplit`), where the process's
+/// [`Tuning`](crate::tuning::Tuning) sets it (`TREELET_SPLITS` for the
+/// command; 0: no splitting) for every build; `None` where it does not
+/// (each builder's default then holds: `crate::bvh::tree::split_budget`).
 pub fn split_override() -> Option<f32> {
-    std::env::var("TREELET_SPLITS").ok().and_then(|v| v.parse::<f32>().ok()).filter(|b| b.is_finite() && *b >= 0.0)
+    crate::tuning::Tuning::current().splits
 }
 
 /// The kernels splitting adds to a build.
@@ -355,11 +355,7 @@ fn build_from_first_pass<B: Backend>(
 
     b.stage("bounds");
     // Dev knob, to measure other key lengths (sort passes) against tree quality.
-    let key_bits = std::env::var("TREELET_MORTON_KEY_BITS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(SORTED_KEY_BITS)
-        .clamp(1, KEY_BITS);
+    let key_bits = crate::tuning::Tuning::current().morton_key_bits.unwrap_or(SORTED_KEY_BITS).clamp(1, KEY_BITS);
     params.key_shift = KEY_BITS - key_bits;
     if hierarchy == Hierarchy::Hploc {
         (params.cluster_keep, params.cluster_radius) = hploc_settings();
@@ -472,8 +468,8 @@ fn build_from_first_pass<B: Backend>(
 /// (0: any two of the range): [`HPLOC_KEEP`] and [`HPLOC_RADIUS`], or
 /// `TREELET_HPLOC_KEEP` and `TREELET_HPLOC_RADIUS` (0: the most) to measure.
 pub fn hploc_settings() -> (u32, u32) {
-    let get = |name: &str, default| std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default);
-    (get("TREELET_HPLOC_KEEP", HPLOC_KEEP), get("TREELET_HPLOC_RADIUS", HPLOC_RADIUS))
+    let tuning = crate::tuning::Tuning::current();
+    (tuning.hploc_keep.unwrap_or(HPLOC_KEEP), tuning.hploc_radius.unwrap_or(HPLOC_RADIUS))
 }
 
 /// Clusters a merged range keeps: 2, not the paper's 16. Measured on the
@@ -530,14 +526,10 @@ impl Hierarchy {
         })
     }
 
-    /// The hierarchy `TREELET_HIERARCHY` asks for, if it does.
+    /// The hierarchy the process's [`Tuning`](crate::tuning::Tuning) asks
+    /// for (`TREELET_HIERARCHY` for the command), if it does.
     pub fn from_env() -> Option<Hierarchy> {
-        match std::env::var("TREELET_HIERARCHY").as_deref() {
-            Ok("radix") => Some(Hierarchy::RadixTreeThenFit),
-            Ok("agglomerative") => Some(Hierarchy::Agglomerative),
-            Ok("subgroup") => Some(Hierarchy::AgglomerativeSubgroup),
-            _ => None,
-        }
+        crate::tuning::Tuning::current().hierarchy
     }
 
     /// The kernels of a hierarchy (`ordered` as the device allows: see

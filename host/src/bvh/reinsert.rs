@@ -35,7 +35,7 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
     // Developers' switch: `TREELET_REINSERT_LEAVES=0` moves internal nodes only (nodes
     // 1 to n - 2 in the LBVH layout: the first n - 2 moves), half the searches.
-    let leaves = std::env::var("TREELET_REINSERT_LEAVES").map_or(true, |v| v != "0");
+    let leaves = crate::tuning::Tuning::current().reinsert_leaves;
     let searched = if leaves { movers } else { n - 2 };
     let (move_groups, node_groups) = (groups_for(searched, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
     for iteration in 0..iterations {

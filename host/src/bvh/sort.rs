@@ -91,12 +91,8 @@ impl SortTiles {
         if self != SortTiles::Auto {
             return self;
         }
-        match std::env::var("TREELET_SORT_TILES").as_deref() {
-            Ok("small") => SortTiles::Small,
-            Ok("large") => SortTiles::Large,
-            Ok("multisplit") => SortTiles::Multisplit,
-            Ok("multisplit-small") => SortTiles::MultisplitSmall,
-            Ok("multisplit-medium") => SortTiles::MultisplitMedium,
+        match crate::tuning::Tuning::current().sort_tiles {
+            Some(tiles) => tiles,
             _ if n <= if multisplit { SMALL_TILES_BESIDE_MULTISPLIT_UP_TO } else { SMALL_TILES_UP_TO } => {
                 SortTiles::Small
             }
@@ -286,7 +282,7 @@ fn high_first<B: Backend>(
 /// Whether builds sort by the high digits first ([`radix_sort_high_first`]):
 /// yes, unless `TREELET_SORT_HIGH_FIRST=0` (to measure against).
 pub fn high_first_by_default() -> bool {
-    std::env::var("TREELET_SORT_HIGH_FIRST").map_or(true, |v| v != "0")
+    crate::tuning::Tuning::current().sort_high_first
 }
 
 /// Stable sort of `n` pairs by the digits `passes` (a range of

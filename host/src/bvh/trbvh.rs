@@ -66,15 +66,9 @@ impl Default for TreeletConfig {
     /// `TREELET_TREELETS=ROUNDS,GAMMA,MAX_LEAF`, `TREELET_REINSERT=ITERATIONS`
     /// and `TREELET_REINSERT_CLIMB=ANCESTORS`.
     fn default() -> Self {
-        let (rounds, gamma, max_leaf) = std::env::var("TREELET_TREELETS")
-            .ok()
-            .and_then(|v| {
-                let n: Vec<u32> = v.split(',').map(|x| x.trim().parse().ok()).collect::<Option<_>>()?;
-                (n.len() == 3 && n[2] >= 1).then(|| (n[0], n[1], n[2]))
-            })
-            .unwrap_or((3, 3, 8));
-        let env = |name| std::env::var(name).ok().and_then(|v| v.trim().parse::<u32>().ok());
-        let (reinsert, reinsert_climb) = (env("TREELET_REINSERT"), env("TREELET_REINSERT_CLIMB").unwrap_or(REINSERT_CLIMB));
+        let tuning = crate::tuning::Tuning::current();
+        let (rounds, gamma, max_leaf) = tuning.treelets.unwrap_or((3, 3, 8));
+        let (reinsert, reinsert_climb) = (tuning.reinsert, tuning.reinsert_climb.unwrap_or(REINSERT_CLIMB));
         Self {
             rounds,
             gamma,
@@ -124,7 +118,7 @@ impl TreeletConfig {
 
 /// [`SINGLE_INVOCATION_HEIGHTS`], or `TREELET_SINGLE_HEIGHTS` (to measure).
 fn single_invocation_heights() -> u32 {
-    std::env::var("TREELET_SINGLE_HEIGHTS").ok().and_then(|v| v.parse().ok()).unwrap_or(SINGLE_INVOCATION_HEIGHTS)
+    crate::tuning::Tuning::current().single_heights.unwrap_or(SINGLE_INVOCATION_HEIGHTS)
 }
 
 /// Per-node scratch the passes share.
@@ -197,9 +191,10 @@ fn rounds<B: Backend>(
         ["round 1", "round 2", "round 3", "round 4", "round 5", "round 6", "round 7", "round 8"];
     let mut gamma = config.gamma;
     // Developers' profiling switch: time each height as its own stage.
-    let profile_levels = std::env::var_os("TREELET_PROFILE_LEVELS").is_some();
+    let profile = crate::tuning::Tuning::current().profile_levels;
+    let profile_levels = profile.is_some();
     // ... and with `empty`, an empty launch after each height.
-    let profile_empty = std::env::var("TREELET_PROFILE_LEVELS").is_ok_and(|v| v == "empty");
+    let profile_empty = profile == Some(crate::tuning::ProfileLevels::WithEmptyLaunches);
     let single_heights = config.single_heights;
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
@@ -280,7 +275,7 @@ fn rounds<B: Backend>(
         b.stage("reinsert");
         let iterations = config.reinsert_iterations();
         let made = crate::bvh::reinsert::reinsert(b, &bvh, root_box, iterations, config.reinsert_climb)?;
-        if std::env::var_os("TREELET_PROFILE_REINSERT").is_some() {
+        if crate::tuning::Tuning::current().profile_reinsert {
             let made = crate::bvh::reinsert::moves_made(b, made.as_ref(), iterations)?;
             eprintln!("reinsertion: moves made per iteration {made:?}");
         }

@@ -694,8 +694,9 @@ fn bound_threads() {
 
 fn run(cli: Cli) -> Result<bool> {
     treelet::input::set_max_input_bytes(cli.max_input_bytes);
-    // A cap that cannot be read is an error before any work, not ignored.
-    treelet::runtime::memory::memory_cap()?;
+    // Every TREELET_* knob, read and checked once, before any work: a value
+    // that does not parse is an error, not a knob ignored.
+    let _ = treelet::tuning::Tuning::from_env()?.install();
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, reinsert, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });

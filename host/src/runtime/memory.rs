@@ -5,27 +5,22 @@ use anyhow::{bail, Result};
 
 /// Bytes of memory available to new allocations (free, plus caches the
 /// kernel gives back), or `None` where it cannot be read.
-/// `TREELET_MAX_MEMORY` caps it (to leave room for other work on a
-/// shared machine, and for tests): see [`memory_cap`].
+/// The process's [`Tuning`](crate::tuning::Tuning) caps it
+/// (`TREELET_MAX_MEMORY` for the command: room for other work on a shared
+/// machine, and for tests): see [`memory_cap`].
 pub fn available_bytes() -> Option<u64> {
-    let cap = memory_cap().ok().flatten();
+    let cap = memory_cap();
     match (machine_available_bytes(), cap) {
         (Some(a), Some(c)) => Some(a.min(c)),
         (a, c) => a.or(c),
     }
 }
 
-/// The cap `TREELET_MAX_MEMORY` sets (`None` where unset or empty): bytes,
-/// or a number with a unit (`8GiB`, `512M`, `1.5GB`; see [`parse_bytes`]).
-/// A value that is neither is an error that names the variable, not a cap
-/// silently ignored.
-pub fn memory_cap() -> Result<Option<u64>> {
-    match std::env::var("TREELET_MAX_MEMORY") {
-        Err(std::env::VarError::NotPresent) => Ok(None),
-        Err(std::env::VarError::NotUnicode(_)) => bail!("TREELET_MAX_MEMORY is not text"),
-        Ok(v) if v.trim().is_empty() => Ok(None),
-        Ok(v) => parse_bytes(&v).map(Some).map_err(|e| anyhow::anyhow!("TREELET_MAX_MEMORY={v}: {e}")),
-    }
+/// The cap `TREELET_MAX_MEMORY` sets (`None` where unset or empty), as the
+/// process's [`Tuning`](crate::tuning::Tuning) holds it: bytes, or a number
+/// with a unit (`8GiB`, `512M`, `1.5GB`; see [`parse_bytes`]).
+pub fn memory_cap() -> Option<u64> {
+    crate::tuning::Tuning::current().max_memory
 }
 
 /// A size in bytes: a number, then an optional unit (any case): `B`; `K`,
@@ -102,7 +97,6 @@ pub fn human(bytes: u64) -> String {
 /// Refuses `what` if it needs more than the memory available: the error
 /// gives the estimate, what it is made of (`detail`) and the limit.
 pub fn check_fits(what: &str, needed: u64, detail: &str) -> Result<()> {
-    memory_cap()?;
     if let Some(available) = available_bytes() {
         if needed > available {
             bail!(

@@ -268,7 +268,7 @@ impl Backend for GpuBackend {
     fn look_back_works(&self) -> bool {
         // TREELET_SORT_LOOK_BACK=0 forces the sort without look-back (to measure it).
         self.ctx.info.device_type != wgpu::DeviceType::Cpu
-            && std::env::var("TREELET_SORT_LOOK_BACK").map_or(true, |v| v != "0")
+            && crate::tuning::Tuning::current().sort_look_back
     }
     fn min_subgroup_size(&self) -> u32 {
         // Vulkan's minSubgroupSize (subgroup size control, core in 1.3);
@@ -277,7 +277,7 @@ impl Backend for GpuBackend {
     }
     fn subgroup_partitioned(&self) -> bool {
         // TREELET_SORT_MATCH=ballots keeps the ballots (to measure).
-        self.ctx.subgroup_partitioned && std::env::var("TREELET_SORT_MATCH").map_or(true, |v| v != "ballots")
+        self.ctx.subgroup_partitioned && !crate::tuning::Tuning::current().sort_match_ballots
     }
     fn max_buffer_bytes(&self) -> u64 {
         self.ctx.max_buffer_bytes()

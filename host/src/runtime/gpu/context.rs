@@ -13,6 +13,7 @@ use std::time::Instant;
 use anyhow::{bail, Context as _, Result};
 
 use crate::runtime::kernels::{Access, Kernel};
+use crate::tuning::PipelineCache;
 
 use super::shaders::{self, SHADERS};
 
@@ -67,10 +68,10 @@ struct DiskCache {
 /// The folder of the pipeline cache: `TREELET_PIPELINE_CACHE` (a folder, or
 /// `off`), else `$XDG_CACHE_HOME/treelet`, else `$HOME/.cache/treelet`.
 fn cache_dir() -> Option<PathBuf> {
-    match std::env::var_os("TREELET_PIPELINE_CACHE") {
-        Some(v) if v == "off" => None,
-        Some(v) => Some(PathBuf::from(v)),
-        None => std::env::var_os("XDG_CACHE_HOME")
+    match &crate::tuning::Tuning::current().pipeline_cache {
+        PipelineCache::Off => None,
+        PipelineCache::At(dir) => Some(dir.clone()),
+        PipelineCache::Default => std::env::var_os("XDG_CACHE_HOME")
             .map(PathBuf::from)
             .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
             .map(|d| d.join("treelet")),
@@ -149,7 +150,7 @@ const PARTITIONED: &std::ffi::CStr = c"VK_NV_shader_subgroup_partitioned";
 /// Whether `adapter` has [`PARTITIONED`] and runs partition operations in
 /// compute shaders (`TREELET_SUBGROUP_PARTITIONED=0` says no, to measure).
 fn subgroup_partitioned_supported(adapter: &wgpu::Adapter) -> bool {
-    if std::env::var("TREELET_SUBGROUP_PARTITIONED").is_ok_and(|v| v == "0") {
+    if !crate::tuning::Tuning::current().subgroup_partitioned {
         return false;
     }
     // SAFETY: queries of the physical device only; the adapter, and with it
