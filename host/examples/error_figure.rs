@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use treelet::plot::{error_vs_time, Series};
+use treelet::internals::plot::{error_vs_time, Series};
 
 fn main() -> Result<()> {
     let dir = std::env::args().nth(1).unwrap_or_else(|| "docs/results/h100-nee".into());

@@ -86,8 +86,9 @@
 //!
 //! - [`runtime`]: where kernels run: the [`Backend`] trait, the GPU through
 //!   wgpu, and the CPU runner that calls the same kernel functions over
-//!   every invocation id; [`plot`]: charts for reports and benchmarks;
-//!   [`input`]: reading the files a user names (regular files only, capped);
+//!   every invocation id; [`tuning`]: the developers' knobs, read once;
+//!   [`internals`]: what the command uses that is not API (notes that
+//!   never panic, files read within caps, plots);
 //! - [`scene`]: what is built and rendered: spheres and triangles, meshes,
 //!   scene files, and the checks that reject bad input;
 //! - [`bvh`]: the BVH builders (LBVH, treelet restructuring, full-sweep
@@ -101,17 +102,15 @@
 //! The `treelet` command (`cli/`: `main.rs`, `bench/`) sits on top. The kernels
 //! themselves are in the `treelet-core` crate, which an engine may also use
 //! directly (`no_std`): see its docs for the traversal functions.
-/// Notes on standard error that never panic (see [`console`]); defined
+/// Notes on standard error that never panic (see [`internals::console`]); defined
 /// before the modules, so that theirs is this one.
 macro_rules! eprintln {
-    () => { $crate::console::err(format_args!("")) };
-    ($($t:tt)*) => { $crate::console::err(format_args!($($t)*)) };
+    () => { $crate::internals::console::err(format_args!("")) };
+    ($($t:tt)*) => { $crate::internals::console::err(format_args!($($t)*)) };
 }
 
-pub mod console;
+pub mod internals;
 pub mod bvh;
-pub mod input;
-pub mod plot;
 pub mod render;
 pub mod runtime;
 pub mod scene;

@@ -20,8 +20,6 @@
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use crate::bvh::lbvh::Hierarchy;
-use crate::bvh::sort::SortTiles;
 
 /// A `TREELET_*` variable whose value does not parse.
 #[derive(Debug, thiserror::Error)]
@@ -47,6 +45,29 @@ pub enum PipelineCache {
     At(PathBuf),
 }
 
+/// The radix sort's tiles, forced (`TREELET_SORT_TILES`; the builders map
+/// it onto `crate::bvh::sort::SortTiles`, a floor above this one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SortTiles {
+    Small,
+    Large,
+    Multisplit,
+    MultisplitSmall,
+    MultisplitMedium,
+}
+
+/// The LBVH's hierarchy, forced (`TREELET_HIERARCHY`; mapped onto
+/// `crate::bvh::lbvh::Hierarchy`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hierarchy {
+    /// `radix`: the radix tree, then the fit.
+    Radix,
+    /// `agglomerative`: both in one bottom-up pass.
+    Agglomerative,
+    /// `subgroup`: the same, the lowest levels within subgroups.
+    Subgroup,
+}
+
 /// Timing of the TRBVH's heights (`TREELET_PROFILE_LEVELS`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProfileLevels {
@@ -61,7 +82,7 @@ pub enum ProfileLevels {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tuning {
     /// `TREELET_MAX_MEMORY`: caps the host memory work may count on
-    /// (`8GiB`, `512M`, bytes: see [`crate::runtime::memory::parse_bytes`]).
+    /// (`8GiB`, `512M`, bytes: see [`parse_bytes`]).
     pub max_memory: Option<u64>,
     /// `TREELET_PIPELINE_CACHE`: a folder, or `off`.
     pub pipeline_cache: PipelineCache,
@@ -149,7 +170,7 @@ impl Tuning {
         let mut t = Tuning::default();
         let get = |name: &'static str| var(name).filter(|v| !v.trim().is_empty()).map(|v| (name, v));
         if let Some((name, v)) = get("TREELET_MAX_MEMORY") {
-            t.max_memory = Some(crate::runtime::memory::parse_bytes(&v).map_err(|why| err(name, &v, why))?);
+            t.max_memory = Some(parse_bytes(&v).map_err(|why| err(name, &v, why))?);
         }
         if let Some((_, v)) = get("TREELET_PIPELINE_CACHE") {
             t.pipeline_cache = if v == "off" { PipelineCache::Off } else { PipelineCache::At(PathBuf::from(v)) };
@@ -185,9 +206,9 @@ impl Tuning {
         }
         if let Some((name, v)) = get("TREELET_HIERARCHY") {
             t.hierarchy = Some(match v.trim() {
-                "radix" => Hierarchy::RadixTreeThenFit,
+                "radix" => Hierarchy::Radix,
                 "agglomerative" => Hierarchy::Agglomerative,
-                "subgroup" => Hierarchy::AgglomerativeSubgroup,
+                "subgroup" => Hierarchy::Subgroup,
                 _ => return Err(err(name, &v, "expected radix, agglomerative or subgroup")),
             });
         }
@@ -251,6 +272,33 @@ impl Tuning {
         static DEFAULTS: OnceLock<Tuning> = OnceLock::new();
         INSTALLED.get().unwrap_or_else(|| DEFAULTS.get_or_init(Tuning::default))
     }
+}
+
+/// A size in bytes: a number, then an optional unit (any case): `B`; `K`,
+/// `M`, `G`, `T` and `KiB`, `MiB`, `GiB`, `TiB` as powers of 1024; `KB`,
+/// `MB`, `GB`, `TB` as powers of 1000. At least one byte.
+pub fn parse_bytes(text: &str) -> std::result::Result<u64, String> {
+    let t = text.trim();
+    let split = t.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(t.len());
+    let (number, unit) = (t[..split].trim(), t[split..].trim());
+    let value: f64 = number.parse().map_err(|_| format!("`{t}` does not start with a number (use 8GiB, 512M or 1000000000)"))?;
+    let scale: f64 = match unit.to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "k" | "kib" => 1024.0,
+        "m" | "mib" => 1024f64.powi(2),
+        "g" | "gib" => 1024f64.powi(3),
+        "t" | "tib" => 1024f64.powi(4),
+        "kb" => 1e3,
+        "mb" => 1e6,
+        "gb" => 1e9,
+        "tb" => 1e12,
+        _ => return Err(format!("unknown unit `{unit}` (use B, K/KiB, M/MiB, G/GiB, T/TiB, or KB, MB, GB, TB)")),
+    };
+    let bytes = value * scale;
+    if !(bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("`{t}` is not a size between 1 byte and 16 EiB"));
+    }
+    Ok(bytes as u64)
 }
 
 fn err(name: &'static str, value: &str, why: impl Into<String>) -> TuningError {
@@ -328,6 +376,18 @@ mod tests {
             let e = from(&[(name, value)]).expect_err(value);
             assert_eq!(e.name, name);
             assert!(e.to_string().starts_with(&format!("{name}=")), "{e}");
+        }
+    }
+
+    #[test]
+    fn sizes_read_with_their_units() {
+        assert_eq!(parse_bytes("1000000000"), Ok(1_000_000_000));
+        assert_eq!(parse_bytes("1GB"), Ok(1_000_000_000));
+        assert_eq!(parse_bytes("1 GiB"), Ok(1 << 30));
+        assert_eq!(parse_bytes("512m"), Ok(512 << 20));
+        assert_eq!(parse_bytes("1.5K"), Ok(1536));
+        for bad in ["lots", "1XB", "0", "-5", "1e999", ""] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
         }
     }
 }

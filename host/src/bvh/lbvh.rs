@@ -529,7 +529,12 @@ impl Hierarchy {
     /// The hierarchy the process's [`Tuning`](crate::tuning::Tuning) asks
     /// for (`TREELET_HIERARCHY` for the command), if it does.
     pub fn from_env() -> Option<Hierarchy> {
-        crate::tuning::Tuning::current().hierarchy
+        use crate::tuning::Hierarchy as Forced;
+        crate::tuning::Tuning::current().hierarchy.map(|h| match h {
+            Forced::Radix => Hierarchy::RadixTreeThenFit,
+            Forced::Agglomerative => Hierarchy::Agglomerative,
+            Forced::Subgroup => Hierarchy::AgglomerativeSubgroup,
+        })
     }
 
     /// The kernels of a hierarchy (`ordered` as the device allows: see

@@ -91,8 +91,13 @@ impl SortTiles {
         if self != SortTiles::Auto {
             return self;
         }
+        use crate::tuning::SortTiles as Forced;
         match crate::tuning::Tuning::current().sort_tiles {
-            Some(tiles) => tiles,
+            Some(Forced::Small) => SortTiles::Small,
+            Some(Forced::Large) => SortTiles::Large,
+            Some(Forced::Multisplit) => SortTiles::Multisplit,
+            Some(Forced::MultisplitSmall) => SortTiles::MultisplitSmall,
+            Some(Forced::MultisplitMedium) => SortTiles::MultisplitMedium,
             _ if n <= if multisplit { SMALL_TILES_BESIDE_MULTISPLIT_UP_TO } else { SMALL_TILES_UP_TO } => {
                 SortTiles::Small
             }

@@ -10,7 +10,7 @@ use treelet::runtime::device::{Device, DeviceChoice};
 use treelet::runtime::gpu::GpuContext;
 use treelet::render::image_io;
 use treelet::bvh::layout::Layout;
-use treelet::plot::Series;
+use treelet::internals::plot::Series;
 use treelet::bvh::tree::{Accel, Builder};
 use treelet::render::parts::{self, PartInfo};
 use treelet::render::settings::MemoryEstimate;
@@ -21,18 +21,18 @@ use treelet::scene::Scene;
 use treelet::bvh::trbvh::TreeletConfig;
 use treelet::render::variant::{self, KernelChoice};
 
-// Output that never panics on a full or closed stream (`treelet::console`);
+// Output that never panics on a full or closed stream (`treelet::internals::console`);
 // defined before the modules, so that theirs are these.
 macro_rules! println {
-    () => { treelet::console::out(format_args!(""), true) };
-    ($($t:tt)*) => { treelet::console::out(format_args!($($t)*), true) };
+    () => { treelet::internals::console::out(format_args!(""), true) };
+    ($($t:tt)*) => { treelet::internals::console::out(format_args!($($t)*), true) };
 }
 macro_rules! print {
-    ($($t:tt)*) => { treelet::console::out(format_args!($($t)*), false) };
+    ($($t:tt)*) => { treelet::internals::console::out(format_args!($($t)*), false) };
 }
 macro_rules! eprintln {
-    () => { treelet::console::err(format_args!("")) };
-    ($($t:tt)*) => { treelet::console::err(format_args!($($t)*)) };
+    () => { treelet::internals::console::err(format_args!("")) };
+    ($($t:tt)*) => { treelet::internals::console::err(format_args!($($t)*)) };
 }
 
 mod bench;
@@ -45,7 +45,7 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// The largest file (scene, mesh, image, part) read, in bytes.
-    #[arg(long, global = true, value_name = "BYTES", default_value_t = treelet::input::DEFAULT_MAX_INPUT_BYTES)]
+    #[arg(long, global = true, value_name = "BYTES", default_value_t = treelet::internals::input::DEFAULT_MAX_INPUT_BYTES)]
     max_input_bytes: u64,
 }
 
@@ -636,7 +636,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         }
         let title = format!("{}: {}x{}, {spp} spp, accel {}, {adapter}", scene.name, args.width, args.height, result.plan.accel.name());
         let series = [Series { label: format!("{device} ({adapter})"), points }];
-        match treelet::plot::error_vs_time(&plot_path, &title, label, &series) {
+        match treelet::internals::plot::error_vs_time(&plot_path, &title, label, &series) {
             Ok(()) => eprintln!("wrote {} and {}", path.display(), plot_path.display()),
             Err(e) => eprintln!("wrote {}; no plot: {e:#}", path.display()),
         }
@@ -693,7 +693,7 @@ fn bound_threads() {
 }
 
 fn run(cli: Cli) -> Result<bool> {
-    treelet::input::set_max_input_bytes(cli.max_input_bytes);
+    treelet::internals::input::set_max_input_bytes(cli.max_input_bytes);
     // Every TREELET_* knob, read and checked once, before any work: a value
     // that does not parse is an error, not a knob ignored.
     let _ = treelet::tuning::Tuning::from_env()?.install();
@@ -865,7 +865,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     treelet::runtime::timeline::mark("arguments");
     let mut outcome = run(cli);
-    if let Err(e) = treelet::console::finish() {
+    if let Err(e) = treelet::internals::console::finish() {
         outcome = outcome.and_then(|_| Err(anyhow::anyhow!("cannot write to standard output: {e}")));
     }
     // A render stopped by a signal exits as the shell expects of one (128 + SIGINT).

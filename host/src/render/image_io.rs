@@ -154,7 +154,7 @@ fn write_format(path: &Path, ext: &str, image: &HdrImage) -> Result<()> {
 
 /// Reads a linear HDR image (.exr or .pfm).
 pub fn read_hdr(path: &Path) -> Result<HdrImage> {
-    crate::input::check(path, "image")?;
+    crate::internals::input::check(path, "image")?;
     match extension(path).as_str() {
         "exr" => {
             let img = image::open(path).with_context(|| format!("cannot read {}", path.display()))?.into_rgb32f();
@@ -163,7 +163,7 @@ pub fn read_hdr(path: &Path) -> Result<HdrImage> {
             Ok(HdrImage { width, height, pixels })
         }
         "pfm" => {
-            let bytes = crate::input::read(path, "image")?;
+            let bytes = crate::internals::input::read(path, "image")?;
             parse_pfm(&bytes).with_context(|| format!("{}: not a valid colour PFM file", path.display()))
         }
         other => bail!("{}: a reference must be .exr or .pfm, not `.{other}`", path.display()),

@@ -121,7 +121,7 @@ fn pixels_or_none(width: usize, height: usize) -> Vec<[f32; 4]> {
 
 /// Reads a part: what it is of, and its sums.
 pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
-    crate::input::check(path, "part")?;
+    crate::internals::input::check(path, "part")?;
     // The header's size is allocated before any pixel is read: a damaged
     // header can ask for petabytes, which must be an error, not an abort.
     let image = read_first_rgba_layer_from_file(

@@ -18,36 +18,9 @@ pub fn available_bytes() -> Option<u64> {
 
 /// The cap `TREELET_MAX_MEMORY` sets (`None` where unset or empty), as the
 /// process's [`Tuning`](crate::tuning::Tuning) holds it: bytes, or a number
-/// with a unit (`8GiB`, `512M`, `1.5GB`; see [`parse_bytes`]).
+/// with a unit (`8GiB`, `512M`, `1.5GB`; see [`crate::tuning::parse_bytes`]).
 pub fn memory_cap() -> Option<u64> {
     crate::tuning::Tuning::current().max_memory
-}
-
-/// A size in bytes: a number, then an optional unit (any case): `B`; `K`,
-/// `M`, `G`, `T` and `KiB`, `MiB`, `GiB`, `TiB` as powers of 1024; `KB`,
-/// `MB`, `GB`, `TB` as powers of 1000. At least one byte.
-pub fn parse_bytes(text: &str) -> std::result::Result<u64, String> {
-    let t = text.trim();
-    let split = t.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(t.len());
-    let (number, unit) = (t[..split].trim(), t[split..].trim());
-    let value: f64 = number.parse().map_err(|_| format!("`{t}` does not start with a number (use 8GiB, 512M or 1000000000)"))?;
-    let scale: f64 = match unit.to_ascii_lowercase().as_str() {
-        "" | "b" => 1.0,
-        "k" | "kib" => 1024.0,
-        "m" | "mib" => 1024f64.powi(2),
-        "g" | "gib" => 1024f64.powi(3),
-        "t" | "tib" => 1024f64.powi(4),
-        "kb" => 1e3,
-        "mb" => 1e6,
-        "gb" => 1e9,
-        "tb" => 1e12,
-        _ => return Err(format!("unknown unit `{unit}` (use B, K/KiB, M/MiB, G/GiB, T/TiB, or KB, MB, GB, TB)")),
-    };
-    let bytes = value * scale;
-    if !(bytes >= 1.0 && bytes < u64::MAX as f64) {
-        return Err(format!("`{t}` is not a size between 1 byte and 16 EiB"));
-    }
-    Ok(bytes as u64)
 }
 
 fn machine_available_bytes() -> Option<u64> {
@@ -122,17 +95,5 @@ mod tests {
         check_fits("a test", 1024, "a little").unwrap();
         assert_eq!(human(512), "512 bytes");
         assert_eq!(human(3 << 29), "1.5 GiB");
-    }
-
-    #[test]
-    fn sizes_read_with_their_units() {
-        assert_eq!(parse_bytes("1000000000"), Ok(1_000_000_000));
-        assert_eq!(parse_bytes("1GB"), Ok(1_000_000_000));
-        assert_eq!(parse_bytes("1 GiB"), Ok(1 << 30));
-        assert_eq!(parse_bytes("512m"), Ok(512 << 20));
-        assert_eq!(parse_bytes("1.5K"), Ok(1536));
-        for bad in ["lots", "1XB", "0", "-5", "1e999", ""] {
-            assert!(parse_bytes(bad).is_err(), "{bad}");
-        }
     }
 }

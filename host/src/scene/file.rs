@@ -189,7 +189,7 @@ pub fn load(path: &Path) -> Result<Scene> {
 /// Reads a scene file with its meshes once each and their copies as
 /// instances (see [`super::instanced`]).
 pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
-    let text = crate::input::read_text(path, "scene file")?;
+    let text = crate::internals::input::read_text(path, "scene file")?;
     parse_instanced_in(&text, &path.display().to_string(), path.parent().unwrap_or(Path::new(".")))
 }
 

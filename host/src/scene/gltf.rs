@@ -38,7 +38,7 @@ pub fn load(path: &Path) -> Result<Scene> {
 /// material at fault.
 pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     let name = path.display().to_string();
-    let bytes = crate::input::read(path, "glTF file")?;
+    let bytes = crate::internals::input::read(path, "glTF file")?;
     // glTF readers may ignore a byte-order mark before the JSON.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     precheck(bytes, &name)?;
@@ -232,7 +232,7 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
                 if uri.contains("://") {
                     bail!("{name}: buffer {i}: `{uri}` is not a local file");
                 }
-                crate::input::read(&dir.join(uri), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
+                crate::internals::input::read(&dir.join(uri), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
             }
         };
         if data.len() < buffer.length() {

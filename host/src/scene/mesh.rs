@@ -11,9 +11,9 @@ use treelet_core::geometry::triangle::Triangle;
 use crate::scene::primitives::Primitives;
 
 /// What kind of mesh file `path` names: `"obj"` or `"ply"`, either also
-/// compressed (`mesh.ply.xz`, read through [`crate::input::read`]).
+/// compressed (`mesh.ply.xz`, read through [`crate::internals::input::read`]).
 pub fn mesh_kind(path: &Path) -> Option<&'static str> {
-    let name = crate::input::content_name(path);
+    let name = crate::internals::input::content_name(path);
     let ext = name.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("obj") => Some("obj"),
@@ -40,7 +40,7 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
 /// Wavefront OBJ: every object's faces, triangulated; materials are not read.
 pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let text = crate::input::read_text(path, "mesh")?;
+    let text = crate::internals::input::read_text(path, "mesh")?;
     // Material libraries are ignored: Treelet assigns its own material.
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default())).map_err(|e| {
         match obj_error_line(&text, &e) {
@@ -257,7 +257,7 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
     use ply_rs_bw::parser::{Parser, Reader};
     use ply_rs_bw::ply::DefaultElement;
-    let bytes = crate::input::read(path, "mesh")?;
+    let bytes = crate::internals::input::read(path, "mesh")?;
     let name = path.display();
     let parse_error = |e: ply_rs_bw::parser::ParseError| {
         // The parser's message spans lines and names a line of the file, not

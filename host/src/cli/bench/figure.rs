@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
-use treelet::plot::{chart, Chart, Series};
+use treelet::internals::plot::{chart, Chart, Series};
 
 use super::measure::median;
 use treelet::runtime::device::DeviceChoice;

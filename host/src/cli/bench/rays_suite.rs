@@ -55,7 +55,7 @@ fn real_scenes_dir(dir: Option<&Path>) -> Result<PathBuf> {
 /// (`cameras.json`: `NAME: {eye, look_at}` in the file's coordinates).
 fn listing(dir: &Path) -> Result<(Vec<String>, std::collections::HashMap<String, ([f32; 3], [f32; 3])>)> {
     let cameras_path = dir.join("cameras.json");
-    let cameras: serde_json::Value = serde_json::from_str(&treelet::input::read_text(&cameras_path, "camera list")?)
+    let cameras: serde_json::Value = serde_json::from_str(&treelet::internals::input::read_text(&cameras_path, "camera list")?)
         .with_context(|| format!("{}: not valid JSON", cameras_path.display()))?;
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .with_context(|| format!("{}: cannot list it", dir.display()))?
