@@ -269,7 +269,12 @@ fn one_instance_in_place_is_the_mesh_itself() {
 fn instanced_tracer_rejects_bad_input_by_name() {
     let b = &mut CpuBackend::new();
     let tri = [Triangle::new([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])];
-    let err = |r: anyhow::Result<InstancedTracer<CpuBackend>>| format!("{:#}", r.err().expect("an error"));
+    // Each is the caller's input, and typed so.
+    let err = |r: treelet::error::Result<InstancedTracer<CpuBackend>>| {
+        let e = r.err().expect("an error");
+        assert_eq!(e.kind(), treelet::error::ErrorKind::Input, "{e}");
+        e.to_string()
+    };
     let at = |k: u32| Instance::translated(k, [0.0, 0.0, 1.0]);
     let e = err(InstancedTracer::build(b, &[&tri], &[at(0), at(3)], Quality::Fast));
     assert!(e.contains("instances[1] places mesh 3, but there are 1 meshes"), "{e}");
@@ -294,8 +299,9 @@ fn instanced_tracer_rejects_bad_input_by_name() {
     assert_eq!(scene.occluded(b, &[ray]).unwrap(), vec![false]);
     scene.set_instances(b, &[at(0)]).unwrap();
     assert_eq!(scene.closest_hits(b, &[ray]).unwrap()[0].t, 2.0);
-    let e = format!("{:#}", scene.refit_mesh(b, 2, &tri).unwrap_err());
-    assert!(e.contains("refit of mesh 2: there are 1 meshes"), "{e}");
+    let e = scene.refit_mesh(b, 2, &tri).unwrap_err();
+    assert_eq!(e.kind(), treelet::error::ErrorKind::Input, "{e}");
+    assert!(e.to_string().contains("refit of mesh 2: there are 1 meshes"), "{e}");
     let e = format!("{:#}", scene.refit_mesh(b, 0, &[tri[0], tri[0]]).unwrap_err());
     assert!(e.contains("mesh 0") && e.contains("refit with 0 spheres and 2 triangles"), "{e}");
     let e = format!("{:#}", scene.refit_mesh(b, 0, &[Triangle::parallelogram([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])]).unwrap_err());

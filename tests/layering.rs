@@ -26,7 +26,7 @@ const CORE_FLOORS: &[(&str, u32)] =
 /// The engine API (`tracer`) sits below the renderer, which traces a scene's
 /// placed copies of meshes through its `InstancedTracer`.
 const HOST_LIB_FLOORS: &[(&str, u32)] =
-    &[("internals", 0), ("tuning", 0), ("runtime", 0), ("scene", 1), ("bvh", 2), ("tracer", 3), ("render", 4)];
+    &[("error", 0), ("internals", 0), ("tuning", 0), ("runtime", 0), ("scene", 1), ("bvh", 2), ("tracer", 3), ("render", 4)];
 
 /// The crate roots checked, relative to the workspace root.
 const CRATES: &[CrateSpec] = &[

@@ -216,11 +216,15 @@ fn tracer_small_and_empty_scenes() {
 fn tracer_rejects_bad_input_by_name() {
     let b = &mut CpuBackend::new();
     let bad = [Triangle::new([0.0, f32::NAN, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
-    let e = format!("{:#}", Tracer::build(b, &[], &bad, Quality::Fast).err().expect("NaN accepted"));
+    let e = Tracer::build(b, &[], &bad, Quality::Fast).err().expect("NaN accepted");
+    assert_eq!(e.kind(), treelet::error::ErrorKind::Input, "{e}");
+    let e = e.to_string();
     assert!(e.contains("triangle 0") || e.contains("NaN"), "{e}");
     let good = [Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])];
     let mut t = Tracer::build(b, &[], &good, Quality::Fast).unwrap();
-    let e = format!("{:#}", t.refit(b, &[], &[good[0], good[0]]).unwrap_err());
+    let e = t.refit(b, &[], &[good[0], good[0]]).unwrap_err();
+    assert_eq!(e.kind(), treelet::error::ErrorKind::Input, "{e}");
+    let e = e.to_string();
     assert!(e.contains("2 triangles") && e.contains("built over"), "{e}");
 }
 

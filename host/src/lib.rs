@@ -30,6 +30,11 @@
 //! # anyhow::Ok(())
 //! ```
 //!
+//! The engine API returns [`error::Error`]: its [`kind`](error::Error::kind)
+//! says whether the input was at fault (a non-finite vertex, a mesh index
+//! past the meshes: the message names which), the work is too large for the
+//! device, or the device cannot run Treelet; its message tells the rest.
+//!
 //! An engine that has no use for the `treelet` command depends on the
 //! crate with `default-features = false`: the feature `cli` (on by default)
 //! brings in clap and the command line's parsing of the option types
@@ -109,6 +114,7 @@ macro_rules! eprintln {
     ($($t:tt)*) => { $crate::internals::console::err(format_args!($($t)*)) };
 }
 
+pub mod error;
 pub mod internals;
 pub mod bvh;
 pub mod render;

@@ -181,11 +181,9 @@ pub const SMALL_ZEROED_BYTES: u64 = 64;
 pub fn check_fits<B: Backend>(backend: &B, label: &str, bytes: u64) -> Result<()> {
     let max = backend.max_buffer_bytes();
     if bytes > max {
-        anyhow::bail!(
-            "scene too large for this device: buffer `{label}` needs {bytes} bytes, \
+        return Err(crate::error::too_large(format!("scene too large for this device: buffer `{label}` needs {bytes} bytes, \
              the adapter `{}` allows {max} bytes per buffer",
-            backend.adapter()
-        );
+            backend.adapter())));
     }
     Ok(())
 }

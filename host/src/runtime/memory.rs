@@ -1,7 +1,7 @@
 //! Host memory: what the machine has left, and a check that refuses work
 //! whose estimate is past it, before anything is allocated (an allocation
 //! that fails aborts the process, with no word of what was too large).
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 /// Bytes of memory available to new allocations (free, plus caches the
 /// kernel gives back), or `None` where it cannot be read.
@@ -72,11 +72,9 @@ pub fn human(bytes: u64) -> String {
 pub fn check_fits(what: &str, needed: u64, detail: &str) -> Result<()> {
     if let Some(available) = available_bytes() {
         if needed > available {
-            bail!(
-                "{what} needs about {} of memory ({detail}), and this machine has {} available",
+            return Err(crate::error::too_large(format!("{what} needs about {} of memory ({detail}), and this machine has {} available",
                 human(needed),
-                human(available)
-            );
+                human(available))));
         }
     }
     Ok(())

@@ -1,6 +1,6 @@
 //! What a BVH is built over: spheres and triangles, in one index space
 //! (spheres first, then triangles), as the kernels see them.
-use anyhow::{bail, Result};
+use anyhow::Result;
 use treelet_core::geometry::triangle::{Triangle, SHAPE_DISK, SHAPE_PARALLELOGRAM, SHAPE_TRIANGLE};
 use treelet_core::{Aabb, Sphere};
 
@@ -69,17 +69,15 @@ impl<'a> Primitives<'a> {
         if !known(t) {
             // Words an engine left in the padding (a w of 1.0, say) would
             // otherwise make a triangle another shape.
-            bail!(
-                "triangle {i}: shape tag {:#x} is none of {SHAPE_TRIANGLE} (triangle), {SHAPE_DISK} (disk), {SHAPE_PARALLELOGRAM} (parallelogram); `Triangle::new` sets it",
-                t.shape
-            );
+            return Err(crate::error::input(format!("triangle {i}: shape tag {:#x} is none of {SHAPE_TRIANGLE} (triangle), {SHAPE_DISK} (disk), {SHAPE_PARALLELOGRAM} (parallelogram); `Triangle::new` sets it",
+                t.shape)));
         }
         for (k, v) in [t.v0, t.v1, t.v2].iter().enumerate() {
             if v.iter().any(|x| !x.is_finite()) {
-                bail!("triangle {i}: vertex {k} {v:?} is not finite");
+                return Err(crate::error::input(format!("triangle {i}: vertex {k} {v:?} is not finite")));
             }
         }
-        bail!("triangle {i}: its extent overflows f32")
+        Err(crate::error::input(format!("triangle {i}: its extent overflows f32")))
     }
 }
 
@@ -88,18 +86,16 @@ impl<'a> Primitives<'a> {
 pub fn validate_spheres(spheres: &[Sphere]) -> Result<()> {
     for (i, s) in spheres.iter().enumerate() {
         if let Some(k) = s.center.iter().position(|c| !c.is_finite()) {
-            bail!(
-                "sphere {i}: centre coordinate {} is {} (every coordinate must be finite)",
+            return Err(crate::error::input(format!("sphere {i}: centre coordinate {} is {} (every coordinate must be finite)",
                 "xyz".as_bytes()[k] as char,
-                s.center[k]
-            );
+                s.center[k])));
         }
         if !s.radius.is_finite() || s.radius < 0.0 {
-            bail!("sphere {i}: radius is {} (must be finite and non-negative)", s.radius);
+            return Err(crate::error::input(format!("sphere {i}: radius is {} (must be finite and non-negative)", s.radius)));
         }
         // A box corner (centre ± radius) must stay finite too.
         if s.center.iter().any(|c| !(c.abs() + s.radius).is_finite()) {
-            bail!("sphere {i}: its bounding box overflows f32 (centre {:?}, radius {})", s.center, s.radius);
+            return Err(crate::error::input(format!("sphere {i}: its bounding box overflows f32 (centre {:?}, radius {})", s.center, s.radius)));
         }
     }
     Ok(())

@@ -7,7 +7,7 @@
 //! first (sizes, alignment), and what they hold by the gather (indices
 //! past the vertices, coordinates that are not finite), the first bad
 //! triangle named.
-use anyhow::{bail, ensure, Result};
+use anyhow::Result;
 use treelet_core::geometry::buffers::{CopyParams, GatherParams, Sphere};
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
@@ -61,35 +61,43 @@ impl<B: Backend> MeshBuffers<'_, B> {
     /// the index words are bound from).
     fn params(&self, b: &B, index_base: u64) -> Result<GatherParams> {
         let (n, v) = (self.triangle_count as u64, self.vertex_count as u64);
-        ensure!(n <= MAX_PRIMITIVES as u64, "engine mesh: {n} triangles: at most {MAX_PRIMITIVES} are supported");
-        ensure!(
-            self.vertex_stride >= 12 && self.vertex_stride % 4 == 0 && self.vertex_offset % 4 == 0,
-            "engine mesh: vertex stride {} and offset {} (bytes) must be multiples of 4, the stride at least 12 (three f32)",
+        if !(n <= MAX_PRIMITIVES as u64) {
+ return Err(crate::error::too_large(format!("engine mesh: {n} triangles: at most {MAX_PRIMITIVES} are supported")));
+ }
+        if !(self.vertex_stride >= 12 && self.vertex_stride % 4 == 0 && self.vertex_offset % 4 == 0) {
+ return Err(crate::error::input(format!("engine mesh: vertex stride {} and offset {} (bytes) must be multiples of 4, the stride at least 12 (three f32)",
             self.vertex_stride,
-            self.vertex_offset
-        );
+            self.vertex_offset)));
+ }
         let vertex_bytes = b.buffer_bytes(self.vertices);
         let vertex_end = if v == 0 { 0 } else { self.vertex_offset + (v - 1) * self.vertex_stride + 12 };
-        ensure!(
-            vertex_end <= vertex_bytes,
-            "engine mesh: {v} vertices of stride {} from byte {} reach byte {vertex_end}, past the vertex buffer's {vertex_bytes} bytes",
+        if !(vertex_end <= vertex_bytes) {
+ return Err(crate::error::input(format!("engine mesh: {v} vertices of stride {} from byte {} reach byte {vertex_end}, past the vertex buffer's {vertex_bytes} bytes",
             self.vertex_stride,
-            self.vertex_offset
-        );
-        ensure!(vertex_end <= u32::MAX as u64, "engine mesh: the vertices reach byte {vertex_end}: at most 4 GiB are read");
+            self.vertex_offset)));
+ }
+        if !(vertex_end <= u32::MAX as u64) {
+ return Err(crate::error::too_large(format!("engine mesh: the vertices reach byte {vertex_end}: at most 4 GiB are read")));
+ }
         fits_binding(b, "vertex buffer", vertex_bytes)?;
         fits_binding(b, "triangles gathered", n * 48)?;
         let (index_offset, index_bytes) = match &self.indices {
             None => {
-                ensure!(v >= 3 * n, "engine mesh: {n} triangles without an index buffer need {} vertices, not {v}", 3 * n);
+                if !(v >= 3 * n) {
+ return Err(crate::error::input(format!("engine mesh: {n} triangles without an index buffer need {} vertices, not {v}", 3 * n)));
+ }
                 (0, treelet_core::geometry::gather::NO_INDICES)
             }
             Some(i) => {
                 let size = i.format.bytes();
-                ensure!(i.offset % size == 0, "engine mesh: index offset {} is not a multiple of the {size}-byte entries", i.offset);
+                if !(i.offset % size == 0) {
+ return Err(crate::error::input(format!("engine mesh: index offset {} is not a multiple of the {size}-byte entries", i.offset)));
+ }
                 let end = i.offset + 3 * n * size;
                 let bytes = b.buffer_bytes(i.buffer);
-                ensure!(end <= bytes, "engine mesh: {n} triangles of {size}-byte indices from byte {} reach byte {end}, past the index buffer's {bytes} bytes", i.offset);
+                if !(end <= bytes) {
+ return Err(crate::error::input(format!("engine mesh: {n} triangles of {size}-byte indices from byte {} reach byte {end}, past the index buffer's {bytes} bytes", i.offset)));
+ }
                 fits_binding(b, "index buffer", bytes)?;
                 ((i.offset - index_base) as u32, size as u32)
             }
@@ -138,10 +146,10 @@ pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>) -> Result<Pri
     b.dispatch(Kernel::GatherTriangles, &[&p, mesh.vertices, &indices, &triangles, &flags], groups_for(n, WORKGROUP_SIZE));
     let flags = b.read::<u32>(&flags, 2)?;
     if flags[0] != u32::MAX {
-        bail!("engine mesh: triangle {} names a vertex past the {} vertices", flags[0], mesh.vertex_count);
+        return Err(crate::error::input(format!("engine mesh: triangle {} names a vertex past the {} vertices", flags[0], mesh.vertex_count)));
     }
     if flags[1] != u32::MAX {
-        bail!("engine mesh: triangle {} has a coordinate that is not finite (or an extent past f32's range)", flags[1]);
+        return Err(crate::error::input(format!("engine mesh: triangle {} has a coordinate that is not finite (or an extent past f32's range)", flags[1])));
     }
     Ok(PrimBuffers { spheres, triangles, sphere_count: 0, triangle_count: n })
 }
@@ -149,6 +157,8 @@ pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>) -> Result<Pri
 /// The gather binds each buffer whole.
 fn fits_binding<B: Backend>(b: &B, what: &str, bytes: u64) -> Result<()> {
     let max = b.max_binding_bytes();
-    ensure!(bytes <= max, "engine mesh: the {what} ({bytes} bytes) is larger than one binding of `{}` holds ({max} bytes)", b.adapter());
+    if !(bytes <= max) {
+ return Err(crate::error::too_large(format!("engine mesh: the {what} ({bytes} bytes) is larger than one binding of `{}` holds ({max} bytes)", b.adapter())));
+ }
     Ok(())
 }

@@ -20,7 +20,7 @@
 //! assert_eq!(scene.closest_hits(b, &[ray])?[0].instance, 1);
 //! # anyhow::Ok(())
 //! ```
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use treelet_core::geometry::buffers::{CopyParams, LayoutParams, MeshRecord, PlacedMesh, RenderParams};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
@@ -133,47 +133,51 @@ impl<B: Backend> InstancedTracer<B> {
     /// tree over `instances`. Every mesh needs a triangle; bad input (a
     /// non-finite vertex, an instance of a mesh that is not there, a
     /// non-finite or singular transform) is refused by name.
-    pub fn build(b: &mut B, meshes: &[&[Triangle]], instances: &[Instance], quality: Quality) -> Result<Self> {
-        if meshes.len() > u32::MAX as usize {
-            bail!("{} meshes: at most {} are supported", meshes.len(), u32::MAX);
-        }
-        let mut trees = Vec::with_capacity(meshes.len());
-        let mut bounds = Vec::with_capacity(meshes.len());
-        let mut update_ms = 0.0;
-        for (m, triangles) in meshes.iter().enumerate() {
-            if triangles.is_empty() {
-                bail!("mesh {m} has no triangles: every instanced mesh needs one");
+    pub fn build(b: &mut B, meshes: &[&[Triangle]], instances: &[Instance], quality: Quality) -> crate::error::Result<Self> {
+        crate::error::typed(|| {
+            if meshes.len() > u32::MAX as usize {
+                return Err(crate::error::too_large(format!("{} meshes: at most {} are supported", meshes.len(), u32::MAX)));
             }
-            only_triangles(triangles).with_context(|| format!("mesh {m}"))?;
-            let tracer = Tracer::build(b, &[], triangles, quality).with_context(|| format!("mesh {m}"))?;
-            update_ms += tracer.last_update_ms();
-            trees.push(tracer);
-            bounds.push(mesh_bounds(triangles));
-        }
-        Self::from_trees(b, trees, bounds, instances, update_ms)
+            let mut trees = Vec::with_capacity(meshes.len());
+            let mut bounds = Vec::with_capacity(meshes.len());
+            let mut update_ms = 0.0;
+            for (m, triangles) in meshes.iter().enumerate() {
+                if triangles.is_empty() {
+                    return Err(crate::error::input(format!("mesh {m} has no triangles: every instanced mesh needs one")));
+                }
+                only_triangles(triangles).with_context(|| format!("mesh {m}"))?;
+                let tracer = Tracer::build(b, &[], triangles, quality).with_context(|| format!("mesh {m}"))?;
+                update_ms += tracer.last_update_ms();
+                trees.push(tracer);
+                bounds.push(mesh_bounds(triangles));
+            }
+            Self::from_trees(b, trees, bounds, instances, update_ms)
+        })
     }
 
     /// [`Self::build`] over meshes in an engine's own buffers (see
     /// [`Tracer::build_from_buffers`]): mesh `k` is `meshes[k]`, gathered
     /// and built on the device; each mesh's box is read from its tree's root
     /// (64 bytes a mesh).
-    pub fn build_from_buffers(b: &mut B, meshes: &[MeshBuffers<B>], instances: &[Instance], quality: Quality) -> Result<Self> {
-        if meshes.len() > u32::MAX as usize {
-            bail!("{} meshes: at most {} are supported", meshes.len(), u32::MAX);
-        }
-        let mut trees = Vec::with_capacity(meshes.len());
-        let mut bounds = Vec::with_capacity(meshes.len());
-        let mut update_ms = 0.0;
-        for (m, mesh) in meshes.iter().enumerate() {
-            if mesh.triangle_count == 0 {
-                bail!("mesh {m} has no triangles: every instanced mesh needs one");
+    pub fn build_from_buffers(b: &mut B, meshes: &[MeshBuffers<B>], instances: &[Instance], quality: Quality) -> crate::error::Result<Self> {
+        crate::error::typed(|| {
+            if meshes.len() > u32::MAX as usize {
+                return Err(crate::error::too_large(format!("{} meshes: at most {} are supported", meshes.len(), u32::MAX)));
             }
-            let tracer = Tracer::build_from_buffers(b, mesh, quality).with_context(|| format!("mesh {m}"))?;
-            update_ms += tracer.last_update_ms();
-            bounds.push(tracer.layout_bounds(b)?);
-            trees.push(tracer);
-        }
-        Self::from_trees(b, trees, bounds, instances, update_ms)
+            let mut trees = Vec::with_capacity(meshes.len());
+            let mut bounds = Vec::with_capacity(meshes.len());
+            let mut update_ms = 0.0;
+            for (m, mesh) in meshes.iter().enumerate() {
+                if mesh.triangle_count == 0 {
+                    return Err(crate::error::input(format!("mesh {m} has no triangles: every instanced mesh needs one")));
+                }
+                let tracer = Tracer::build_from_buffers(b, mesh, quality).with_context(|| format!("mesh {m}"))?;
+                update_ms += tracer.last_update_ms();
+                bounds.push(tracer.layout_bounds(b)?);
+                trees.push(tracer);
+            }
+            Self::from_trees(b, trees, bounds, instances, update_ms)
+        })
     }
 
     /// The scene over meshes whose trees are built: their layouts gathered,
@@ -207,68 +211,76 @@ impl<B: Backend> InstancedTracer<B> {
     /// disks and parallelograms are refused by name (the instanced walk
     /// tests triangles only). Materials are the renderer's; hits carry
     /// mesh and primitive, by which an engine finds its own.
-    pub fn build_scene(b: &mut B, scene: &crate::scene::instanced::InstancedScene, quality: Quality) -> Result<Self> {
-        let name = &scene.loose.name;
-        if !scene.loose.spheres.is_empty() {
-            bail!("{name}: {} spheres: instanced scenes take triangles only", scene.loose.spheres.len());
-        }
-        let mut meshes: Vec<&[Triangle]> = scene.meshes.iter().map(|m| m.triangles.as_slice()).collect();
-        let mut instances: Vec<Instance> =
-            scene.instances.iter().map(|i| Instance { mesh: i.mesh, transform: i.rows() }).collect();
-        if !scene.loose.triangles.is_empty() {
-            only_triangles(&scene.loose.triangles).with_context(|| format!("{name}: the scene's own (not instanced) primitives"))?;
-            instances.push(Instance { mesh: meshes.len() as u32, transform: Instance::IDENTITY });
-            meshes.push(&scene.loose.triangles);
-        }
-        Self::build(b, &meshes, &instances, quality).with_context(|| format!("{name}"))
+    pub fn build_scene(b: &mut B, scene: &crate::scene::instanced::InstancedScene, quality: Quality) -> crate::error::Result<Self> {
+        crate::error::typed(|| {
+            let name = &scene.loose.name;
+            if !scene.loose.spheres.is_empty() {
+                return Err(crate::error::input(format!("{name}: {} spheres: instanced scenes take triangles only", scene.loose.spheres.len())));
+            }
+            let mut meshes: Vec<&[Triangle]> = scene.meshes.iter().map(|m| m.triangles.as_slice()).collect();
+            let mut instances: Vec<Instance> =
+                scene.instances.iter().map(|i| Instance { mesh: i.mesh, transform: i.rows() }).collect();
+            if !scene.loose.triangles.is_empty() {
+                only_triangles(&scene.loose.triangles).with_context(|| format!("{name}: the scene's own (not instanced) primitives"))?;
+                instances.push(Instance { mesh: meshes.len() as u32, transform: Instance::IDENTITY });
+                meshes.push(&scene.loose.triangles);
+            }
+            Self::build(b, &meshes, &instances, quality).with_context(|| format!("{name}"))
+        })
     }
 
     /// Places the meshes anew (any number of instances, any transforms):
     /// rebuilds the top-level tree only.
-    pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> Result<()> {
-        let placed = self.placed(instances)?;
-        self.instances = instances.to_vec();
-        self.top = None;
-        self.update_ms = 0.0;
-        if instances.is_empty() {
-            return Ok(());
-        }
-        let needed = top_nodes_for(placed.len());
-        if needed > self.gathered.top_capacity {
-            // Room for twice as many, so that a growing scene gathers its
-            // meshes again only now and then.
-            self.gathered = gather(b, &self.meshes, &self.bounds, needed.saturating_mul(2))?;
-        }
-        let (top, stages) = build_top_level(b, &placed, &self.gathered)?;
-        self.top = Some(top);
-        self.update_ms = stages.total();
-        self.top_stages = stages;
-        Ok(())
+    pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            let placed = self.placed(instances)?;
+            self.instances = instances.to_vec();
+            self.top = None;
+            self.update_ms = 0.0;
+            if instances.is_empty() {
+                return Ok(());
+            }
+            let needed = top_nodes_for(placed.len());
+            if needed > self.gathered.top_capacity {
+                // Room for twice as many, so that a growing scene gathers its
+                // meshes again only now and then.
+                self.gathered = gather(b, &self.meshes, &self.bounds, needed.saturating_mul(2))?;
+            }
+            let (top, stages) = build_top_level(b, &placed, &self.gathered)?;
+            self.top = Some(top);
+            self.update_ms = stages.total();
+            self.top_stages = stages;
+            Ok(())
+        })
     }
 
     /// Moves the triangles of mesh `mesh` (the same count, in the same
     /// order): its tree is refit (see [`Tracer::refit`]), its part of the
     /// gathered buffers copied again, and the top level rebuilt over the
     /// instances' new boxes.
-    pub fn refit_mesh(&mut self, b: &mut B, mesh: usize, triangles: &[Triangle]) -> Result<()> {
-        let Some(tracer) = self.meshes.get_mut(mesh) else {
-            bail!("refit of mesh {mesh}: there are {} meshes", self.meshes.len());
-        };
-        only_triangles(triangles).with_context(|| format!("mesh {mesh}"))?;
-        tracer.refit(b, &[], triangles).with_context(|| format!("mesh {mesh}"))?;
-        self.after_mesh_refit(b, mesh, mesh_bounds(triangles))
+    pub fn refit_mesh(&mut self, b: &mut B, mesh: usize, triangles: &[Triangle]) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            let Some(tracer) = self.meshes.get_mut(mesh) else {
+                return Err(crate::error::input(format!("refit of mesh {mesh}: there are {} meshes", self.meshes.len())));
+            };
+            only_triangles(triangles).with_context(|| format!("mesh {mesh}"))?;
+            tracer.refit(b, &[], triangles).with_context(|| format!("mesh {mesh}"))?;
+            self.after_mesh_refit(b, mesh, mesh_bounds(triangles))
+        })
     }
 
     /// [`Self::refit_mesh`] from an engine's buffers (see
     /// [`Tracer::refit_from_buffers`]); the mesh's new box is read from its
     /// tree's root.
-    pub fn refit_mesh_from_buffers(&mut self, b: &mut B, mesh: usize, buffers: &MeshBuffers<B>) -> Result<()> {
-        let Some(tracer) = self.meshes.get_mut(mesh) else {
-            bail!("refit of mesh {mesh}: there are {} meshes", self.meshes.len());
-        };
-        tracer.refit_from_buffers(b, buffers).with_context(|| format!("mesh {mesh}"))?;
-        let bounds = tracer.layout_bounds(b)?;
-        self.after_mesh_refit(b, mesh, bounds)
+    pub fn refit_mesh_from_buffers(&mut self, b: &mut B, mesh: usize, buffers: &MeshBuffers<B>) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            let Some(tracer) = self.meshes.get_mut(mesh) else {
+                return Err(crate::error::input(format!("refit of mesh {mesh}: there are {} meshes", self.meshes.len())));
+            };
+            tracer.refit_from_buffers(b, buffers).with_context(|| format!("mesh {mesh}"))?;
+            let bounds = tracer.layout_bounds(b)?;
+            self.after_mesh_refit(b, mesh, bounds)
+        })
     }
 
     /// After mesh `mesh`'s tree was refit (its new box `bounds`): its part
@@ -311,27 +323,35 @@ impl<B: Backend> InstancedTracer<B> {
     /// The closest hit of each ray: as [`Tracer::closest_hits`], with the
     /// instance hit, the primitive within its mesh, and the geometric normal
     /// in world space.
-    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
-        let out = read_batch(b, rays, |b, buffer| self.closest_hits_on_device(b, buffer, rays.len()))?;
-        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<RayHit>> {
+        crate::error::typed(|| {
+            let out = read_batch(b, rays, |b, buffer| Ok(self.closest_hits_on_device(b, buffer, rays.len())?))?;
+            Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+        })
     }
 
     /// Whether each ray hits anything up to its `t_max`, as [`Tracer::occluded`].
-    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
-        let out = read_batch(b, rays, |b, buffer| self.occluded_on_device(b, buffer, rays.len()))?;
-        Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<bool>> {
+        crate::error::typed(|| {
+            let out = read_batch(b, rays, |b, buffer| Ok(self.occluded_on_device(b, buffer, rays.len())?))?;
+            Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+        })
     }
 
     /// [`Tracer::closest_hits_on_device`] through the instances: the same
     /// layout, and the second vector of a hit holds the bits of the
     /// instance in its last word.
-    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
-        self.cast_on_device(b, rays, count, CAST_RAYS)
+    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            self.cast_on_device(b, rays, count, CAST_RAYS)
+        })
     }
 
     /// [`Tracer::occluded_on_device`] through the instances.
-    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
-        self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+        })
     }
 
     fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
@@ -384,14 +404,14 @@ impl<B: Backend> InstancedTracer<B> {
     /// `instances` as the top level's build reads them, after checking them.
     fn placed(&self, instances: &[Instance]) -> Result<Vec<PlacedMesh>> {
         if instances.len() > (u32::MAX / 2) as usize {
-            bail!("{} instances: at most {} are supported", instances.len(), u32::MAX / 2);
+            return Err(crate::error::too_large(format!("{} instances: at most {} are supported", instances.len(), u32::MAX / 2)));
         }
         instances
             .iter()
             .enumerate()
             .map(|(k, i)| {
                 if i.mesh as usize >= self.meshes.len() {
-                    bail!("instances[{k}] places mesh {}, but there are {} meshes", i.mesh, self.meshes.len());
+                    return Err(crate::error::input(format!("instances[{k}] places mesh {}, but there are {} meshes", i.mesh, self.meshes.len())));
                 }
                 check_transform(&i.transform).with_context(|| format!("instances[{k}]"))?;
                 Ok(PlacedMesh { world_from_object: i.transform, mesh: i.mesh, _pad: [0; 3] })
@@ -428,7 +448,7 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>
     b.dispatch(Kernel::TopLevelNodes, &bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
     let deepest = b.read::<u32>(&deepest, 1)?[0];
     if deepest as usize + 1 > STACK_DEPTH {
-        bail!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1);
+        return Err(crate::error::too_large(format!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1)));
     }
     let rest = b.take_times()?;
     for stage in &rest.order {
@@ -448,7 +468,7 @@ fn top_nodes_for(instances: usize) -> u32 {
 /// meaning). The device inverts it.
 fn check_transform(m: &[[f32; 4]; 3]) -> Result<()> {
     if m.iter().flatten().any(|x| !x.is_finite()) {
-        bail!("the transform has a non-finite entry: {m:?}");
+        return Err(crate::error::input(format!("the transform has a non-finite entry: {m:?}")));
     }
     let a = |r: usize, c: usize| m[r][c] as f64;
     let cof = |r: usize, c: usize| {
@@ -458,13 +478,13 @@ fn check_transform(m: &[[f32; 4]; 3]) -> Result<()> {
     let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
     let scale = (0..9).map(|k| a(k / 3, k % 3).abs()).fold(0.0f64, f64::max);
     if !(det.abs() > 1e-12 * scale * scale * scale) {
-        bail!("the transform is singular (determinant {det:e}): it flattens the mesh");
+        return Err(crate::error::input(format!("the transform is singular (determinant {det:e}): it flattens the mesh")));
     }
     // The inverse's entries are cofactors over the determinant.
     let largest = (0..9).map(|k| cof(k / 3, k % 3).abs()).fold(0.0f64, f64::max) / det.abs();
     let shift = (0..3).map(|r| a(r, 3).abs()).fold(0.0f64, f64::max);
     if !(largest * (1.0 + shift) * 3.0 < f32::MAX as f64) {
-        bail!("the transform's inverse overflows f32: {m:?}");
+        return Err(crate::error::input(format!("the transform's inverse overflows f32: {m:?}")));
     }
     Ok(())
 }
@@ -473,7 +493,7 @@ fn check_transform(m: &[[f32; 4]; 3]) -> Result<()> {
 /// fewer registers): a disk or parallelogram among them is refused by name.
 fn only_triangles(triangles: &[Triangle]) -> Result<()> {
     match triangles.iter().position(|t| !t.is_triangle()) {
-        Some(i) => bail!("triangle {i} has shape {} (a disk or parallelogram): instanced meshes take triangles only", triangles[i].shape),
+        Some(i) => return Err(crate::error::input(format!("triangle {i} has shape {} (a disk or parallelogram): instanced meshes take triangles only", triangles[i].shape))),
         None => Ok(()),
     }
 }
@@ -506,7 +526,7 @@ fn gather<B: Backend>(b: &mut B, meshes: &[Tracer<B>], bounds: &[[[f64; 3]; 2]],
         leaves += t.counts.1 as u64;
         triangles += t.counts.1 as u64;
         if nodes > u32::MAX as u64 / 16 || leaves > u32::MAX as u64 / 12 {
-            bail!("the meshes hold {triangles} triangles together: too many for one instanced scene");
+            return Err(crate::error::too_large(format!("the meshes hold {triangles} triangles together: too many for one instanced scene")));
         }
     }
     let gathered = Gathered {

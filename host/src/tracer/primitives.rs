@@ -1,5 +1,5 @@
 //! A tree over one set of an engine's primitives: build, refit, trace.
-use anyhow::{bail, Result};
+use anyhow::Result;
 use treelet_core::geometry::buffers::{RenderParams, Sphere};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::groups_for;
@@ -70,26 +70,28 @@ pub struct Tracer<B: Backend> {
 impl<B: Backend> Tracer<B> {
     /// Builds the tree over `spheres` and `triangles` on `b` and lays it out
     /// for tracing. Rejects non-finite or degenerate input, naming it.
-    pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> Result<Self> {
-        let all = Primitives { spheres, triangles };
-        all.check()?;
-        let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
-        let prims = match &built {
-            Some(t) => t.prim_buffers(b, all)?,
-            None => PrimBuffers::upload(b, all)?,
-        };
-        let mut tracer = Tracer {
-            built,
-            prims,
-            tree: None,
-            counts: (spheres.len(), triangles.len()),
-            update_ms: 0.0,
-            refit_state: None,
-        };
-        let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
-        tracer.update_ms = build_ms + tracer.lay_out(b)?;
-        tracer.keep_buffers(b);
-        Ok(tracer)
+    pub fn build(b: &mut B, spheres: &[Sphere], triangles: &[Triangle], quality: Quality) -> crate::error::Result<Self> {
+        crate::error::typed(|| {
+            let all = Primitives { spheres, triangles };
+            all.check()?;
+            let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
+            let prims = match &built {
+                Some(t) => t.prim_buffers(b, all)?,
+                None => PrimBuffers::upload(b, all)?,
+            };
+            let mut tracer = Tracer {
+                built,
+                prims,
+                tree: None,
+                counts: (spheres.len(), triangles.len()),
+                update_ms: 0.0,
+                refit_state: None,
+            };
+            let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
+            tracer.update_ms = build_ms + tracer.lay_out(b)?;
+            tracer.keep_buffers(b);
+            Ok(tracer)
+        })
     }
 
     /// Builds the tree over an engine's mesh in its own buffers on `b`'s
@@ -102,43 +104,45 @@ impl<B: Backend> Tracer<B> {
     /// on `b`'s queue (the engine's, for a [`GpuContext::from_wgpu`](crate::runtime::gpu::GpuContext::from_wgpu)
     /// context): work the engine recorded into its own encoders is not
     /// seen unless submitted before.
-    pub fn build_from_buffers(b: &mut B, mesh: &MeshBuffers<B>, quality: Quality) -> Result<Self> {
-        b.begin_build();
-        let prims = gather(b, mesh)?;
-        let n = prims.triangle_count as usize;
-        let built = if n == 0 {
-            None
-        } else {
-            let builder = match quality.builder(b.class(), n) {
-                // The CPU builders take host primitives: the device's best instead.
-                Builder::Sweep | Builder::Reference => Builder::Trbvh,
-                builder => builder,
+    pub fn build_from_buffers(b: &mut B, mesh: &MeshBuffers<B>, quality: Quality) -> crate::error::Result<Self> {
+        crate::error::typed(|| {
+            b.begin_build();
+            let prims = gather(b, mesh)?;
+            let n = prims.triangle_count as usize;
+            let built = if n == 0 {
+                None
+            } else {
+                let builder = match quality.builder(b.class(), n) {
+                    // The CPU builders take host primitives: the device's best instead.
+                    Builder::Sweep | Builder::Reference => Builder::Trbvh,
+                    builder => builder,
+                };
+                Some(binary_tree_uploaded(b, &prims, builder, split_budget(builder))?)
             };
-            Some(binary_tree_uploaded(b, &prims, builder, split_budget(builder))?)
-        };
-        let mut tracer = Tracer { built, prims, tree: None, counts: (0, n), update_ms: 0.0, refit_state: None };
-        let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
-        tracer.update_ms = build_ms + tracer.lay_out(b)?;
-        tracer.keep_buffers(b);
-        Ok(tracer)
+            let mut tracer = Tracer { built, prims, tree: None, counts: (0, n), update_ms: 0.0, refit_state: None };
+            let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
+            tracer.update_ms = build_ms + tracer.lay_out(b)?;
+            tracer.keep_buffers(b);
+            Ok(tracer)
+        })
     }
 
     /// [`Tracer::refit`] from an engine's buffers: the mesh of
     /// [`Tracer::build_from_buffers`] moved (the same triangle count and
     /// vertex indices), gathered again on the device and the tree refit
     /// there.
-    pub fn refit_from_buffers(&mut self, b: &mut B, mesh: &MeshBuffers<B>) -> Result<()> {
-        if (0, mesh.triangle_count as usize) != self.counts {
-            bail!(
-                "refit with {} triangles: the tree was built over {} spheres and {} triangles (build a new one)",
-                mesh.triangle_count,
-                self.counts.0,
-                self.counts.1
-            );
-        }
-        b.begin_build();
-        let prims = gather(b, mesh)?;
-        self.refit_with(b, prims)
+    pub fn refit_from_buffers(&mut self, b: &mut B, mesh: &MeshBuffers<B>) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            if (0, mesh.triangle_count as usize) != self.counts {
+                return Err(crate::error::input(format!("refit with {} triangles: the tree was built over {} spheres and {} triangles (build a new one)",
+                    mesh.triangle_count,
+                    self.counts.0,
+                    self.counts.1)));
+            }
+            b.begin_build();
+            let prims = gather(b, mesh)?;
+            self.refit_with(b, prims)
+        })
     }
 
     /// Moves the primitives: the same counts, in the same order, at new
@@ -147,25 +151,25 @@ impl<B: Backend> Tracer<B> {
     /// [`crate::bvh::refit::refit_bvh2`]). A refit tree stays
     /// correct however far things move, but its rays slow down as it drifts
     /// from what a new build would make: rebuild after large changes.
-    pub fn refit(&mut self, b: &mut B, spheres: &[Sphere], triangles: &[Triangle]) -> Result<()> {
-        if (spheres.len(), triangles.len()) != self.counts {
-            bail!(
-                "refit with {} spheres and {} triangles: the tree was built over {} and {} (build a new one)",
-                spheres.len(),
-                triangles.len(),
-                self.counts.0,
-                self.counts.1
-            );
-        }
-        let all = Primitives { spheres, triangles };
-        all.check()?;
-        // The last update's temporaries go back to the pool (what this and
-        // other tracers hold was kept out of it), so that a tracer refit
-        // every frame does not make the pool grow.
-        b.begin_build();
-        // Uploaded once, for the refit and for tracing.
-        let prims = PrimBuffers::upload(b, all)?;
-        self.refit_with(b, prims)
+    pub fn refit(&mut self, b: &mut B, spheres: &[Sphere], triangles: &[Triangle]) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            if (spheres.len(), triangles.len()) != self.counts {
+                return Err(crate::error::input(format!("refit with {} spheres and {} triangles: the tree was built over {} and {} (build a new one)",
+                    spheres.len(),
+                    triangles.len(),
+                    self.counts.0,
+                    self.counts.1)));
+            }
+            let all = Primitives { spheres, triangles };
+            all.check()?;
+            // The last update's temporaries go back to the pool (what this and
+            // other tracers hold was kept out of it), so that a tracer refit
+            // every frame does not make the pool grow.
+            b.begin_build();
+            // Uploaded once, for the refit and for tracing.
+            let prims = PrimBuffers::upload(b, all)?;
+            self.refit_with(b, prims)
+        })
     }
 
     /// The refit of the tree over `prims` (on the device, the same counts).
@@ -242,26 +246,30 @@ impl<B: Backend> Tracer<B> {
     }
 
     /// The closest hit of each ray, with its hit record (see [`RayHit`]).
-    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
-        if self.tree.is_none() {
-            check_rays(rays)?;
-            return Ok(vec![RayHit::MISS; rays.len()]);
-        }
-        let out = read_batch(b, rays, |b, buffer| self.closest_hits_on_device(b, buffer, rays.len()))?;
-        Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+    pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<RayHit>> {
+        crate::error::typed(|| {
+            if self.tree.is_none() {
+                check_rays(rays)?;
+                return Ok(vec![RayHit::MISS; rays.len()]);
+            }
+            let out = read_batch(b, rays, |b, buffer| Ok(self.closest_hits_on_device(b, buffer, rays.len())?))?;
+            Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
+        })
     }
 
     /// Whether each ray hits anything up to its `t_max` (inclusive): an
     /// occlusion query, which stops at the first hit it finds (shadow and
     /// ambient-occlusion rays). Agrees with [`Tracer::closest_hits`]: a ray
     /// is occluded exactly when its closest hit is within `t_max`.
-    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
-        if self.tree.is_none() {
-            check_rays(rays)?;
-            return Ok(vec![false; rays.len()]);
-        }
-        let out = read_batch(b, rays, |b, buffer| self.occluded_on_device(b, buffer, rays.len()))?;
-        Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+    pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<bool>> {
+        crate::error::typed(|| {
+            if self.tree.is_none() {
+                check_rays(rays)?;
+                return Ok(vec![false; rays.len()]);
+            }
+            let out = read_batch(b, rays, |b, buffer| Ok(self.occluded_on_device(b, buffer, rays.len())?))?;
+            Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
+        })
     }
 
     /// Traces `count` rays that are already on the device (for callers that
@@ -275,15 +283,19 @@ impl<B: Backend> Tracer<B> {
     /// and (0, 0, 0, bits of `u32::MAX`). The buffer holds [`batch_slots`](crate::tracer::batch_slots)`(count)` such pairs; pairs past
     /// `count` must be zero. Recorded, not submitted: on a GPU, submitted at
     /// the backend's next flush ([`GpuBackend::submit`](crate::runtime::gpu::GpuBackend::submit), a read).
-    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
-        self.cast_on_device(b, rays, count, CAST_RAYS)
+    pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            self.cast_on_device(b, rays, count, CAST_RAYS)
+        })
     }
 
     /// [`Tracer::occluded`] on rays already on the device, laid out as for
     /// [`Tracer::closest_hits_on_device`]: `rays[2k]` becomes (1 if
     /// occluded else 0, 0, 0, 0). Recorded, as [`Tracer::closest_hits_on_device`].
-    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
-        self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+    pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
+        crate::error::typed(|| {
+            self.cast_on_device(b, rays, count, CAST_OCCLUDED)
+        })
     }
 
     fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
@@ -299,7 +311,7 @@ impl<B: Backend> Tracer<B> {
         let p = b.upload("trace params", &[params])?;
         let materials = b.upload("no materials", &[treelet_core::geometry::buffers::Material::default()])?;
         let Some(tree) = &self.tree else {
-            bail!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)");
+            return Err(crate::error::input(format!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)")));
         };
         let kernel = Kernel::Cast(Method::Bvh2, self.counts.0 == 0);
         b.stage("trace");

@@ -1,6 +1,6 @@
 //! What [`Tracer`] and [`InstancedTracer`] share: ray queries on a built
 //! scene, so that an engine's code can take either.
-use anyhow::Result;
+use crate::error::Result;
 
 use super::instances::InstancedTracer;
 use super::primitives::Tracer;

@@ -1,7 +1,7 @@
 //! The engine API's rays and hits, and how a batch of them travels to the
 //! device and back (shared by [`crate::tracer::Tracer`] and
 //! [`crate::tracer::InstancedTracer`]).
-use anyhow::{bail, Result};
+use anyhow::Result;
 
 use crate::runtime::backend::Backend;
 
@@ -94,36 +94,40 @@ pub(super) const BATCH_WIDTH: u32 = 1024;
 /// The device layout has no `t_min`: a ray is moved `t_min` along its
 /// direction and its `t_max` shortened by as much (hit distances then count
 /// from there); engines that fill device buffers themselves do the same.
-pub fn device_rays(rays: &[Ray]) -> Result<Vec<[f32; 4]>> {
-    check_rays(rays)?;
-    let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
-    for (k, r) in rays.iter().enumerate() {
-        let d = glam::Vec3::from(r.dir);
-        let o = if r.t_min > 0.0 && d.length() > 0.0 {
-            glam::Vec3::from(r.origin) + d.normalize() * r.t_min
-        } else {
-            r.origin.into()
-        };
-        data[2 * k] = [o.x, o.y, o.z, r.t_max - r.t_min];
-        data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
-    }
-    Ok(data)
+pub fn device_rays(rays: &[Ray]) -> crate::error::Result<Vec<[f32; 4]>> {
+    crate::error::typed(|| {
+        check_rays(rays)?;
+        let mut data = vec![[0f32; 4]; 2 * batch_slots(rays.len())?];
+        for (k, r) in rays.iter().enumerate() {
+            let d = glam::Vec3::from(r.dir);
+            let o = if r.t_min > 0.0 && d.length() > 0.0 {
+                glam::Vec3::from(r.origin) + d.normalize() * r.t_min
+            } else {
+                r.origin.into()
+            };
+            data[2 * k] = [o.x, o.y, o.z, r.t_max - r.t_min];
+            data[2 * k + 1] = [r.dir[0], r.dir[1], r.dir[2], 1.0];
+        }
+        Ok(data)
+    })
 }
 
 /// Every ray's `t_min` is finite and at least 0.
 pub(super) fn check_rays(rays: &[Ray]) -> Result<()> {
     if let Some((k, r)) = rays.iter().enumerate().find(|(_, r)| !(r.t_min >= 0.0 && r.t_min.is_finite())) {
-        bail!("ray {k}: t_min {} must be finite and at least 0", r.t_min);
+        return Err(crate::error::input(format!("ray {k}: t_min {} must be finite and at least 0", r.t_min)));
     }
     Ok(())
 }
 
 /// Ray pairs a device batch of `count` rays holds (rows of whole width).
-pub fn batch_slots(count: usize) -> Result<usize> {
-    let width = BATCH_WIDTH as usize;
-    let slots = if count <= width { count.max(1) } else { count.div_ceil(width) * width };
-    if slots > u32::MAX as usize / 4 {
-        bail!("{count} rays in one batch: at most {} are supported", u32::MAX / 4);
-    }
-    Ok(slots)
+pub fn batch_slots(count: usize) -> crate::error::Result<usize> {
+    crate::error::typed(|| {
+        let width = BATCH_WIDTH as usize;
+        let slots = if count <= width { count.max(1) } else { count.div_ceil(width) * width };
+        if slots > u32::MAX as usize / 4 {
+            return Err(crate::error::too_large(format!("{count} rays in one batch: at most {} are supported", u32::MAX / 4)));
+        }
+        Ok(slots)
+    })
 }

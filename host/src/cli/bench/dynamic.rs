@@ -189,7 +189,7 @@ pub(crate) fn bench_dynamic<B: Backend>(
 /// the update timed next runs at full clock rather than the idle clock the
 /// host's work on the frame lets the GPU fall to.
 fn warm_up<B: Backend>(b: &mut B, tracer: &Tracer<B>, rays: &[Ray]) -> Result<()> {
-    traced_in_place_ms(b, rays, 1, 0.05, &|b, r, n| tracer.closest_hits_on_device(b, r, n)).map(drop)
+    traced_in_place_ms(b, rays, 1, 0.05, &|b, r, n| Ok(tracer.closest_hits_on_device(b, r, n)?)).map(drop)
 }
 
 /// Device ms of the closest hits and of the occlusion queries of `rays`
@@ -198,7 +198,7 @@ fn warm_up<B: Backend>(b: &mut B, tracer: &Tracer<B>, rays: &[Ray]) -> Result<()
 /// on the frame, the H100 traced at its idle clock (345 MHz) and this
 /// benchmark reported a quarter of the rays/s `bench rays` measures.
 fn trace<B: Backend>(b: &mut B, tracer: &Tracer<B>, rays: &[Ray]) -> Result<(f64, f64)> {
-    let closest = traced_in_place_ms(b, rays, 3, 0.1, &|b, r, n| tracer.closest_hits_on_device(b, r, n))?;
-    let occluded = traced_in_place_ms(b, rays, 3, 0.1, &|b, r, n| tracer.occluded_on_device(b, r, n))?;
+    let closest = traced_in_place_ms(b, rays, 3, 0.1, &|b, r, n| Ok(tracer.closest_hits_on_device(b, r, n)?))?;
+    let occluded = traced_in_place_ms(b, rays, 3, 0.1, &|b, r, n| Ok(tracer.occluded_on_device(b, r, n)?))?;
     Ok((closest, occluded))
 }

@@ -151,8 +151,8 @@ pub(crate) fn bench_instances<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| single.closest_hits(b, r),
-            on_device: &|b, r, n| single.closest_hits_on_device(b, r, n),
+            closest: &|b, r| Ok(single.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(single.closest_hits_on_device(b, r, n)?),
         },
     )?;
     let check_rays = camera_rays((lo, hi), OBLIQUE, size);
@@ -169,7 +169,7 @@ pub(crate) fn bench_instances<B: Backend>(
         size,
         extent,
         repeats,
-        &Traced { closest: &|b, r| one.closest_hits(b, r), on_device: &|b, r, n| one.closest_hits_on_device(b, r, n) },
+        &Traced { closest: &|b, r| Ok(one.closest_hits(b, r)?), on_device: &|b, r, n| Ok(one.closest_hits_on_device(b, r, n)?) },
     )?;
     drop(one);
 
@@ -196,8 +196,8 @@ pub(crate) fn bench_instances<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| scene_tracer.closest_hits(b, r),
-            on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n),
+            closest: &|b, r| Ok(scene_tracer.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(scene_tracer.closest_hits_on_device(b, r, n)?),
         },
     )?;
     let (ap, ad, _, _) = rays_per_second(
@@ -207,8 +207,8 @@ pub(crate) fn bench_instances<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| scene_tracer.closest_hits(b, r),
-            on_device: &|b, r, n| scene_tracer.closest_hits_on_device(b, r, n),
+            closest: &|b, r| Ok(scene_tracer.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(scene_tracer.closest_hits_on_device(b, r, n)?),
         },
     )?;
 

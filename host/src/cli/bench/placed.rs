@@ -72,8 +72,8 @@ pub(crate) fn bench_placed<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| placed.closest_hits(b, r),
-            on_device: &|b, r, n| placed.closest_hits_on_device(b, r, n),
+            closest: &|b, r| Ok(placed.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(placed.closest_hits_on_device(b, r, n)?),
         },
     )?;
     let (fp, fd, _, _) = rays_per_second(
@@ -83,8 +83,8 @@ pub(crate) fn bench_placed<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| whole.closest_hits(b, r),
-            on_device: &|b, r, n| whole.closest_hits_on_device(b, r, n),
+            closest: &|b, r| Ok(whole.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(whole.closest_hits_on_device(b, r, n)?),
         },
     )?;
 

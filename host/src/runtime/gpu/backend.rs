@@ -362,14 +362,14 @@ impl Backend for GpuBackend {
                 })
             } else if b.size() > self.ctx.max_binding_bytes() {
                 self.error.get_or_insert_with(|| {
-                    anyhow::anyhow!(
+                    crate::error::too_large(format!(
                         "scene too large for this device: `{}` binds a buffer of {} bytes whole, the adapter `{}` \
                          allows {} bytes per binding (the builds, the bvh2 layout and its traversal split large buffers; cwbvh does not yet)",
                         kernel.entry_point(),
                         b.size(),
                         self.ctx.info.name,
                         self.ctx.max_binding_bytes()
-                    )
+                    ))
                 });
                 return;
             } else {

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result};
 
 use crate::runtime::kernels::{Access, Kernel};
 use crate::tuning::PipelineCache;
@@ -211,13 +211,13 @@ fn open_with_partitioned(
 impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred) and
     /// loads the shader module. Fails with a clear message when there is none.
-    pub fn new() -> Result<Arc<Self>> {
-        pollster::block_on(Self::new_async(None))
+    pub fn new() -> crate::error::Result<Arc<Self>> {
+        crate::error::typed(|| pollster::block_on(Self::new_async(None)))
     }
 
     /// Opens the Vulkan adapter of index `index` in [`GpuContext::adapters`].
-    pub fn with_adapter(index: usize) -> Result<Arc<Self>> {
-        pollster::block_on(Self::new_async(Some(index)))
+    pub fn with_adapter(index: usize) -> crate::error::Result<Arc<Self>> {
+        crate::error::typed(|| pollster::block_on(Self::new_async(Some(index))))
     }
 
     /// The names of the machine's Vulkan adapters, in index order.
@@ -250,16 +250,17 @@ impl GpuContext {
                 })
                 .cloned(),
         };
-        let adapter = adapter
-            .context(
+        let adapter = adapter.ok_or_else(|| {
+            crate::error::device(
                 "no Vulkan adapter found (install a Vulkan driver; without a GPU, \
                  `apt-get install mesa-vulkan-drivers` gives lavapipe)",
-            )?;
+            )
+        })?;
         let info = adapter.get_info();
         let needed = Self::required_features();
         let missing = needed - adapter.features();
         if !missing.is_empty() {
-            bail!("adapter `{}` lacks features Treelet needs: {missing:?}", info.name);
+            return Err(crate::error::device(format!("adapter `{}` lacks features Treelet needs: {missing:?}", info.name)));
         }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let device_memory = device_local_bytes(&adapter);
@@ -323,41 +324,43 @@ impl GpuContext {
     /// device has are used (timestamps, a pipeline cache); NVIDIA's
     /// partition instruction is not (wgpu cannot enable its extension on a
     /// device opened elsewhere), so the sort ranks digits with ballots.
-    pub fn from_wgpu(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Result<Arc<Self>> {
-        let start = Instant::now();
-        let info = adapter.get_info();
-        if info.backend != wgpu::Backend::Vulkan {
-            bail!("device of adapter `{}` runs on {:?}: Treelet's kernels are SPIR-V and need a Vulkan device", info.name, info.backend);
-        }
-        let features = device.features();
-        let missing = Self::required_features() - features;
-        let limits = device.limits();
-        let needed = Self::required_limits(wgpu::Limits::downlevel_defaults());
-        let mut short = Vec::new();
-        let mut check = |name: &str, has: u32, needs: u32| {
-            if has < needs {
-                short.push(format!("{name} is {has}, the kernels need {needs}"));
+    pub fn from_wgpu(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> crate::error::Result<Arc<Self>> {
+        crate::error::typed(|| {
+            let start = Instant::now();
+            let info = adapter.get_info();
+            if info.backend != wgpu::Backend::Vulkan {
+                return Err(crate::error::device(format!("device of adapter `{}` runs on {:?}: Treelet's kernels are SPIR-V and need a Vulkan device", info.name, info.backend)));
             }
-        };
-        check("max_storage_buffers_per_shader_stage", limits.max_storage_buffers_per_shader_stage, needed.max_storage_buffers_per_shader_stage);
-        check("max_compute_workgroup_storage_size", limits.max_compute_workgroup_storage_size, needed.max_compute_workgroup_storage_size);
-        check("max_compute_invocations_per_workgroup", limits.max_compute_invocations_per_workgroup, needed.max_compute_invocations_per_workgroup);
-        check("max_compute_workgroup_size_x", limits.max_compute_workgroup_size_x, needed.max_compute_workgroup_size_x);
-        if !missing.is_empty() || !short.is_empty() {
-            let mut why = Vec::new();
-            if !missing.is_empty() {
-                why.push(format!("it lacks features {missing:?} (open it with GpuContext::required_features(), wgpu's experimental features enabled)"));
+            let features = device.features();
+            let missing = Self::required_features() - features;
+            let limits = device.limits();
+            let needed = Self::required_limits(wgpu::Limits::downlevel_defaults());
+            let mut short = Vec::new();
+            let mut check = |name: &str, has: u32, needs: u32| {
+                if has < needs {
+                    short.push(format!("{name} is {has}, the kernels need {needs}"));
+                }
+            };
+            check("max_storage_buffers_per_shader_stage", limits.max_storage_buffers_per_shader_stage, needed.max_storage_buffers_per_shader_stage);
+            check("max_compute_workgroup_storage_size", limits.max_compute_workgroup_storage_size, needed.max_compute_workgroup_storage_size);
+            check("max_compute_invocations_per_workgroup", limits.max_compute_invocations_per_workgroup, needed.max_compute_invocations_per_workgroup);
+            check("max_compute_workgroup_size_x", limits.max_compute_workgroup_size_x, needed.max_compute_workgroup_size_x);
+            if !missing.is_empty() || !short.is_empty() {
+                let mut why = Vec::new();
+                if !missing.is_empty() {
+                    why.push(format!("it lacks features {missing:?} (open it with GpuContext::required_features(), wgpu's experimental features enabled)"));
+                }
+                if !short.is_empty() {
+                    why.push(format!("{} (open it with GpuContext::required_limits(..))", short.join("; ")));
+                }
+                return Err(crate::error::device(format!("the device of adapter `{}` cannot run Treelet: {}", info.name, why.join("; "))));
             }
-            if !short.is_empty() {
-                why.push(format!("{} (open it with GpuContext::required_limits(..))", short.join("; ")));
-            }
-            bail!("the device of adapter `{}` cannot run Treelet: {}", info.name, why.join("; "));
-        }
-        let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        let cache_path = cache_file(&info).filter(|_| features.contains(wgpu::Features::PIPELINE_CACHE));
-        let device_memory = device_local_bytes(adapter);
-        let opened = Opened { device, queue, info, limits, timestamps, device_memory, partitioned: false, cache_path };
-        Ok(Self::assemble(opened, start))
+            let timestamps = features.contains(wgpu::Features::TIMESTAMP_QUERY);
+            let cache_path = cache_file(&info).filter(|_| features.contains(wgpu::Features::PIPELINE_CACHE));
+            let device_memory = device_local_bytes(adapter);
+            let opened = Opened { device, queue, info, limits, timestamps, device_memory, partitioned: false, cache_path };
+            Ok(Self::assemble(opened, start))
+        })
     }
 
     /// The context of a device just opened; `start`: when opening began.
