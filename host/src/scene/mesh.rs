@@ -251,14 +251,23 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
 }
 
 /// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
-/// `face` elements with a `vertex_indices` (or `vertex_index`) list. Read
-/// into compact records (other elements are read and dropped), so a mesh
-/// takes little more memory than its triangles.
+/// `face` elements with a `vertex_indices` (or `vertex_index`) list. The
+/// common binary layout is read directly ([`super::ply_binary`]); others
+/// are parsed into compact records (other elements are read and dropped),
+/// so a mesh takes little more memory than its triangles.
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
+    let bytes = crate::internals::input::read(path, "mesh")?;
+    let name = path.display().to_string();
+    match super::ply_binary::read(&bytes, &name) {
+        Some(triangles) => triangles,
+        None => parse_ply(&bytes, &name),
+    }
+}
+
+/// Any PLY through `ply-rs-bw`'s parser.
+fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<Triangle>> {
     use ply_rs_bw::parser::{Parser, Reader};
     use ply_rs_bw::ply::DefaultElement;
-    let bytes = crate::internals::input::read(path, "mesh")?;
-    let name = path.display();
     let parse_error = |e: ply_rs_bw::parser::ParseError| {
         // The parser's message spans lines and names a line of the file, not
         // the element: one line, with the element that line holds.
@@ -269,12 +278,12 @@ pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
             Some((head, rest)) => format!("{} in `{}`", head.trim_end_matches('.'), rest.split('\'').nth(1).unwrap_or("").trim()),
             None => full,
         };
-        match ply_error_element(&bytes, &message) {
+        match ply_error_element(bytes, &message) {
             Some((element, index)) => anyhow!("{name}: {element} {index}: {message}"),
             None => anyhow!("{name}: not a valid PLY file: {message}"),
         }
     };
-    let mut reader = Reader::new(bytes.as_slice());
+    let mut reader = Reader::new(bytes);
     let header = Parser::<DefaultElement>::new().read_header(&mut reader).map_err(parse_error)?;
     let (mut vertices, mut faces) = (None, None);
     for (element, def) in &header.elements {
@@ -390,6 +399,79 @@ mod tests {
         }
         let t = load(&write("tri.ply", &bytes)).unwrap();
         assert_eq!(t, vec![Triangle::new([0.0; 3], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0])]);
+    }
+
+    /// A binary PLY of `positions` and `faces`, vertices carrying a normal
+    /// and a colour beside x, y, z (in the order `order`), faces a count of
+    /// type `count` and indices of type `index`.
+    fn binary_ply(positions: &[[f32; 3]], faces: &[Vec<i64>], order: [usize; 3], count: &str, index: &str) -> Vec<u8> {
+        let axes = ["x", "y", "z"];
+        let mut h = format!("ply\nformat binary_little_endian 1.0\ncomment made by a test\nelement vertex {}\n", positions.len());
+        h += "property float nx\n";
+        for (a, colour) in order.into_iter().zip(["red", "green", "blue"]) {
+            h += &format!("property float {}\nproperty uchar {colour}\n", axes[a]);
+        }
+        h += &format!("element face {}\nproperty list {count} {index} vertex_indices\nend_header\n", faces.len());
+        let mut b = h.into_bytes();
+        let int = |b: &mut Vec<u8>, t: &str, v: i64| match t {
+            "uchar" | "char" => b.push(v as u8),
+            "ushort" | "short" => b.extend_from_slice(&(v as u16).to_le_bytes()),
+            _ => b.extend_from_slice(&(v as u32).to_le_bytes()),
+        };
+        for p in positions {
+            b.extend_from_slice(&0.5f32.to_le_bytes());
+            for a in order {
+                b.extend_from_slice(&p[a].to_le_bytes());
+                b.push(7);
+            }
+        }
+        for f in faces {
+            int(&mut b, count, f.len() as i64);
+            for &i in f {
+                int(&mut b, index, i);
+            }
+        }
+        b
+    }
+
+    /// The direct reader of the common binary layout gives what the general
+    /// parser gives, on random meshes of polygons with properties in any
+    /// order, and its errors name the face at fault.
+    #[test]
+    fn binary_ply_read_directly_equals_the_parser() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        for (case, (count, index)) in [("uchar", "int"), ("uchar", "uint"), ("ushort", "uint"), ("uchar", "ushort"), ("int", "int")].into_iter().enumerate() {
+            let n = rng.random_range(3..200usize);
+            let positions: Vec<[f32; 3]> = (0..n).map(|_| [rng.random(), rng.random::<f32>() * 1e3, -rng.random::<f32>()]).collect();
+            let faces: Vec<Vec<i64>> = (0..rng.random_range(1..300))
+                .map(|_| (0..rng.random_range(3..7)).map(|_| rng.random_range(0..n as i64)).collect())
+                .collect();
+            let order = [[0, 1, 2], [2, 0, 1], [1, 2, 0]][case % 3];
+            let bytes = binary_ply(&positions, &faces, order, count, index);
+            let direct = crate::scene::ply_binary::read(&bytes, "m.ply").expect("the common layout").unwrap();
+            assert_eq!(direct, parse_ply(&bytes, "m.ply").unwrap(), "{count} {index}");
+            assert_eq!(direct.len(), faces.iter().map(|f| f.len() - 2).sum::<usize>());
+        }
+        let quad = binary_ply(&[[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], &[vec![0, 1, 2, 3], vec![0, 2, 9]], [0, 1, 2], "uchar", "int");
+        let e = crate::scene::ply_binary::read(&quad, "q.ply").unwrap().unwrap_err().to_string();
+        assert!(e.contains("q.ply: face 1: vertex index 9 out of range 0..4"), "{e}");
+        let e = crate::scene::ply_binary::read(&quad[..quad.len() - 3], "q.ply").unwrap().unwrap_err().to_string();
+        assert!(e.contains("face 1") && e.contains("truncated"), "{e}");
+        let body = quad.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let e = crate::scene::ply_binary::read(&quad[..body + 10], "q.ply").unwrap().unwrap_err().to_string();
+        assert!(e.contains("vertices") && e.contains("truncated"), "{e}");
+        let two = binary_ply(&[[0.0; 3], [1.0, 0.0, 0.0]], &[vec![0, 1]], [0, 1, 2], "uchar", "int");
+        let e = crate::scene::ply_binary::read(&two, "t.ply").unwrap().unwrap_err().to_string();
+        assert!(e.contains("face 0 has 2 vertices"), "{e}");
+        // Other layouts go to the parser: ASCII, big-endian, double coordinates.
+        for other in [
+            b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nend_header\n".as_slice(),
+            b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+            b"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty double x\nproperty double y\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
+        ] {
+            assert!(crate::scene::ply_binary::read(other, "o.ply").is_none());
+        }
     }
 
     /// Each bad file gives an error naming the file and the problem; none panics.

@@ -1,0 +1,157 @@
+//! The common binary PLY, read at the memory's pace: little-endian, a
+//! `vertex` element of scalar properties with `float` `x`, `y`, `z`, then a
+//! `face` element whose one property is the list of vertex indices. Scans
+//! and large meshes come so (a 53M-triangle, 1 GB file took 37 s through
+//! the general parser, which makes a record per element); every other PLY
+//! goes to the general parser ([`super::mesh::load_ply`]), and so do files
+//! this reader finds any doubt in, so that their errors are that parser's.
+use anyhow::{anyhow, bail, Result};
+use treelet_core::geometry::triangle::Triangle;
+
+/// Size in bytes of a PLY scalar type, and whether it is an integer.
+fn scalar(name: &str) -> Option<(usize, bool)> {
+    Some(match name {
+        "char" | "int8" | "uchar" | "uint8" => (1, true),
+        "short" | "int16" | "ushort" | "uint16" => (2, true),
+        "int" | "int32" | "uint" | "uint32" => (4, true),
+        "float" | "float32" => (4, false),
+        "double" | "float64" => (8, false),
+        _ => return None,
+    })
+}
+
+/// Reads unsigned little-endian integers of `size` bytes (and signed ones,
+/// for the signed type names) at `at`.
+#[derive(Clone, Copy)]
+struct Int {
+    size: usize,
+    signed: bool,
+}
+
+impl Int {
+    fn of(name: &str) -> Option<Int> {
+        let (size, integer) = scalar(name)?;
+        integer.then(|| Int { size, signed: matches!(name, "char" | "int8" | "short" | "int16" | "int" | "int32") })
+    }
+
+    #[inline]
+    fn read(self, b: &[u8], at: usize) -> i64 {
+        match (self.size, self.signed) {
+            (1, false) => b[at] as i64,
+            (1, true) => b[at] as i8 as i64,
+            (2, false) => u16::from_le_bytes([b[at], b[at + 1]]) as i64,
+            (2, true) => i16::from_le_bytes([b[at], b[at + 1]]) as i64,
+            (_, false) => u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]) as i64,
+            (_, true) => i32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]) as i64,
+        }
+    }
+}
+
+/// What the header says, when it is the layout this reader takes.
+struct Layout {
+    body: usize,
+    vertices: usize,
+    stride: usize,
+    /// Byte offsets of x, y, z within a vertex.
+    xyz: [usize; 3],
+    faces: usize,
+    count: Int,
+    index: Int,
+}
+
+fn layout(bytes: &[u8]) -> Option<Layout> {
+    let end = bytes.windows(11).take(1 << 16).position(|w| w == b"end_header\n")?;
+    let header = std::str::from_utf8(&bytes[..end]).ok()?;
+    let mut lines = header.lines().map(str::trim);
+    if lines.next()? != "ply" || lines.next()? != "format binary_little_endian 1.0" {
+        return None;
+    }
+    let (mut vertex, mut face) = (None::<(usize, usize, [Option<usize>; 3])>, None::<(usize, Option<(Int, Int)>)>);
+    for line in lines {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            [] | ["comment", ..] | ["obj_info", ..] => {}
+            ["element", "vertex", n] if vertex.is_none() && face.is_none() => vertex = Some((n.parse().ok()?, 0, [None; 3])),
+            ["element", "face", n] if vertex.is_some() && face.is_none() => face = Some((n.parse().ok()?, None)),
+            ["property", "list", c, i, "vertex_indices" | "vertex_index"] if face.is_some_and(|f| f.1.is_none()) => {
+                face.as_mut()?.1 = Some((Int::of(c)?, Int::of(i)?));
+            }
+            ["property", t, name] if face.is_none() => {
+                let (size, integer) = scalar(t)?;
+                let v = vertex.as_mut()?;
+                if let Some(axis) = ["x", "y", "z"].iter().position(|a| a == name) {
+                    // Only float coordinates, each named once.
+                    if integer || size != 4 || v.2[axis].is_some() {
+                        return None;
+                    }
+                    v.2[axis] = Some(v.1);
+                }
+                v.1 += size;
+            }
+            _ => return None,
+        }
+    }
+    let (vertices, stride, [Some(x), Some(y), Some(z)]) = vertex? else { return None };
+    let (faces, Some((count, index))) = face? else { return None };
+    Some(Layout { body: end + 11, vertices, stride, xyz: [x, y, z], faces, count, index })
+}
+
+/// The triangles of `bytes` if they are the common binary layout (see the
+/// module doc), `None` for any other PLY; errors name the element at fault
+/// as the general reader does.
+pub fn read(bytes: &[u8], name: &str) -> Option<Result<Vec<Triangle>>> {
+    let l = layout(bytes)?;
+    Some(triangles(bytes, name, &l))
+}
+
+fn triangles(bytes: &[u8], name: &str, l: &Layout) -> Result<Vec<Triangle>> {
+    let body = &bytes[l.body..];
+    let vertex_bytes = l.vertices.checked_mul(l.stride).filter(|&b| b <= body.len());
+    let Some(vertex_bytes) = vertex_bytes else {
+        bail!("{name}: the header's {} vertices of {} bytes are past the file's end (truncated?)", l.vertices, l.stride);
+    };
+    let f32_at = |at: usize| f32::from_le_bytes([body[at], body[at + 1], body[at + 2], body[at + 3]]);
+    let positions: Vec<[f32; 3]> = (0..l.vertices)
+        .map(|v| {
+            let base = v * l.stride;
+            [f32_at(base + l.xyz[0]), f32_at(base + l.xyz[1]), f32_at(base + l.xyz[2])]
+        })
+        .collect();
+    let faces = &body[vertex_bytes..];
+    // No more room than the file can hold: a face takes at least its count
+    // and three indices.
+    let smallest = l.count.size + 3 * l.index.size;
+    let mut triangles = Vec::with_capacity(l.faces.min(faces.len() / smallest));
+    let mut at = 0usize;
+    for f in 0..l.faces {
+        if at + l.count.size > faces.len() {
+            bail!("{name}: face {f}: the file ends inside it (truncated?)");
+        }
+        let n = l.count.read(faces, at);
+        at += l.count.size;
+        if n < 3 {
+            bail!("{name}: face {f} has {n} vertices (at least 3 needed)");
+        }
+        let n = n as usize;
+        if n.checked_mul(l.index.size).is_none_or(|b| at + b > faces.len()) {
+            bail!("{name}: face {f}: the file ends inside it (truncated?)");
+        }
+        let vertex = |k: usize| -> Result<[f32; 3]> {
+            let i = l.index.read(faces, at + k * l.index.size);
+            usize::try_from(i)
+                .ok()
+                .and_then(|i| positions.get(i).copied())
+                .ok_or_else(|| anyhow!("{name}: face {f}: vertex index {i} out of range 0..{}", positions.len()))
+        };
+        // A polygon becomes a fan of triangles around its first vertex.
+        let first = vertex(0)?;
+        for k in 1..n - 1 {
+            triangles.push(Triangle::new(first, vertex(k)?, vertex(k + 1)?));
+        }
+        at += n * l.index.size;
+    }
+    if at != faces.len() {
+        bail!("{name}: {} bytes after the last face: not the layout the header gives", faces.len() - at);
+    }
+    Ok(triangles)
+}
