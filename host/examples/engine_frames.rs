@@ -7,7 +7,7 @@
 //! the build and the shading; the last frame's picture is read back and
 //! written at the end.
 //!
-//!     cargo run --release -p treelet --example engine_frames [FRAMES] [OUT.png]
+//!     cargo run --release -p treelet --example engine_frames [FRAMES] [OUT.png] [GRID]
 //!
 //! Runs on the first Vulkan GPU, or lavapipe where there is none.
 use std::time::Instant;
@@ -17,7 +17,8 @@ use treelet::tracer::{device_rays, IndexBuffer, IndexFormat, MeshBuffers};
 use treelet::wgpu;
 use treelet::{Backend, GpuBackend, GpuContext, Quality, Ray, Tracer};
 
-/// The engine's mesh: a wavy sheet of `GRID x GRID` quads.
+/// The engine's mesh: a wavy sheet of `grid x grid` quads, 256 unless the
+/// third argument says otherwise.
 const GRID: u32 = 256;
 /// The engine's vertex: position, normal, uv (8 f32: a stride of 32 bytes).
 const VERTEX_WORDS: usize = 8;
@@ -25,23 +26,23 @@ const WIDTH: u32 = 480;
 const HEIGHT: u32 = 270;
 
 /// The sheet at time `t`: vertices (the engine's layout) and indices.
-fn sheet(t: f32) -> Vec<f32> {
-    let mut v = Vec::with_capacity(((GRID + 1) * (GRID + 1)) as usize * VERTEX_WORDS);
-    for j in 0..=GRID {
-        for i in 0..=GRID {
-            let (x, z) = (i as f32 / GRID as f32 * 20.0 - 10.0, j as f32 / GRID as f32 * 20.0 - 10.0);
+fn sheet(t: f32, grid: u32) -> Vec<f32> {
+    let mut v = Vec::with_capacity(((grid + 1) * (grid + 1)) as usize * VERTEX_WORDS);
+    for j in 0..=grid {
+        for i in 0..=grid {
+            let (x, z) = (i as f32 / grid as f32 * 20.0 - 10.0, j as f32 / grid as f32 * 20.0 - 10.0);
             let y = (x * 0.7 + t).sin() * (z * 0.5 - 0.5 * t).cos();
-            v.extend([x, y, z, 0.0, 1.0, 0.0, i as f32 / GRID as f32, j as f32 / GRID as f32]);
+            v.extend([x, y, z, 0.0, 1.0, 0.0, i as f32 / grid as f32, j as f32 / grid as f32]);
         }
     }
     v
 }
 
-fn indices() -> Vec<u32> {
-    let row = GRID + 1;
-    (0..GRID * GRID)
+fn indices(grid: u32) -> Vec<u32> {
+    let row = grid + 1;
+    (0..grid * grid)
         .flat_map(|q| {
-            let (i, j) = (q % GRID, q / GRID);
+            let (i, j) = (q % grid, q / grid);
             let a = j * row + i;
             [a, a + row, a + 1, a + 1, a + row, a + row + 1]
         })
@@ -91,6 +92,8 @@ fn main() -> Result<()> {
     let frames: u32 = args.first().map_or(Ok(30), |f| f.parse()).context("FRAMES: a number")?;
     anyhow::ensure!(frames >= 1, "FRAMES: at least 1");
     let out = args.get(1).cloned().unwrap_or_else(|| "engine_frames.png".into());
+    let grid: u32 = args.get(2).map_or(Ok(GRID), |g| g.parse()).context("GRID: a number")?;
+    anyhow::ensure!((1..=4096).contains(&grid), "GRID {grid}: from 1 to 4096 quads a side");
 
     // 1. The engine's device, opened with the features and limits Treelet needs.
     treelet::runtime::gpu::quiet_mesa_runtime_dir();
@@ -111,7 +114,7 @@ fn main() -> Result<()> {
     };
     let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))?;
     let b = &mut GpuBackend::new(GpuContext::from_wgpu(&adapter, device.clone(), queue.clone())?);
-    println!("{}: {} triangles, {WIDTH}x{HEIGHT} rays, {frames} frames", b.adapter(), 2 * GRID * GRID);
+    println!("{}: {} triangles, {WIDTH}x{HEIGHT} rays, {frames} frames", b.adapter(), 2 * grid * grid);
 
     // 2. The engine's buffers: its mesh, its rays (the hits come back in
     //    place), its image; and its shading pipeline.
@@ -123,9 +126,9 @@ fn main() -> Result<()> {
             mapped_at_creation: false,
         })
     };
-    let first = sheet(0.0);
+    let first = sheet(0.0, grid);
     let vertices = storage("engine vertices", first.len() as u64 * 4);
-    let index_data = indices();
+    let index_data = indices(grid);
     let index_buffer = storage("engine indices", index_data.len() as u64 * 4);
     queue.write_buffer(&index_buffer, 0, bytemuck::cast_slice(&index_data));
     let rays = camera_rays();
@@ -153,9 +156,9 @@ fn main() -> Result<()> {
         vertices: &vertices,
         vertex_offset: 0,
         vertex_stride: (VERTEX_WORDS * 4) as u64,
-        vertex_count: (GRID + 1) * (GRID + 1),
+        vertex_count: (grid + 1) * (grid + 1),
         indices: Some(IndexBuffer { buffer: &index_buffer, offset: 0, format: IndexFormat::U32 }),
-        triangle_count: 2 * GRID * GRID,
+        triangle_count: 2 * grid * grid,
     };
 
     // 3. Frames.
@@ -163,7 +166,7 @@ fn main() -> Result<()> {
     let (mut frame_ms, mut update_ms) = (Vec::new(), Vec::new());
     for frame in 0..frames {
         let start = Instant::now();
-        queue.write_buffer(&vertices, 0, bytemuck::cast_slice(&sheet(frame as f32 * 0.1)));
+        queue.write_buffer(&vertices, 0, bytemuck::cast_slice(&sheet(frame as f32 * 0.1, grid)));
         match &mut tracer {
             None => tracer = Some(Tracer::build_from_buffers(b, &mesh, Quality::Fast)?),
             Some(t) => t.refit_from_buffers(b, &mesh)?,
