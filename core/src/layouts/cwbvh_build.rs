@@ -55,11 +55,11 @@ const FEWER: u32 = 0;
 const LEAF: u32 = 0x80;
 
 /// The cost model of the DP: per wide node visited and per primitive tested,
-/// per unit of (scaled) area. An 8-wide node's test costs about three
-/// primitive tests; the constants are the paper's ratio as this
-/// implementation reads it (`c_node = 1`, `c_prim = 0.3`).
+/// per unit of (scaled) area. The paper's ratio (`c_prim = 0.3`) made 0.6 on
+/// the H200: 2-6% more diffuse rays inside real scenes, primary ones 0-3% fewer
+/// (`docs/results/h200-cwbvh-unroll-2026-12-02/README.md`, "knobs").
 pub const WIDE_NODE_COST: f32 = 1.0;
-pub const WIDE_PRIM_COST: f32 = 0.3;
+pub const WIDE_PRIM_COST: f32 = 0.6;
 
 impl LayoutParams {
     #[inline]

@@ -342,16 +342,12 @@ impl<B: Backend> InstancedTracer<B> {
     /// layout, and the second vector of a hit holds the bits of the
     /// instance in its last word.
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
-        crate::error::typed(|| {
-            self.cast_on_device(b, rays, count, CAST_RAYS)
-        })
+        crate::error::typed(|| self.cast_on_device(b, rays, count, CAST_RAYS))
     }
 
     /// [`Tracer::occluded_on_device`] through the instances.
     pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
-        crate::error::typed(|| {
-            self.cast_on_device(b, rays, count, CAST_OCCLUDED)
-        })
+        crate::error::typed(|| self.cast_on_device(b, rays, count, CAST_OCCLUDED))
     }
 
     fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {

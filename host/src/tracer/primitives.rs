@@ -284,18 +284,14 @@ impl<B: Backend> Tracer<B> {
     /// `count` must be zero. Recorded, not submitted: on a GPU, submitted at
     /// the backend's next flush ([`GpuBackend::submit`](crate::runtime::gpu::GpuBackend::submit), a read).
     pub fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
-        crate::error::typed(|| {
-            self.cast_on_device(b, rays, count, CAST_RAYS)
-        })
+        crate::error::typed(|| self.cast_on_device(b, rays, count, CAST_RAYS))
     }
 
     /// [`Tracer::occluded`] on rays already on the device, laid out as for
     /// [`Tracer::closest_hits_on_device`]: `rays[2k]` becomes (1 if
     /// occluded else 0, 0, 0, 0). Recorded, as [`Tracer::closest_hits_on_device`].
     pub fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> crate::error::Result<()> {
-        crate::error::typed(|| {
-            self.cast_on_device(b, rays, count, CAST_OCCLUDED)
-        })
+        crate::error::typed(|| self.cast_on_device(b, rays, count, CAST_OCCLUDED))
     }
 
     fn cast_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize, cast_mode: u32) -> Result<()> {
