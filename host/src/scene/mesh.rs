@@ -252,7 +252,7 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
 
 /// Stanford PLY, ASCII or binary: `vertex` elements with `x`, `y`, `z`, and
 /// `face` elements with a `vertex_indices` (or `vertex_index`) list. The
-/// common binary layout is read directly ([`super::ply_binary`]); others
+/// common binary layout is read directly (`scene::ply_binary`); others
 /// are parsed into compact records (other elements are read and dropped),
 /// so a mesh takes little more memory than its triangles.
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
