@@ -205,7 +205,18 @@ fn device_optimization_matches_cpu_and_lowers_sah() {
                 continue;
             }
             assert_eq!(g.parents, c.parents, "n = {n}");
-            assert_eq!(g.prim_indices, c.prim_indices, "n = {n}");
+            // The same leaves (the nodes are equal) must hold the same
+            // primitives; their order within a leaf may differ (seed
+            // 9233121803222398508, n = 30 000, max_leaf 8 on lavapipe: equal
+            // nodes, a leaf's primitives in another order; a leaf is tested
+            // whole, so traversal gives the same hits).
+            for leaf in c.nodes.iter().filter(|x| x.is_leaf()) {
+                let range = leaf.left as usize..(leaf.left + leaf.prim_count()) as usize;
+                let (mut gs, mut cs) = (g.prim_indices[range.clone()].to_vec(), c.prim_indices[range.clone()].to_vec());
+                gs.sort_unstable();
+                cs.sort_unstable();
+                assert_eq!(gs, cs, "n = {n}: the leaf of slots {range:?} holds other primitives on the GPU");
+            }
         }
     }
 }
