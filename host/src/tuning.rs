@@ -66,6 +66,9 @@ pub enum Hierarchy {
     Agglomerative,
     /// `subgroup`: the same, the lowest levels within subgroups.
     Subgroup,
+    /// `hploc`: H-PLOC's tree (so `--accel trbvh` restructures H-PLOC's
+    /// tree instead of the radix tree).
+    Hploc,
 }
 
 /// Timing of the TRBVH's heights (`TREELET_PROFILE_LEVELS`).
@@ -100,7 +103,7 @@ pub struct Tuning {
     pub sort_high_first: bool,
     /// `TREELET_MORTON_KEY_BITS`: bits of the Morton keys sorted (1 to 64).
     pub morton_key_bits: Option<u32>,
-    /// `TREELET_HIERARCHY=radix|agglomerative|subgroup`.
+    /// `TREELET_HIERARCHY=radix|agglomerative|subgroup|hploc`.
     pub hierarchy: Option<Hierarchy>,
     /// `TREELET_HPLOC_KEEP`: clusters an H-PLOC range keeps.
     pub hploc_keep: Option<u32>,
@@ -209,7 +212,8 @@ impl Tuning {
                 "radix" => Hierarchy::Radix,
                 "agglomerative" => Hierarchy::Agglomerative,
                 "subgroup" => Hierarchy::Subgroup,
-                _ => return Err(err(name, &v, "expected radix, agglomerative or subgroup")),
+                "hploc" => Hierarchy::Hploc,
+                _ => return Err(err(name, &v, "expected radix, agglomerative, subgroup or hploc")),
             });
         }
         if let Some(v) = get("TREELET_HPLOC_KEEP") {
@@ -347,8 +351,10 @@ mod tests {
             ("TREELET_PIPELINE_CACHE", "off"),
             ("TREELET_PROFILE_LEVELS", "empty"),
             ("TREELET_WIDE_COSTS", "1.5,2"),
+            ("TREELET_HIERARCHY", "hploc"),
         ])
         .unwrap();
+        assert_eq!(t.hierarchy, Some(Hierarchy::Hploc));
         assert_eq!(t.splits, Some(0.5));
         assert_eq!(t.treelets, Some((2, 3, 4)));
         assert!(!t.sort_look_back);
