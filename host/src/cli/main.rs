@@ -99,8 +99,9 @@ enum Command {
         reference: std::path::PathBuf,
     },
     /// Write a scene's triangles as a binary PLY mesh, for other tracers
-    /// (peers/mitsuba/rays.py times OptiX on it): a generated scene, a
-    /// glTF or scene file flattened, or a mesh.
+    /// (peers/mitsuba/rays.py times OptiX on it), or as OBJ text where
+    /// --out ends in .obj: a generated scene, a glTF or scene file
+    /// flattened, or a mesh.
     Export {
         /// Scene: terrain:N, city:N[:SEED], a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
         #[arg(long)]

@@ -37,15 +37,26 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
     Ok(triangles)
 }
 
-/// Wavefront OBJ: every object's faces, triangulated; materials are not read.
+/// Wavefront OBJ: every object's faces, triangulated; materials are not
+/// read. The common form (positions and faces) is read on every core
+/// (`scene::obj_plain`); other files and any error go through `tobj`.
 pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let text = crate::internals::input::read_text(path, "mesh")?;
+    // The common form on every core; the rest, and errors, through tobj.
+    match super::obj_plain::read(&text) {
+        Some(triangles) => Ok(triangles),
+        None => parse_obj(&text, &path.display().to_string()),
+    }
+}
+
+/// Any OBJ through tobj.
+fn parse_obj(text: &str, name: &str) -> Result<Vec<Triangle>> {
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     // Material libraries are ignored: Treelet assigns its own material.
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default())).map_err(|e| {
-        match obj_error_line(&text, &e) {
-            Some((line, content)) => anyhow!("{}: line {line}: {e} in `{}`", path.display(), content.trim()),
-            None => anyhow!("{}: not a valid OBJ file: {e}", path.display()),
+        match obj_error_line(text, &e) {
+            Some((line, content)) => anyhow!("{name}: line {line}: {e} in `{}`", content.trim()),
+            None => anyhow!("{name}: not a valid OBJ file: {e}"),
         }
     })?;
     let mut triangles = Vec::new();
@@ -56,11 +67,11 @@ pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
             mesh.positions
                 .get(3 * i..3 * i + 3)
                 .map(|p| [p[0], p[1], p[2]])
-                .ok_or_else(|| anyhow!("{}: object `{}`: vertex index {i} out of range", path.display(), model.name))
+                .ok_or_else(|| anyhow!("{name}: object `{}`: vertex index {i} out of range", model.name))
         };
         for (f, face) in mesh.indices.chunks(3).enumerate() {
             if face.len() < 3 {
-                bail!("{}: object `{}`: face {f} has {} vertices", path.display(), model.name, face.len());
+                bail!("{name}: object `{}`: face {f} has {} vertices", model.name, face.len());
             }
             triangles.push(Triangle::new(vertex(face[0])?, vertex(face[1])?, vertex(face[2])?));
         }
@@ -434,6 +445,74 @@ mod tests {
         b
     }
 
+    /// The parallel reader of the common OBJ gives what tobj gives, on
+    /// random files of polygons (every index form, negative indices,
+    /// groups, comments, CRLF) cut into chunks of a few lines; other files
+    /// go to tobj.
+    #[test]
+    fn plain_obj_read_in_chunks_equals_tobj() {
+        use rand::{Rng, SeedableRng};
+        use std::fmt::Write as _;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+        for case in 0..40 {
+            let mut text = String::from("# made by a test\nmtllib none.mtl\n");
+            let mut vertices = 0i64;
+            let mut faces = 0;
+            let eol = if case % 5 == 0 { "\r\n" } else { "\n" };
+            for _ in 0..rng.random_range(1..60) {
+                match rng.random_range(0..10) {
+                    0 => write!(text, "o part{}{eol}g g{}{eol}usemtl m{eol}s off{eol}", rng.random::<u8>(), rng.random::<u8>()).unwrap(),
+                    1 => write!(text, "vt 0.5 0.25{eol}vn 0 0 1{eol}# a comment{eol}{eol}").unwrap(),
+                    2..=5 => {
+                        let p: [f32; 3] = [rng.random::<f32>() * 100.0 - 50.0, rng.random(), rng.random::<f32>() * 1e-3];
+                        write!(text, "v {} {:e} {}{eol}", p[0], p[1], p[2]).unwrap();
+                        vertices += 1;
+                    }
+                    _ if vertices >= 3 => {
+                        text.push('f');
+                        for _ in 0..rng.random_range(3..8) {
+                            let i = rng.random_range(0..vertices);
+                            let index = if rng.random_bool(0.3) { i - vertices } else { i + 1 };
+                            match rng.random_range(0..4) {
+                                0 => write!(text, " {index}"),
+                                1 => write!(text, " {index}/1"),
+                                2 => write!(text, " {index}//1"),
+                                _ => write!(text, "  {index}/1/1"),
+                            }
+                            .unwrap();
+                        }
+                        text.push_str(eol);
+                        faces += 1;
+                    }
+                    _ => {}
+                }
+            }
+            let expected = parse_obj(&text, "m.obj");
+            for chunk in [1, 16, 100, 1 << 20] {
+                let read = crate::scene::obj_plain::read_in_chunks(&text, chunk);
+                match &expected {
+                    Ok(triangles) => assert_eq!(read.as_ref(), Some(triangles), "case {case}, chunks of {chunk}, {faces} faces:\n{text}"),
+                    Err(e) => assert!(read.is_none(), "case {case}: tobj: {e}"),
+                }
+            }
+        }
+        // Files in doubt go to tobj, which names the fault.
+        for (text, fault) in [
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", ""),
+            ("v 0 0 0\nv 1 0 x\nv 0 1 0\nf 1 2 3\n", "line 2"),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ""),
+            ("v 0 0 0 1\nv 1 0 0 1\nv 0 1 0 1\nf 1 2 3\n", ""),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nf 1 2 3\n", ""),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", ""),
+        ] {
+            assert!(crate::scene::obj_plain::read_in_chunks(text, 4).is_none(), "{text}");
+            if let Err(e) = parse_obj(text, "m.obj") {
+                assert!(e.to_string().contains(fault), "{e}");
+            }
+        }
+    }
+
     /// The direct reader of the common binary layout gives what the general
     /// parser gives, on random meshes of polygons with properties in any
     /// order, and its errors name the face at fault.
@@ -444,8 +523,10 @@ mod tests {
         for (case, (count, index)) in [("uchar", "int"), ("uchar", "uint"), ("ushort", "uint"), ("uchar", "ushort"), ("int", "int")].into_iter().enumerate() {
             let n = rng.random_range(3..200usize);
             let positions: Vec<[f32; 3]> = (0..n).map(|_| [rng.random(), rng.random::<f32>() * 1e3, -rng.random::<f32>()]).collect();
+            // Polygons, or triangles alone (read on every core as records of one size).
+            let largest = if case % 2 == 0 { 7 } else { 4 };
             let faces: Vec<Vec<i64>> = (0..rng.random_range(1..300))
-                .map(|_| (0..rng.random_range(3..7)).map(|_| rng.random_range(0..n as i64)).collect())
+                .map(|_| (0..rng.random_range(3..largest)).map(|_| rng.random_range(0..n as i64)).collect())
                 .collect();
             let order = [[0, 1, 2], [2, 0, 1], [1, 2, 0]][case % 3];
             let bytes = binary_ply(&positions, &faces, order, count, index);
@@ -461,6 +542,9 @@ mod tests {
         let body = quad.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
         let e = crate::scene::ply_binary::read(&quad[..body + 10], "q.ply").unwrap().unwrap_err().to_string();
         assert!(e.contains("vertices") && e.contains("truncated"), "{e}");
+        let triangles = binary_ply(&[[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]], &[vec![0, 1, 2], vec![2, 1, 3]], [0, 1, 2], "uchar", "int");
+        let e = crate::scene::ply_binary::read(&triangles, "t.ply").unwrap().unwrap_err().to_string();
+        assert!(e.contains("t.ply: face 1: vertex index 3 out of range 0..3"), "{e}");
         let two = binary_ply(&[[0.0; 3], [1.0, 0.0, 0.0]], &[vec![0, 1]], [0, 1, 2], "uchar", "int");
         let e = crate::scene::ply_binary::read(&two, "t.ply").unwrap().unwrap_err().to_string();
         assert!(e.contains("face 0 has 2 vertices"), "{e}");

@@ -19,6 +19,7 @@ pub mod mesh;
 pub mod model;
 pub mod placed;
 pub mod ply;
+mod obj_plain;
 mod ply_binary;
 pub mod primitives;
 pub mod spec;

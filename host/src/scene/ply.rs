@@ -1,5 +1,6 @@
 //! Writing a scene's triangles as a binary little-endian PLY (`treelet
-//! export`): three vertices per triangle, unshared, and faces of a `uchar`
+//! export`), or as an OBJ where the path ends in `.obj` (to time the OBJ
+//! reader: `treelet bench load`): three vertices per triangle, unshared, and faces of a `uchar`
 //! count and `int` indices, the form [`super::mesh`] reads back and the
 //! peers (`peers/mitsuba/rays.py`, OptiX through Mitsuba 3) take, so that a
 //! generated scene (`city:N`) or a glTF file can be timed by other tracers.
@@ -59,7 +60,9 @@ pub fn write(scene: &Scene, path: &Path) -> Result<Written> {
         _ => Path::new("."),
     };
     let tmp = tempfile::NamedTempFile::new_in(dir).with_context(|| format!("cannot write in {}", dir.display()))?;
-    write_body(tmp.as_file(), &scene.name, &triangles).with_context(|| format!("cannot write {}", path.display()))?;
+    let obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    let body = if obj { write_obj_body(tmp.as_file(), &scene.name, &triangles) } else { write_body(tmp.as_file(), &scene.name, &triangles) };
+    body.with_context(|| format!("cannot write {}", path.display()))?;
     tmp.persist(path).with_context(|| format!("cannot write {}", path.display()))?;
     let (min_area, max_area) = triangles.iter().map(area).fold((f64::MAX, 0.0f64), |(lo, hi), a| (lo.min(a), hi.max(a)));
     Ok(Written { triangles: triangles.len(), min_area, max_area, left_out })
@@ -97,6 +100,21 @@ fn write_body(file: &std::fs::File, name: &str, triangles: &[[[f32; 3]; 3]]) -> 
     Ok(())
 }
 
+/// The same as OBJ text: `v` lines in f32's shortest exact form (they
+/// read back bit for bit), then `f` lines.
+fn write_obj_body(file: &std::fs::File, name: &str, triangles: &[[[f32; 3]; 3]]) -> Result<()> {
+    let mut w = std::io::BufWriter::new(file);
+    writeln!(w, "# {}", name.replace(char::is_control, " "))?;
+    for [x, y, z] in triangles.iter().flatten() {
+        writeln!(w, "v {x} {y} {z}")?;
+    }
+    for i in 0..triangles.len() {
+        writeln!(w, "f {} {} {}", 3 * i + 1, 3 * i + 2, 3 * i + 3)?;
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,13 +123,15 @@ mod tests {
     fn a_written_scene_reads_back_as_the_same_triangles() {
         let scene = Scene::from_spec("city:2000:3").unwrap();
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("city.ply");
-        let w = write(&scene, &path).unwrap();
-        assert_eq!(w.triangles, scene.triangles.len());
-        let back = super::super::mesh::load(&path).unwrap();
-        assert_eq!(back.len(), scene.triangles.len());
-        for (a, b) in back.iter().zip(&scene.triangles) {
-            assert_eq!((a.v0, a.v1, a.v2), (b.v0, b.v1, b.v2));
+        for name in ["city.ply", "city.obj"] {
+            let path = dir.path().join(name);
+            let w = write(&scene, &path).unwrap();
+            assert_eq!(w.triangles, scene.triangles.len());
+            let back = super::super::mesh::load(&path).unwrap();
+            assert_eq!(back.len(), scene.triangles.len());
+            for (a, b) in back.iter().zip(&scene.triangles) {
+                assert_eq!((a.v0, a.v1, a.v2), (b.v0, b.v1, b.v2), "{name}");
+            }
         }
         assert!(write(&Scene::from_spec("random:10").unwrap(), &dir.path().join("none.ply")).is_err());
     }

@@ -21,6 +21,7 @@ mod dynamic;
 mod error_curves;
 mod figure;
 mod instances;
+mod load;
 mod measure;
 mod placed;
 mod rays_suite;
@@ -178,6 +179,25 @@ pub enum BenchCommand {
         /// needs Mitsuba 3 and an NVIDIA GPU), with the ratios.
         #[arg(long, requires = "suite")]
         with_optix: bool,
+    },
+    /// Mesh loading speed against reading the file's bytes: the files
+    /// given, and a binary PLY and an OBJ of terrain:N for each size (made
+    /// in --dir where missing). On the host's cores; no device.
+    Load {
+        /// Mesh files (.obj, .ply, either as .xz).
+        files: Vec<std::path::PathBuf>,
+        /// Triangle counts of the terrains to make and time (default, when no
+        /// file is given: 1000000,10000000).
+        #[arg(long, value_delimiter = ',')]
+        sizes: Vec<usize>,
+        /// Where the terrains' files are made (and kept for later runs).
+        #[arg(long, default_value = "target/bench-load")]
+        dir: std::path::PathBuf,
+        /// Timed loads per file (median).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
     },
     /// An animated mesh through the engine API: per frame, refit against
     /// rebuild (LBVH, TRBVH), and one frame's rays (closest hits and
@@ -387,6 +407,15 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let clocks = clocks.map(|(before, after)| serde_json::json!({ "before": before, "after": after }));
                 let doc = serde_json::json!({ "adapter": adapter, "scene": scene.loose.name, "width": width, "height": height, "repeats": repeats, "row": row, "clocks": clocks });
                 std::fs::write(&path, serde_json::to_string_pretty(&doc)?)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Load { files, sizes, dir, repeats, json } => {
+            println!("mesh loads on {} threads, median of {repeats}", rayon::current_num_threads());
+            let sizes = if sizes.is_empty() && files.is_empty() { vec![1_000_000, 10_000_000] } else { sizes };
+            let rows = load::bench_load(&files, &sizes, &dir, repeats)?;
+            if let Some(path) = json {
+                std::fs::write(&path, serde_json::to_string_pretty(&serde_json::json!({ "threads": rayon::current_num_threads(), "rows": rows }))?)?;
             }
             Ok(())
         }
