@@ -499,6 +499,12 @@ fn tracer_from_an_engines_buffers() {
         tracer.refit_from_buffers(b, &mesh(None, &moved_buffer, 3 * n)).unwrap();
         let moved: Geometry = (vec![], moved_tris.clone());
         check(&what("no index buffer, refit"), &tracer.closest_hits(b, &rs).unwrap(), &moved, &rs);
+        // Back and forth: from the second refit on, each gathers into the
+        // primitives of the update before the last.
+        for (case, (source, geometry)) in [(&buffer, &g), (&moved_buffer, &moved), (&buffer, &g)].into_iter().enumerate() {
+            tracer.refit_from_buffers(b, &mesh(None, source, 3 * n)).unwrap();
+            check(&what(&format!("no index buffer, refit {}", case + 2)), &tracer.closest_hits(b, &rs).unwrap(), geometry, &rs);
+        }
 
         // Instanced: the indexed mesh and the moved soup, placed five times,
         // from the buffers against the same scene built from host triangles

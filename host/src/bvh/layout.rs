@@ -96,6 +96,13 @@ pub struct PrimBuffers<B: Backend> {
     pub triangle_count: u32,
 }
 
+// By hand: a derive would ask `B: Clone`; the buffers are handles.
+impl<B: Backend> Clone for PrimBuffers<B> {
+    fn clone(&self) -> Self {
+        PrimBuffers { spheres: self.spheres.clone(), triangles: self.triangles.clone(), sphere_count: self.sphere_count, triangle_count: self.triangle_count }
+    }
+}
+
 impl<B: Backend> PrimBuffers<B> {
     /// Uploads `prims` (call after any build: a build may hand out again
     /// buffers taken before it).

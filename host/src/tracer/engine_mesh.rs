@@ -119,10 +119,13 @@ impl<B: Backend> MeshBuffers<'_, B> {
 /// the first triangle with an index past the vertices, or with a
 /// coordinate that is not finite (one read back of two words, which waits
 /// for the gather).
-pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>) -> Result<PrimBuffers<B>> {
+pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>, into: Option<&PrimBuffers<B>>) -> Result<PrimBuffers<B>> {
     let n = mesh.triangle_count;
-    let spheres = b.upload("no spheres", &[Sphere::default()])?;
-    let triangles = b.scratch("engine triangles", (n as u64).max(1) * 48)?;
+    let (spheres, triangles) = match into {
+        // The same count: the last gather's buffers, written over in queue order.
+        Some(p) if p.triangle_count == n && p.sphere_count == 0 => (p.spheres.clone(), p.triangles.clone()),
+        _ => (b.upload("no spheres", &[Sphere::default()])?, b.scratch("engine triangles", (n as u64).max(1) * 48)?),
+    };
     if n == 0 {
         return Ok(PrimBuffers { spheres, triangles, sphere_count: 0, triangle_count: 0 });
     }
