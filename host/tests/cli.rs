@@ -1165,3 +1165,47 @@ fn hostile_arguments_and_outputs_get_clear_errors() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A glTF file's cameras and extensions as `render` takes them: `--camera
+/// N` picks camera N (a camera that does not exist, or a scene without
+/// cameras, is an error naming it); each extension Treelet does not read
+/// gets one note, the ones it reads none.
+#[test]
+fn gltf_cameras_are_chosen_and_unread_extensions_named() {
+    use base64::Engine as _;
+    let dir = std::env::temp_dir().join(format!("treelet-cli-cameras-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let positions: Vec<u8> = [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|x| x.to_le_bytes()).collect();
+    let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&positions));
+    let gltf = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_materials_ior", "KHR_texture_transform", "KHR_lights_punctual"],
+  "scene": 0, "scenes": [{{"nodes": [0, 1, 2]}}],
+  "nodes": [{{"mesh": 0}}, {{"translation": [0.3, 0.3, 4], "camera": 0}}, {{"translation": [0.3, 0.3, 2], "camera": 1}}],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1}}}}, {{"type": "perspective", "perspective": {{"yfov": 1.2, "znear": 0.1}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+  "buffers": [{{"uri": "{uri}", "byteLength": 36}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}]}}"#
+    );
+    let path = dir.join("two_cameras.gltf");
+    std::fs::write(&path, gltf).unwrap();
+    let scene = path.to_str().unwrap();
+    let out_png = dir.join("c1.png");
+    let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--camera", "1", "--width", "16", "--height", "12", "--spp", "1", "--out", out_png.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("extension KHR_texture_transform is not supported"), "{err}");
+    assert!(err.contains("punctual lights (KHR_lights_punctual) are not supported"), "{err}");
+    assert!(!err.contains("KHR_materials_ior"), "a read extension got a note: {err}");
+    assert!(!err.contains("perspective cameras; the first placed is used"), "--camera was given: {err}");
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", scene, "--camera", "7", "--spp", "1"]);
+    assert!(e.contains("no camera 7: the file has 2"), "{e}");
+    let e = stderr_of(&["render", "--device", "cpu", "--scene", "cornell", "--camera", "0", "--spp", "1"]);
+    assert!(e.contains("only glTF scenes"), "{e}");
+    // Without --camera, a note says which of the two is used.
+    let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", "16", "--height", "12", "--spp", "1", "--out", dir.join("c0.png").to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && err.contains("2 perspective cameras; the first placed is used"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -127,6 +127,11 @@ struct RenderArgs {
     /// more than once keeps its copies placed: one tree per mesh).
     #[arg(long)]
     flatten: bool,
+    /// A glTF scene's camera N (its index in the file's cameras list),
+    /// placed by the first node that names it; by default the first
+    /// perspective camera the scene places, else one framing the scene.
+    #[arg(long, value_name = "N")]
+    camera: Option<usize>,
     #[arg(long, default_value_t = 512, value_parser = positive)]
     width: u32,
     #[arg(long, default_value_t = 384, value_parser = positive)]
@@ -340,7 +345,11 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     // The devices open (Vulkan's instance and device: a tenth of a second
     // each on an H100) while the scene and any parts load.
     let opening = OpenDevices::start(args.devices.clone(), args.device);
-    let scene = if args.flatten { Scene::from_spec(&args.scene)? } else { Scene::for_render(&args.scene)? };
+    let scene = match args.camera {
+        Some(camera) => Scene::with_gltf_camera(&args.scene, camera, args.flatten)?,
+        None if args.flatten => Scene::from_spec(&args.scene)?,
+        None => Scene::for_render(&args.scene)?,
+    };
     treelet::runtime::timeline::mark("scene");
     if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);

@@ -2,8 +2,10 @@
 //! crate: the triangle meshes of the default scene, each read once and
 //! placed by every node that names it (an instance: [`load_instanced`];
 //! [`load`] flattens them into one set of triangles), their materials
-//! mapped to the path tracer's, and the first perspective camera (else one
-//! framing the placed meshes' boxes).
+//! mapped to the path tracer's, and the first perspective camera placed
+//! (or camera N of the file's list: `render --camera N`; else one framing
+//! the placed meshes' boxes). Extensions beyond the materials' are named
+//! in a note each ([`SUPPORTED_EXTENSIONS`]).
 //!
 //! Materials (metallic-roughness, with the transmission, IOR and emissive
 //! strength extensions): transmission above one half is glass (colour: the
@@ -26,10 +28,20 @@ use super::file::MAX_EMISSION;
 use super::instanced::{InstancedScene, SceneInstance, SceneMesh};
 use super::model::{CameraSpec, Scene};
 
+/// The extensions read (the materials'); a note names each other one a
+/// file uses.
+pub const SUPPORTED_EXTENSIONS: [&str; 3] = ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_emissive_strength"];
+
 /// Loads a glTF 2.0 file as a scene, its instances flattened; errors name
 /// the file and the mesh, primitive or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
     load_instanced(path)?.flatten()
+}
+
+/// [`load`] seen from the file's camera `camera` (its index in the file's
+/// `cameras` list), or from the first perspective camera a node places.
+pub fn load_with_camera(path: &Path, camera: Option<usize>) -> Result<Scene> {
+    load_instanced_with_camera(path, camera)?.flatten()
 }
 
 /// Loads a glTF 2.0 file with each mesh once, in its own space, and an
@@ -37,6 +49,11 @@ pub fn load(path: &Path) -> Result<Scene> {
 /// [`super::instanced`]); errors name the file and the mesh, primitive or
 /// material at fault.
 pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
+    load_instanced_with_camera(path, None)
+}
+
+/// [`load_instanced`] from the file's camera `camera`, as [`load_with_camera`].
+pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<InstancedScene> {
     let name = path.display().to_string();
     let bytes = crate::internals::input::read(path, "glTF file")?;
     // glTF readers may ignore a byte-order mark before the JSON.
@@ -48,7 +65,11 @@ pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     let document = &gltf.document;
     let scene =
         document.default_scene().or_else(|| document.scenes().next()).with_context(|| format!("{name}: no scene"))?;
-    let mut out = Loaded { mesh_slots: vec![None; document.meshes().len()], ..Default::default() };
+    let mut out = Loaded {
+        mesh_slots: vec![None; document.meshes().len()],
+        cameras: vec![None; document.cameras().len()],
+        ..Default::default()
+    };
     walk(document, &scene, &buffers, &name, &mut out)?;
     let placed = out.instances.iter().map(|i| out.meshes[i.mesh as usize].triangles.len() as u64).sum::<u64>();
     if placed == 0 {
@@ -57,17 +78,26 @@ pub fn load_instanced(path: &Path) -> Result<InstancedScene> {
     if out.textured {
         eprintln!("note: {name}: textures are not read; textured materials render in their colour factors alone");
     }
-    if document.extensions_used().any(|e| e == "KHR_lights_punctual") {
-        eprintln!(
-            "note: {name}: punctual lights (KHR_lights_punctual) are not supported; only emissive materials give light"
-        );
+    for extension in document.extensions_used() {
+        match extension {
+            e if SUPPORTED_EXTENSIONS.contains(&e) => {}
+            "KHR_lights_punctual" => eprintln!(
+                "note: {name}: punctual lights (KHR_lights_punctual) are not supported; only emissive materials give light"
+            ),
+            other => eprintln!("note: {name}: extension {other} is not supported; what it adds is ignored"),
+        }
     }
-    let camera = match (out.camera, out.orthographic) {
-        (Some(c), _) => c,
-        (None, Some(node)) => bail!(
+    let placed_cameras = out.cameras.iter().filter(|c| c.is_some_and(|c| c.yfov.is_some())).count();
+    if camera.is_none() && placed_cameras > 1 {
+        eprintln!("note: {name}: {placed_cameras} perspective cameras; the first placed is used (--camera N picks camera N of the file's list)");
+    }
+    let camera = match (camera, out.camera, out.orthographic) {
+        (Some(index), _, _) => chosen_camera(&name, &out.cameras, index)?,
+        (None, Some(c), _) => c,
+        (None, None, Some(node)) => bail!(
             "{name}: node {node}: orthographic cameras are not supported (perspective only); remove it to get a camera that frames the scene"
         ),
-        (None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
+        (None, None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
     };
     let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new(), placed: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
@@ -200,6 +230,8 @@ struct Loaded {
     mesh_slots: Vec<Option<u32>>,
     instances: Vec<SceneInstance>,
     camera: Option<CameraSpec>,
+    /// Per camera of the file, the first node that places it.
+    cameras: Vec<Option<CameraNode>>,
     /// The first node with an orthographic camera, if any.
     orthographic: Option<usize>,
     textured: bool,
@@ -325,34 +357,68 @@ fn visit(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: 
         };
         out.instances.push(SceneInstance { mesh: slot, transform: Affine3A::from_mat4(world), material: None });
     }
-    if let (None, Some(camera)) = (&out.camera, node.camera()) {
-        match camera.projection() {
-            gltf::camera::Projection::Perspective(p) => {
-                let origin = world.transform_point3(Vec3::ZERO);
-                let direction = world.transform_vector3(-Vec3::Z);
-                let yfov = p.yfov();
-                if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
-                    bail!("{name}: node {}: camera field of view {yfov} radians (it must lie between 0 and pi)", node.index());
-                }
-                if !(direction.length_squared() > 0.0 && direction.is_finite()) {
-                    bail!("{name}: node {}: the camera's transform gives it no direction to look in", node.index());
-                }
-                out.camera = Some(CameraSpec {
-                    origin: origin.into(),
-                    direction: direction.into(),
-                    near: 0.0,
-                    // `fov` is the image plane's full height at unit
-                    // distance (`Camera::look`); glTF's `yfov` the whole
-                    // vertical angle.
-                    fov: 2.0 * (yfov / 2.0).tan(),
-                });
-            }
-            gltf::camera::Projection::Orthographic(_) => {
+    if let Some(camera) = node.camera() {
+        let yfov = match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => Some(p.yfov()),
+            gltf::camera::Projection::Orthographic(_) => None,
+        };
+        let slot = &mut out.cameras[camera.index()];
+        if slot.is_none() {
+            *slot = Some(CameraNode { node: node.index(), world, yfov });
+        }
+        match yfov {
+            Some(yfov) if out.camera.is_none() => out.camera = Some(camera_spec(name, node.index(), world, yfov)?),
+            None => {
                 out.orthographic.get_or_insert(node.index());
             }
+            _ => {}
         }
     }
     Ok(world)
+}
+
+/// The first node that places one of the file's cameras: where, and its
+/// vertical field of view (`None`: orthographic).
+#[derive(Clone, Copy)]
+struct CameraNode {
+    node: usize,
+    world: Mat4,
+    yfov: Option<f32>,
+}
+
+/// A perspective camera placed by `world`, checked.
+fn camera_spec(name: &str, node: usize, world: Mat4, yfov: f32) -> Result<CameraSpec> {
+    let origin = world.transform_point3(Vec3::ZERO);
+    let direction = world.transform_vector3(-Vec3::Z);
+    if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+        bail!("{name}: node {node}: camera field of view {yfov} radians (it must lie between 0 and pi)");
+    }
+    if !(direction.length_squared() > 0.0 && direction.is_finite()) {
+        bail!("{name}: node {node}: the camera's transform gives it no direction to look in");
+    }
+    Ok(CameraSpec {
+        origin: origin.into(),
+        direction: direction.into(),
+        near: 0.0,
+        // `fov` is the image plane's full height at unit distance
+        // (`Camera::look`); glTF's `yfov` the whole vertical angle.
+        fov: 2.0 * (yfov / 2.0).tan(),
+    })
+}
+
+/// Camera `index` of the file (its `cameras` array), where the first node
+/// that names it places it; an error says why it cannot be used.
+fn chosen_camera(name: &str, cameras: &[Option<CameraNode>], index: usize) -> Result<CameraSpec> {
+    let Some(slot) = cameras.get(index) else {
+        bail!("{name}: no camera {index}: the file has {} (numbered from 0 in its `cameras` list)", cameras.len());
+    };
+    let Some(c) = slot else {
+        bail!("{name}: camera {index} is placed by no node of the scene");
+    };
+    match c.yfov {
+        Some(yfov) => camera_spec(name, c.node, c.world, yfov),
+        None => bail!("{name}: camera {index} (node {}) is orthographic; only perspective cameras are supported", c.node),
+    }
 }
 
 /// A glTF mesh's triangles in its own space, every primitive's in order,
@@ -568,6 +634,43 @@ mod tests {
         assert_eq!(s.camera.origin, [0.0, 0.0, 9.0]);
         assert_eq!(s.camera.direction, [0.0, 0.0, -1.0]);
         assert!((s.camera.fov - 2.0 * 0.5f32.tan()).abs() < 1e-6);
+    }
+
+    /// `--camera N` picks the file's camera N where the first node that
+    /// names it places it: the square's document with four cameras (0 at
+    /// the node of the default, 1 orthographic, 2 placed by two nodes, 3
+    /// by none); the refusals name the camera and why.
+    #[test]
+    fn a_camera_is_chosen_by_its_index_in_the_file() {
+        let d = dir();
+        let path = d.join("cameras.gltf");
+        let text = document(&data_uri(), 4, 6)
+            .replace(
+                r#"{"translation": [0, 0, 9], "camera": 0}"#,
+                r#"{"translation": [0, 0, 9], "camera": 0}, {"translation": [0, 5, 0], "camera": 1}, {"translation": [3, 0, 7], "rotation": [0, 0.38268343, 0, 0.9238795], "camera": 2}, {"translation": [-3, 0, 7], "camera": 2}"#,
+            )
+            .replace(r#""nodes": [0, 2]"#, r#""nodes": [0, 2, 3, 4, 5]"#)
+            .replace(
+                r#""cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]"#,
+                r#""cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}, {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}, {"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}, {"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]"#,
+            );
+        assert!(text.contains(r#""camera": 2}, {"translation": [-3"#), "the document changed: {text}");
+        std::fs::write(&path, &text).unwrap();
+        // The default: the first perspective camera placed.
+        assert_eq!(load(&path).unwrap().camera.origin, [0.0, 0.0, 9.0]);
+        assert_eq!(load_with_camera(&path, Some(0)).unwrap().camera, load(&path).unwrap().camera);
+        let c = load_with_camera(&path, Some(2)).unwrap().camera;
+        assert_eq!(c.origin, [3.0, 0.0, 7.0], "the first node that names camera 2");
+        // Turned 45 degrees about y: -z goes to (-sin 45, 0, -cos 45).
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        assert!((c.direction[0] + h).abs() < 1e-6 && c.direction[1].abs() < 1e-6 && (c.direction[2] + h).abs() < 1e-6, "{:?}", c.direction);
+        assert!((c.fov - 2.0 * 0.25f32.tan()).abs() < 1e-6);
+        for (camera, needle) in [(1, "camera 1 (node 3) is orthographic"), (3, "camera 3 is placed by no node"), (4, "no camera 4: the file has 4")] {
+            let e = load_with_camera(&path, Some(camera)).unwrap_err().to_string();
+            assert!(e.contains(needle), "camera {camera}: {e}");
+        }
+        let e = Scene::with_gltf_camera("scenes/cornell.json", 0, true).unwrap_err().to_string();
+        assert!(e.contains("only glTF scenes"), "{e}");
     }
 
     /// Where a glTF camera puts things in the picture: the camera at

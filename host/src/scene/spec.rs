@@ -123,6 +123,21 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// A glTF scene seen from the file's camera `camera` (its index in the
+    /// file's `cameras` list: `render --camera N`), flattened or as
+    /// `render` traces it ([`Scene::for_render`]); other scenes have no
+    /// cameras to choose from, and are refused.
+    pub fn with_gltf_camera(spec: &str, camera: usize, flatten: bool) -> Result<Scene> {
+        let lower = spec.to_ascii_lowercase();
+        if !(lower.ends_with(".gltf") || lower.ends_with(".glb")) {
+            bail!("--camera {camera}: only glTF scenes (.gltf, .glb) have cameras to choose from; `{spec}` is not one");
+        }
+        let scene = super::gltf::load_instanced_with_camera(std::path::Path::new(spec), Some(camera))?;
+        if flatten { scene.flatten() } else { scene.for_render() }
+    }
+}
+
 impl InstancedScene {
     /// Loads a glTF 2.0 file or a JSON scene file with its instances kept
     /// (see [`super::instanced`]).
