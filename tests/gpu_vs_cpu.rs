@@ -18,7 +18,7 @@ fn lbvh_matches_cpu_on_random_scenes() {
 }
 
 /// The build sorts its keys by their high digits first and settles the
-/// ties after (`treelet_core::construct::sort_ties`), or sorts every digit
+/// ties after (`treelet_core::construct::sort::ties`), or sorts every digit
 /// when a run of ties is too long: both give the full sort's order
 /// (`compare_builds` checks it against keys recomputed on the host), on
 /// spheres whose keys tie in short runs (three to a centre), and on a dense
@@ -33,7 +33,7 @@ fn lbvh_sorts_every_bit_with_short_and_long_runs_of_ties() {
     // The longest run of keys tied in the digits sorted first, in the CPU build.
     let longest_run = |spheres: &[treelet_core::Sphere]| {
         let keys = treelet_tests::build_cpu_checked(spheres, "runs").sorted_keys;
-        let low_bits = 8 * treelet_core::construct::sort_ties::first_high_digit(keys.len() as u32, 8);
+        let low_bits = 8 * treelet_core::construct::sort::ties::first_high_digit(keys.len() as u32, 8);
         let (mut longest, mut run) = (1, 1);
         for w in keys.windows(2) {
             run = if w[0] >> low_bits == w[1] >> low_bits { run + 1 } else { 1 };
@@ -41,7 +41,7 @@ fn lbvh_sorts_every_bit_with_short_and_long_runs_of_ties() {
         }
         longest
     };
-    use treelet_core::construct::sort_ties::MAX_TIE_RUN;
+    use treelet_core::construct::sort::ties::MAX_TIE_RUN;
     assert!((2..=MAX_TIE_RUN).contains(&longest_run(&triples)), "runs of ties to settle");
     compare_builds(&triples, &format!("three spheres a centre, seed {seed}"));
     let mut room = random_spheres(3000, seed ^ 1);
@@ -193,7 +193,7 @@ fn sort_by_high_digits_settles_runs_of_ties() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     for (n, highs) in [(2u32, 1u64), (100, 40), (5000, 2500), (70_000, 30_000), (70_000, 2_000), (70_000, 60_000)] {
         // The digits sorted first take `highs` values; below them, few bits vary.
-        let low_bits = 8 * treelet_core::construct::sort_ties::first_high_digit(n, 8);
+        let low_bits = 8 * treelet_core::construct::sort::ties::first_high_digit(n, 8);
         let keys: Vec<u64> = (0..n)
             .map(|_| rng.random_range(0..highs) << low_bits | rng.random_range(0..8u64) << (low_bits - 3) | rng.random::<u8>() as u64)
             .collect();
@@ -306,10 +306,10 @@ fn check_high_first(
     (ek, ev): (&[u64], &[u32]),
     what: &str,
 ) {
-    use treelet_core::construct::sort_ties::MAX_TIE_RUN;
+    use treelet_core::construct::sort::ties::MAX_TIE_RUN;
     let passes = key_bits.div_ceil(8);
     let sorted = |k: u64| if passes >= 8 { k } else { k & ((1u64 << (8 * passes)) - 1) };
-    let first = treelet_core::construct::sort_ties::first_high_digit(keys.len() as u32, passes);
+    let first = treelet_core::construct::sort::ties::first_high_digit(keys.len() as u32, passes);
     let high = |k: u64| sorted(k) >> (8 * first);
     let mut longest = 1;
     let mut run = 1;

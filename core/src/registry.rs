@@ -148,7 +148,7 @@ macro_rules! per_invocation_kernels {
                 1 keys: write [u64],
                 2 values: write [u32],
                 3 sort_state: write [u32],
-            } |id, params| $crate::construct::sort_ties::settle_ties_kernel(id, params, keys, values, sort_state);
+            } |id, params| $crate::construct::sort::ties::settle_ties_kernel(id, params, keys, values, sort_state);
 
             /// The binary radix tree over sorted Morton codes (Karras 2012).
             RadixTree = radix_tree_cs($crate::geometry::buffers::BuildParams) {
@@ -209,7 +209,7 @@ macro_rules! per_invocation_kernels {
                 7 tree_leaves: write [u32],
                 8 queue: write [u32],
                 9 queued: write [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
+            } |id, params| $crate::construct::treelet::kernels::treelet_init_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
 
             /// The climbs `TreeletInit` queued.
             TreeletInitClimb / TreeletInitClimbRelaxed = treelet_init_climb_cs / treelet_init_climb_relaxed_cs($crate::geometry::buffers::TreeletParams) {
@@ -222,7 +222,7 @@ macro_rules! per_invocation_kernels {
                 7 tree_leaves: write [u32],
                 8 queue: read [u32],
                 9 queued: read [u32],
-            } |id, params| $crate::construct::treelet_kernels::treelet_init_climb_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
+            } |id, params| $crate::construct::treelet::kernels::treelet_init_climb_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
 
             /// SAH leaf collapse and depth-first compaction into fresh arrays.
             Collapse = collapse_cs($crate::geometry::buffers::TreeletParams) {
@@ -307,7 +307,7 @@ macro_rules! per_invocation_kernels {
                 4 counts: write [u32],
                 5 costs: write [f32],
                 6 decisions: write [u32],
-            } |id, params| $crate::layouts::cwbvh_build::wide_dp_kernel::<ORDERED>(id, params, nodes, parents, flags, counts, costs, decisions);
+            } |id, params| $crate::layouts::cwbvh::build::wide_dp_kernel::<ORDERED>(id, params, nodes, parents, flags, counts, costs, decisions);
 
             /// The compressed wide BVH: which nodes are wide nodes, their children's counts.
             WideCount = wide_count_cs($crate::geometry::buffers::LayoutParams) {
@@ -318,7 +318,7 @@ macro_rules! per_invocation_kernels {
                 5 is_wide: write [u32],
                 6 child_counts: write [u32],
                 7 prim_counts: write [u32],
-            } |id, params| $crate::layouts::cwbvh_build::wide_count_kernel(id, params, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts);
+            } |id, params| $crate::layouts::cwbvh::build::wide_count_kernel(id, params, nodes, parents, counts, decisions, is_wide, child_counts, prim_counts);
 
             /// The compressed wide BVH: nodes and leaf primitives.
             WideEmit = wide_emit_cs($crate::geometry::buffers::LayoutParams) {
@@ -333,7 +333,7 @@ macro_rules! per_invocation_kernels {
                 9 triangles: read [$crate::geometry::triangle::Triangle] | 12 triangles_hi,
                 10 out_nodes: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::WideNode],
                 11 out_prims: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::LeafPrim],
-            } |id, params| $crate::layouts::cwbvh_build::wide_emit_kernel(
+            } |id, params| $crate::layouts::cwbvh::build::wide_emit_kernel(
                 id, params, nodes, slots, is_wide, child_offsets, prim_offsets, positions, prim_indices, spheres, triangles, out_nodes, out_prims,
             );
 
@@ -345,7 +345,7 @@ macro_rules! per_invocation_kernels {
                 4 child_offsets: read [u32],
                 5 positions: write [u32],
                 6 slots: write [u32],
-            } |id, params| $crate::layouts::cwbvh_build::wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions, slots);
+            } |id, params| $crate::layouts::cwbvh::build::wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions, slots);
         }
     };
 }

@@ -1,6 +1,6 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::construct::multisplit::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
+use treelet_core::construct::sort::multisplit_rank::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
 use treelet_core::geometry::buffers::SortParams;
 use treelet_core::gpu::subgroup::{apply, Lane};
 use treelet_core::gpu::workgroup::{linear_group, linear_id};

@@ -1,6 +1,6 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
-use treelet_core::construct::scan;
+use treelet_core::construct::sort::scan;
 use treelet_core::geometry::buffers::ScanParams;
 use treelet_core::gpu::workgroup::{WG, linear_group};
 

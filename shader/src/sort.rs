@@ -1,7 +1,7 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
-use treelet_core::construct::sort_multisplit::{
+use treelet_core::construct::sort::multisplit::{
     MEDIUM_MULTISPLIT_SORT_ITEMS, MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
     multisplit_pass_phases, multisplit_pass_sync,
 };

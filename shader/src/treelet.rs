@@ -1,7 +1,7 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet_kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
+use treelet_core::construct::treelet::kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
 use treelet_core::geometry::split::SplitMut;
 use treelet_core::gpu::subgroup::subgroup_barrier;

@@ -14,8 +14,8 @@
 //! an odd previous value ([`second_arrival`]).
 //!
 //! Users: the bounds fit ([`crate::construct::fit`]), the treelet rounds'
-//! counts, costs and heights ([`crate::construct::treelet_kernels`]) and the
-//! wide layout's DP (`crate::layouts::cwbvh_build`) climb with [`Climb`];
+//! counts, costs and heights ([`crate::construct::treelet::kernels`]) and the
+//! wide layout's DP (`crate::layouts::cwbvh::build`) climb with [`Climb`];
 //! the `bvh2` layout's refit (`crate::layouts::bvh2::refit_kernel`) with
 //! [`second_arrival`], its boxes kept in the layout's nodes;
 //! the agglomerative build ([`crate::construct::agglomerate`], after

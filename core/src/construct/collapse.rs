@@ -6,7 +6,7 @@
 //! Inputs are a tree in the LBVH layout (leaf of primitive slot `j` at node
 //! `n - 1 + j`, one primitive each) and, per node, its primitive count and
 //! its leaf count in the output (`tree_leaves`: 1 where the subtree
-//! collapses), as [`crate::construct::treelet_kernels::treelet_init_kernel`] writes them.
+//! collapses), as [`crate::construct::treelet::kernels::treelet_init_kernel`] writes them.
 //! In depth-first (pre-)order every node's position follows from counts
 //! along its path to the root alone:
 //!

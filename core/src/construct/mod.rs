@@ -8,12 +8,12 @@
 //! | large triangles split into pieces (optional) | [`presplit`] | Karras & Aila 2013, section 5.1 |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
-//! | sort | [`sort`], [`scan`]; [`sort_multisplit`] (the pass ranked by subgroups), [`multisplit`] (its ranking alone), [`sort_ties`] (high digits first, then ties) | Adinets & Merrill 2022 (Onesweep) |
+//! | sort | [`sort`] (the Onesweep pass), [`sort::scan`]; [`sort::multisplit`] (the pass ranked by subgroups), [`sort::multisplit_rank`] (its ranking alone), [`sort::ties`] (high digits first, then ties) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`]; [`climb_queue`] (climbs handed from one kernel to the next) | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
 //! | hierarchy and boxes in one pass | [`agglomerate`]; [`agglomerate_subgroup`] (its lowest levels merged within subgroups) | Apetrei 2014 |
-//! | treelet restructuring | [`treelet`] (the DP), [`treelet_kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
+//! | treelet restructuring | [`treelet`] (the DP), [`treelet::kernels`] (the device schedule) | Karras & Aila 2013, section 4 |
 //! | reinsertion of nodes where they lower the SAH most | [`reinsert`] | Meister & Bittner 2018 |
 //! | SAH leaf collapse, depth-first compaction | [`collapse`] | Karras & Aila 2013, section 4.4 |
 //! | SAH cost | [`sah`] | MacDonald & Booth 1990 |
@@ -35,15 +35,10 @@ pub mod fit;
 pub mod hploc;
 pub mod instances;
 pub mod morton;
-pub mod multisplit;
 pub mod presplit;
 pub mod primitive_boxes;
 pub mod radix_tree;
 pub mod reinsert;
 pub mod sah;
-pub mod scan;
 pub mod sort;
-pub mod sort_multisplit;
-pub mod sort_ties;
 pub mod treelet;
-pub mod treelet_kernels;

@@ -34,7 +34,7 @@ pub const KEY_BITS: u32 = 3 * BITS_PER_AXIS;
 /// the whole bunny falls into a handful of ten-bit cells, where primitive
 /// order decides the tree. The SAH, dominated by the walls, hardly shows it.
 /// The sort takes about half the passes anyway, every bit kept: see
-/// [`crate::construct::sort_ties`].
+/// [`crate::construct::sort::ties`].
 pub const SORTED_KEY_BITS: u32 = KEY_BITS;
 const CELLS: f32 = (1u32 << BITS_PER_AXIS) as f32;
 const MAX_CELL: f32 = CELLS - 1.0;

@@ -551,7 +551,7 @@ pub struct WideNode {
 const _: () = assert!(core::mem::size_of::<WideNode>() == 80);
 
 /// Parameters of the traversal-layout kernels ([`crate::trace::bvh2`],
-/// [`crate::layouts::cwbvh_build`]). repr(C), Pod, 32 bytes.
+/// [`crate::layouts::cwbvh::build`]). repr(C), Pod, 32 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]

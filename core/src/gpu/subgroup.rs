@@ -7,7 +7,7 @@
 //! (`const fn <kernel>_op(phase) -> u32`, one of the `OP_*` below, or
 //! `<kernel>_sync` where it also carries a barrier: [`THEN_SUBGROUP_BARRIER`],
 //! [`THEN_WORKGROUP_BARRIER`], for kernels that also share workgroup
-//! memory, such as the sort pass of `construct::sort_multisplit`): the phase
+//! memory, such as the sort pass of `construct::sort::multisplit`): the phase
 //! writes the operation's input into its lane's [`Lane`], the entry point (or
 //! the CPU runner) applies the operation, and the next phase reads the result
 //! from the same [`Lane`]. A value that crosses a subgroup operation lives in

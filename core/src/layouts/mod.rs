@@ -4,7 +4,7 @@
 //! - [`bvh2`]: two-box binary nodes (Aila & Laine 2009), made from the
 //!   collapsed tree in depth-first order;
 //! - [`bvh4`]: 4-wide nodes of full-precision boxes, made from `bvh2`'s;
-//! - [`cwbvh`] (the node format) and [`cwbvh_build`]: compressed 8-wide
+//! - [`cwbvh`] (the node format) and [`cwbvh::build`]: compressed 8-wide
 //!   nodes (Ylitie, Karras & Laine 2017), made bottom-up from the tree of
 //!   one primitive per leaf.
 //!
@@ -14,4 +14,3 @@ pub mod bvh2;
 pub mod bvh4;
 pub mod depth;
 pub mod cwbvh;
-pub mod cwbvh_build;

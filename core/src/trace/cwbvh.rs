@@ -2,7 +2,7 @@
 //! Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs"): its
 //! node ([`WideNode`], 80 bytes) quantizes the eight child boxes to bytes
 //! on a grid of the node's own, so a ray tests eight boxes with one
-//! 80-byte load. How the tree is made: [`crate::layouts::cwbvh_build`].
+//! 80-byte load. How the tree is made: [`crate::layouts::cwbvh::build`].
 //!
 //! ## Traversal
 //! As in the paper: the ray carries a *node group* (the base index of a

@@ -1,13 +1,13 @@
 //! Traversal layouts: how a built binary tree is laid out for the kernels
-//! that trace it (the kernels: `treelet_core::{traverse, bvh2, cwbvh,
-//! cwbvh_build}`). Every builder (LBVH, TRBVH, sweep) gives a tree of one
+//! that trace it (the kernels: `treelet_core::layouts::{bvh2, bvh4, cwbvh,
+//! cwbvh::build}`). Every builder (LBVH, TRBVH, sweep) gives a tree of one
 //! primitive per leaf; [`lay_out`] turns it into any layout, on the device.
 use anyhow::{bail, Result};
 use serde::Serialize;
 use treelet_core::geometry::aabb::Aabb;
 use treelet_core::geometry::buffers::{Bvh2Node, Bvh4Node, LayoutParams, LeafPrim, WideNode};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
-use treelet_core::layouts::cwbvh_build::{WIDE_NODE_COST, WIDE_PRIM_COST};
+use treelet_core::layouts::cwbvh::build::{WIDE_NODE_COST, WIDE_PRIM_COST};
 use treelet_core::trace::hit::STACK_DEPTH;
 
 use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
@@ -313,7 +313,7 @@ fn write_bvh2_nodes<B: Backend>(
 }
 
 /// The compressed wide BVH of a tree of one primitive per leaf (see
-/// `treelet_core::layouts::cwbvh_build` for the steps).
+/// `treelet_core::layouts::cwbvh::build` for the steps).
 fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> Result<TracedTree<B>> {
     let n = bvh.n;
     if bvh.node_count != 2 * n - 1 {

@@ -1,9 +1,9 @@
 //! Stage order of the radix sort and of the prefix sum it uses, over any
 //! [`Backend`]. The kernels are in `treelet_core::{sort, scan}`.
 use anyhow::Result;
-use treelet_core::construct::scan::SCAN_TILE;
+use treelet_core::construct::sort::scan::SCAN_TILE;
 use treelet_core::construct::sort::{MAX_KEYS, RADIX, SMALL_SORT_TILE, SORT_TILE, histogram_tile, passes_for, state};
-use treelet_core::construct::sort_multisplit::{
+use treelet_core::construct::sort::multisplit::{
     MEDIUM_MULTISPLIT_SORT_TILE, MIN_SUBGROUP_SIZE, MULTISPLIT_SORT_TILE, SMALL_MULTISPLIT_SORT_TILE,
 };
 use treelet_core::geometry::buffers::{ScanParams, SortParams};
@@ -63,7 +63,7 @@ pub enum SortTiles {
     /// `treelet_core::construct::sort::SORT_TILE` keys per workgroup.
     Large,
     /// Tiles ranked by subgroups
-    /// (`treelet_core::construct::sort_multisplit`), on devices whose
+    /// (`treelet_core::construct::sort::multisplit`), on devices whose
     /// subgroups have at least `MIN_SUBGROUP_SIZE` lanes.
     Multisplit,
     /// The same with half the keys per lane (`SMALL_MULTISPLIT_SORT_TILE`).
@@ -182,7 +182,7 @@ pub fn radix_sort_tiled<B: Backend>(
 /// Sorts as [`radix_sort`] does, in about half the passes where few keys
 /// agree in their high digits: a stable sort by the high digits (enough for
 /// `log2(n)` and eight bits more), then each run of keys tied in those ordered by the low ones
-/// (`treelet_core::construct::sort_ties`): the same result. Returns `None`
+/// (`treelet_core::construct::sort::ties`): the same result. Returns `None`
 /// when a run of ties was too long to settle that way; the buffers then hold
 /// the pairs sorted by the high digits only, and the caller sorts every
 /// digit from its inputs again. One word is read back (the run flag).
@@ -232,7 +232,7 @@ pub fn radix_sort_high_first_zeroed<B: Backend>(
 
 /// The first digit the sort by high digits sorts (0: every digit).
 fn high_first_digit(n: u32, passes: u32) -> u32 {
-    if passes < 2 || n < 2 { 0 } else { treelet_core::construct::sort_ties::first_high_digit(n, passes) }
+    if passes < 2 || n < 2 { 0 } else { treelet_core::construct::sort::ties::first_high_digit(n, passes) }
 }
 
 /// Words of a sort's state that must be zero before it, where its first

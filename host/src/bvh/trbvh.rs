@@ -1,5 +1,5 @@
 //! Treelet restructuring of an LBVH on the device (Karras & Aila 2013),
-//! round by round (the kernels: `treelet_core::construct::treelet_kernels`): a
+//! round by round (the kernels: `treelet_core::construct::treelet::kernels`): a
 //! bottom-up pass computes each node's primitive count, SAH cost and height
 //! once; each round lists the roots of its treelets (at least `gamma`
 //! primitives) by height, then restructures them with one dispatch per
@@ -12,7 +12,7 @@
 //! for visibility guarantees that need no device-scope atomics.)
 use anyhow::{bail, Result};
 use treelet_core::construct::sah::SahCosts;
-use treelet_core::construct::treelet_kernels::{MAX_LEVELS, TEAMS, subset_order};
+use treelet_core::construct::treelet::kernels::{MAX_LEVELS, TEAMS, subset_order};
 use treelet_core::geometry::buffers::TreeletParams;
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use treelet_core::{Aabb, Node};
@@ -165,7 +165,7 @@ pub fn restructure<B: Backend>(
 }
 
 /// Treelets of subtrees this high or lower are restructured one invocation
-/// each (`treelet_core::construct::treelet_kernels::treelet_restructure_single`),
+/// each (`treelet_core::construct::treelet::kernels::treelet_restructure_single`),
 /// higher ones by a team of lanes each; `TREELET_SINGLE_HEIGHTS` overrides it
 /// (to measure). Both give the same tree. On the H100 (1M random spheres,
 /// gamma 3) the 225 526 treelets of height 2 took 0.497 ms one invocation

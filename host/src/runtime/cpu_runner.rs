@@ -13,7 +13,7 @@ use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::geometry::split::{Split, SplitMut};
 use treelet_core::geometry::aabb::Aabb;
-use treelet_core::construct::multisplit::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
+use treelet_core::construct::sort::multisplit_rank::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
 use treelet_core::gpu::subgroup::{self, Lane};
 use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE, groups_for};
 use treelet_core::render::integrator::{SceneRefs, accumulate, render_pixel};
@@ -25,7 +25,9 @@ use treelet_core::trace::placed::PlacedScene;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
-use treelet_core::construct::{bounds, presplit, scan, sort, treelet_kernels};
+use treelet_core::construct::sort::{self, scan};
+use treelet_core::construct::treelet::kernels as treelet_kernels;
+use treelet_core::construct::{bounds, presplit};
 
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::{Kernel, Method};
@@ -232,7 +234,7 @@ fn multisplit_sort_pass<const ITEMS: u32>(
     size: u32,
     partitioned: bool,
 ) {
-    use treelet_core::construct::sort_multisplit::*;
+    use treelet_core::construct::sort::multisplit::*;
     let mut ticket = [0u32; 1];
     let mut counts = [0u32; SUBGROUP_COUNTS];
     let (mut running, mut local_offsets, mut global_offsets, mut scan_sums) = ([0u32; WG], [0u32; WG], [0u32; WG], [0u32; 16]);
@@ -557,7 +559,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             Kernel::SortMultisplit | Kernel::SortMultisplitPartitioned,
             [p, keys_in, values_in, keys_out, values_out, sort_state],
         ) => {
-            use treelet_core::construct::sort_multisplit::MULTISPLIT_SORT_ITEMS;
+            use treelet_core::construct::sort::multisplit::MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
             let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
             let partitioned = kernel == Kernel::SortMultisplitPartitioned;
@@ -567,7 +569,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             Kernel::SortMultisplitSmall | Kernel::SortMultisplitSmallPartitioned,
             [p, keys_in, values_in, keys_out, values_out, sort_state],
         ) => {
-            use treelet_core::construct::sort_multisplit::SMALL_MULTISPLIT_SORT_ITEMS;
+            use treelet_core::construct::sort::multisplit::SMALL_MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
             let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
             let partitioned = kernel == Kernel::SortMultisplitSmallPartitioned;
@@ -577,7 +579,7 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             Kernel::SortMultisplitMedium | Kernel::SortMultisplitMediumPartitioned,
             [p, keys_in, values_in, keys_out, values_out, sort_state],
         ) => {
-            use treelet_core::construct::sort_multisplit::MEDIUM_MULTISPLIT_SORT_ITEMS;
+            use treelet_core::construct::sort::multisplit::MEDIUM_MULTISPLIT_SORT_ITEMS;
             let p: treelet_core::SortParams = params(p);
             let io = (&*view(keys_in), &*view(values_in), view(keys_out), view(values_out), view(sort_state));
             let partitioned = kernel == Kernel::SortMultisplitMediumPartitioned;

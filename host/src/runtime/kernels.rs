@@ -130,7 +130,7 @@ macro_rules! kernel_table {
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
     SortOnesweepSmall,
     /// Radix sort: one pass ranked by subgroups (Onesweep's warp-level
-    /// multisplit; `treelet_core::construct::sort_multisplit`).
+    /// multisplit; `treelet_core::construct::sort::multisplit`).
     SortMultisplit,
     /// The same with half the keys per lane (small tiles).
     SortMultisplitSmall,
@@ -150,7 +150,7 @@ macro_rules! kernel_table {
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
     SortOnesweepScanned,
     /// Ranks keys by digit within their subgroup with ballots (Onesweep's
-    /// warp-level multisplit; `treelet_core::construct::multisplit`).
+    /// warp-level multisplit; `treelet_core::construct::sort::multisplit_rank`).
     Multisplit,
     ScanReduce,
     ScanSpine,

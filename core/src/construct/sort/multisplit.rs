@@ -3,7 +3,7 @@
 //! `BlockRadixRankMatch`), for devices whose subgroups have at least
 //! [`MIN_SUBGROUP_SIZE`] lanes.
 //!
-//! [`super::sort::onesweep_phase`] ranks a tile's keys in workgroup memory,
+//! [`super::onesweep_phase`] ranks a tile's keys in workgroup memory,
 //! two barriers per round of 256 keys. Here each subgroup ranks a
 //! contiguous run of the tile's keys, `ITEMS` per lane, without a
 //! workgroup barrier:
@@ -18,9 +18,9 @@
 //!    subgroups (so each subgroup's keys of a digit follow the earlier
 //!    subgroups'), giving the tile's digit counts;
 //! 3. from there as in Onesweep's pass: the tile's offsets by look-back
-//!    ([`super::sort::tile_offset`]), the digits' offsets within the tile,
+//!    ([`super::tile_offset`]), the digits' offsets within the tile,
 //!    each key's place, the keys written out digit run by digit run
-//!    ([`super::sort::write_tile`]).
+//!    ([`super::write_tile`]).
 //!
 //! Subgroup `s` of `S` lanes takes keys `s * S * ITEMS ..` of the tile, lane
 //! `l` its keys `s * S * ITEMS + i * S + l` for `i` in `0..ITEMS`: so keys are
@@ -40,7 +40,7 @@
 //! 7.2 KB in all (27.7 KB before), which took its 8 passes from 0.66 to
 //! 0.35 ms at 1M keys and from 9.8 to 3.25 ms at 16M. Devices with smaller
 //! subgroups (lavapipe: 8; some of Intel's: 16) keep
-//! [`super::sort::onesweep_phase`], which runs at any size. The result is
+//! [`super::onesweep_phase`], which runs at any size. The result is
 //! the same stable order on every device, at every subgroup size, and on
 //! the CPU runner.
 //!

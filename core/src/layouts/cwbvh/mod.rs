@@ -1,8 +1,10 @@
 //! The compressed 8-wide node format (Ylitie, Karras & Laine 2017): children
 //! per node, leaf sizes, and the quantization of child boxes to a node's
 //! own grid, rounded outwards so the dequantized box always contains the
-//! exact one. The builder is [`crate::layouts::cwbvh_build`], the traversal
+//! exact one. The builder is [`crate::layouts::cwbvh::build`], the traversal
 //! [`crate::trace::cwbvh`].
+
+pub mod build;
 
 /// Children per node.
 pub const WIDTH: usize = 8;

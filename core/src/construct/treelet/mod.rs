@@ -26,8 +26,10 @@
 //! tree and one leaf holding all its primitives (`C_t·A·N`): the DP and the
 //! rounds optimize for the tree that [`crate::construct::collapse`] finally produces.
 //! [`restructure`] is the steps in one invocation (the reference the tests
-//! use); [`crate::construct::treelet_kernels`] runs them on the device, the DP of each
+//! use); [`crate::construct::treelet::kernels`] runs them on the device, the DP of each
 //! treelet spread over a team of lanes.
+pub mod kernels;
+
 use crate::geometry::aabb::Aabb;
 use crate::geometry::buffers::{Node, TreeletParams};
 use crate::geometry::records::{RecordLoad, RecordStore};

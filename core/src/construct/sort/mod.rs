@@ -55,7 +55,7 @@
 //! phases (barriers), its ranking sharing a phase with the next round's
 //! counting in a second set of counters. On the H100 this pass is bound by
 //! its 21.8 KB of workgroup memory, which lets an SM hold only two of its
-//! workgroups (see [`super::sort_multisplit`], which measured it). [`super::sort_multisplit`] is the same pass
+//! workgroups (see [`multisplit`], which measured it). [`multisplit`] is the same pass
 //! ranked by subgroup ballots instead (Onesweep's own ranking), for devices
 //! with subgroups of 32 lanes or more; it shares [`tile_offset`] and
 //! [`write_tile`] with this one.
@@ -63,6 +63,11 @@
 //! Kernels are phase functions: see [`crate::gpu::workgroup`]. Hot reads and
 //! writes skip bounds checks on the GPU ([`crate::gpu::unchecked`]; the CPU runner
 //! keeps them), as in the treelet kernel.
+pub mod multisplit;
+pub mod multisplit_rank;
+pub mod scan;
+pub mod ties;
+
 use crate::geometry::buffers::SortParams;
 use crate::gpu::atomics;
 use crate::gpu::unchecked::{at, get, put, set};
@@ -130,7 +135,7 @@ pub mod state {
     pub const COUNTS: u32 = 0;
     /// Ticket counter of each pass.
     pub const TICKETS: u32 = MAX_PASSES * RADIX;
-    /// Set to 1 by `construct::sort_ties` where a run of ties is too long to
+    /// Set to 1 by `construct::sort::ties` where a run of ties is too long to
     /// settle: a spare word of the tickets' region, so that the flag is
     /// zeroed with the state rather than by a fill dispatch of its own.
     pub const TIE_OVERFLOW: u32 = TICKETS + MAX_PASSES;
@@ -167,7 +172,7 @@ const INCLUSIVE: u32 = 2 << FLAG_SHIFT;
 pub const HISTOGRAM_PHASES: u32 = 3;
 
 /// Kernel: digit counts of every pass from `params.pass` on (0 for a sort of
-/// every digit; see [`super::sort_ties`] for one of the high digits) over one
+/// every digit; see [`ties`] for one of the high digits) over one
 /// tile of [`histogram_tile`] keys, added to the state's counts.
 pub fn histogram_phase(
     phase: u32,
