@@ -51,6 +51,18 @@ fn check_meta(path: &Path, what: &str, meta: &std::fs::Metadata) -> Result<u64> 
     Ok(meta.len())
 }
 
+/// An empty vector with room for `n` elements, or an error naming `what`
+/// and the bytes asked for where the memory cannot hold them (an
+/// allocation that fails would abort the process).
+pub fn room_for<T>(n: usize, what: &str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        let bytes = n as f64 * std::mem::size_of::<T>() as f64;
+        anyhow::anyhow!("not enough memory for {what}: {n} of {} bytes ({:.2} GB)", std::mem::size_of::<T>(), bytes / 1e9)
+    })?;
+    Ok(v)
+}
+
 /// Reads the whole of `path` (see [`check`]); never more than the cap,
 /// even if the file grows while it is read.
 pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
@@ -58,7 +70,7 @@ pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
     let file = std::fs::File::open(path).with_context(|| format!("{what} {}: cannot open it", path.display()))?;
     // What was opened is checked too: the path may have changed since.
     let len = check_meta(path, what, &file.metadata().with_context(|| format!("{what} {}", path.display()))?)?;
-    let mut bytes = Vec::with_capacity(len as usize);
+    let mut bytes = room_for(len as usize, &format!("{what} {}", path.display()))?;
     let max = max_input_bytes();
     file.take(max + 1).read_to_end(&mut bytes).with_context(|| format!("{what} {}: read error", path.display()))?;
     if bytes.len() as u64 > max {
@@ -155,5 +167,14 @@ mod tests {
         let e = format!("{:#}", read_text(&dir.join("bin.obj"), "mesh").unwrap_err());
         assert!(e.contains("line 2") && e.contains("not UTF-8"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Room the memory cannot give is an error naming what it was for,
+    /// not an abort; room it can give is given.
+    #[test]
+    fn room_past_the_memory_is_an_error() {
+        let e = room_for::<[f32; 12]>(usize::MAX / 16, "the mesh's triangles").unwrap_err().to_string();
+        assert!(e.contains("not enough memory for the mesh's triangles") && e.contains("of 48 bytes"), "{e}");
+        assert!(room_for::<u64>(1000, "words").unwrap().capacity() >= 1000);
     }
 }

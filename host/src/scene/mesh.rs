@@ -44,7 +44,7 @@ pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     let text = crate::internals::input::read_text(path, "mesh")?;
     // The common form on every core; the rest, and errors, through tobj.
     match super::obj_plain::read(&text) {
-        Some(triangles) => Ok(triangles),
+        Some(triangles) => triangles.with_context(|| path.display().to_string()),
         None => parse_obj(&text, &path.display().to_string()),
     }
 }
@@ -489,7 +489,7 @@ mod tests {
             }
             let expected = parse_obj(&text, "m.obj");
             for chunk in [1, 16, 100, 1 << 20] {
-                let read = crate::scene::obj_plain::read_in_chunks(&text, chunk);
+                let read = crate::scene::obj_plain::read_in_chunks(&text, chunk).map(Result::unwrap);
                 match &expected {
                     Ok(triangles) => assert_eq!(read.as_ref(), Some(triangles), "case {case}, chunks of {chunk}, {faces} faces:\n{text}"),
                     Err(e) => assert!(read.is_none(), "case {case}: tobj: {e}"),

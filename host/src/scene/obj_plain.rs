@@ -9,8 +9,11 @@
 //! bad number, an index out of range, a face of fewer than three vertices,
 //! another keyword), goes to tobj ([`super::mesh::load_obj`]), so that its
 //! errors are tobj's, with the line that [`super::mesh`] finds for them.
+use anyhow::Result;
 use rayon::prelude::*;
 use treelet_core::geometry::triangle::Triangle;
+
+use crate::internals::input::room_for;
 
 /// Bytes a chunk takes at least: enough to keep a core busy for a while,
 /// few enough to share a file of a few megabytes among the cores.
@@ -35,13 +38,14 @@ enum Index {
 
 /// The triangles of `text`, faces fanned from their first vertex as tobj
 /// triangulates them, in the file's order; `None` where tobj should read
-/// the file instead (see the module doc).
-pub(super) fn read(text: &str) -> Option<Vec<Triangle>> {
+/// the file instead (see the module doc); an error where the memory cannot
+/// hold the triangles.
+pub(super) fn read(text: &str) -> Option<Result<Vec<Triangle>>> {
     read_in_chunks(text, CHUNK_BYTES)
 }
 
 /// [`read`] in chunks of `chunk_bytes` or more (tests cut small files small).
-pub(super) fn read_in_chunks(text: &str, chunk_bytes: usize) -> Option<Vec<Triangle>> {
+pub(super) fn read_in_chunks(text: &str, chunk_bytes: usize) -> Option<Result<Vec<Triangle>>> {
     let bytes = text.as_bytes();
     let chunks: Vec<Chunk> = chunk_ranges(bytes, chunk_bytes).into_par_iter().map(|r| parse_chunk(&bytes[r])).collect::<Option<_>>()?;
     // Where each chunk's vertices start in the file, and where its triangles go.
@@ -54,8 +58,16 @@ pub(super) fn read_in_chunks(text: &str, chunk_bytes: usize) -> Option<Vec<Trian
         vertices += c.vertices.len() as i64;
         triangles += c.sizes.iter().map(|&s| s as usize - 2).sum::<usize>();
     }
-    let all: Vec<[f32; 3]> = chunks.iter().flat_map(|c| c.vertices.iter().copied()).collect();
-    let mut out = vec![Triangle::default(); triangles];
+    let mut all = match room_for(vertices as usize, "the mesh's vertices") {
+        Ok(v) => v,
+        Err(e) => return Some(Err(e)),
+    };
+    all.extend(chunks.iter().flat_map(|c| c.vertices.iter().copied()));
+    let mut out = match room_for(triangles, "the mesh's triangles") {
+        Ok(v) => v,
+        Err(e) => return Some(Err(e)),
+    };
+    out.resize(triangles, Triangle::default());
     // Each chunk fills its own run of `out`.
     let mut runs = Vec::with_capacity(chunks.len());
     let mut rest = out.as_mut_slice();
@@ -87,7 +99,7 @@ pub(super) fn read_in_chunks(text: &str, chunk_bytes: usize) -> Option<Vec<Trian
             Some(())
         })
         .collect::<Option<Vec<()>>>()?;
-    Some(out)
+    Some(Ok(out))
 }
 
 /// `bytes` cut into ranges of `least` bytes or more (four a core), each

@@ -111,7 +111,7 @@ pub fn read(bytes: &[u8], name: &str) -> Option<Result<Vec<Triangle>>> {
 /// loop after it then reads the faces one by one and names the fault).
 /// Vertices are read from the file's bytes where they lie (`position`),
 /// not copied first: at 10M triangles that copy was 360 MB of fresh pages.
-fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] + Sync) -> Option<Vec<Triangle>> {
+fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] + Sync) -> Option<Result<Vec<Triangle>>> {
     let record = l.count.size + 3 * l.index.size;
     if l.faces.checked_mul(record) != Some(faces.len()) {
         return None;
@@ -127,7 +127,10 @@ fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] 
     }
     // Written in place on every core (a collect through rayon's lists of
     // vectors would copy them).
-    let mut triangles = Vec::with_capacity(l.faces);
+    let mut triangles = match crate::internals::input::room_for(l.faces, "the mesh's triangles") {
+        Ok(v) => v,
+        Err(e) => return Some(Err(e)),
+    };
     (0..l.faces)
         .into_par_iter()
         .map(|f| {
@@ -136,7 +139,7 @@ fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] 
             Triangle::new(vertex(0), vertex(1), vertex(2))
         })
         .collect_into_vec(&mut triangles);
-    Some(triangles)
+    Some(Ok(triangles))
 }
 
 fn triangles(bytes: &[u8], name: &str, l: &Layout) -> Result<Vec<Triangle>> {
@@ -152,13 +155,14 @@ fn triangles(bytes: &[u8], name: &str, l: &Layout) -> Result<Vec<Triangle>> {
     };
     let faces = &body[vertex_bytes..];
     if let Some(triangles) = all_triangles(faces, l, position) {
-        return Ok(triangles);
+        return triangles;
     }
-    let positions: Vec<[f32; 3]> = (0..l.vertices).into_par_iter().map(position).collect();
+    let mut positions = crate::internals::input::room_for(l.vertices, "the mesh's vertices")?;
+    (0..l.vertices).into_par_iter().map(position).collect_into_vec(&mut positions);
     // No more room than the file can hold: a face takes at least its count
     // and three indices.
     let smallest = l.count.size + 3 * l.index.size;
-    let mut triangles = Vec::with_capacity(l.faces.min(faces.len() / smallest));
+    let mut triangles = crate::internals::input::room_for(l.faces.min(faces.len() / smallest), "the mesh's triangles")?;
     let mut at = 0usize;
     for f in 0..l.faces {
         if at + l.count.size > faces.len() {
