@@ -702,11 +702,42 @@ fn bound_threads() {
     }
 }
 
+/// A bar for each load that takes more than a second (the library counts
+/// its bytes: `treelet::internals::progress`), drawn on stderr where it is
+/// a terminal, by a thread that looks ten times a second.
+fn show_long_loads() {
+    use std::sync::Arc;
+    use treelet::internals::progress::{current, Work};
+    std::thread::spawn(|| {
+        let mut shown: Option<(Arc<Work>, ProgressBar)> = None;
+        loop {
+            std::thread::sleep(std::time::Duration::from_millis(100));
+            let work = current();
+            if let Some((w, bar)) = &shown {
+                if work.as_ref().is_some_and(|now| Arc::ptr_eq(now, w)) {
+                    bar.set_position(w.done().min(w.total));
+                    continue;
+                }
+                bar.finish_and_clear();
+                shown = None;
+            }
+            if let Some(w) = work.filter(|w| w.started.elapsed().as_secs_f64() > 1.0) {
+                let bar = ProgressBar::new(w.total);
+                bar.set_style(ProgressStyle::with_template("{bar:40} {bytes}/{total_bytes}  {msg}").unwrap());
+                bar.set_message(w.what.clone());
+                bar.set_position(w.done().min(w.total));
+                shown = Some((w, bar));
+            }
+        }
+    });
+}
+
 fn run(cli: Cli) -> Result<bool> {
     treelet::internals::input::set_max_input_bytes(cli.max_input_bytes);
     // Every TREELET_* knob, read and checked once, before any work: a value
     // that does not parse is an error, not a knob ignored.
     let _ = treelet::tuning::Tuning::from_env()?.install();
+    show_long_loads();
     match cli.command {
         Command::Build { scene, builder, device, rounds, gamma, max_leaf, reinsert, json } => {
             let rounds = rounds.unwrap_or(if builder == Builder::Trbvh { TreeletConfig::default().rounds } else { 0 });

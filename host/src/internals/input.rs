@@ -72,7 +72,17 @@ pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
     let len = check_meta(path, what, &file.metadata().with_context(|| format!("{what} {}", path.display()))?)?;
     let mut bytes = room_for(len as usize, &format!("{what} {}", path.display()))?;
     let max = max_input_bytes();
-    file.take(max + 1).read_to_end(&mut bytes).with_context(|| format!("{what} {}: read error", path.display()))?;
+    // In blocks, so that a watcher can show how far a large file has got.
+    let progress = super::progress::track(format!("reading {what} {}", path.display()), len);
+    let mut rest = file.take(max + 1);
+    loop {
+        let n = (&mut rest).take(16 << 20).read_to_end(&mut bytes).with_context(|| format!("{what} {}: read error", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        progress.add(n as u64);
+    }
+    drop(progress);
     if bytes.len() as u64 > max {
         bail!("{what} {} grew past the {max} bytes an input may have while it was read", path.display());
     }

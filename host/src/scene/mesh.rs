@@ -43,7 +43,7 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
 pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     let text = crate::internals::input::read_text(path, "mesh")?;
     // The common form on every core; the rest, and errors, through tobj.
-    match super::obj_plain::read(&text) {
+    match super::obj_plain::read(&text, &path.display().to_string()) {
         Some(triangles) => triangles.with_context(|| path.display().to_string()),
         None => parse_obj(&text, &path.display().to_string()),
     }
@@ -489,7 +489,7 @@ mod tests {
             }
             let expected = parse_obj(&text, "m.obj");
             for chunk in [1, 16, 100, 1 << 20] {
-                let read = crate::scene::obj_plain::read_in_chunks(&text, chunk).map(Result::unwrap);
+                let read = crate::scene::obj_plain::read_in_chunks(&text, "m.obj", chunk).map(Result::unwrap);
                 match &expected {
                     Ok(triangles) => assert_eq!(read.as_ref(), Some(triangles), "case {case}, chunks of {chunk}, {faces} faces:\n{text}"),
                     Err(e) => assert!(read.is_none(), "case {case}: tobj: {e}"),
@@ -506,7 +506,7 @@ mod tests {
             ("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nf 1 2 3\n", ""),
             ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", ""),
         ] {
-            assert!(crate::scene::obj_plain::read_in_chunks(text, 4).is_none(), "{text}");
+            assert!(crate::scene::obj_plain::read_in_chunks(text, "m.obj", 4).is_none(), "{text}");
             if let Err(e) = parse_obj(text, "m.obj") {
                 assert!(e.to_string().contains(fault), "{e}");
             }

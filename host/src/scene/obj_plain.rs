@@ -40,14 +40,23 @@ enum Index {
 /// triangulates them, in the file's order; `None` where tobj should read
 /// the file instead (see the module doc); an error where the memory cannot
 /// hold the triangles.
-pub(super) fn read(text: &str) -> Option<Result<Vec<Triangle>>> {
-    read_in_chunks(text, CHUNK_BYTES)
+pub(super) fn read(text: &str, name: &str) -> Option<Result<Vec<Triangle>>> {
+    read_in_chunks(text, name, CHUNK_BYTES)
 }
 
 /// [`read`] in chunks of `chunk_bytes` or more (tests cut small files small).
-pub(super) fn read_in_chunks(text: &str, chunk_bytes: usize) -> Option<Result<Vec<Triangle>>> {
+pub(super) fn read_in_chunks(text: &str, name: &str, chunk_bytes: usize) -> Option<Result<Vec<Triangle>>> {
     let bytes = text.as_bytes();
-    let chunks: Vec<Chunk> = chunk_ranges(bytes, chunk_bytes).into_par_iter().map(|r| parse_chunk(&bytes[r])).collect::<Option<_>>()?;
+    let progress = crate::internals::progress::track(format!("parsing {name}"), bytes.len() as u64);
+    let chunks: Vec<Chunk> = chunk_ranges(bytes, chunk_bytes)
+        .into_par_iter()
+        .map(|r| {
+            let chunk = parse_chunk(&bytes[r.clone()]);
+            progress.add(r.len() as u64);
+            chunk
+        })
+        .collect::<Option<_>>()?;
+    drop(progress);
     // Where each chunk's vertices start in the file, and where its triangles go.
     let mut vertex_base = Vec::with_capacity(chunks.len());
     let mut triangle_base = Vec::with_capacity(chunks.len());
