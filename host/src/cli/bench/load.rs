@@ -92,7 +92,7 @@ pub fn bench_load(files: &[PathBuf], sizes: &[usize], dir: &Path, repeats: usize
     Ok(rows)
 }
 
-/// Median seconds of `repeats` runs of `f`.
+/// Median seconds of `repeats` runs of `f` (the median of `measure`).
 fn median(repeats: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
     let mut times = Vec::with_capacity(repeats);
     for _ in 0..repeats.max(1) {
@@ -100,6 +100,5 @@ fn median(repeats: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
         f()?;
         times.push(start.elapsed().as_secs_f64());
     }
-    times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
+    Ok(super::measure::median(times))
 }
