@@ -665,6 +665,21 @@ mod tests {
         let h = std::f32::consts::FRAC_1_SQRT_2;
         assert!((c.direction[0] + h).abs() < 1e-6 && c.direction[1].abs() < 1e-6 && (c.direction[2] + h).abs() < 1e-6, "{:?}", c.direction);
         assert!((c.fov - 2.0 * 0.25f32.tan()).abs() < 1e-6);
+        // In the picture: the middle pixel's ray leaves the node's place
+        // along its turned axis; the top and bottom rows' (rows count up)
+        // run half of yfov (0.25 radian) above and below it.
+        let (w, rows) = (101, 1000);
+        let camera = c.camera(w, rows);
+        let (o, mid) = camera.primary_ray(w / 2, rows / 2, 0, w, rows, (0.5, 0.0));
+        assert!((o - Vec3::new(3.0, 0.0, 7.0)).length() < 1e-4, "{o:?}");
+        assert!((mid.normalize() - Vec3::new(-h, 0.0, -h)).length() < 1e-3, "{mid:?}");
+        let elevation = |y: u32| {
+            let (_, d) = camera.primary_ray(w / 2, y, 0, w, rows, (0.5, 0.5));
+            d.y.atan2((d.x * d.x + d.z * d.z).sqrt())
+        };
+        let pixel = 1.0 / rows as f32;
+        assert!((elevation(rows - 1) - 0.25).abs() < pixel, "top row at {} radians", elevation(rows - 1));
+        assert!((elevation(0) + 0.25).abs() < pixel, "bottom row at {} radians", elevation(0));
         for (camera, needle) in [(1, "camera 1 (node 3) is orthographic"), (3, "camera 3 is placed by no node"), (4, "no camera 4: the file has 4")] {
             let e = load_with_camera(&path, Some(camera)).unwrap_err().to_string();
             assert!(e.contains(needle), "camera {camera}: {e}");
