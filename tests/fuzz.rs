@@ -135,3 +135,37 @@ proptest! {
         check(&written_corpus()[1..], which, &edits, image_io::read_hdr)?;
     }
 }
+
+/// Inputs the libFuzzer targets (`tests/fuzz`) found a fault with, kept once
+/// fixed: `corpus/regressions/<target>/`, each read as its target reads it
+/// (no panic; an error names the file). The first: a relative texture
+/// index past the start (`f 1/-11`), which overflowed in tobj's bounds
+/// check where overflow is checked.
+#[test]
+fn fuzz_findings_stay_fixed() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpus/regressions");
+    let mut seen = 0;
+    for target in std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()) {
+        let kind = target.file_name().unwrap().to_string_lossy().into_owned();
+        for file in std::fs::read_dir(&target).unwrap().map(|e| e.unwrap().path()) {
+            let mut bytes = std::fs::read(&file).unwrap();
+            let case = |name: &str, bytes: Vec<u8>| vec![(name.to_string(), bytes)];
+            let result = match kind.as_str() {
+                "obj" => check(&case("input.obj", bytes), 0, &[], treelet::scene::mesh::load),
+                "ply" => check(&case("input.ply", bytes), 0, &[], treelet::scene::mesh::load),
+                "scene_file" => check(&case("scene.json", bytes), 0, &[], treelet::scene::file::load),
+                "gltf" => check(&case("scene.gltf", bytes), 0, &[], treelet::scene::gltf::load),
+                "glb" => check(&case("scene.glb", bytes), 0, &[], treelet::scene::gltf::load),
+                "part" => check(&case("part.exr", bytes), 0, &[], parts::read_part),
+                "hdr_image" if !bytes.is_empty() => {
+                    let name = if bytes.remove(0) & 1 == 0 { "image.exr" } else { "image.pfm" };
+                    check(&case(name, bytes), 0, &[], image_io::read_hdr)
+                }
+                other => panic!("{}: no fuzz target `{other}`", file.display()),
+            };
+            result.unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+            seen += 1;
+        }
+    }
+    assert!(seen > 0, "no finding in {}", dir.display());
+}
