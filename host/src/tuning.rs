@@ -232,12 +232,14 @@ impl Tuning {
         if let Some((name, v)) = get("TREELET_TREELETS") {
             let n: Vec<u32> = v.split(',').map(|x| x.trim().parse().ok()).collect::<Option<_>>().unwrap_or_default();
             match n[..] {
-                [rounds, gamma, max_leaf] if max_leaf >= 1 => t.treelets = Some((rounds, gamma, max_leaf)),
-                _ => return Err(err(name, &v, "expected ROUNDS,GAMMA,MAX_LEAF, whole numbers, MAX_LEAF >= 1")),
+                [rounds, gamma, max_leaf] if (1..=1024).contains(&max_leaf) => t.treelets = Some((rounds, gamma, max_leaf)),
+                _ => return Err(err(name, &v, "expected ROUNDS,GAMMA,MAX_LEAF, whole numbers, MAX_LEAF from 1 to 1024")),
             }
         }
         if let Some(v) = get("TREELET_REINSERT") {
-            t.reinsert = Some(number_in(v, 0..=u32::MAX)?);
+            // As `--reinsert`: each iteration is a pass over the tree, and
+            // four billion of them never end.
+            t.reinsert = Some(number_in(v, 0..=64)?);
         }
         if let Some(v) = get("TREELET_REINSERT_CLIMB") {
             t.reinsert_climb = Some(number_in(v, 0..=u32::MAX)?);
@@ -372,6 +374,10 @@ mod tests {
             ("TREELET_SPLITS", "lots"),
             ("TREELET_TREELETS", "3,3"),
             ("TREELET_TREELETS", "3,3,0"),
+            ("TREELET_TREELETS", "3,3,1025"),
+            // Bounded as `--reinsert` is: 2^32 - 1 iterations never ended (a probe, 2026-12-02).
+            ("TREELET_REINSERT", "4294967295"),
+            ("TREELET_REINSERT", "65"),
             ("TREELET_SORT_LOOK_BACK", "maybe"),
             ("TREELET_SORT_TILES", "huge"),
             ("TREELET_MORTON_KEY_BITS", "65"),

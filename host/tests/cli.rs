@@ -1166,6 +1166,68 @@ fn hostile_arguments_and_outputs_get_clear_errors() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Cases a probe of 428 hostile inputs found (2026-12-02), each of which
+/// replaced an input, hung or said the wrong thing: no output over a file
+/// the command read, bounded knobs, empty device names, unknown export
+/// formats, a memory cap named as such.
+#[test]
+fn outputs_never_replace_inputs_and_probe_findings_stay_fixed() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-probe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let scene = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/cornell.json")).unwrap();
+    std::fs::write(dir.join("in.json"), &scene).unwrap();
+    let small = ["--device", "cpu", "--width", "8", "--height", "6", "--spp", "1"];
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render"];
+        args.extend_from_slice(&small);
+        args.extend_from_slice(extra);
+        stderr_of(&args)
+    };
+    // --report over the scene file it renders: refused, the scene kept.
+    let e = render(&["--scene", &path("in.json"), "--out", &path("o.png"), "--report", &path("in.json")]);
+    assert!(e.contains("--report") && e.contains("read that file as an input"), "{e}");
+    assert_eq!(std::fs::read_to_string(dir.join("in.json")).unwrap(), scene);
+    // --out over the reference image it is scored against.
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--out", &path("ref.pfm")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reference = std::fs::read(dir.join("ref.pfm")).unwrap();
+    let e = render(&["--reference", &path("ref.pfm"), "--out", &path("ref.pfm")]);
+    assert!(e.contains("--out") && e.contains("read that file as an input"), "{e}");
+    assert_eq!(std::fs::read(dir.join("ref.pfm")).unwrap(), reference);
+    // export over the mesh it exports, or over the mesh a scene file names.
+    let mesh = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::fs::write(dir.join("q.obj"), mesh).unwrap();
+    let e = stderr_of(&["export", "--scene", &path("q.obj"), "--out", &path("q.obj")]);
+    assert!(e.contains("read that file as an input"), "{e}");
+    assert_eq!(std::fs::read_to_string(dir.join("q.obj")).unwrap(), mesh);
+    let e = stderr_of(&["export", "--scene", &path("q.obj"), "--out", &path("q.stl")]);
+    assert!(e.contains("export writes .ply or .obj"), "{e}");
+    // Knobs bounded as their options are: 2^32 - 1 reinsertion iterations ran for ever.
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["build", "--scene", "terrain:300", "--builder", "trbvh", "--device", "cpu"])
+        .env("TREELET_REINSERT", "4294967295")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.code() == Some(1) && err.contains("TREELET_REINSERT=4294967295"), "{err}");
+    // An empty device name matched every adapter.
+    let e = stderr_of(&["render", "--devices", ",,", "--width", "8", "--height", "6", "--spp", "1", "--out", &path("d.png")]);
+    assert!(e.contains("an empty name in the list"), "{e}");
+    // A memory cap that refuses a render is named as the cause.
+    let out = Command::new(env!("CARGO_BIN_EXE_treelet"))
+        .args(["render", "--device", "cpu", "--width", "64", "--height", "64", "--spp", "1", "--out", &path("m.png")])
+        .env("TREELET_MAX_MEMORY", "1")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("TREELET_MAX_MEMORY"), "{err}");
+    // A --max-input-bytes of 2^64 - 1 read every input as empty (it wrapped).
+    let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--scene", &path("in.json"), "--max-input-bytes", "18446744073709551615", "--out", &path("x.png")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A glTF file's cameras and extensions as `render` takes them: `--camera
 /// N` picks camera N (a camera that does not exist, or a scene without
 /// cameras, is an error naming it); each extension Treelet does not read

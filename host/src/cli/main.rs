@@ -357,6 +357,14 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let first_sample = part.as_ref().map_or(0, |r| r.start);
     let resumed = args.resume.as_deref().map(|path| parts::read_part(path).map(|r| (path, r))).transpose()?;
     let reference = args.reference.as_deref().map(|r| parts::read_scored_image(r, "--reference")).transpose()?;
+    // No output over a file this render read: its scene, the meshes and
+    // buffers that names, the reference. (The part it continues is written
+    // over by its checkpoints: that is what continuing it means.)
+    for (output, what) in [(Some(&args.out), "--out"), (args.report.as_ref(), "--report"), (Some(&part_path), "the part beside --out")] {
+        if let Some(output) = output.filter(|o| !args.resume.as_ref().is_some_and(|r| same(r, o))) {
+            treelet::internals::input::refuse_if_read(output, what)?;
+        }
+    }
     let mut settings = RenderSettings {
         width: args.width,
         height: args.height,
@@ -482,6 +490,15 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     let bad = result.image.pixels.iter().filter(|p| !p.iter().all(|v| v.is_finite())).count();
     if bad > 0 {
         eprintln!("warning: {bad} of {} pixels are NaN or infinite (a material or light out of range?)", result.image.pixels.len());
+    }
+    // So is an image of nothing at all from a scene that emits light (the
+    // note before the render covers one that does not): the camera sees
+    // nothing lit, or nothing at all.
+    let emits = scene.materials.iter().any(|m| m.emission.iter().any(|&e| e > 0.0));
+    if emits && result.samples.end > result.samples.start && result.image.pixels.iter().all(|p| p.iter().all(|&v| v == 0.0)) {
+        eprintln!(
+            "warning: every pixel of the image is black: the camera sees nothing lit (is its near plane past the scene, or the scene flattened by a transform?)"
+        );
     }
     let done = result.samples.clone();
     let write_start = std::time::Instant::now();
@@ -800,7 +817,12 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Export { scene, out } => {
+            let ext = image_io::extension(&out);
+            if ext != "ply" && ext != "obj" {
+                anyhow::bail!("--out {}: export writes .ply or .obj meshes", out.display());
+            }
             let scene = Scene::from_spec(&scene)?;
+            treelet::internals::input::refuse_if_read(&out, "--out")?;
             let w = treelet::scene::ply::write(&scene, &out)?;
             if !w.left_out.is_empty() {
                 eprintln!("note: left out {} (a PLY mesh holds triangles)", w.left_out.join(", "));

@@ -30,7 +30,35 @@ pub fn max_input_bytes() -> u64 {
 /// Returns its size.
 pub fn check(path: &Path, what: &str) -> Result<u64> {
     let meta = std::fs::metadata(path).with_context(|| format!("{what} {}: cannot read it", path.display()))?;
-    check_meta(path, what, &meta)
+    let len = check_meta(path, what, &meta)?;
+    note_read(path);
+    Ok(len)
+}
+
+/// Every file [`check`] passed in this process (so every file read through
+/// this module), by its canonical path: the command writes no output over
+/// one of them ([`refuse_if_read`]).
+static READ: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn note_read(path: &Path) {
+    if let Ok(canonical) = path.canonicalize() {
+        let mut read = READ.lock().unwrap_or_else(|e| e.into_inner());
+        if !read.contains(&canonical) {
+            read.push(canonical);
+        }
+    }
+}
+
+/// Refuses `path` as an output (`what`: `--out`) where this process has read
+/// it as an input, by any name that resolves to it: the scene, a mesh or
+/// buffer it names, a reference image. (A render's `--report` over its scene
+/// file, or `export` over the mesh it exports, replaced the input.)
+pub fn refuse_if_read(path: &Path, what: &str) -> Result<()> {
+    let Ok(canonical) = path.canonicalize() else { return Ok(()) };
+    if READ.lock().unwrap_or_else(|e| e.into_inner()).contains(&canonical) {
+        bail!("{what} {}: this command read that file as an input, and writing would replace it; write elsewhere", path.display());
+    }
+    Ok(())
 }
 
 fn check_meta(path: &Path, what: &str, meta: &std::fs::Metadata) -> Result<u64> {
@@ -63,6 +91,14 @@ pub fn room_for<T>(n: usize, what: &str) -> Result<Vec<T>> {
     Ok(v)
 }
 
+/// `n` zeroed elements, or an error naming `what` where the memory cannot
+/// hold them ([`room_for`]): read-backs and the CPU runner's buffers.
+pub fn zeroed_vec<T: bytemuck::Pod>(n: usize, what: &str) -> Result<Vec<T>> {
+    let mut v = room_for(n, what)?;
+    v.resize(n, T::zeroed());
+    Ok(v)
+}
+
 /// Reads the whole of `path` (see [`check`]); never more than the cap,
 /// even if the file grows while it is read.
 pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
@@ -74,7 +110,7 @@ pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
     let max = max_input_bytes();
     // In blocks, so that a watcher can show how far a large file has got.
     let progress = super::progress::track(format!("reading {what} {}", path.display()), len);
-    let mut rest = file.take(max + 1);
+    let mut rest = file.take(max.saturating_add(1));
     loop {
         let n = (&mut rest).take(16 << 20).read_to_end(&mut bytes).with_context(|| format!("{what} {}: read error", path.display()))?;
         if n == 0 {

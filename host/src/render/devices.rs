@@ -36,6 +36,9 @@ pub fn open(spec: &str) -> Result<Vec<Device>> {
                 }
             }
             "cpu" => out.push(Device::Cpu),
+            // An empty name is part of every adapter's name: `--devices ,,`
+            // opened adapter 0 three times.
+            "" => bail!("--devices `{spec}`: an empty name in the list (name adapters by index or name, or use cpu, gpu, all)"),
             _ => {
                 let index = match item.parse::<usize>() {
                     Ok(i) if i < adapters.len() => i,

@@ -196,6 +196,11 @@ pub fn parse_pfm(bytes: &[u8]) -> Result<HdrImage> {
     let width: u32 = tokens[1].parse().context("bad width")?;
     let height: u32 = tokens[2].parse().context("bad height")?;
     let scale: f32 = tokens[3].parse().context("bad scale")?;
+    // Its sign says the byte order; 0 or NaN says neither (and were read as
+    // big-endian, so an image equal to its reference scored an error of 0.5).
+    if !(scale.is_finite() && scale != 0.0) {
+        bail!("scale {scale}: its sign gives the byte order, so it must be a non-zero number");
+    }
     if width == 0 || height == 0 {
         bail!("empty image {width}x{height}");
     }
@@ -244,6 +249,11 @@ mod tests {
         assert!(parse_pfm(b"P6\n1 1\n255\n\0\0\0").is_err());
         assert!(parse_pfm(b"PF\n2 2\n-1.0\n\0\0\0\0").unwrap_err().to_string().contains("bytes of pixel data"));
         assert!(parse_pfm(b"PF\n2").is_err());
+        for scale in ["0", "nan", "-0.0"] {
+            let text = format!("PF\n1 1\n{scale}\n");
+            let bytes = [text.as_bytes(), &[0u8; 12]].concat();
+            assert!(parse_pfm(&bytes).unwrap_err().to_string().contains("non-zero"), "scale {scale}");
+        }
     }
 
     #[test]

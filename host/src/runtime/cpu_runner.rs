@@ -365,15 +365,15 @@ impl Backend for CpuBackend {
         u64::MAX
     }
 
-    fn upload<T: Pod>(&mut self, _label: &'static str, data: &[T]) -> Result<CpuBuffer> {
+    fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<CpuBuffer> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        let mut words = vec![0u64; bytes.len().div_ceil(8).max(1)];
+        let mut words = zeroed_words(bytes.len() as u64, label)?;
         bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
         Ok(Rc::new(RefCell::new(words)))
     }
 
-    fn scratch(&mut self, _label: &'static str, bytes: u64) -> Result<CpuBuffer> {
-        Ok(Rc::new(RefCell::new(vec![0u64; (bytes as usize).div_ceil(8).max(1)])))
+    fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<CpuBuffer> {
+        Ok(Rc::new(RefCell::new(zeroed_words(bytes, label)?)))
     }
 
     fn stage(&mut self, stage: &'static str) {
@@ -395,7 +395,9 @@ impl Backend for CpuBackend {
 
     fn read<T: Pod>(&mut self, buffer: &CpuBuffer, count: usize) -> Result<Vec<T>> {
         let mut words = buffer.borrow_mut();
-        Ok(view::<T>(&mut words)[..count].to_vec())
+        let mut out = crate::internals::input::room_for(count, "a buffer read back from the CPU runner")?;
+        out.extend_from_slice(&view::<T>(&mut words)[..count]);
+        Ok(out)
     }
 
     fn take_times(&mut self) -> Result<StageTimes> {
@@ -404,6 +406,15 @@ impl Backend for CpuBackend {
         times.source = "wall-clock";
         Ok(times)
     }
+}
+
+/// A runner buffer of at least `bytes` bytes, zeroed: its memory asked for
+/// first, so that a buffer the machine cannot hold is an error naming it
+/// (`buffer \`nodes\``), not an abort.
+fn zeroed_words(bytes: u64, label: &str) -> Result<Vec<u64>> {
+    let words = usize::try_from(bytes.div_ceil(8).max(1))
+        .map_err(|_| crate::error::too_large(format!("buffer `{label}`: {bytes} bytes do not fit this machine's addresses")))?;
+    crate::internals::input::zeroed_vec(words, &format!("buffer `{label}` on the CPU runner"))
 }
 
 /// A binding of a registered kernel as its call takes it: a shared or a
@@ -849,5 +860,23 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             }
         }
         (kernel, b) => panic!("{kernel:?} dispatched with {} bindings", b.len()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::runtime::backend::Backend;
+
+    #[test]
+    fn a_buffer_past_the_memory_is_an_error_naming_it() {
+        let mut b = CpuBackend::new();
+        // 2^60 bytes: no machine holds it; the allocation must fail as an error, not abort.
+        let e = b.scratch("nodes", 1 << 60).err().expect("an exabyte buffer was allocated");
+        assert!(format!("{e:#}").contains("buffer `nodes`"), "{e:#}");
+        let ok = b.scratch("small", 12).unwrap();
+        assert_eq!(ok.borrow().len(), 2);
+        let up = b.upload("data", &[1u32, 2, 3]).unwrap();
+        assert_eq!(b.read::<u32>(&up, 3).unwrap(), [1, 2, 3]);
     }
 }

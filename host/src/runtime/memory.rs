@@ -72,7 +72,11 @@ pub fn human(bytes: u64) -> String {
 pub fn check_fits(what: &str, needed: u64, detail: &str) -> Result<()> {
     if let Some(available) = available_bytes() {
         if needed > available {
-            return Err(crate::error::too_large(format!("{what} needs about {} of memory ({detail}), and this machine has {} available",
+            // Where the cap set the limit, say so: "this machine has 1 byte"
+            // read as a fault of the machine's.
+            let capped = memory_cap().is_some_and(|c| c <= available);
+            let limit = if capped { " (the cap TREELET_MAX_MEMORY sets)" } else { "" };
+            return Err(crate::error::too_large(format!("{what} needs about {} of memory ({detail}), and this machine has {} available{limit}",
                 human(needed),
                 human(available))));
         }

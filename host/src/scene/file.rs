@@ -158,11 +158,13 @@ struct MaterialSpec {
 
 /// Indices of refraction a glass may have (relative ones below 1 included:
 /// a bubble of air in water is 0.75).
-const MIN_IOR: f32 = 0.01;
-const MAX_IOR: f32 = 100.0;
+pub(crate) const MIN_IOR: f32 = 0.01;
+pub(crate) const MAX_IOR: f32 = 100.0;
 /// The widest camera: an image plane `2 tan(89.9 degrees)` high at unit
 /// distance (`fov` is the full height: see `Camera::look`).
 const MAX_FOV: f32 = 1146.0;
+/// The narrowest camera a scene file may have (see where it is checked).
+const MIN_FOV: f32 = 1e-6;
 
 fn default_ior() -> f32 {
     1.5
@@ -350,6 +352,11 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
         bail!("scene file {name}: the camera needs a finite origin, a non-zero direction and a positive fov");
     }
     // Cameras that would render black, or from behind their origin.
+    // Below this, the camera's basis underflows to NaN (fov 1e-23 and less
+    // rendered black, the probe of 2026-12-02): a view of 6e-5 degrees.
+    if c.fov < MIN_FOV {
+        bail!("scene file {name}: camera fov {} (the height of the image plane at unit distance) is below {MIN_FOV:e}, a view of 6e-5 degrees", c.fov);
+    }
     if c.fov > MAX_FOV {
         bail!("scene file {name}: camera fov {} (the height of the image plane at unit distance) is past {MAX_FOV}, a view of 179.8 degrees", c.fov);
     }
@@ -399,6 +406,7 @@ mod tests {
         };
         for (camera, expected) in [
             (r#"{"origin": [0,0,0], "direction": [0,0,1], "fov": 1e38}"#, "fov"),
+            (r#"{"origin": [0,0,0], "direction": [0,0,1], "fov": 1e-30}"#, "below 1e-6"),
             (r#"{"origin": [0,0,0], "direction": [0,0,1], "near": -1}"#, "behind the camera"),
             (r#"{"origin": [0,0,0], "direction": [0,0,1e-30]}"#, "non-zero direction"),
         ] {

@@ -62,6 +62,7 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
     let buffers = buffers(&gltf, path.parent().unwrap_or(Path::new(".")), &name)?;
     check_ranges(&gltf.document, &name)?;
+    check_node_transforms(&gltf.document, &name)?;
     let document = &gltf.document;
     let scene =
         document.default_scene().or_else(|| document.scenes().next()).with_context(|| format!("{name}: no scene"))?;
@@ -174,7 +175,7 @@ fn check_glb(bytes: &[u8], name: &str) -> Result<()> {
     if length > bytes.len() {
         bail!("{name}: truncated: the GLB header says {length} bytes, the file has {}", bytes.len());
     }
-    let (mut at, mut k) = (12usize, 0);
+    let (mut at, mut k, mut binary) = (12usize, 0, false);
     while at < length {
         let (Some(chunk), Some(kind)) = (word(at), bytes.get(at + 4..at + 8).filter(|_| at + 8 <= length)) else {
             bail!("{name}: truncated: the header of chunk {k} at byte {at} is cut off");
@@ -182,11 +183,31 @@ fn check_glb(bytes: &[u8], name: &str) -> Result<()> {
         if k == 0 && kind != b"JSON" {
             bail!("{name}: the first GLB chunk is not JSON");
         }
+        // One BIN chunk at most (glTF 2.0, 4.4.3); the crate read the first
+        // of two and left the other, silently.
+        if kind == b"BIN\0" {
+            if binary {
+                bail!("{name}: chunk {k} at byte {at} is a second BIN chunk; a GLB file holds one");
+            }
+            binary = true;
+        }
         if chunk > length - at - 8 {
             bail!("{name}: truncated or corrupt: chunk {k} says {chunk} bytes, {} remain", length - at - 8);
         }
         at += 8 + chunk;
         k += 1;
+    }
+    Ok(())
+}
+
+/// A node gives its transform once: as a matrix, or as translation,
+/// rotation and scale (glTF 2.0, 5.25). With both, the `gltf` crate takes
+/// the matrix and drops the rest without a word.
+fn check_node_transforms(document: &gltf::Document, name: &str) -> Result<()> {
+    for (i, node) in document.as_json().nodes.iter().enumerate() {
+        if node.matrix.is_some() && (node.translation.is_some() || node.rotation.is_some() || node.scale.is_some()) {
+            bail!("{name}: node {i} has both a matrix and translation, rotation or scale; glTF allows one or the other");
+        }
     }
     Ok(())
 }
@@ -264,7 +285,13 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
                 if uri.contains("://") {
                     bail!("{name}: buffer {i}: `{uri}` is not a local file");
                 }
-                crate::internals::input::read(&dir.join(uri), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
+                // A URI reference relative to the file (glTF 2.0, 2.8): an
+                // absolute path would read any file of the machine as geometry.
+                if uri.starts_with('/') || uri.starts_with('\\') || uri.get(1..2) == Some(":") {
+                    bail!("{name}: buffer {i}: `{uri}` is an absolute path; glTF buffers are named relative to the file");
+                }
+                let file = percent_decoded(uri).with_context(|| format!("{name}: buffer {i}: `{uri}`"))?;
+                crate::internals::input::read(&dir.join(file), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
             }
         };
         if data.len() < buffer.length() {
@@ -390,8 +417,9 @@ struct CameraNode {
 fn camera_spec(name: &str, node: usize, world: Mat4, yfov: f32) -> Result<CameraSpec> {
     let origin = world.transform_point3(Vec3::ZERO);
     let direction = world.transform_vector3(-Vec3::Z);
-    if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
-        bail!("{name}: node {node}: camera field of view {yfov} radians (it must lie between 0 and pi)");
+    // Narrower than 1e-6 radians, the camera's basis underflows (1e-40 rendered black).
+    if !(yfov >= 1e-6 && yfov < std::f32::consts::PI) {
+        bail!("{name}: node {node}: camera field of view {yfov} radians (it must lie between 1e-6 and pi)");
     }
     if !(direction.length_squared() > 0.0 && direction.is_finite()) {
         bail!("{name}: node {node}: the camera's transform gives it no direction to look in");
@@ -505,8 +533,10 @@ fn material(m: &gltf::Material, at: &str, out: &mut Loaded) -> Result<Material> 
     let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
     let (kind, ior) = if transmission > 0.5 {
         let ior = m.ior().unwrap_or(1.5);
-        if !(ior > 0.0 && ior.is_finite()) {
-            bail!("{what}: index of refraction {ior}");
+        // As scene files: past these, refraction's arithmetic gives NaN pixels.
+        let (min, max) = (super::file::MIN_IOR, super::file::MAX_IOR);
+        if !(ior >= min && ior <= max) {
+            bail!("{what}: index of refraction {ior} (it must lie between {min} and {max})");
         }
         (GLASS, ior)
     } else if pbr.metallic_factor() >= 0.5 && pbr.roughness_factor() < 0.2 {
@@ -526,6 +556,25 @@ fn framing((lo, hi): (Vec3, Vec3)) -> CameraSpec {
     let fov = 0.5;
     let distance = 1.1 * half.x.max(half.y) / (fov / 2.0) + half.z;
     CameraSpec { origin: (center + Vec3::Z * distance.max(1e-3)).into(), direction: [0.0, 0.0, -1.0], near: 0.0, fov }
+}
+
+/// A URI's path with its `%XX` escapes decoded (`my%20data.bin` names
+/// `my data.bin`); a bad escape or bytes that are not UTF-8 are an error.
+fn percent_decoded(uri: &str) -> Result<String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut k = 0;
+    while k < bytes.len() {
+        if bytes[k] == b'%' {
+            let hex = uri.get(k + 1..k + 3).and_then(|h| u8::from_str_radix(h, 16).ok());
+            out.push(hex.with_context(|| format!("a `%` at byte {k} not followed by two hex digits"))?);
+            k += 3;
+        } else {
+            out.push(bytes[k]);
+            k += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| anyhow!("its escapes decode to bytes that are not UTF-8"))
 }
 
 #[cfg(test)]
@@ -741,6 +790,11 @@ mod tests {
         let external = d.join("external.gltf");
         std::fs::write(&external, document("square.bin", 4, 6)).unwrap();
         check_scene(&load(&external).unwrap());
+        // A name with a space, escaped in the URI as glTF asks (`my%20data.bin`).
+        std::fs::write(d.join("my data.bin"), square_buffer()).unwrap();
+        let escaped = d.join("escaped.gltf");
+        std::fs::write(&escaped, document("my%20data.bin", 4, 6)).unwrap();
+        check_scene(&load(&escaped).unwrap());
         // GLB: a header, the JSON chunk (padded with spaces), the BIN chunk.
         let (glb, _) = square_glb();
         let binary = d.join("square.glb");
@@ -758,6 +812,9 @@ mod tests {
             ("short.gltf", document(&data_uri(), 4, 5), "not a multiple of three"),
             ("missing.gltf", document("nowhere.bin", 4, 6), "buffer 0"),
             ("remote.gltf", document("https://example.com/a.bin", 4, 6), "not a local file"),
+            // Any file of the machine read as a buffer (the probe of 2026-12-02 read /etc/passwd).
+            ("absolute.gltf", document("/etc/passwd", 4, 6), "`/etc/passwd` is an absolute path"),
+            ("badescape.gltf", document("a%zz.bin", 4, 6), "not followed by two hex digits"),
             (
                 "noaccessor.gltf",
                 document(&data_uri(), 4, 6).replacen(r#""POSITION": 0"#, r#""POSITION": 7"#, 1),
@@ -795,6 +852,16 @@ mod tests {
                 document(&data_uri(), 4, 6).replace(r#""scenes": [{"nodes": [0, 2]}]"#, r#""scenes": [{"nodes": [0, 2], "nodes": [0]}]"#),
                 "the key \"nodes\" appears twice",
             ),
+            // Found by a probe (2026-12-02), each rendered a wrong image with exit 0:
+            // a transform given twice (the crate took the matrix alone), a camera
+            // too narrow for its basis, glass past the range of its arithmetic.
+            (
+                "matrixandscale.gltf",
+                document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""scale": [2, 2, 2], "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]"#),
+                "node 1 has both a matrix and translation",
+            ),
+            ("narrow.gltf", document(&data_uri(), 4, 6).replace(r#""yfov": 1.0"#, r#""yfov": 1e-40"#), "between 1e-6 and pi"),
+            ("ior.gltf", document(&data_uri(), 4, 6).replace(r#""ior": 1.33"#, r#""ior": 1e30"#), "(it must lie between 0.01 and 100)"),
             // A rotation that is no rotation; a camera Treelet cannot make.
             ("quaternion.gltf", document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [10, 0, 0, 0]"#), "not a unit quaternion"),
             (
@@ -828,6 +895,18 @@ mod tests {
     }
 
     #[test]
+    fn extras_of_any_json_type_are_read_past() {
+        // glTF allows any value in `extras`; the crate without its `extras`
+        // feature refused all but objects ("expected unit").
+        let d = dir();
+        let path = d.join("extras.gltf");
+        let text = document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""scale": [2, 2, 2], "extras": [1, "two", null]"#);
+        std::fs::write(&path, text).unwrap();
+        check_scene(&load(&path).unwrap());
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
     fn a_slightly_unnormalised_rotation_is_normalised() {
         let d = dir();
         let path = d.join("rounded.gltf");
@@ -850,6 +929,16 @@ mod tests {
             let e = format!("{:#}", load(&path).unwrap_err());
             assert!(e.contains("truncated") && e.contains("cut.glb"), "cut at {cut}: {e}");
         }
+        // A second BIN chunk (the crate read the first, silently).
+        let mut two = glb.clone();
+        two.extend(8u32.to_le_bytes());
+        two.extend(b"BIN\0");
+        two.extend([0u8; 8]);
+        let total = two.len() as u32;
+        two[8..12].copy_from_slice(&total.to_le_bytes());
+        std::fs::write(&path, &two).unwrap();
+        let e = format!("{:#}", load(&path).unwrap_err());
+        assert!(e.contains("a second BIN chunk"), "{e}");
         for (length, expected) in [(8u32, "less than a header"), (u32::MAX, "truncated")] {
             let mut lying = glb.clone();
             lying[8..12].copy_from_slice(&length.to_le_bytes());

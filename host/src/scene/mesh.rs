@@ -51,6 +51,15 @@ pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
 
 /// Any OBJ through tobj.
 fn parse_obj(text: &str, name: &str) -> Result<Vec<Triangle>> {
+    // tobj makes a face of two vertices a triangle with one of them twice:
+    // a degenerate triangle where the file meant a line (or was cut).
+    let short = text.lines().enumerate().find(|(_, l)| {
+        let mut words = l.split_whitespace();
+        words.next() == Some("f") && words.count() < 3
+    });
+    if let Some((n, line)) = short {
+        bail!("{name}: line {}: a face of fewer than three vertices in `{}`", n + 1, line.trim());
+    }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     // Material libraries are ignored: Treelet assigns its own material.
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default())).map_err(|e| {
@@ -275,6 +284,52 @@ pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
     }
 }
 
+/// Longest line an ASCII PLY's element may take: one element a line, a few
+/// dozen numbers. ply-rs echoes a bad line whole in its error, so a file of
+/// one 3 GB line took 3 GB more to say so (and aborted under `ulimit -v`).
+const MAX_ASCII_PLY_LINE: usize = 64 << 10;
+
+/// An ASCII PLY's elements, line by line, before ply-rs reads them: no line
+/// past [`MAX_ASCII_PLY_LINE`], and no more values on a line than its
+/// element's properties take (ply-rs ignores the rest, so a header that
+/// left out a property shifted every coordinate without a word). Lines
+/// ply-rs will refuse anyway (too few values, not numbers) are left to it.
+fn check_ascii_lines(bytes: &[u8], header: &ply_rs_bw::ply::Header, name: &str) -> Result<()> {
+    use ply_rs_bw::ply::PropertyType;
+    let Some(end) = bytes.windows(10).position(|w| w == b"end_header") else { return Ok(()) };
+    let Some(body) = bytes[end..].iter().position(|&b| b == b'\n').map(|n| end + n + 1) else { return Ok(()) };
+    let header_lines = bytes[..body].iter().filter(|&&b| b == b'\n').count();
+    let mut lines = bytes[body..].split(|&b| b == b'\n').enumerate();
+    for (element, def) in &header.elements {
+        for index in 0..def.count {
+            let Some((k, line)) = lines.next() else { return Ok(()) };
+            let at = || format!("{name}: line {} ({element} {index})", header_lines + k + 1);
+            if line.len() > MAX_ASCII_PLY_LINE {
+                bail!("{}: {} bytes long; an ASCII PLY line holds one element (at most {MAX_ASCII_PLY_LINE} bytes here)", at(), line.len());
+            }
+            let Ok(text) = std::str::from_utf8(line) else { continue };
+            let values: Vec<&str> = text.split_ascii_whitespace().collect();
+            let mut taken = 0usize;
+            for property in def.properties.values() {
+                taken = taken.saturating_add(match property.data_type {
+                    PropertyType::Scalar(_) => 1,
+                    PropertyType::List(..) => match values.get(taken).and_then(|v| v.parse::<usize>().ok()) {
+                        Some(n) => n.saturating_add(1),
+                        None => usize::MAX,
+                    },
+                });
+                if taken >= values.len() {
+                    break;
+                }
+            }
+            if taken < values.len() {
+                bail!("{}: {} values where its properties take {taken}", at(), values.len());
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Any PLY through `ply-rs-bw`'s parser.
 fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<Triangle>> {
     use ply_rs_bw::parser::{Parser, Reader};
@@ -296,6 +351,9 @@ fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<Triangle>> {
     };
     let mut reader = Reader::new(bytes);
     let header = Parser::<DefaultElement>::new().read_header(&mut reader).map_err(parse_error)?;
+    if header.encoding == ply_rs_bw::ply::Encoding::Ascii {
+        check_ascii_lines(bytes, &header, name)?;
+    }
     let (mut vertices, mut faces) = (None, None);
     for (element, def) in &header.elements {
         match element.as_str() {
@@ -357,6 +415,47 @@ mod tests {
         let mut out = Vec::new();
         lzma_rs::xz_compress(&mut std::io::BufReader::new(bytes), &mut out).unwrap();
         out
+    }
+
+    const QUAD_PLY_HEAD: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                                 element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+    #[test]
+    fn an_obj_face_of_two_vertices_is_refused_by_line() {
+        // tobj made it a triangle with a vertex twice; the chunked reader
+        // hands such files to tobj, so both forms are checked.
+        for (case, text) in [("plain", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"), ("tobj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1\n")] {
+            let path = write(&format!("two-{case}.obj"), text.as_bytes());
+            let e = format!("{:#}", load(&path).unwrap_err());
+            assert!(e.contains("line 4") && e.contains("fewer than three vertices") || e.contains("line 5") && e.contains("fewer than three"), "{case}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_mesh_too_small_to_place_is_refused_as_such() {
+        let path = write("tiny.obj", b"v 0 0 0\nv 1e-42 0 0\nv 0 1e-42 0\nf 1 2 3\n");
+        let e = format!("{:#}", crate::scene::Scene::from_spec(path.to_str().unwrap()).unwrap_err());
+        assert!(e.contains("tiny.obj") && e.contains("too small to scale"), "{e}");
+    }
+
+    #[test]
+    fn ascii_ply_lines_hold_what_their_properties_take() {
+        let good = format!("{QUAD_PLY_HEAD}0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+        assert_eq!(load(&write("lines-good.ply", good.as_bytes())).unwrap().len(), 2);
+        // A vertex of six values where x, y and z are declared (the probe of
+        // 2026-12-02: read as its first three, silently), and a face past its count.
+        for (case, body, at) in [
+            ("vertex", "0 0 0 9 9 9\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n", "line 10 (vertex 0): 6 values where its properties take 3"),
+            ("face", "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 3\n", "line 14 (face 0): 5 values where its properties take 4"),
+        ] {
+            let path = write(&format!("lines-{case}.ply"), format!("{QUAD_PLY_HEAD}{body}").as_bytes());
+            let e = format!("{:#}", load(&path).unwrap_err());
+            assert!(e.contains(&path.display().to_string()) && e.contains(at), "{case}: {e}");
+        }
+        // One line of a megabyte: refused by its length, not echoed whole.
+        let long = format!("{QUAD_PLY_HEAD}0 0 0 {}\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n", "x".repeat(1 << 20));
+        let e = format!("{:#}", load(&write("lines-long.ply", long.as_bytes())).unwrap_err());
+        assert!(e.contains("line 10 (vertex 0): 1048582 bytes long") && e.len() < 1000, "{}", &e[..e.len().min(300)]);
     }
 
     #[test]

@@ -32,6 +32,12 @@ impl Scene {
         }
         if super::mesh::mesh_kind(std::path::Path::new(spec)).is_some() {
             let triangles = super::mesh::load(std::path::Path::new(spec))?;
+            // A mesh alone is scaled to fit the room: one too small for that
+            // scale in f32 became NaN coordinates, blamed on the file's triangle 0.
+            let size = triangles.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb())).extent().max_element();
+            if size > 0.0 && !(60.0 / size).is_finite() {
+                bail!("{spec}: the mesh spans {size:e} units, too small to scale into the room (scale it up in the file, or place it with a scene file)");
+            }
             return Ok(mesh_scene(spec, &triangles));
         }
         let mut parts = spec.split(':');

@@ -412,7 +412,7 @@ impl Backend for GpuBackend {
         let total = (count * std::mem::size_of::<T>()) as u64;
         // Mapped bytes are copied once, straight into the result (a render's
         // sums are tens of MB, and every copy is on the way to the image).
-        let mut out: Vec<T> = bytemuck::zeroed_vec(count);
+        let mut out: Vec<T> = crate::internals::input::zeroed_vec(count, "a buffer read back from the device")?;
         let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut out);
         let mut offset = 0;
         while offset < total {
