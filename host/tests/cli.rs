@@ -1188,6 +1188,10 @@ fn outputs_never_replace_inputs_and_probe_findings_stay_fixed() {
     let e = render(&["--scene", &path("in.json"), "--out", &path("o.png"), "--report", &path("in.json")]);
     assert!(e.contains("--report") && e.contains("read that file as an input"), "{e}");
     assert_eq!(std::fs::read_to_string(dir.join("in.json")).unwrap(), scene);
+    // --report naming --out by another path (`sub/../o.png`), before either exists.
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let e = render(&["--out", &path("o2.pfm"), "--report", &path("sub/../o2.pfm")]);
+    assert!(e.contains("--report") && e.contains("same file as --out"), "{e}");
     // --out over the reference image it is scored against.
     let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--out", &path("ref.pfm")]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -264,6 +264,28 @@ fn catch_stop_signals() {
     });
 }
 
+/// Where `path` leads, for comparing outputs that do not exist yet: the
+/// file itself where it exists, else its folder resolved and its name (so
+/// `./o.pfm`, `sub/../o.pfm` and `/abs/o.pfm` are one file), and a link
+/// that points nowhere yet by where it points.
+fn resolved(path: &std::path::Path) -> std::path::PathBuf {
+    if let Ok(full) = path.canonicalize() {
+        return full;
+    }
+    let in_folder = |p: &std::path::Path| match (p.parent(), p.file_name()) {
+        (Some(dir), Some(name)) => {
+            let dir = if dir.as_os_str().is_empty() { std::path::Path::new(".") } else { dir };
+            dir.canonicalize().map_or_else(|_| p.to_path_buf(), |d| d.join(name))
+        }
+        _ => p.to_path_buf(),
+    };
+    match std::fs::read_link(path) {
+        Ok(target) if target.is_absolute() => in_folder(&target),
+        Ok(target) => in_folder(&path.parent().unwrap_or(std::path::Path::new(".")).join(target)),
+        Err(_) => in_folder(path),
+    }
+}
+
 fn run_render(mut args: RenderArgs) -> Result<()> {
     let part = args.samples.clone();
     // Every output is checked before any work, so a typo never costs a render.
@@ -286,9 +308,7 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
         image_io::check_output(report, "--report", &[])?;
     }
     // Files one render would write over another it reads or writes.
-    let same = |a: &std::path::Path, b: &std::path::Path| {
-        a == b || a.canonicalize().is_ok_and(|a| b.canonicalize().is_ok_and(|b| a == b))
-    };
+    let same = |a: &std::path::Path, b: &std::path::Path| a == b || resolved(a) == resolved(b);
     if let (Some(resume), None) = (&args.resume, &part) {
         if same(resume, &args.out) {
             anyhow::bail!("--resume {} and --out name the same file: the image would replace the part it continues", resume.display());
@@ -825,7 +845,7 @@ fn run(cli: Cli) -> Result<bool> {
             treelet::internals::input::refuse_if_read(&out, "--out")?;
             let w = treelet::scene::ply::write(&scene, &out)?;
             if !w.left_out.is_empty() {
-                eprintln!("note: left out {} (a PLY mesh holds triangles)", w.left_out.join(", "));
+                eprintln!("note: left out {} (a mesh file holds triangles)", w.left_out.join(", "));
             }
             println!(
                 "{}: {} triangles, areas {:.3e} to {:.3e} ({:.1e} apart)",

@@ -162,7 +162,7 @@ pub(crate) const MIN_IOR: f32 = 0.01;
 pub(crate) const MAX_IOR: f32 = 100.0;
 /// The widest camera: an image plane `2 tan(89.9 degrees)` high at unit
 /// distance (`fov` is the full height: see `Camera::look`).
-const MAX_FOV: f32 = 1146.0;
+pub(crate) const MAX_FOV: f32 = 1146.0;
 /// The narrowest camera a scene file may have (see where it is checked).
 const MIN_FOV: f32 = 1e-6;
 

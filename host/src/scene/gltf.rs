@@ -285,12 +285,13 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
                 if uri.contains("://") {
                     bail!("{name}: buffer {i}: `{uri}` is not a local file");
                 }
+                let file = percent_decoded(uri).with_context(|| format!("{name}: buffer {i}: `{uri}`"))?;
                 // A URI reference relative to the file (glTF 2.0, 2.8): an
-                // absolute path would read any file of the machine as geometry.
-                if uri.starts_with('/') || uri.starts_with('\\') || uri.get(1..2) == Some(":") {
+                // absolute path (escaped as `%2F` too) would read any file
+                // of the machine as geometry.
+                if file.starts_with('/') || file.starts_with('\\') || file.get(1..2) == Some(":") {
                     bail!("{name}: buffer {i}: `{uri}` is an absolute path; glTF buffers are named relative to the file");
                 }
-                let file = percent_decoded(uri).with_context(|| format!("{name}: buffer {i}: `{uri}`"))?;
                 crate::internals::input::read(&dir.join(file), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?
             }
         };
@@ -417,9 +418,11 @@ struct CameraNode {
 fn camera_spec(name: &str, node: usize, world: Mat4, yfov: f32) -> Result<CameraSpec> {
     let origin = world.transform_point3(Vec3::ZERO);
     let direction = world.transform_vector3(-Vec3::Z);
-    // Narrower than 1e-6 radians, the camera's basis underflows (1e-40 rendered black).
-    if !(yfov >= 1e-6 && yfov < std::f32::consts::PI) {
-        bail!("{name}: node {node}: camera field of view {yfov} radians (it must lie between 1e-6 and pi)");
+    // Narrower than 1e-6 radians, the camera's basis underflows (1e-40
+    // rendered black); wider, as scene files' widest (179.8 degrees).
+    let widest = 2.0 * (super::file::MAX_FOV / 2.0).atan();
+    if !(yfov >= 1e-6 && yfov <= widest) {
+        bail!("{name}: node {node}: camera field of view {yfov} radians (it must lie between 1e-6 and {widest}, 179.8 degrees)");
     }
     if !(direction.length_squared() > 0.0 && direction.is_finite()) {
         bail!("{name}: node {node}: the camera's transform gives it no direction to look in");
@@ -814,6 +817,8 @@ mod tests {
             ("remote.gltf", document("https://example.com/a.bin", 4, 6), "not a local file"),
             // Any file of the machine read as a buffer (the probe of 2026-12-02 read /etc/passwd).
             ("absolute.gltf", document("/etc/passwd", 4, 6), "`/etc/passwd` is an absolute path"),
+            ("escapedabsolute.gltf", document("%2Fetc%2Fpasswd", 4, 6), "is an absolute path"),
+            ("wide.gltf", document(&data_uri(), 4, 6).replace(r#""yfov": 1.0"#, r#""yfov": 3.14002"#), "179.8 degrees"),
             ("badescape.gltf", document("a%zz.bin", 4, 6), "not followed by two hex digits"),
             (
                 "noaccessor.gltf",
@@ -860,7 +865,7 @@ mod tests {
                 document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""scale": [2, 2, 2], "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]"#),
                 "node 1 has both a matrix and translation",
             ),
-            ("narrow.gltf", document(&data_uri(), 4, 6).replace(r#""yfov": 1.0"#, r#""yfov": 1e-40"#), "between 1e-6 and pi"),
+            ("narrow.gltf", document(&data_uri(), 4, 6).replace(r#""yfov": 1.0"#, r#""yfov": 1e-40"#), "between 1e-6 and"),
             ("ior.gltf", document(&data_uri(), 4, 6).replace(r#""ior": 1.33"#, r#""ior": 1e30"#), "(it must lie between 0.01 and 100)"),
             // A rotation that is no rotation; a camera Treelet cannot make.
             ("quaternion.gltf", document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [10, 0, 0, 0]"#), "not a unit quaternion"),
