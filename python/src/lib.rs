@@ -1,0 +1,288 @@
+//! The `treelet` Python module: Treelet's engine API ([`treelet::Tracer`])
+//! for NumPy arrays. A `Tracer` builds a BVH over a triangle mesh on a
+//! Vulkan GPU or on the CPU runner (the same kernels), and answers closest
+//! hits and occlusion queries for arrays of rays. Wrong shapes and dtypes
+//! are `TypeError`s or `ValueError`s that name the argument; what the
+//! library refuses (NaN coordinates, an index past the vertices, a
+//! direction of length 0) is a `ValueError` with its message.
+//!
+//! What is copied: vertices and indices once into the triangles the build
+//! takes (any layout, C order or not, is read through NumPy's view);
+//! rays once into the library's rays; hits once into the returned arrays.
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use treelet::error::{Error, ErrorKind};
+use treelet::runtime::device::{Device, DeviceChoice};
+use treelet::{CpuBackend, GpuBackend, Quality, Ray, RayHit, Triangle};
+
+/// A library error as the Python exception of its kind.
+fn py_err(e: Error) -> PyErr {
+    let message = format!("{e:#}");
+    match e.kind() {
+        ErrorKind::Input => PyValueError::new_err(message),
+        ErrorKind::TooLarge => PyMemoryError::new_err(message),
+        _ => PyRuntimeError::new_err(message),
+    }
+}
+
+/// The tree and the device it lives on.
+enum Inner {
+    Gpu(GpuBackend, treelet::Tracer<GpuBackend>, String),
+    Cpu(CpuBackend, treelet::Tracer<CpuBackend>),
+}
+
+/// A BVH over a triangle mesh, on a GPU (Vulkan) or the CPU runner, and
+/// the ray queries it answers.
+///
+/// >>> import numpy as np, treelet
+/// >>> v = np.array([[0, 0, 5], [1, 0, 5], [0, 1, 5]], dtype=np.float32)
+/// >>> t = treelet.Tracer(v, np.array([[0, 1, 2]]), device="cpu")
+/// >>> hits = t.closest_hits(np.array([[0.2, 0.2, 0.0]]), np.array([[0.0, 0.0, 1.0]]))
+/// >>> float(hits.t[0]), int(hits.primitive[0])
+/// (5.0, 0)
+#[pyclass(unsendable, module = "treelet")]
+struct Tracer {
+    inner: Inner,
+    triangles: usize,
+}
+
+/// The closest hit of each ray: `t` (distance along the normalized
+/// direction; inf for a miss), `primitive` (the triangle, -1 for a miss),
+/// `instance` (0 for a hit, -1 for a miss), `barycentrics` (n, 2: of the
+/// triangle's second and third vertex), `normal` (n, 3: unit, the
+/// triangle's `(v1 - v0) x (v2 - v0)`), `hit` (a bool mask).
+#[pyclass(module = "treelet", get_all)]
+struct Hits {
+    t: Py<PyArray1<f32>>,
+    primitive: Py<PyArray1<i64>>,
+    instance: Py<PyArray1<i64>>,
+    barycentrics: Py<PyArray2<f32>>,
+    normal: Py<PyArray2<f32>>,
+    hit: Py<PyArray1<bool>>,
+}
+
+#[pymethods]
+impl Hits {
+    fn __len__(&self, py: Python<'_>) -> usize {
+        self.t.bind(py).len()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let hit = self.hit.bind(py).to_vec().unwrap_or_default();
+        format!("Hits({} rays, {} hit)", hit.len(), hit.iter().filter(|&&h| h).count())
+    }
+}
+
+/// An (n, 3) array of numbers as rows of f32, any dtype NumPy converts
+/// losslessly enough (floats, ints), any memory order.
+fn rows3(py: Python<'_>, array: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f32; 3]>> {
+    let np = py.import("numpy")?;
+    let a = np.call_method1("asarray", (array,)).map_err(|_| PyTypeError::new_err(format!("{what}: not an array")))?;
+    let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u") {
+        return Err(PyTypeError::new_err(format!("{what}: numbers expected, got an array of dtype {}", a.getattr("dtype")?)));
+    }
+    let a = np.call_method1("ascontiguousarray", (a, "float32"))?;
+    let a: PyReadonlyArray2<f32> = a
+        .extract()
+        .map_err(|_| PyValueError::new_err(format!("{what}: expected a 2-dimensional (n, 3) array, got shape {}", shape_of(array))))?;
+    if a.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("{what}: expected shape (n, 3), got {:?}", a.shape())));
+    }
+    Ok(a.as_slice()?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+fn shape_of(array: &Bound<'_, PyAny>) -> String {
+    array.getattr("shape").map(|s| s.to_string()).unwrap_or_else(|_| "(none)".into())
+}
+
+/// `t_min` or `t_max`: a number for every ray, or an (n,) array.
+fn per_ray(py: Python<'_>, value: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<f32>> {
+    if let Ok(x) = value.extract::<f32>() {
+        return Ok(vec![x; n]);
+    }
+    let np = py.import("numpy")?;
+    let a = np.call_method1("ascontiguousarray", (value, "float32"))?;
+    let a: PyReadonlyArray1<f32> =
+        a.extract().map_err(|_| PyValueError::new_err(format!("{what}: a number, or an array of one number per ray")))?;
+    if a.len() != n {
+        return Err(PyValueError::new_err(format!("{what}: {} values for {n} rays", a.len())));
+    }
+    Ok(a.as_slice()?.to_vec())
+}
+
+/// The triangles of `vertices` ((v, 3) numbers) and `indices` ((m, 3)
+/// integers, one triangle a row), each index checked against the vertices.
+fn triangles_of(py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_, PyAny>) -> PyResult<Vec<Triangle>> {
+    let positions = rows3(py, vertices, "vertices")?;
+    let np = py.import("numpy")?;
+    let idx = np.call_method1("asarray", (indices,))?;
+    let kind: String = idx.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "i" | "u") {
+        return Err(PyTypeError::new_err(format!("indices: integers expected, got an array of dtype {}", idx.getattr("dtype")?)));
+    }
+    let idx = np.call_method1("ascontiguousarray", (idx, "int64"))?;
+    let idx: PyReadonlyArray2<i64> = idx
+        .extract()
+        .map_err(|_| PyValueError::new_err(format!("indices: expected a 2-dimensional (m, 3) array, got shape {}", shape_of(indices))))?;
+    if idx.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("indices: expected shape (m, 3), got {:?}", idx.shape())));
+    }
+    let mut triangles = Vec::with_capacity(idx.shape()[0]);
+    for (t, row) in idx.as_slice()?.chunks_exact(3).enumerate() {
+        let vertex = |k: usize| -> PyResult<[f32; 3]> {
+            usize::try_from(row[k]).ok().and_then(|i| positions.get(i).copied()).ok_or_else(|| {
+                PyValueError::new_err(format!("indices[{t}]: vertex index {} is not one of the {} vertices", row[k], positions.len()))
+            })
+        };
+        triangles.push(Triangle::new(vertex(0)?, vertex(1)?, vertex(2)?));
+    }
+    Ok(triangles)
+}
+
+impl Tracer {
+    fn rays(py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, t_min: &Bound<'_, PyAny>, t_max: &Bound<'_, PyAny>) -> PyResult<Vec<Ray>> {
+        let o = rows3(py, origins, "origins")?;
+        let d = rows3(py, directions, "directions")?;
+        if o.len() != d.len() {
+            return Err(PyValueError::new_err(format!("{} origins but {} directions", o.len(), d.len())));
+        }
+        let (lo, hi) = (per_ray(py, t_min, o.len(), "t_min")?, per_ray(py, t_max, o.len(), "t_max")?);
+        Ok((0..o.len()).map(|k| Ray { origin: o[k], dir: d[k], t_min: lo[k], t_max: hi[k] }).collect())
+    }
+}
+
+#[pymethods]
+impl Tracer {
+    /// Builds the tree over `vertices` ((v, 3) numbers) and `indices`
+    /// ((m, 3) integers: one triangle a row) on `device`: "auto" (the first
+    /// GPU, else the CPU runner), "gpu" (a Vulkan adapter, or an error) or
+    /// "cpu" (the CPU runner). `quality`: "fast" (the LBVH), "balanced"
+    /// (H-PLOC) or "high" (the TRBVH: the slowest build, the fastest rays).
+    #[new]
+    #[pyo3(signature = (vertices, indices, device = "auto", quality = "fast"))]
+    fn new(py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_, PyAny>, device: &str, quality: &str) -> PyResult<Self> {
+        let triangles = triangles_of(py, vertices, indices)?;
+        let quality = match quality {
+            "fast" => Quality::Fast,
+            "balanced" => Quality::Balanced,
+            "high" => Quality::High,
+            other => return Err(PyValueError::new_err(format!("quality `{other}`: use fast, balanced or high"))),
+        };
+        let choice = match device {
+            "auto" => DeviceChoice::Auto,
+            "gpu" => DeviceChoice::Gpu,
+            "cpu" => DeviceChoice::Cpu,
+            other => return Err(PyValueError::new_err(format!("device `{other}`: use auto, gpu or cpu"))),
+        };
+        let (opened, _note) = choice.open_with_note().map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))?;
+        let inner = match opened {
+            Device::Gpu(ctx) => {
+                let name = ctx.info.name.clone();
+                let mut b = GpuBackend::new(ctx);
+                let tracer = treelet::Tracer::build(&mut b, &[], &triangles, quality).map_err(py_err)?;
+                Inner::Gpu(b, tracer, name)
+            }
+            Device::Cpu => {
+                let mut b = CpuBackend::new();
+                let tracer = treelet::Tracer::build(&mut b, &[], &triangles, quality).map_err(py_err)?;
+                Inner::Cpu(b, tracer)
+            }
+        };
+        Ok(Tracer { inner, triangles: triangles.len() })
+    }
+
+    /// The device the tree is on: the adapter's name, or "cpu".
+    #[getter]
+    fn device(&self) -> String {
+        match &self.inner {
+            Inner::Gpu(_, _, name) => name.clone(),
+            Inner::Cpu(..) => "cpu".into(),
+        }
+    }
+
+    fn __len__(&self) -> usize {
+        self.triangles
+    }
+
+    /// The closest hit of each ray `origins[k] + t directions[k]` (both
+    /// (n, 3); directions of any length but 0), from `t_min` to `t_max`
+    /// (numbers, or one per ray), `t` along the normalized direction.
+    #[pyo3(signature = (origins, directions, t_min = None, t_max = None))]
+    fn closest_hits(
+        &mut self,
+        py: Python<'_>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        t_min: Option<&Bound<'_, PyAny>>,
+        t_max: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Hits> {
+        let zero = 0.0f32.into_pyobject(py)?.into_any();
+        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
+        let rays = Self::rays(py, origins, directions, t_min.unwrap_or(&zero), t_max.unwrap_or(&inf))?;
+        let hits: Vec<RayHit> = match &mut self.inner {
+            Inner::Gpu(b, t, _) => t.closest_hits(b, &rays),
+            Inner::Cpu(b, t) => t.closest_hits(b, &rays),
+        }
+        .map_err(py_err)?;
+        let n = hits.len();
+        let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
+        let bary = Array2::from_shape_vec((n, 2), hits.iter().flat_map(|h| h.barycentrics).collect()).expect("n rows of 2");
+        let normal = Array2::from_shape_vec((n, 3), hits.iter().flat_map(|h| h.normal).collect()).expect("n rows of 3");
+        Ok(Hits {
+            t: hits.iter().map(|h| h.t).collect::<Vec<_>>().into_pyarray(py).unbind(),
+            primitive: hits.iter().map(|h| signed(h.prim)).collect::<Vec<_>>().into_pyarray(py).unbind(),
+            instance: hits.iter().map(|h| signed(h.instance)).collect::<Vec<_>>().into_pyarray(py).unbind(),
+            barycentrics: bary.into_pyarray(py).unbind(),
+            normal: normal.into_pyarray(py).unbind(),
+            hit: hits.iter().map(RayHit::is_hit).collect::<Vec<_>>().into_pyarray(py).unbind(),
+        })
+    }
+
+    /// Whether each ray hits anything from `t_min` up to `t_max`
+    /// (inclusive): a bool array, as `closest_hits(...).t <= t_max`.
+    #[pyo3(signature = (origins, directions, t_min = None, t_max = None))]
+    fn occluded<'py>(
+        &mut self,
+        py: Python<'py>,
+        origins: &Bound<'py, PyAny>,
+        directions: &Bound<'py, PyAny>,
+        t_min: Option<&Bound<'py, PyAny>>,
+        t_max: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let zero = 0.0f32.into_pyobject(py)?.into_any();
+        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
+        let rays = Self::rays(py, origins, directions, t_min.unwrap_or(&zero), t_max.unwrap_or(&inf))?;
+        let hit = match &mut self.inner {
+            Inner::Gpu(b, t, _) => t.occluded(b, &rays),
+            Inner::Cpu(b, t) => t.occluded(b, &rays),
+        }
+        .map_err(py_err)?;
+        Ok(hit.into_pyarray(py))
+    }
+
+    /// Moves the mesh's vertices (the same count; the indices stay) and
+    /// refits the tree's boxes: the tree keeps its shape, so rays slow
+    /// down as the mesh moves far from where it was built.
+    fn refit(&mut self, py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_, PyAny>) -> PyResult<()> {
+        let triangles = triangles_of(py, vertices, indices)?;
+        if triangles.len() != self.triangles {
+            return Err(PyValueError::new_err(format!("refit: {} triangles where the tree has {}", triangles.len(), self.triangles)));
+        }
+        match &mut self.inner {
+            Inner::Gpu(b, t, _) => t.refit(b, &[], &triangles),
+            Inner::Cpu(b, t) => t.refit(b, &[], &triangles),
+        }
+        .map_err(py_err)
+    }
+}
+
+#[pymodule(name = "treelet")]
+fn treelet_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Tracer>()?;
+    m.add_class::<Hits>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
