@@ -263,6 +263,30 @@ impl Tracer {
         Ok(hit.into_pyarray(py))
     }
 
+    /// The benchmark's baseline (python/examples/bench_rays.py): the median
+    /// wall milliseconds of the Rust API's `closest_hits` on these rays,
+    /// taken `repeats` times, the rays already made (what an engine calling
+    /// the Rust API pays, without this module's conversions).
+    #[pyo3(signature = (origins, directions, repeats = 7))]
+    fn _rust_api_ms(&mut self, py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, repeats: usize) -> PyResult<f64> {
+        let zero = 0.0f32.into_pyobject(py)?.into_any();
+        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
+        let rays = Self::rays(py, origins, directions, &zero, &inf)?;
+        let mut ms = Vec::with_capacity(repeats);
+        for _ in 0..repeats.max(1) {
+            let start = std::time::Instant::now();
+            let hits = match &mut self.inner {
+                Inner::Gpu(b, t, _) => t.closest_hits(b, &rays),
+                Inner::Cpu(b, t) => t.closest_hits(b, &rays),
+            }
+            .map_err(py_err)?;
+            ms.push(start.elapsed().as_secs_f64() * 1e3);
+            std::hint::black_box(hits);
+        }
+        ms.sort_by(f64::total_cmp);
+        Ok(ms[ms.len() / 2])
+    }
+
     /// Moves the mesh's vertices (the same count; the indices stay) and
     /// refits the tree's boxes: the tree keeps its shape, so rays slow
     /// down as the mesh moves far from where it was built.

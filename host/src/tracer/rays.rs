@@ -129,7 +129,7 @@ pub(super) fn check_rays(rays: &[Ray]) -> Result<()> {
             r.origin, r.dir
         )));
     }
-    if let Some((k, r)) = rays.iter().enumerate().find(|(_, r)| r.t_max.is_nan()) {
+    if let Some(k) = rays.iter().position(|r| r.t_max.is_nan()) {
         return Err(crate::error::input(format!("ray {k}: t_max is NaN (use infinity for no limit)")));
     }
     Ok(())

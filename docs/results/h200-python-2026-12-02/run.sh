@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The Python package on the H200 (issue 67): its tests with the GPU (CI set: the H200 must open),
+# then 1M incoherent rays from NumPy to NumPy hits against the Rust API's closest_hits on the same
+# tree and rays, and against Mitsuba 3 (OptiX) from Python, transfers included; three meshes:
+# two real scenes of the suite and a 1M-triangle height field made here.
+# Carry: .gl (the Vulkan loader's debs), .whl (Mitsuba 3's site, slimmed), .dev/py (the wheel, pytest).
+for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm --format=csv
+python3 --version
+mkdir -p /tmp/pyt && for w in .dev/py/*.whl; do (cd /tmp/pyt && python3 -m zipfile -e $OLDPWD/$w .); done
+(cd /tmp && tar xJf $OLDPWD/.whl/site.tar.xz)
+export PYTHONPATH=/tmp/pyt:/tmp/site
+cd /tmp && CI=true timeout 200 python3 -m pytest -q -p no:cacheprovider $OLDPWD/python/tests 2>&1 | tail -4; cd $OLDPWD
+python3 - <<'PY'
+import numpy as np
+n = 708  # 2 * 707 * 707 = 999 698 triangles
+x, y = np.meshgrid(np.linspace(0, 100, n), np.linspace(0, 100, n))
+z = 3 * np.sin(x * 0.3) * np.cos(y * 0.2) + np.random.default_rng(2).normal(0, 0.05, x.shape)
+v = np.stack([x, y, z], -1).reshape(-1, 3).astype("<f4")
+i = np.arange(n * n).reshape(n, n)
+a, b, c, d = i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel(), i[1:, :-1].ravel()
+f = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]).astype("<i4")
+head = f"ply\nformat binary_little_endian 1.0\nelement vertex {len(v)}\nproperty float x\nproperty float y\nproperty float z\nelement face {len(f)}\nproperty list uchar int vertex_indices\nend_header\n"
+rec = np.zeros(len(f), dtype=np.dtype([("n", "u1"), ("i", "<i4", 3)])); rec["n"] = 3; rec["i"] = f
+open("/tmp/field.ply", "wb").write(head.encode() + v.tobytes() + rec.tobytes())
+print("height field:", len(f), "triangles")
+PY
+for mesh in scenes/real/breakfast_room.ply.xz scenes/real/staircase.ply.xz /tmp/field.ply; do
+  echo "== $mesh"
+  timeout 150 python3 python/examples/bench_rays.py $mesh --rays 1000000 --device gpu --repeats 7 --mitsuba 2>&1 | grep -v "^$" | tail -6
+done
+nvidia-smi --query-gpu=clocks.sm --format=csv
