@@ -75,9 +75,9 @@ impl Hits {
     }
 }
 
-/// An (n, 3) array of numbers as rows of f32, any dtype NumPy converts
-/// losslessly enough (floats, ints), any memory order.
-fn rows3(py: Python<'_>, array: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f32; 3]>> {
+/// An (n, 3) array of numbers as a C-ordered f32 array (no copy where it is
+/// one already), any dtype NumPy converts (floats, ints), any memory order.
+fn f32_rows<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyArray2<'py, f32>> {
     let np = py.import("numpy")?;
     let a = np.call_method1("asarray", (array,)).map_err(|_| PyTypeError::new_err(format!("{what}: not an array")))?;
     let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
@@ -91,17 +91,36 @@ fn rows3(py: Python<'_>, array: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[
     if a.shape()[1] != 3 {
         return Err(PyValueError::new_err(format!("{what}: expected shape (n, 3), got {:?}", a.shape())));
     }
-    Ok(a.as_slice()?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    Ok(a)
+}
+
+/// [`f32_rows`] as `[f32; 3]` rows.
+fn rows3(py: Python<'_>, array: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f32; 3]>> {
+    Ok(f32_rows(py, array, what)?.as_slice()?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
 fn shape_of(array: &Bound<'_, PyAny>) -> String {
     array.getattr("shape").map(|s| s.to_string()).unwrap_or_else(|_| "(none)".into())
 }
 
-/// `t_min` or `t_max`: a number for every ray, or an (n,) array.
-fn per_ray(py: Python<'_>, value: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<f32>> {
+/// `t_min` or `t_max`: one number for every ray, or an (n,) array.
+enum PerRay<'py> {
+    All(f32),
+    Each(PyReadonlyArray1<'py, f32>),
+}
+
+impl PerRay<'_> {
+    fn at(&self, values: &[f32], k: usize) -> f32 {
+        match self {
+            PerRay::All(x) => *x,
+            PerRay::Each(_) => values[k],
+        }
+    }
+}
+
+fn per_ray<'py>(py: Python<'py>, value: &Bound<'py, PyAny>, n: usize, what: &str) -> PyResult<PerRay<'py>> {
     if let Ok(x) = value.extract::<f32>() {
-        return Ok(vec![x; n]);
+        return Ok(PerRay::All(x));
     }
     let np = py.import("numpy")?;
     let a = np.call_method1("ascontiguousarray", (value, "float32"))?;
@@ -110,7 +129,7 @@ fn per_ray(py: Python<'_>, value: &Bound<'_, PyAny>, n: usize, what: &str) -> Py
     if a.len() != n {
         return Err(PyValueError::new_err(format!("{what}: {} values for {n} rays", a.len())));
     }
-    Ok(a.as_slice()?.to_vec())
+    Ok(PerRay::Each(a))
 }
 
 /// The triangles of `vertices` ((v, 3) numbers) and `indices` ((m, 3)
@@ -143,14 +162,43 @@ fn triangles_of(py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_,
 }
 
 impl Tracer {
+    /// The rays of the arrays, made in one pass over them (the arrays are
+    /// read in place where they are C-ordered f32 already).
     fn rays(py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, t_min: &Bound<'_, PyAny>, t_max: &Bound<'_, PyAny>) -> PyResult<Vec<Ray>> {
-        let o = rows3(py, origins, "origins")?;
-        let d = rows3(py, directions, "directions")?;
+        let (o, d) = (f32_rows(py, origins, "origins")?, f32_rows(py, directions, "directions")?);
+        let (o, d) = (o.as_slice()?, d.as_slice()?);
         if o.len() != d.len() {
-            return Err(PyValueError::new_err(format!("{} origins but {} directions", o.len(), d.len())));
+            return Err(PyValueError::new_err(format!("{} origins but {} directions", o.len() / 3, d.len() / 3)));
         }
-        let (lo, hi) = (per_ray(py, t_min, o.len(), "t_min")?, per_ray(py, t_max, o.len(), "t_max")?);
-        Ok((0..o.len()).map(|k| Ray { origin: o[k], dir: d[k], t_min: lo[k], t_max: hi[k] }).collect())
+        let n = o.len() / 3;
+        // NaN and infinite coordinates are the caller's error here (the engine
+        // API traces them as misses); a direction of length 0 hits nothing.
+        if let Some(k) = o.iter().chain(d).position(|v| !v.is_finite()) {
+            let (what, values, k) = if k < o.len() { ("origins", o, k) } else { ("directions", d, k - o.len()) };
+            return Err(PyValueError::new_err(format!("{what}[{}]: not finite ({})", k / 3, values[k])));
+        }
+        let (lo, hi) = (per_ray(py, t_min, n, "t_min")?, per_ray(py, t_max, n, "t_max")?);
+        for (what, values) in [("t_min", &lo), ("t_max", &hi)] {
+            let bad = match values {
+                PerRay::All(x) => x.is_nan().then_some(0),
+                PerRay::Each(a) => a.as_slice()?.iter().position(|x| x.is_nan()),
+            };
+            if let Some(k) = bad {
+                return Err(PyValueError::new_err(format!("{what}: NaN (at ray {k}); use inf for no limit")));
+            }
+        }
+        let (lo_values, hi_values) = (
+            if let PerRay::Each(a) = &lo { a.as_slice()? } else { &[] },
+            if let PerRay::Each(a) = &hi { a.as_slice()? } else { &[] },
+        );
+        Ok((0..n)
+            .map(|k| Ray {
+                origin: [o[3 * k], o[3 * k + 1], o[3 * k + 2]],
+                dir: [d[3 * k], d[3 * k + 1], d[3 * k + 2]],
+                t_min: lo.at(lo_values, k),
+                t_max: hi.at(hi_values, k),
+            })
+            .collect())
     }
 }
 
@@ -227,17 +275,28 @@ impl Tracer {
             Inner::Cpu(b, t) => t.closest_hits(b, &rays),
         }
         .map_err(py_err)?;
+        // The six arrays in one pass over the hits.
         let n = hits.len();
         let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
-        let bary = Array2::from_shape_vec((n, 2), hits.iter().flat_map(|h| h.barycentrics).collect()).expect("n rows of 2");
-        let normal = Array2::from_shape_vec((n, 3), hits.iter().flat_map(|h| h.normal).collect()).expect("n rows of 3");
+        let (mut t, mut primitive, mut instance, mut hit) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        let (mut bary, mut normal) = (Vec::with_capacity(2 * n), Vec::with_capacity(3 * n));
+        for h in &hits {
+            t.push(h.t);
+            primitive.push(signed(h.prim));
+            instance.push(signed(h.instance));
+            hit.push(h.is_hit());
+            bary.extend_from_slice(&h.barycentrics);
+            normal.extend_from_slice(&h.normal);
+        }
+        let bary = Array2::from_shape_vec((n, 2), bary).expect("n rows of 2");
+        let normal = Array2::from_shape_vec((n, 3), normal).expect("n rows of 3");
         Ok(Hits {
-            t: hits.iter().map(|h| h.t).collect::<Vec<_>>().into_pyarray(py).unbind(),
-            primitive: hits.iter().map(|h| signed(h.prim)).collect::<Vec<_>>().into_pyarray(py).unbind(),
-            instance: hits.iter().map(|h| signed(h.instance)).collect::<Vec<_>>().into_pyarray(py).unbind(),
+            t: t.into_pyarray(py).unbind(),
+            primitive: primitive.into_pyarray(py).unbind(),
+            instance: instance.into_pyarray(py).unbind(),
             barycentrics: bary.into_pyarray(py).unbind(),
             normal: normal.into_pyarray(py).unbind(),
-            hit: hits.iter().map(RayHit::is_hit).collect::<Vec<_>>().into_pyarray(py).unbind(),
+            hit: hit.into_pyarray(py).unbind(),
         })
     }
 

@@ -189,10 +189,14 @@ def test_bad_rays_are_named():
         tracer.closest_hits(o, np.ones((2, 4)))
     with pytest.raises(ValueError, match="t_max: 3 values for 2 rays"):
         tracer.occluded(o, d, t_max=np.ones(3))
-    with pytest.raises(ValueError, match="ray 0: .*non-zero length"):
-        tracer.closest_hits(o, np.zeros((2, 3)))
-    with pytest.raises(ValueError, match="must be finite"):
+    # A direction of length 0 hits nothing, as in the Rust API.
+    assert not tracer.closest_hits(o, np.zeros((2, 3))).hit.any()
+    with pytest.raises(ValueError, match=r"origins\[0\]: not finite"):
         tracer.closest_hits(np.full((2, 3), np.nan), d)
+    with pytest.raises(ValueError, match=r"directions\[1\]: not finite"):
+        tracer.closest_hits(o, np.array([[0, 0, 1], [np.inf, 0, 0]]))
+    with pytest.raises(ValueError, match="t_max: NaN"):
+        tracer.occluded(o, d, t_max=np.array([1.0, np.nan]))
     with pytest.raises(ValueError, match="t_min -1"):
         tracer.occluded(o, d, t_min=-1.0)
     with pytest.raises(TypeError, match="origins: numbers expected"):
