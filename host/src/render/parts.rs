@@ -108,12 +108,20 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &[[f32; 4]]) -> Result<()>
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Zeroed room for `width * height` pixels, or none where the machine
-/// cannot hold them (the caller then reports the header's size).
-fn pixels_or_none(width: usize, height: usize) -> Vec<[f32; 4]> {
+/// How many times larger than its file an EXR's pixels may be: deflate's
+/// limit (about 1032:1), the best of EXR's lossless compressions.
+const MAX_EXR_EXPANSION: u64 = 1100;
+
+/// Zeroed room for `width * height` pixels, or none where a file of
+/// `file_bytes` cannot hold them even compressed, or the machine cannot
+/// (the caller then reports the header's size). A 900-byte part whose
+/// header asked for 300M pixels took 4.7 GB before its data ran out.
+fn pixels_or_none(width: usize, height: usize, file_bytes: u64) -> Vec<[f32; 4]> {
     let mut pixels = Vec::new();
     match width.checked_mul(height) {
-        Some(n) if pixels.try_reserve_exact(n).is_ok() => pixels.resize(n, [0f32; 4]),
+        Some(n) if (n as u64).saturating_mul(16) <= file_bytes.saturating_mul(MAX_EXR_EXPANSION) && pixels.try_reserve_exact(n).is_ok() => {
+            pixels.resize(n, [0f32; 4])
+        }
         _ => {}
     }
     pixels
@@ -121,12 +129,12 @@ fn pixels_or_none(width: usize, height: usize) -> Vec<[f32; 4]> {
 
 /// Reads a part: what it is of, and its sums.
 pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
-    crate::internals::input::check(path, "part")?;
+    let file_bytes = crate::internals::input::check(path, "part")?;
     // The header's size is allocated before any pixel is read: a damaged
     // header can ask for petabytes, which must be an error, not an abort.
     let image = read_first_rgba_layer_from_file(
         path,
-        |size, _| (size.width(), pixels_or_none(size.width(), size.height())),
+        move |size, _| (size.width(), pixels_or_none(size.width(), size.height(), file_bytes)),
         |(w, pixels), p, (r, g, b, a): (f32, f32, f32, f32)| {
             if let Some(pixel) = pixels.get_mut(p.y() * *w + p.x()) {
                 *pixel = [r, g, b, a];
@@ -136,7 +144,12 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, Vec<[f32; 4]>)> {
     .with_context(|| format!("cannot read {} as an EXR image", path.display()))?;
     let size = image.layer_data.size;
     if image.layer_data.channel_data.pixels.1.len() != size.width() * size.height() {
-        bail!("{}: its header says {}x{} pixels, more than this machine can hold", path.display(), size.width(), size.height());
+        bail!(
+            "{}: its header says {}x{} pixels, more than a file of {file_bytes} bytes holds (or this machine can)",
+            path.display(),
+            size.width(),
+            size.height()
+        );
     }
     let other = &image.layer_data.attributes.other;
     let field = |key: &str| -> Result<String> {
@@ -253,13 +266,39 @@ pub fn merge(paths: &[PathBuf]) -> Result<(PartInfo, HdrImage)> {
 mod tests {
     use super::*;
 
+    /// A 900-byte part found by the fuzz target `part` (kept in
+    /// `tests/corpus/regressions/part/`), whose header asks for far more
+    /// pixels than its bytes hold: no room is made for them (it took 4.7 GB
+    /// and 8 s before its data ran out; now the EXR reader's error at once).
+    #[test]
+    fn a_header_larger_than_its_file_is_refused_before_its_room_is_made() {
+        let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/corpus/regressions/part/header_asks_for_gigabytes"));
+        let dir = std::env::temp_dir().join(format!("treelet-part-big-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let part = dir.join("part.exr");
+        std::fs::copy(path, &part).unwrap();
+        // The process's peak resident memory (Linux), before and after.
+        let peak_kb = || -> u64 {
+            let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+            status.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse().ok()).unwrap_or(0)
+        };
+        let before = peak_kb();
+        let e = format!("{:#}", read_part(&part).unwrap_err());
+        assert!(e.contains("part.exr"), "{e}");
+        let grown_mb = peak_kb().saturating_sub(before) / 1024;
+        assert!(grown_mb < 512, "reading a 900-byte part raised the peak memory by {grown_mb} MB");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
     /// Room for a header's pixels is asked for, not assumed: a damaged
     /// header found by `tests/fuzz.rs` asked for 49 PB, and `vec!` aborts.
     #[test]
     fn room_for_impossible_sizes_is_refused() {
-        assert_eq!(pixels_or_none(3, 2).len(), 6);
-        assert!(pixels_or_none(1 << 31, 1 << 31).is_empty());
-        assert!(pixels_or_none(usize::MAX, 2).is_empty());
+        assert_eq!(pixels_or_none(3, 2, 1000).len(), 6);
+        // Past what a file of 1 000 bytes holds, even compressed.
+        assert!(pixels_or_none(1000, 1000, 1000).is_empty());
+        assert!(pixels_or_none(1 << 31, 1 << 31, u64::MAX).is_empty());
+        assert!(pixels_or_none(usize::MAX, 2, u64::MAX).is_empty());
     }
 
     /// A part records its sampler, reads it back, and parts of two samplers
