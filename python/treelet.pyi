@@ -60,7 +60,8 @@ class Tracer:
         t_max: Optional[Union[float, npt.ArrayLike]] = None,
     ) -> Hits:
         """The closest hit of each ray origins[k] + t directions[k] ((n, 3) each; directions of
-        any non-zero length), from t_min (default 0) to t_max (default inf): numbers, or one per ray."""
+        any length, one of length 0 hitting nothing), from t_min (default 0) to t_max (default
+        inf): numbers, or one per ray."""
     def occluded(
         self,
         origins: npt.ArrayLike,

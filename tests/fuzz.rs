@@ -157,7 +157,8 @@ fn fuzz_findings_stay_fixed() {
                 "gltf" => check(&case("scene.gltf", bytes), 0, &[], treelet::scene::gltf::load),
                 "glb" => check(&case("scene.glb", bytes), 0, &[], treelet::scene::gltf::load),
                 "part" => check(&case("part.exr", bytes), 0, &[], parts::read_part),
-                "hdr_image" if !bytes.is_empty() => {
+                "hdr_image" => {
+                    assert!(!bytes.is_empty(), "{}: an hdr_image input starts with its kind byte", file.display());
                     let name = if bytes.remove(0) & 1 == 0 { "image.exr" } else { "image.pfm" };
                     check(&case(name, bytes), 0, &[], image_io::read_hdr)
                 }

@@ -1192,6 +1192,12 @@ fn outputs_never_replace_inputs_and_probe_findings_stay_fixed() {
     std::fs::create_dir_all(dir.join("sub")).unwrap();
     let e = render(&["--out", &path("o2.pfm"), "--report", &path("sub/../o2.pfm")]);
     assert!(e.contains("--report") && e.contains("same file as --out"), "{e}");
+    // A part rendered again over its own finished part (a requeued Slurm or
+    // Kubernetes task): read only to judge it, not an input, so not refused.
+    for _ in 0..2 {
+        let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--samples", "0..2", "--out", &path("again.exr")]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
     // --out over the reference image it is scored against.
     let out = treelet(&["render", "--device", "cpu", "--width", "8", "--height", "6", "--spp", "1", "--out", &path("ref.pfm")]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -3,8 +3,8 @@
 //! Vulkan GPU or on the CPU runner (the same kernels), and answers closest
 //! hits and occlusion queries for arrays of rays. Wrong shapes and dtypes
 //! are `TypeError`s or `ValueError`s that name the argument; what the
-//! library refuses (NaN coordinates, an index past the vertices, a
-//! direction of length 0) is a `ValueError` with its message.
+//! library refuses (NaN coordinates, an index past the vertices) is a
+//! `ValueError` with its message. A direction of length 0 hits nothing.
 //!
 //! What is copied: vertices and indices once into the triangles the build
 //! takes (any layout, C order or not, is read through NumPy's view);
@@ -119,10 +119,17 @@ impl PerRay<'_> {
 }
 
 fn per_ray<'py>(py: Python<'py>, value: &Bound<'py, PyAny>, n: usize, what: &str) -> PyResult<PerRay<'py>> {
-    if let Ok(x) = value.extract::<f32>() {
-        return Ok(PerRay::All(x));
-    }
     let np = py.import("numpy")?;
+    // One number only where it is one (a size-1 array for many rays is an
+    // error, not a value for all).
+    let ndim: usize = np.call_method1("ndim", (value,))?.extract()?;
+    if ndim == 0 {
+        return value.extract::<f32>().map(PerRay::All).map_err(|_| PyTypeError::new_err(format!("{what}: a number expected")));
+    }
+    let kind: String = np.call_method1("asarray", (value,))?.getattr("dtype")?.getattr("kind")?.extract()?;
+    if !matches!(kind.as_str(), "f" | "i" | "u") {
+        return Err(PyTypeError::new_err(format!("{what}: numbers expected")));
+    }
     let a = np.call_method1("ascontiguousarray", (value, "float32"))?;
     let a: PyReadonlyArray1<f32> =
         a.extract().map_err(|_| PyValueError::new_err(format!("{what}: a number, or an array of one number per ray")))?;
@@ -256,7 +263,8 @@ impl Tracer {
     }
 
     /// The closest hit of each ray `origins[k] + t directions[k]` (both
-    /// (n, 3); directions of any length but 0), from `t_min` to `t_max`
+    /// (n, 3); directions of any length, one of length 0 hitting nothing),
+    /// from `t_min` to `t_max`
     /// (numbers, or one per ray), `t` along the normalized direction.
     #[pyo3(signature = (origins, directions, t_min = None, t_max = None))]
     fn closest_hits(

@@ -195,6 +195,10 @@ def test_bad_rays_are_named():
         tracer.closest_hits(np.full((2, 3), np.nan), d)
     with pytest.raises(ValueError, match=r"directions\[1\]: not finite"):
         tracer.closest_hits(o, np.array([[0, 0, 1], [np.inf, 0, 0]]))
+    with pytest.raises(ValueError, match="t_max: 1 values for 2 rays"):
+        tracer.occluded(o, d, t_max=np.array([1.0]))
+    with pytest.raises(TypeError, match="t_min: numbers expected"):
+        tracer.occluded(o, d, t_min=np.array(["a", "b"]))
     with pytest.raises(ValueError, match="t_max: NaN"):
         tracer.occluded(o, d, t_max=np.array([1.0, np.nan]))
     with pytest.raises(ValueError, match="t_min -1"):

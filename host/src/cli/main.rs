@@ -326,6 +326,10 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
             Ok((info, _)) => part.is_none() || info.samples.end < info.planned_end,
             Err(_) => false,
         };
+        // Read to be judged, not as an input: a finished part this render
+        // will write over again (a requeued Slurm or Kubernetes task) is
+        // not one of the inputs no output may replace.
+        treelet::internals::input::forget_read(&part_path);
         if unfinished {
             anyhow::bail!(
                 "{} holds the samples of a render that did not finish: continue it with `--resume {}` and the same options, or delete it to start again",

@@ -49,6 +49,14 @@ fn note_read(path: &Path) {
     }
 }
 
+/// Takes `path` off the files read (a file read only to be judged, such as
+/// a finished part a render will write over again).
+pub fn forget_read(path: &Path) {
+    if let Ok(canonical) = path.canonicalize() {
+        READ.lock().unwrap_or_else(|e| e.into_inner()).retain(|p| *p != canonical);
+    }
+}
+
 /// Refuses `path` as an output (`what`: `--out`) where this process has read
 /// it as an input, by any name that resolves to it: the scene, a mesh or
 /// buffer it names, a reference image. (A render's `--report` over its scene

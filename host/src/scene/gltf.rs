@@ -286,10 +286,11 @@ fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
                     bail!("{name}: buffer {i}: `{uri}` is not a local file");
                 }
                 let file = percent_decoded(uri).with_context(|| format!("{name}: buffer {i}: `{uri}`"))?;
-                // A URI reference relative to the file (glTF 2.0, 2.8): an
-                // absolute path (escaped as `%2F` too) would read any file
-                // of the machine as geometry.
-                if file.starts_with('/') || file.starts_with('\\') || file.get(1..2) == Some(":") {
+                // A URI reference relative to the file (glTF 2.0, 2.8), so
+                // not an absolute path (escaped as `%2F` too). `..` is legal
+                // glTF: a file may still name its parent folders' files.
+                let drive = file.as_bytes().get(..3).is_some_and(|d| d[0].is_ascii_alphabetic() && d[1] == b':' && matches!(d[2], b'/' | b'\\'));
+                if file.starts_with('/') || file.starts_with('\\') || drive {
                     bail!("{name}: buffer {i}: `{uri}` is an absolute path; glTF buffers are named relative to the file");
                 }
                 crate::internals::input::read(&dir.join(file), "glTF buffer").with_context(|| format!("{name}: buffer {i}"))?

@@ -296,9 +296,18 @@ const MAX_ASCII_PLY_LINE: usize = 64 << 10;
 /// ply-rs will refuse anyway (too few values, not numbers) are left to it.
 fn check_ascii_lines(bytes: &[u8], header: &ply_rs_bw::ply::Header, name: &str) -> Result<()> {
     use ply_rs_bw::ply::PropertyType;
-    let Some(end) = bytes.windows(10).position(|w| w == b"end_header") else { return Ok(()) };
-    let Some(body) = bytes[end..].iter().position(|&b| b == b'\n').map(|n| end + n + 1) else { return Ok(()) };
-    let header_lines = bytes[..body].iter().filter(|&&b| b == b'\n').count();
+    // The body starts after the line that is `end_header` (a comment may
+    // hold those words too).
+    let mut body = None;
+    let mut at = 0;
+    for (n, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        at += line.len() + 1;
+        if line.trim_ascii() == b"end_header" {
+            body = Some((at, n + 1));
+            break;
+        }
+    }
+    let Some((body, header_lines)) = body.filter(|&(at, _)| at <= bytes.len()) else { return Ok(()) };
     let mut lines = bytes[body..].split(|&b| b == b'\n').enumerate();
     for (element, def) in &header.elements {
         for index in 0..def.count {
@@ -337,7 +346,14 @@ fn parse_ply(bytes: &[u8], name: &str) -> Result<Vec<Triangle>> {
     let parse_error = |e: ply_rs_bw::parser::ParseError| {
         // The parser's message spans lines and names a line of the file, not
         // the element: one line, with the element that line holds.
-        let full = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+        let mut full = e.to_string();
+        // A bad line is echoed whole (a header line of gigabytes, too): keep its start.
+        if full.len() > 600 {
+            let cut = (0..=600).rev().find(|&k| full.is_char_boundary(k)).unwrap_or(0);
+            full.truncate(cut);
+            full.push_str("...");
+        }
+        let full = full.split_whitespace().collect::<Vec<_>>().join(" ");
         // "Line N: Couldn't read element line. String: '...' Error: ..." names
         // the line's text and then repeats itself: keep the first sentence and the text.
         let message = match full.split_once(" String: ") {
@@ -442,6 +458,9 @@ mod tests {
     fn ascii_ply_lines_hold_what_their_properties_take() {
         let good = format!("{QUAD_PLY_HEAD}0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
         assert_eq!(load(&write("lines-good.ply", good.as_bytes())).unwrap().len(), 2);
+        // The words `end_header` in a comment do not end the header.
+        let commented = good.replacen("format ascii 1.0\n", "format ascii 1.0\ncomment data after end_header\n", 1);
+        assert_eq!(load(&write("lines-comment.ply", commented.as_bytes())).unwrap().len(), 2);
         // A vertex of six values where x, y and z are declared (the probe of
         // 2026-12-02: read as its first three, silently), and a face past its count.
         for (case, body, at) in [
