@@ -75,23 +75,34 @@ impl Hits {
     }
 }
 
-/// An (n, 3) array of numbers as a C-ordered f32 array (no copy where it is
-/// one already), any dtype NumPy converts (floats, ints), any memory order.
-fn f32_rows<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyArray2<'py, f32>> {
+/// An (n, 3) array as a C-ordered array of `dtype` (no copy where it is
+/// one already), any memory order, its dtype's kind one of `kinds` (`what`
+/// names the argument, `rows` its rows' letter in messages).
+fn rows_of<'py, T: numpy::Element>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+    what: &str,
+    (kinds, expected, dtype, rows): (&[&str], &str, &str, &str),
+) -> PyResult<PyReadonlyArray2<'py, T>> {
     let np = py.import("numpy")?;
     let a = np.call_method1("asarray", (array,)).map_err(|_| PyTypeError::new_err(format!("{what}: not an array")))?;
     let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
-    if !matches!(kind.as_str(), "f" | "i" | "u") {
-        return Err(PyTypeError::new_err(format!("{what}: numbers expected, got an array of dtype {}", a.getattr("dtype")?)));
+    if !kinds.contains(&kind.as_str()) {
+        return Err(PyTypeError::new_err(format!("{what}: {expected} expected, got an array of dtype {}", a.getattr("dtype")?)));
     }
-    let a = np.call_method1("ascontiguousarray", (a, "float32"))?;
-    let a: PyReadonlyArray2<f32> = a
-        .extract()
-        .map_err(|_| PyValueError::new_err(format!("{what}: expected a 2-dimensional (n, 3) array, got shape {}", shape_of(array))))?;
+    let a = np.call_method1("ascontiguousarray", (a, dtype))?;
+    let a: PyReadonlyArray2<T> = a.extract().map_err(|_| {
+        PyValueError::new_err(format!("{what}: expected a 2-dimensional ({rows}, 3) array, got shape {}", shape_of(array)))
+    })?;
     if a.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("{what}: expected shape (n, 3), got {:?}", a.shape())));
+        return Err(PyValueError::new_err(format!("{what}: expected shape ({rows}, 3), got {:?}", a.shape())));
     }
     Ok(a)
+}
+
+/// An (n, 3) array of numbers (floats, ints) as C-ordered f32.
+fn f32_rows<'py>(py: Python<'py>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyArray2<'py, f32>> {
+    rows_of(py, array, what, (&["f", "i", "u"], "numbers", "float32", "n"))
 }
 
 /// [`f32_rows`] as `[f32; 3]` rows.
@@ -143,19 +154,7 @@ fn per_ray<'py>(py: Python<'py>, value: &Bound<'py, PyAny>, n: usize, what: &str
 /// integers, one triangle a row), each index checked against the vertices.
 fn triangles_of(py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_, PyAny>) -> PyResult<Vec<Triangle>> {
     let positions = rows3(py, vertices, "vertices")?;
-    let np = py.import("numpy")?;
-    let idx = np.call_method1("asarray", (indices,))?;
-    let kind: String = idx.getattr("dtype")?.getattr("kind")?.extract()?;
-    if !matches!(kind.as_str(), "i" | "u") {
-        return Err(PyTypeError::new_err(format!("indices: integers expected, got an array of dtype {}", idx.getattr("dtype")?)));
-    }
-    let idx = np.call_method1("ascontiguousarray", (idx, "int64"))?;
-    let idx: PyReadonlyArray2<i64> = idx
-        .extract()
-        .map_err(|_| PyValueError::new_err(format!("indices: expected a 2-dimensional (m, 3) array, got shape {}", shape_of(indices))))?;
-    if idx.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("indices: expected shape (m, 3), got {:?}", idx.shape())));
-    }
+    let idx: PyReadonlyArray2<i64> = rows_of(py, indices, "indices", (&["i", "u"], "integers", "int64", "m"))?;
     let mut triangles = Vec::with_capacity(idx.shape()[0]);
     for (t, row) in idx.as_slice()?.chunks_exact(3).enumerate() {
         let vertex = |k: usize| -> PyResult<[f32; 3]> {
