@@ -437,7 +437,10 @@ fn nee_converges_to_the_smallpt_estimate() {
         let mp = bp.iter().sum::<f64>() / bp.len() as f64;
         for (integrator, sampler) in [(Integrator::Nee, Sampler::Sobol), (Integrator::Nee, Sampler::Independent), (Integrator::Caustics, Sampler::Sobol)] {
             let name = format!("{} ({})", integrator.name(), sampler.name());
-            let seeds: &[u32] = if integrator == Integrator::Caustics { &[0, 0x5555, 0xaaaa, 0x3333] } else { &[0, 0x5555] };
+            // Four seeds a side: with two, the noise of next-event
+            // estimation's mean was under-estimated for the small lamp
+            // (seed 5000679523681914735: blocks 2.38x the noise, means equal to 0.1%).
+            let seeds: &[u32] = &[0, 0x5555, 0xaaaa, 0x3333];
             let (bn, var_n) = mean_and_variance(&blocks_of(&scene, integrator, sampler, seeds, &name));
             let mn = bn.iter().sum::<f64>() / bn.len() as f64;
             let diff = (bp.iter().zip(&bn).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
