@@ -566,3 +566,64 @@ fn tracer_from_an_engines_buffers() {
         indices.iter().position(|&i| i == k).unwrap() / 3
     }
 }
+
+/// Rays given as columns through `closest_hits_with` and `occluded_with`
+/// (what the Python package does: written straight into the device's upload
+/// memory, hits read where they land) give exactly the slice API's answers,
+/// each ray's once and in order, on batches of several sizes through the
+/// same kept staging memory; a bad ray in the middle is an error naming it,
+/// and the next batch is unharmed.
+#[test]
+fn rays_as_columns_give_the_slice_apis_answers() {
+    use treelet::tracer::RayQueries;
+    let seed = fresh_seed();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let g = geometry(&mut rng, 100, 900);
+    let all = rays(&mut rng, 5000);
+    fn run<B: Backend>(b: &mut B, g: &Geometry, all: &[Ray], seed: u64) {
+        let t = Tracer::build(b, &g.0, &g.1, Quality::Fast).unwrap();
+        let what = format!("{} seed {seed}", b.adapter());
+        // Larger, smaller, then larger again than the kept staging.
+        for n in [3000, 17, 1, 0, 5000, 1025] {
+            let rays = &all[..n];
+            let columns: [Vec<f32>; 4] = [
+                rays.iter().flat_map(|r| r.origin).collect(),
+                rays.iter().flat_map(|r| r.dir).collect(),
+                rays.iter().map(|r| r.t_min).collect(),
+                rays.iter().map(|r| r.t_max).collect(),
+            ];
+            let ray = |k: usize| Ray {
+                origin: columns[0][3 * k..3 * k + 3].try_into().unwrap(),
+                dir: columns[1][3 * k..3 * k + 3].try_into().unwrap(),
+                t_min: columns[2][k],
+                t_max: columns[3][k],
+            };
+            let mut hits = Vec::new();
+            t.closest_hits_with(b, n, ray, |k, h| {
+                assert_eq!(k, hits.len(), "{what}: hit {k} out of order");
+                hits.push(h)
+            })
+            .unwrap();
+            assert_eq!(hits, t.closest_hits(b, rays).unwrap(), "{what}: {n} rays");
+            if n > 100 {
+                check(&format!("{what}, {n} rays as columns"), &hits, g, rays);
+            }
+            let mut occluded = vec![None; n];
+            t.occluded_with(b, n, ray, |k, o| occluded[k] = Some(o)).unwrap();
+            let occluded: Vec<bool> = occluded.into_iter().map(|o| o.expect("every ray answered")).collect();
+            assert_eq!(occluded, t.occluded(b, rays).unwrap(), "{what}: {n} rays");
+            // Closest hits stop at t_max too: occluded exactly where one was found.
+            assert_eq!(occluded, hits.iter().map(RayHit::is_hit).collect::<Vec<_>>(), "{what}: {n} rays");
+        }
+        let bad = |k: usize| Ray { t_min: if k == 1500 { -1.0 } else { 0.0 }, ..all[k] };
+        let err = t.closest_hits_with(b, 3000, bad, |_, _| {}).unwrap_err().to_string();
+        assert!(err.contains("ray 1500") && err.contains("t_min"), "{what}: {err}");
+        let mut hits = Vec::new();
+        t.closest_hits_with(b, 3000, |k| all[k], |_, h| hits.push(h)).unwrap();
+        assert_eq!(hits, t.closest_hits(b, &all[..3000]).unwrap(), "{what}: after an error");
+    }
+    run(&mut CpuBackend::new(), &g, &all, seed);
+    if let Some(ctx) = gpu() {
+        run(&mut GpuBackend::new(ctx), &g, &all, seed);
+    }
+}

@@ -8,13 +8,17 @@
 //!
 //! What is copied: vertices and indices once into the triangles the build
 //! takes (any layout, C order or not, is read through NumPy's view);
-//! rays once into the library's rays; hits once into the returned arrays.
+//! rays are read from the arrays in place (C-ordered float32 already, else
+//! after one conversion) straight into the device's upload memory, and
+//! hits from its read-back memory straight into the returned arrays. The
+//! GIL is released while a GPU traces: the arrays must not change meanwhile.
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use treelet::error::{Error, ErrorKind};
 use treelet::runtime::device::{Device, DeviceChoice};
+use treelet::tracer::RayQueries;
 use treelet::{CpuBackend, GpuBackend, Quality, Ray, RayHit, Triangle};
 
 /// A library error as the Python exception of its kind.
@@ -120,15 +124,6 @@ enum PerRay<'py> {
     Each(PyReadonlyArray1<'py, f32>),
 }
 
-impl PerRay<'_> {
-    fn at(&self, values: &[f32], k: usize) -> f32 {
-        match self {
-            PerRay::All(x) => *x,
-            PerRay::Each(_) => values[k],
-        }
-    }
-}
-
 fn per_ray<'py>(py: Python<'py>, value: &Bound<'py, PyAny>, n: usize, what: &str) -> PyResult<PerRay<'py>> {
     let np = py.import("numpy")?;
     // One number only where it is one (a size-1 array for many rays is an
@@ -167,45 +162,151 @@ fn triangles_of(py: Python<'_>, vertices: &Bound<'_, PyAny>, indices: &Bound<'_,
     Ok(triangles)
 }
 
-impl Tracer {
-    /// The rays of the arrays, made in one pass over them (the arrays are
-    /// read in place where they are C-ordered f32 already).
-    fn rays(py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, t_min: &Bound<'_, PyAny>, t_max: &Bound<'_, PyAny>) -> PyResult<Vec<Ray>> {
-        let (o, d) = (f32_rows(py, origins, "origins")?, f32_rows(py, directions, "directions")?);
-        let (o, d) = (o.as_slice()?, d.as_slice()?);
-        if o.len() != d.len() {
-            return Err(PyValueError::new_err(format!("{} origins but {} directions", o.len() / 3, d.len() / 3)));
+/// The arrays of a batch of rays, held while the library reads them.
+struct RayArrays<'py> {
+    origins: PyReadonlyArray2<'py, f32>,
+    directions: PyReadonlyArray2<'py, f32>,
+    t_min: PerRay<'py>,
+    t_max: PerRay<'py>,
+}
+
+/// One value for every ray, or one each.
+#[derive(Clone, Copy)]
+enum Column<'a> {
+    All(f32),
+    Each(&'a [f32]),
+}
+
+/// A batch's rays, read from the arrays in place: ray `k` is made when the
+/// library asks for it, straight into the device's upload memory.
+struct RayColumns<'a> {
+    o: &'a [f32],
+    d: &'a [f32],
+    t_min: Column<'a>,
+    t_max: Column<'a>,
+}
+
+impl<'py> RayArrays<'py> {
+    /// The arrays as C-ordered f32 (no copy where they are), shapes checked.
+    fn new(py: Python<'py>, origins: &Bound<'py, PyAny>, directions: &Bound<'py, PyAny>, t_min: Option<&Bound<'py, PyAny>>, t_max: Option<&Bound<'py, PyAny>>) -> PyResult<Self> {
+        let (origins, directions) = (f32_rows(py, origins, "origins")?, f32_rows(py, directions, "directions")?);
+        let (o, d) = (origins.shape()[0], directions.shape()[0]);
+        if o != d {
+            return Err(PyValueError::new_err(format!("{o} origins but {d} directions")));
         }
-        let n = o.len() / 3;
-        // NaN and infinite coordinates are the caller's error here (the engine
-        // API traces them as misses); a direction of length 0 hits nothing.
+        let bound = |value: Option<&Bound<'py, PyAny>>, default: f32, what| match value {
+            Some(v) => per_ray(py, v, o, what),
+            None => Ok(PerRay::All(default)),
+        };
+        Ok(RayArrays { t_min: bound(t_min, 0.0, "t_min")?, t_max: bound(t_max, f32::INFINITY, "t_max")?, origins, directions })
+    }
+
+    /// The rays, every value checked: NaN and infinite coordinates are the
+    /// caller's error here (the engine API traces them as misses); a
+    /// direction of length 0 hits nothing.
+    fn columns(&self) -> PyResult<RayColumns<'_>> {
+        let (o, d) = (self.origins.as_slice()?, self.directions.as_slice()?);
         if let Some(k) = o.iter().chain(d).position(|v| !v.is_finite()) {
             let (what, values, k) = if k < o.len() { ("origins", o, k) } else { ("directions", d, k - o.len()) };
             return Err(PyValueError::new_err(format!("{what}[{}]: not finite ({})", k / 3, values[k])));
         }
-        let (lo, hi) = (per_ray(py, t_min, n, "t_min")?, per_ray(py, t_max, n, "t_max")?);
-        for (what, values) in [("t_min", &lo), ("t_max", &hi)] {
-            let bad = match values {
-                PerRay::All(x) => x.is_nan().then_some(0),
-                PerRay::Each(a) => a.as_slice()?.iter().position(|x| x.is_nan()),
-            };
-            if let Some(k) = bad {
-                return Err(PyValueError::new_err(format!("{what}: NaN (at ray {k}); use inf for no limit")));
-            }
-        }
-        let (lo_values, hi_values) = (
-            if let PerRay::Each(a) = &lo { a.as_slice()? } else { &[] },
-            if let PerRay::Each(a) = &hi { a.as_slice()? } else { &[] },
-        );
-        Ok((0..n)
-            .map(|k| Ray {
-                origin: [o[3 * k], o[3 * k + 1], o[3 * k + 2]],
-                dir: [d[3 * k], d[3 * k + 1], d[3 * k + 2]],
-                t_min: lo.at(lo_values, k),
-                t_max: hi.at(hi_values, k),
-            })
-            .collect())
+        Ok(RayColumns { o, d, t_min: column(&self.t_min, "t_min")?, t_max: column(&self.t_max, "t_max")? })
     }
+}
+
+/// `t_min` or `t_max` as a column, checked for NaN.
+fn column<'a>(values: &'a PerRay<'_>, what: &str) -> PyResult<Column<'a>> {
+    let column = match values {
+        PerRay::All(x) => Column::All(*x),
+        PerRay::Each(a) => Column::Each(a.as_slice()?),
+    };
+    let nan = match column {
+        Column::All(x) => x.is_nan().then_some(0),
+        Column::Each(a) => a.iter().position(|x| x.is_nan()),
+    };
+    match nan {
+        Some(k) => Err(PyValueError::new_err(format!("{what}: NaN (at ray {k}); use inf for no limit"))),
+        None => Ok(column),
+    }
+}
+
+impl RayColumns<'_> {
+    fn len(&self) -> usize {
+        self.o.len() / 3
+    }
+
+    fn ray(&self, k: usize) -> Ray {
+        let at = |c: Column<'_>| match c {
+            Column::All(x) => x,
+            Column::Each(a) => a[k],
+        };
+        Ray {
+            origin: [self.o[3 * k], self.o[3 * k + 1], self.o[3 * k + 2]],
+            dir: [self.d[3 * k], self.d[3 * k + 1], self.d[3 * k + 2]],
+            t_min: at(self.t_min),
+            t_max: at(self.t_max),
+        }
+    }
+}
+
+/// The arrays of [`Hits`], filled in one pass as the hits are read back.
+struct HitColumns {
+    t: Vec<f32>,
+    primitive: Vec<i64>,
+    instance: Vec<i64>,
+    barycentrics: Vec<f32>,
+    normal: Vec<f32>,
+    hit: Vec<bool>,
+}
+
+impl HitColumns {
+    fn with_capacity(n: usize) -> Self {
+        HitColumns {
+            t: Vec::with_capacity(n),
+            primitive: Vec::with_capacity(n),
+            instance: Vec::with_capacity(n),
+            barycentrics: Vec::with_capacity(2 * n),
+            normal: Vec::with_capacity(3 * n),
+            hit: Vec::with_capacity(n),
+        }
+    }
+
+    fn push(&mut self, h: RayHit) {
+        let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
+        self.t.push(h.t);
+        self.primitive.push(signed(h.prim));
+        self.instance.push(signed(h.instance));
+        self.hit.push(h.is_hit());
+        self.barycentrics.extend_from_slice(&h.barycentrics);
+        self.normal.extend_from_slice(&h.normal);
+    }
+
+    /// The arrays handed to NumPy without a copy.
+    fn into_hits(self, py: Python<'_>) -> Hits {
+        let n = self.t.len();
+        let barycentrics = Array2::from_shape_vec((n, 2), self.barycentrics).expect("n rows of 2");
+        let normal = Array2::from_shape_vec((n, 3), self.normal).expect("n rows of 3");
+        Hits {
+            t: self.t.into_pyarray(py).unbind(),
+            primitive: self.primitive.into_pyarray(py).unbind(),
+            instance: self.instance.into_pyarray(py).unbind(),
+            barycentrics: barycentrics.into_pyarray(py).unbind(),
+            normal: normal.into_pyarray(py).unbind(),
+            hit: self.hit.into_pyarray(py).unbind(),
+        }
+    }
+}
+
+/// Runs `$body` with the tree's backend `$b` and tracer `$t`, the GIL
+/// released while a GPU works (the CPU runner's buffers stay on the thread
+/// that holds the GIL: it works with the GIL held).
+macro_rules! on_device {
+    ($self:expr, $py:expr, |$b:ident, $t:ident| $body:expr) => {
+        match &mut $self.inner {
+            Inner::Gpu($b, $t, _) => $py.allow_threads(|| $body),
+            Inner::Cpu($b, $t) => $body,
+        }
+    };
 }
 
 #[pymethods]
@@ -274,37 +375,11 @@ impl Tracer {
         t_min: Option<&Bound<'_, PyAny>>,
         t_max: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Hits> {
-        let zero = 0.0f32.into_pyobject(py)?.into_any();
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let rays = Self::rays(py, origins, directions, t_min.unwrap_or(&zero), t_max.unwrap_or(&inf))?;
-        let hits: Vec<RayHit> = match &mut self.inner {
-            Inner::Gpu(b, t, _) => t.closest_hits(b, &rays),
-            Inner::Cpu(b, t) => t.closest_hits(b, &rays),
-        }
-        .map_err(py_err)?;
-        // The six arrays in one pass over the hits.
-        let n = hits.len();
-        let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
-        let (mut t, mut primitive, mut instance, mut hit) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
-        let (mut bary, mut normal) = (Vec::with_capacity(2 * n), Vec::with_capacity(3 * n));
-        for h in &hits {
-            t.push(h.t);
-            primitive.push(signed(h.prim));
-            instance.push(signed(h.instance));
-            hit.push(h.is_hit());
-            bary.extend_from_slice(&h.barycentrics);
-            normal.extend_from_slice(&h.normal);
-        }
-        let bary = Array2::from_shape_vec((n, 2), bary).expect("n rows of 2");
-        let normal = Array2::from_shape_vec((n, 3), normal).expect("n rows of 3");
-        Ok(Hits {
-            t: t.into_pyarray(py).unbind(),
-            primitive: primitive.into_pyarray(py).unbind(),
-            instance: instance.into_pyarray(py).unbind(),
-            barycentrics: bary.into_pyarray(py).unbind(),
-            normal: normal.into_pyarray(py).unbind(),
-            hit: hit.into_pyarray(py).unbind(),
-        })
+        let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
+        let rays = arrays.columns()?;
+        let mut out = HitColumns::with_capacity(rays.len());
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| out.push(h))).map_err(py_err)?;
+        Ok(out.into_hits(py))
     }
 
     /// Whether each ray hits anything from `t_min` up to `t_max`
@@ -318,14 +393,10 @@ impl Tracer {
         t_min: Option<&Bound<'py, PyAny>>,
         t_max: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let zero = 0.0f32.into_pyobject(py)?.into_any();
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let rays = Self::rays(py, origins, directions, t_min.unwrap_or(&zero), t_max.unwrap_or(&inf))?;
-        let hit = match &mut self.inner {
-            Inner::Gpu(b, t, _) => t.occluded(b, &rays),
-            Inner::Cpu(b, t) => t.occluded(b, &rays),
-        }
-        .map_err(py_err)?;
+        let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
+        let rays = arrays.columns()?;
+        let mut hit = Vec::with_capacity(rays.len());
+        on_device!(self, py, |b, t| t.occluded_with(b, rays.len(), |k| rays.ray(k), |_, o| hit.push(o))).map_err(py_err)?;
         Ok(hit.into_pyarray(py))
     }
 
@@ -335,17 +406,13 @@ impl Tracer {
     /// the Rust API pays, without this module's conversions).
     #[pyo3(signature = (origins, directions, repeats = 7))]
     fn _rust_api_ms(&mut self, py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, repeats: usize) -> PyResult<f64> {
-        let zero = 0.0f32.into_pyobject(py)?.into_any();
-        let inf = f32::INFINITY.into_pyobject(py)?.into_any();
-        let rays = Self::rays(py, origins, directions, &zero, &inf)?;
+        let arrays = RayArrays::new(py, origins, directions, None, None)?;
+        let columns = arrays.columns()?;
+        let rays: Vec<Ray> = (0..columns.len()).map(|k| columns.ray(k)).collect();
         let mut ms = Vec::with_capacity(repeats);
         for _ in 0..repeats.max(1) {
             let start = std::time::Instant::now();
-            let hits = match &mut self.inner {
-                Inner::Gpu(b, t, _) => t.closest_hits(b, &rays),
-                Inner::Cpu(b, t) => t.closest_hits(b, &rays),
-            }
-            .map_err(py_err)?;
+            let hits = on_device!(self, py, |b, t| t.closest_hits(b, &rays)).map_err(py_err)?;
             ms.push(start.elapsed().as_secs_f64() * 1e3);
             std::hint::black_box(hits);
         }

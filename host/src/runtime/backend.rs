@@ -112,6 +112,19 @@ pub trait Backend: Send {
     fn same_buffer(&self, a: &Self::Buffer, b: &Self::Buffer) -> bool;
     /// A buffer holding `data`.
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
+    /// A buffer of `len` elements written from `items` in order (zeros past
+    /// their end; items past `len` unread): on a GPU straight into upload
+    /// memory kept between calls, so that a large batch (an engine's rays)
+    /// costs no vector of its own first. The first error among the items is
+    /// returned, and nothing is uploaded.
+    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<Self::Buffer> {
+        let mut data: Vec<T> = crate::internals::input::room_for(len, label)?;
+        for item in items.into_iter().take(len) {
+            data.push(item?);
+        }
+        data.resize(len, T::zeroed());
+        self.upload(label, &data)
+    }
     /// A buffer of at least `bytes` bytes whose contents are undefined
     /// (kernels overwrite it). May be a buffer of an earlier build.
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<Self::Buffer>;
@@ -164,6 +177,13 @@ pub trait Backend: Send {
     fn dispatch(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32);
     /// Waits for all work so far and returns the first `count` elements.
     fn read<T: Pod>(&mut self, buffer: &Self::Buffer, count: usize) -> Result<Vec<T>>;
+    /// Waits for all work so far and lends the first `count` elements to
+    /// `take` where they lie: on a GPU, read-back memory kept between calls,
+    /// so that a large result (an engine's hits) is read once, into the
+    /// caller's own form.
+    fn read_with<T: Pod, R>(&mut self, buffer: &Self::Buffer, count: usize, take: impl FnOnce(&[T]) -> R) -> Result<R> {
+        Ok(take(&self.read(buffer, count)?))
+    }
     /// Waits for all work so far and returns the stage times since the last call.
     fn take_times(&mut self) -> Result<StageTimes>;
 }

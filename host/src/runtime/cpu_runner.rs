@@ -372,6 +372,15 @@ impl Backend for CpuBackend {
         Ok(Rc::new(RefCell::new(words)))
     }
 
+    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<CpuBuffer> {
+        let bytes = (len as u64).checked_mul(std::mem::size_of::<T>() as u64).unwrap_or(u64::MAX);
+        let mut words = zeroed_words(bytes, label)?;
+        for (slot, item) in view::<T>(&mut words)[..len].iter_mut().zip(items) {
+            *slot = item?;
+        }
+        Ok(Rc::new(RefCell::new(words)))
+    }
+
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<CpuBuffer> {
         Ok(Rc::new(RefCell::new(zeroed_words(bytes, label)?)))
     }
@@ -398,6 +407,10 @@ impl Backend for CpuBackend {
         let mut out = crate::internals::input::room_for(count, "a buffer read back from the CPU runner")?;
         out.extend_from_slice(&view::<T>(&mut words)[..count]);
         Ok(out)
+    }
+
+    fn read_with<T: Pod, R>(&mut self, buffer: &CpuBuffer, count: usize, take: impl FnOnce(&[T]) -> R) -> Result<R> {
+        Ok(take(&view::<T>(&mut buffer.borrow_mut())[..count]))
     }
 
     fn take_times(&mut self) -> Result<StageTimes> {

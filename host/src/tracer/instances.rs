@@ -30,7 +30,8 @@ use treelet_core::trace::hit::STACK_DEPTH;
 
 use super::engine_mesh::MeshBuffers;
 use super::primitives::{Quality, Tracer};
-use super::rays::{batch_dims, hit_record, read_batch, Ray, RayHit};
+use super::queries::{collect_hits, collect_occluded};
+use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::lbvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::Kernel;
@@ -322,20 +323,20 @@ impl<B: Backend> InstancedTracer<B> {
 
     /// The closest hit of each ray: as [`Tracer::closest_hits`], with the
     /// instance hit, the primitive within its mesh, and the geometric normal
-    /// in world space.
+    /// in world space. Rays in another form than a slice:
+    /// [`RayQueries::closest_hits_with`](crate::tracer::RayQueries::closest_hits_with).
     pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<RayHit>> {
-        crate::error::typed(|| {
-            let out = read_batch(b, rays, |b, buffer| Ok(self.closest_hits_on_device(b, buffer, rays.len())?))?;
-            Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
-        })
+        collect_hits(self, b, rays)
     }
 
     /// Whether each ray hits anything up to its `t_max`, as [`Tracer::occluded`].
     pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<bool>> {
-        crate::error::typed(|| {
-            let out = read_batch(b, rays, |b, buffer| Ok(self.occluded_on_device(b, buffer, rays.len())?))?;
-            Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
-        })
+        collect_occluded(self, b, rays)
+    }
+
+    /// Whether no instance is placed (every ray misses).
+    pub fn is_empty(&self) -> bool {
+        self.instances.is_empty()
     }
 
     /// [`Tracer::closest_hits_on_device`] through the instances: the same

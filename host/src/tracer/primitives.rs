@@ -7,7 +7,8 @@ use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
 use super::engine_mesh::{gather, MeshBuffers};
-use super::rays::{batch_dims, check_rays, hit_record, read_batch, Ray, RayHit};
+use super::queries::{collect_hits, collect_occluded};
+use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::{refit_bvh2, refit_uploaded};
@@ -262,15 +263,9 @@ impl<B: Backend> Tracer<B> {
     }
 
     /// The closest hit of each ray, with its hit record (see [`RayHit`]).
+    /// Rays in another form than a slice: [`RayQueries::closest_hits_with`](crate::tracer::RayQueries::closest_hits_with).
     pub fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<RayHit>> {
-        crate::error::typed(|| {
-            if self.tree.is_none() {
-                check_rays(rays)?;
-                return Ok(vec![RayHit::MISS; rays.len()]);
-            }
-            let out = read_batch(b, rays, |b, buffer| Ok(self.closest_hits_on_device(b, buffer, rays.len())?))?;
-            Ok(rays.iter().zip(out.chunks(2)).map(|(r, o)| hit_record(r, o[0], o[1])).collect())
-        })
+        collect_hits(self, b, rays)
     }
 
     /// Whether each ray hits anything up to its `t_max` (inclusive): an
@@ -278,14 +273,12 @@ impl<B: Backend> Tracer<B> {
     /// ambient-occlusion rays). Agrees with [`Tracer::closest_hits`]: a ray
     /// is occluded exactly when its closest hit is within `t_max`.
     pub fn occluded(&self, b: &mut B, rays: &[Ray]) -> crate::error::Result<Vec<bool>> {
-        crate::error::typed(|| {
-            if self.tree.is_none() {
-                check_rays(rays)?;
-                return Ok(vec![false; rays.len()]);
-            }
-            let out = read_batch(b, rays, |b, buffer| Ok(self.occluded_on_device(b, buffer, rays.len())?))?;
-            Ok((0..rays.len()).map(|k| out[2 * k][0] != 0.0).collect())
-        })
+        collect_occluded(self, b, rays)
+    }
+
+    /// Whether the tracer has no primitives (every ray misses).
+    pub fn is_empty(&self) -> bool {
+        self.tree.is_none()
     }
 
     /// Traces `count` rays that are already on the device (for callers that

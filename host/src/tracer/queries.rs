@@ -4,7 +4,7 @@ use crate::error::Result;
 
 use super::instances::InstancedTracer;
 use super::primitives::Tracer;
-use super::rays::{Ray, RayHit};
+use super::rays::{device_pair, hit_record, trace_batch, Ray, RayHit};
 use crate::runtime::backend::Backend;
 
 /// Ray queries on a built scene of device `B`: closest hits and occlusion,
@@ -38,6 +38,80 @@ pub trait RayQueries<B: Backend> {
     fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()>;
     /// Device time of the last build or update, in ms.
     fn last_update_ms(&self) -> f64;
+    /// Whether the scene holds nothing to hit: every ray misses, and
+    /// nothing is traced.
+    fn is_empty(&self) -> bool;
+
+    /// [`RayQueries::closest_hits`] of `count` rays in the caller's own
+    /// form: ray `k` is `ray(k)`, and its hit is handed to `hit(k, ..)`, in
+    /// order. On a GPU the rays are written straight into upload memory and
+    /// the hits read where they land, both kept between calls: no vector of
+    /// rays or hits in between (an engine's or a binding's arrays of
+    /// origins, directions and distances; `ray` may be called twice for a
+    /// ray). Not in a `dyn RayQueries`.
+    ///
+    /// ```
+    /// use treelet::tracer::RayQueries;
+    /// use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
+    /// let b = &mut CpuBackend::new();
+    /// let tracer = Tracer::build(b, &[], &[Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])], Quality::Fast)?;
+    /// // Rays as columns: a grid of x over the triangle's corner, looking along +z.
+    /// let xs = [0.1f32, 0.5, 0.9, 1.5];
+    /// let mut t = vec![0.0; xs.len()];
+    /// tracer.closest_hits_with(b, xs.len(), |k| Ray::new([xs[k], 0.05, 0.0], [0.0, 0.0, 1.0]), |k, h| t[k] = h.t)?;
+    /// assert_eq!(t, [5.0, 5.0, 5.0, f32::INFINITY]);
+    /// # anyhow::Ok(())
+    /// ```
+    fn closest_hits_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray, mut hit: impl FnMut(usize, RayHit)) -> Result<()>
+    where
+        Self: Sized,
+    {
+        crate::error::typed(|| {
+            if self.is_empty() {
+                return misses(count, &ray, |k| hit(k, RayHit::MISS));
+            }
+            trace_batch(b, count, &ray, |b, rays| Ok(self.closest_hits_on_device(b, rays, count)?), |k, record| hit(k, hit_record(&ray(k), record)))
+        })
+    }
+
+    /// [`RayQueries::occluded`] of `count` rays in the caller's own form, as
+    /// [`RayQueries::closest_hits_with`]: whether ray `ray(k)` hits anything
+    /// up to its `t_max` is handed to `occluded(k, ..)`.
+    fn occluded_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray, mut occluded: impl FnMut(usize, bool)) -> Result<()>
+    where
+        Self: Sized,
+    {
+        crate::error::typed(|| {
+            if self.is_empty() {
+                return misses(count, &ray, |k| occluded(k, false));
+            }
+            trace_batch(b, count, &ray, |b, rays| Ok(self.occluded_on_device(b, rays, count)?), |k, [first, _]| occluded(k, first[0] != 0.0))
+        })
+    }
+}
+
+/// A scene with nothing to hit: every ray checked as a traced one would be
+/// (its `t_min`), then each handed to `miss`.
+fn misses(count: usize, ray: &impl Fn(usize) -> Ray, mut miss: impl FnMut(usize)) -> anyhow::Result<()> {
+    for k in 0..count {
+        device_pair(k, &ray(k))?;
+    }
+    (0..count).for_each(&mut miss);
+    Ok(())
+}
+
+/// [`RayQueries::closest_hits`] of a slice, through [`RayQueries::closest_hits_with`].
+pub(super) fn collect_hits<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
+    let mut out = crate::error::typed(|| crate::internals::input::room_for(rays.len(), "hits of a batch"))?;
+    scene.closest_hits_with(b, rays.len(), |k| rays[k], |_, h| out.push(h))?;
+    Ok(out)
+}
+
+/// [`RayQueries::occluded`] of a slice, through [`RayQueries::occluded_with`].
+pub(super) fn collect_occluded<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
+    let mut out = crate::error::typed(|| crate::internals::input::room_for(rays.len(), "answers of a batch"))?;
+    scene.occluded_with(b, rays.len(), |k| rays[k], |_, o| out.push(o))?;
+    Ok(out)
 }
 
 /// Both implement it by their own methods of the same names.
@@ -58,6 +132,9 @@ macro_rules! ray_queries {
             }
             fn last_update_ms(&self) -> f64 {
                 $t::last_update_ms(self)
+            }
+            fn is_empty(&self) -> bool {
+                $t::is_empty(self)
             }
         }
     };

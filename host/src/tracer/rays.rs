@@ -53,10 +53,9 @@ impl RayHit {
     }
 }
 
-/// The record of a device hit `(t, prim, b1, b2)` with its normal and
-/// instance `(n, bits of the instance)` of ray `r` (traced from `t_min` on:
-/// see [`device_rays`]).
-pub(super) fn hit_record(r: &Ray, [t, prim, b1, b2]: [f32; 4], [nx, ny, nz, instance]: [f32; 4]) -> RayHit {
+/// The hit of ray `r` from its device record `(t, prim, b1, b2)` and
+/// `(n, bits of the instance)` (traced from `t_min` on: see [`device_rays`]).
+pub(super) fn hit_record(r: &Ray, [[t, prim, b1, b2], [nx, ny, nz, instance]]: [[f32; 4]; 2]) -> RayHit {
     let prim = prim.to_bits();
     if prim == u32::MAX {
         return RayHit::MISS;
@@ -64,20 +63,29 @@ pub(super) fn hit_record(r: &Ray, [t, prim, b1, b2]: [f32; 4], [nx, ny, nz, inst
     RayHit { t: t + r.t_min, prim, instance: instance.to_bits(), barycentrics: [b1, b2], normal: [nx, ny, nz] }
 }
 
-/// Uploads `rays`, has `cast` trace them on the device in place, and reads
-/// the two vectors of each back.
-pub(super) fn read_batch<B: Backend>(
+/// Uploads the rays `ray(k)`, `k < count` (written straight into the
+/// device's upload memory), has `cast` trace them on the device in place,
+/// and hands each ray's two records, read where they lie, to `take(k, ..)`.
+pub(super) fn trace_batch<B: Backend>(
     b: &mut B,
-    rays: &[Ray],
+    count: usize,
+    ray: &impl Fn(usize) -> Ray,
     cast: impl FnOnce(&mut B, &B::Buffer) -> Result<()>,
-) -> Result<Vec<[f32; 4]>> {
-    let buffer = b.upload("rays", &device_rays(rays)?)?;
-    cast(b, &buffer)?;
-    let out = b.read(&buffer, 2 * rays.len());
+    mut take: impl FnMut(usize, [[f32; 4]; 2]),
+) -> Result<()> {
+    let slots = batch_slots(count)?;
+    let buffer = b.upload_iter("rays", slots, (0..count).map(|k| device_pair(k, &ray(k))))?;
+    let traced = cast(b, &buffer).and_then(|()| {
+        b.read_with(&buffer, count, |records: &[[[f32; 4]; 2]]| {
+            for (k, &pair) in records.iter().enumerate() {
+                take(k, pair);
+            }
+        })
+    });
     // Waited for: the buffer serves the next batch (without this, every
     // batch took a new one until the next build: 66 MB a 1080p frame).
     b.release(&[&buffer]);
-    out
+    traced
 }
 
 /// The image a batch of `count` rays is cast as (the cast kernels walk one).
@@ -96,35 +104,30 @@ pub(super) const BATCH_WIDTH: u32 = 1024;
 /// from there); engines that fill device buffers themselves do the same.
 pub fn device_rays(rays: &[Ray]) -> crate::error::Result<Vec<[f32; 4]>> {
     crate::error::typed(|| {
-        check_rays(rays)?;
         // Written once, in order (a zeroed vector written over cost a second
         // pass over 32 MB a million rays), its padding zeros last.
         let slots = 2 * batch_slots(rays.len())?;
         let mut data = crate::internals::input::room_for(slots, "a batch of rays")?;
-        for r in rays {
-            let d = glam::Vec3::from(r.dir);
-            let o = if r.t_min > 0.0 && d.length() > 0.0 {
-                glam::Vec3::from(r.origin) + d.normalize() * r.t_min
-            } else {
-                r.origin.into()
-            };
-            data.push([o.x, o.y, o.z, r.t_max - r.t_min]);
-            data.push([r.dir[0], r.dir[1], r.dir[2], 1.0]);
+        for (k, r) in rays.iter().enumerate() {
+            data.extend_from_slice(&device_pair(k, r)?);
         }
         data.resize(slots, [0.0; 4]);
         Ok(data)
     })
 }
 
-/// Every ray's `t_min` is finite and at least 0. (A direction of length 0
-/// hits nothing, and a NaN `t_max` is no bound that a hit is within, as
-/// `tests/tracer.rs` holds the API to; the Python package refuses
-/// non-finite rays before they get here.)
-pub(super) fn check_rays(rays: &[Ray]) -> Result<()> {
-    if let Some((k, r)) = rays.iter().enumerate().find(|(_, r)| !(r.t_min >= 0.0 && r.t_min.is_finite())) {
+/// Ray `k` as the device reads it (see [`device_rays`]); an error where its
+/// `t_min` is not finite or below 0. (A direction of length 0 hits nothing,
+/// and a NaN `t_max` is no bound that a hit is within, as `tests/tracer.rs`
+/// holds the API to; the Python package refuses non-finite rays before they
+/// get here.)
+pub(super) fn device_pair(k: usize, r: &Ray) -> Result<[[f32; 4]; 2]> {
+    if !(r.t_min >= 0.0 && r.t_min.is_finite()) {
         return Err(crate::error::input(format!("ray {k}: t_min {} must be finite and at least 0", r.t_min)));
     }
-    Ok(())
+    let d = glam::Vec3::from(r.dir);
+    let o = if r.t_min > 0.0 && d.length() > 0.0 { glam::Vec3::from(r.origin) + d.normalize() * r.t_min } else { r.origin.into() };
+    Ok([[o.x, o.y, o.z, r.t_max - r.t_min], [r.dir[0], r.dir[1], r.dir[2], 1.0]])
 }
 
 /// Ray pairs a device batch of `count` rays holds (rows of whole width).

@@ -17,6 +17,12 @@ use crate::runtime::kernels::Kernel;
 const READBACK_CHUNK: u64 = 64 << 20;
 /// Every buffer has at least this many bytes (wgpu rejects empty bindings).
 const MIN_BUFFER: u64 = 16;
+/// Largest upload or read-back staging buffer kept for the next call
+/// (`upload_with`, `read_with`): an engine's batches of a million rays are
+/// 32 MB each way, and fresh host memory for each cost more than the copies
+/// (first touches of new pages: 45-70 ms a million rays on the H200's host,
+/// against about 1 ms of tracing). Larger ones are made for the call alone.
+const STAGING_KEEP: u64 = 256 << 20;
 
 struct Dispatch {
     kernel: Kernel,
@@ -55,6 +61,9 @@ pub struct GpuBackend {
     unused_parts: [wgpu::Buffer; 2],
     /// A dispatch that could not be bound, reported by the next wait.
     error: Option<anyhow::Error>,
+    /// Staging kept between `upload_with` calls (MAP_WRITE) and between
+    /// `read_with` calls (MAP_READ), up to [`STAGING_KEEP`] bytes each.
+    staging: [Option<wgpu::Buffer>; 2],
 }
 
 impl GpuBackend {
@@ -71,6 +80,7 @@ impl GpuBackend {
             split_bytes: ctx.split_bytes(),
             unused_parts: [unused_part("unused second part (read)"), unused_part("unused second part (write)")],
             error: None,
+            staging: [None, None],
             ctx,
             free: Default::default(),
             used: Vec::new(),
@@ -156,6 +166,37 @@ impl GpuBackend {
         });
         self.used.push((key, buffer.clone()));
         buffer
+    }
+
+    /// A staging buffer of at least `size` bytes for writing (`write`) or
+    /// reading, the kept one where it is large enough.
+    fn staging(&mut self, write: bool, size: u64) -> wgpu::Buffer {
+        let slot = &mut self.staging[write as usize];
+        if let Some(b) = slot.as_ref().filter(|b| b.size() >= size) {
+            return b.clone();
+        }
+        let usage = if write {
+            wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC
+        } else {
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST
+        };
+        let label = if write { "upload staging" } else { "read-back staging" };
+        let buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
+        if size <= STAGING_KEEP {
+            *slot = Some(buffer.clone());
+        }
+        buffer
+    }
+
+    /// Maps `0..bytes` of a staging buffer once the work before it is done.
+    fn map(&self, staging: &wgpu::Buffer, mode: wgpu::MapMode, bytes: u64) -> Result<()> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(mode, 0..bytes, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv().context("map callback lost")?.context("could not map a staging buffer")?;
+        Ok(())
     }
 
     fn wait(&self) -> Result<()> {
@@ -244,6 +285,35 @@ impl GpuBackend {
     }
 }
 
+/// Writes `len` of `items` into mapped memory of `len` elements' bytes,
+/// zeros past their end (mapped memory may be write-combined: written once,
+/// in order, never read).
+fn write_items<T: Pod>(mut data: wgpu::WriteOnly<'_, [u8]>, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<()> {
+    let ptr = data.as_raw_element_ptr();
+    if !(ptr.as_ptr() as usize).is_multiple_of(std::mem::align_of::<T>()) {
+        // Mapped memory is aligned far beyond any element; if not, a vector first.
+        let mut v: Vec<T> = crate::internals::input::room_for(len, "an upload")?;
+        for item in items.into_iter().take(len) {
+            v.push(item?);
+        }
+        v.resize(len, T::zeroed());
+        data.copy_from_slice(bytemuck::cast_slice(&v));
+        return Ok(());
+    }
+    // SAFETY: the view's `len * size_of::<T>()` bytes are valid for writes
+    // for its lifetime, aligned for `T` (checked above), and `T` is `Pod`:
+    // any bytes written are valid, and none are read.
+    let slots: wgpu::WriteOnly<'_, [T]> = unsafe { wgpu::WriteOnly::new(std::ptr::NonNull::slice_from_raw_parts(ptr.cast::<T>(), len)) };
+    let mut items = items.into_iter();
+    for slot in slots {
+        slot.write(match items.next() {
+            Some(item) => item?,
+            None => T::zeroed(),
+        });
+    }
+    Ok(())
+}
+
 impl Backend for GpuBackend {
     type Buffer = wgpu::Buffer;
 
@@ -310,6 +380,52 @@ impl Backend for GpuBackend {
             self.ctx.queue.write_buffer(&buffer, 0, &padded);
         }
         Ok(buffer)
+    }
+
+    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<wgpu::Buffer> {
+        let bytes = (len as u64).checked_mul(std::mem::size_of::<T>() as u64).unwrap_or(u64::MAX);
+        crate::runtime::backend::check_fits(self, label, bytes)?;
+        let size = bytes.max(MIN_BUFFER).next_multiple_of(8);
+        let staging = self.staging(true, size);
+        self.map(&staging, wgpu::MapMode::Write, size)?;
+        let written = {
+            let mut view = staging.get_mapped_range_mut(0..size)?;
+            let (data, mut padding) = view.slice(..).split_at(bytes as usize);
+            padding.fill(0);
+            write_items(data, len, items)
+        };
+        staging.unmap();
+        written?;
+        let buffer = self.take_buffer(label, size);
+        // Submitted now, so before every dispatch recorded so far, as the
+        // queue's own writes are (the buffer is new to them).
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&staging, 0, &buffer, 0, size);
+        self.ctx.queue.submit([encoder.finish()]);
+        Ok(buffer)
+    }
+
+    fn read_with<T: Pod, R>(&mut self, buffer: &wgpu::Buffer, count: usize, take: impl FnOnce(&[T]) -> R) -> Result<R> {
+        let total = (count as u64).checked_mul(std::mem::size_of::<T>() as u64).unwrap_or(u64::MAX);
+        if total > STAGING_KEEP.min(buffer.size()) || total == 0 {
+            return Ok(take(&self.read(buffer, count)?));
+        }
+        self.flush()?;
+        let padded = total.next_multiple_of(4);
+        let staging = self.staging(false, padded);
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, padded);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.map(&staging, wgpu::MapMode::Read, padded)?;
+        let out = {
+            let view = staging.get_mapped_range(0..padded)?;
+            match bytemuck::try_cast_slice::<u8, T>(&view[..total as usize]) {
+                Ok(data) => take(data),
+                Err(_) => take(&bytemuck::pod_collect_to_vec::<u8, T>(&view[..total as usize])),
+            }
+        };
+        staging.unmap();
+        Ok(out)
     }
 
     fn scratch(&mut self, label: &'static str, bytes: u64) -> Result<wgpu::Buffer> {
