@@ -16,6 +16,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use rayon::prelude::*;
 use treelet::error::{Error, ErrorKind};
 use treelet::runtime::device::{Device, DeviceChoice};
 use treelet::tracer::RayQueries;
@@ -206,9 +207,15 @@ impl<'py> RayArrays<'py> {
     /// direction of length 0 hits nothing.
     fn columns(&self) -> PyResult<RayColumns<'_>> {
         let (o, d) = (self.origins.as_slice()?, self.directions.as_slice()?);
-        if let Some(k) = o.iter().chain(d).position(|v| !v.is_finite()) {
-            let (what, values, k) = if k < o.len() { ("origins", o, k) } else { ("directions", d, k - o.len()) };
-            return Err(PyValueError::new_err(format!("{what}[{}]: not finite ({})", k / 3, values[k])));
+        for (what, values) in [("origins", o), ("directions", d)] {
+            // Chunks in parallel, each in one pass that vectorizes (no early
+            // exit), the place only on failure: a million rays' 6M floats
+            // took 5 ms by `position` alone on the H200's host.
+            let bad = values.par_chunks(1 << 16).any(|c| c.iter().fold(false, |bad, v| bad | !v.is_finite()));
+            if bad {
+                let k = values.iter().position(|v| !v.is_finite()).expect("a value is not finite");
+                return Err(PyValueError::new_err(format!("{what}[{}]: not finite ({})", k / 3, values[k])));
+            }
         }
         Ok(RayColumns { o, d, t_min: column(&self.t_min, "t_min")?, t_max: column(&self.t_max, "t_max")? })
     }
@@ -249,7 +256,8 @@ impl RayColumns<'_> {
     }
 }
 
-/// The arrays of [`Hits`], filled in one pass as the hits are read back.
+/// The arrays of [`Hits`], filled in one pass as the hits are read back
+/// (each written in place: six `push`es a hit took twice as long).
 struct HitColumns {
     t: Vec<f32>,
     primitive: Vec<i64>,
@@ -260,25 +268,20 @@ struct HitColumns {
 }
 
 impl HitColumns {
-    fn with_capacity(n: usize) -> Self {
-        HitColumns {
-            t: Vec::with_capacity(n),
-            primitive: Vec::with_capacity(n),
-            instance: Vec::with_capacity(n),
-            barycentrics: Vec::with_capacity(2 * n),
-            normal: Vec::with_capacity(3 * n),
-            hit: Vec::with_capacity(n),
-        }
+    /// Zeroed arrays for `n` hits (fresh zero pages: each is touched once,
+    /// when its hit is written).
+    fn zeroed(n: usize) -> Self {
+        HitColumns { t: vec![0.0; n], primitive: vec![0; n], instance: vec![0; n], barycentrics: vec![0.0; 2 * n], normal: vec![0.0; 3 * n], hit: vec![false; n] }
     }
 
-    fn push(&mut self, h: RayHit) {
+    fn set(&mut self, k: usize, h: RayHit) {
         let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
-        self.t.push(h.t);
-        self.primitive.push(signed(h.prim));
-        self.instance.push(signed(h.instance));
-        self.hit.push(h.is_hit());
-        self.barycentrics.extend_from_slice(&h.barycentrics);
-        self.normal.extend_from_slice(&h.normal);
+        self.t[k] = h.t;
+        self.primitive[k] = signed(h.prim);
+        self.instance[k] = signed(h.instance);
+        self.hit[k] = h.is_hit();
+        self.barycentrics[2 * k..2 * k + 2].copy_from_slice(&h.barycentrics);
+        self.normal[3 * k..3 * k + 3].copy_from_slice(&h.normal);
     }
 
     /// The arrays handed to NumPy without a copy.
@@ -377,8 +380,8 @@ impl Tracer {
     ) -> PyResult<Hits> {
         let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
         let rays = arrays.columns()?;
-        let mut out = HitColumns::with_capacity(rays.len());
-        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| out.push(h))).map_err(py_err)?;
+        let mut out = HitColumns::zeroed(rays.len());
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| out.set(k, h))).map_err(py_err)?;
         Ok(out.into_hits(py))
     }
 

@@ -112,17 +112,16 @@ pub trait Backend: Send {
     fn same_buffer(&self, a: &Self::Buffer, b: &Self::Buffer) -> bool;
     /// A buffer holding `data`.
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<Self::Buffer>;
-    /// A buffer of `len` elements written from `items` in order (zeros past
-    /// their end; items past `len` unread): on a GPU straight into upload
-    /// memory kept between calls, so that a large batch (an engine's rays)
-    /// costs no vector of its own first. The first error among the items is
-    /// returned, and nothing is uploaded.
-    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<Self::Buffer> {
+    /// A buffer of `len` elements, element `k` being `item(k)`: on a GPU
+    /// made in parallel and written straight into upload memory kept between
+    /// calls, so that a large batch (an engine's rays) costs no vector of its
+    /// own first. Where some items are errors, the first of them is returned
+    /// and nothing is uploaded.
+    fn upload_indexed<T: Pod + Send>(&mut self, label: &'static str, len: usize, item: impl Fn(usize) -> Result<T> + Sync) -> Result<Self::Buffer> {
         let mut data: Vec<T> = crate::internals::input::room_for(len, label)?;
-        for item in items.into_iter().take(len) {
-            data.push(item?);
+        for k in 0..len {
+            data.push(item(k)?);
         }
-        data.resize(len, T::zeroed());
         self.upload(label, &data)
     }
     /// A buffer of at least `bytes` bytes whose contents are undefined

@@ -372,11 +372,11 @@ impl Backend for CpuBackend {
         Ok(Rc::new(RefCell::new(words)))
     }
 
-    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<CpuBuffer> {
+    fn upload_indexed<T: Pod + Send>(&mut self, label: &'static str, len: usize, item: impl Fn(usize) -> Result<T> + Sync) -> Result<CpuBuffer> {
         let bytes = (len as u64).checked_mul(std::mem::size_of::<T>() as u64).unwrap_or(u64::MAX);
         let mut words = zeroed_words(bytes, label)?;
-        for (slot, item) in view::<T>(&mut words)[..len].iter_mut().zip(items) {
-            *slot = item?;
+        for (k, slot) in view::<T>(&mut words)[..len].iter_mut().enumerate() {
+            *slot = item(k)?;
         }
         Ok(Rc::new(RefCell::new(words)))
     }

@@ -43,8 +43,9 @@ pub trait RayQueries<B: Backend> {
     fn is_empty(&self) -> bool;
 
     /// [`RayQueries::closest_hits`] of `count` rays in the caller's own
-    /// form: ray `k` is `ray(k)`, and its hit is handed to `hit(k, ..)`, in
-    /// order. On a GPU the rays are written straight into upload memory and
+    /// form: ray `k` is `ray(k)` (asked for in parallel, from several
+    /// threads), and its hit is handed to `hit(k, ..)`, in order, on the
+    /// caller's thread. On a GPU the rays are written straight into upload memory and
     /// the hits read where they land, both kept between calls: no vector of
     /// rays or hits in between (an engine's or a binding's arrays of
     /// origins, directions and distances; `ray` may be called twice for a
@@ -62,7 +63,7 @@ pub trait RayQueries<B: Backend> {
     /// assert_eq!(t, [5.0, 5.0, 5.0, f32::INFINITY]);
     /// # anyhow::Ok(())
     /// ```
-    fn closest_hits_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray, mut hit: impl FnMut(usize, RayHit)) -> Result<()>
+    fn closest_hits_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray + Sync, mut hit: impl FnMut(usize, RayHit)) -> Result<()>
     where
         Self: Sized,
     {
@@ -77,7 +78,7 @@ pub trait RayQueries<B: Backend> {
     /// [`RayQueries::occluded`] of `count` rays in the caller's own form, as
     /// [`RayQueries::closest_hits_with`]: whether ray `ray(k)` hits anything
     /// up to its `t_max` is handed to `occluded(k, ..)`.
-    fn occluded_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray, mut occluded: impl FnMut(usize, bool)) -> Result<()>
+    fn occluded_with(&self, b: &mut B, count: usize, ray: impl Fn(usize) -> Ray + Sync, mut occluded: impl FnMut(usize, bool)) -> Result<()>
     where
         Self: Sized,
     {

@@ -63,18 +63,18 @@ pub(super) fn hit_record(r: &Ray, [[t, prim, b1, b2], [nx, ny, nz, instance]]: [
     RayHit { t: t + r.t_min, prim, instance: instance.to_bits(), barycentrics: [b1, b2], normal: [nx, ny, nz] }
 }
 
-/// Uploads the rays `ray(k)`, `k < count` (written straight into the
-/// device's upload memory), has `cast` trace them on the device in place,
+/// Uploads the rays `ray(k)`, `k < count` (made in parallel, written
+/// straight into the device's upload memory), has `cast` trace them on the device in place,
 /// and hands each ray's two records, read where they lie, to `take(k, ..)`.
 pub(super) fn trace_batch<B: Backend>(
     b: &mut B,
     count: usize,
-    ray: &impl Fn(usize) -> Ray,
+    ray: &(impl Fn(usize) -> Ray + Sync),
     cast: impl FnOnce(&mut B, &B::Buffer) -> Result<()>,
     mut take: impl FnMut(usize, [[f32; 4]; 2]),
 ) -> Result<()> {
     let slots = batch_slots(count)?;
-    let buffer = b.upload_iter("rays", slots, (0..count).map(|k| device_pair(k, &ray(k))))?;
+    let buffer = b.upload_indexed("rays", slots, |k| if k < count { device_pair(k, &ray(k)) } else { Ok([[0.0; 4]; 2]) })?;
     let traced = cast(b, &buffer).and_then(|()| {
         b.read_with(&buffer, count, |records: &[[[f32; 4]; 2]]| {
             for (k, &pair) in records.iter().enumerate() {

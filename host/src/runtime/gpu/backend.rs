@@ -285,33 +285,40 @@ impl GpuBackend {
     }
 }
 
-/// Writes `len` of `items` into mapped memory of `len` elements' bytes,
-/// zeros past their end (mapped memory may be write-combined: written once,
-/// in order, never read).
-fn write_items<T: Pod>(mut data: wgpu::WriteOnly<'_, [u8]>, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<()> {
-    let ptr = data.as_raw_element_ptr();
-    if !(ptr.as_ptr() as usize).is_multiple_of(std::mem::align_of::<T>()) {
-        // Mapped memory is aligned far beyond any element; if not, a vector first.
-        let mut v: Vec<T> = crate::internals::input::room_for(len, "an upload")?;
-        for item in items.into_iter().take(len) {
-            v.push(item?);
-        }
-        v.resize(len, T::zeroed());
-        data.copy_from_slice(bytemuck::cast_slice(&v));
+/// Bytes made in cached memory before each copy into mapped memory.
+const MAPPED_CHUNK: usize = 64 << 10;
+
+/// Writes `item(k)`, `k < len`, into mapped memory of `len` elements'
+/// bytes. Made a chunk at a time in cached memory and copied whole, chunks
+/// in parallel: mapped upload memory is write-combined or the device's own,
+/// over the bus, and element-by-element writes into it from one thread ran
+/// at 1.5 GB/s on the H200's host (a million rays' 32 MB in 21 ms).
+fn write_items<T: Pod + Send>(data: wgpu::WriteOnly<'_, [u8]>, len: usize, item: impl Fn(usize) -> Result<T> + Sync) -> Result<()> {
+    use rayon::prelude::*;
+    let size = std::mem::size_of::<T>();
+    if size == 0 {
         return Ok(());
     }
-    // SAFETY: the view's `len * size_of::<T>()` bytes are valid for writes
-    // for its lifetime, aligned for `T` (checked above), and `T` is `Pod`:
-    // any bytes written are valid, and none are read.
-    let slots: wgpu::WriteOnly<'_, [T]> = unsafe { wgpu::WriteOnly::new(std::ptr::NonNull::slice_from_raw_parts(ptr.cast::<T>(), len)) };
-    let mut items = items.into_iter();
-    for slot in slots {
-        slot.write(match items.next() {
-            Some(item) => item?,
-            None => T::zeroed(),
-        });
-    }
-    Ok(())
+    // The bytes from `start` on, from the items that span them.
+    let fill = |start: usize, mut out: wgpu::WriteOnly<'_, [u8]>| -> Result<()> {
+        let end = start + out.len();
+        let (first, last) = (start / size, end.div_ceil(size).min(len));
+        let items = (first..last).map(&item).collect::<Result<Vec<T>>>()?;
+        let bytes: &[u8] = bytemuck::cast_slice(&items);
+        out.copy_from_slice(&bytes[start - first * size..end - first * size]);
+        Ok(())
+    };
+    let (chunks, tail) = data.into_chunks::<MAPPED_CHUNK>();
+    let chunks: Vec<wgpu::WriteOnly<'_, [u8; MAPPED_CHUNK]>> = chunks.into_iter().collect();
+    let whole = chunks.len() * MAPPED_CHUNK;
+    let written = chunks
+        .into_par_iter()
+        .enumerate()
+        .try_for_each(|(c, chunk)| fill(c * MAPPED_CHUNK, chunk.into()))
+        .and_then(|()| fill(whole, tail));
+    // Which failing chunk reports first varies: the first failing item, as
+    // a sequential upload would have found it.
+    written.map_err(|e| (0..len).find_map(|k| item(k).err()).unwrap_or(e))
 }
 
 impl Backend for GpuBackend {
@@ -382,7 +389,7 @@ impl Backend for GpuBackend {
         Ok(buffer)
     }
 
-    fn upload_iter<T: Pod>(&mut self, label: &'static str, len: usize, items: impl IntoIterator<Item = Result<T>>) -> Result<wgpu::Buffer> {
+    fn upload_indexed<T: Pod + Send>(&mut self, label: &'static str, len: usize, item: impl Fn(usize) -> Result<T> + Sync) -> Result<wgpu::Buffer> {
         let bytes = (len as u64).checked_mul(std::mem::size_of::<T>() as u64).unwrap_or(u64::MAX);
         crate::runtime::backend::check_fits(self, label, bytes)?;
         let size = bytes.max(MIN_BUFFER).next_multiple_of(8);
@@ -392,7 +399,7 @@ impl Backend for GpuBackend {
             let mut view = staging.get_mapped_range_mut(0..size)?;
             let (data, mut padding) = view.slice(..).split_at(bytes as usize);
             padding.fill(0);
-            write_items(data, len, items)
+            write_items(data, len, item)
         };
         staging.unmap();
         written?;
