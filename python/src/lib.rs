@@ -404,20 +404,29 @@ impl Tracer {
     }
 
     /// The benchmark's baseline (python/examples/bench_rays.py): the median
-    /// wall milliseconds of the Rust API's `closest_hits` on these rays,
-    /// taken `repeats` times, the rays already made (what an engine calling
-    /// the Rust API pays, without this module's conversions).
-    #[pyo3(signature = (origins, directions, repeats = 7))]
-    fn _rust_api_ms(&mut self, py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, repeats: usize) -> PyResult<f64> {
+    /// wall milliseconds of the Rust API on these rays, taken `repeats`
+    /// times, the rays already made (what an engine calling the Rust API
+    /// pays, without this module's conversions): `closest_hits` into a new
+    /// vector of hits, or with `kept`, `closest_hits_with` into one kept
+    /// between calls (an engine's own buffer). Each result is dropped after
+    /// its time is taken, as `bench_rays.py` drops the module's.
+    #[pyo3(signature = (origins, directions, repeats = 7, kept = false))]
+    fn _rust_api_ms(&mut self, py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, repeats: usize, kept: bool) -> PyResult<f64> {
         let arrays = RayArrays::new(py, origins, directions, None, None)?;
         let columns = arrays.columns()?;
         let rays: Vec<Ray> = (0..columns.len()).map(|k| columns.ray(k)).collect();
+        let mut own = vec![RayHit::MISS; rays.len()];
         let mut ms = Vec::with_capacity(repeats);
         for _ in 0..repeats.max(1) {
             let start = std::time::Instant::now();
-            let hits = on_device!(self, py, |b, t| t.closest_hits(b, &rays)).map_err(py_err)?;
+            let hits = if kept {
+                on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays[k], |k, h| own[k] = h)).map_err(py_err)?;
+                Vec::new()
+            } else {
+                on_device!(self, py, |b, t| t.closest_hits(b, &rays)).map_err(py_err)?
+            };
             ms.push(start.elapsed().as_secs_f64() * 1e3);
-            std::hint::black_box(hits);
+            std::hint::black_box((hits, &own));
         }
         ms.sort_by(f64::total_cmp);
         Ok(ms[ms.len() / 2])
