@@ -31,7 +31,7 @@ for mesh in scenes/real/breakfast_room.ply.xz scenes/real/staircase.ply.xz /tmp/
   for v in old new old new; do
     extra=""; [ $v = new ] && extra="--mitsuba"
     echo "== $mesh $v"
-    PYTHONPATH=/tmp/py_$v:/tmp/site timeout 100 python3 python/examples/bench_rays.py $mesh --rays 1000000 --device gpu --repeats 7 $extra 2>&1 | grep -v "^$" | tail -4
+    PYTHONPATH=/tmp/py_$v:/tmp/site timeout 100 python3 python/examples/bench_rays.py $mesh --rays 1000000 --device gpu --repeats 7 $extra 2>&1 | grep -v "^$" | tail -6
   done
 done
 nvidia-smi --query-gpu=clocks.sm --format=csv
