@@ -85,6 +85,8 @@ pub fn check_output(path: &Path, what: &str, formats: &[&str]) -> Result<()> {
 /// link: the file it names is replaced.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        // A FIFO's reader is held open by `_reader_seen` while it is written.
+        let _reader_seen = wait_for_reader(path, FIFO_READER_WAIT)?;
         return write(path);
     }
     let resolved = match std::fs::symlink_metadata(path) {
@@ -108,6 +110,47 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) ->
     write(tmp.path())?;
     tmp.persist(path).map_err(|e| anyhow::anyhow!("cannot rename the finished file over it: {}", e.error))?;
     Ok(())
+}
+
+/// How long a finished render waits for a reader of a FIFO it writes to.
+const FIFO_READER_WAIT: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// Where `path` is a FIFO: waits up to `wait` for a process to read it, and
+/// returns it opened for writing without blocking (held while the output is
+/// written, so the reader sees one stream); an error naming the FIFO if none
+/// came. A plain open would block for ever with no reader (as a shell's
+/// `> fifo` does), after a render that may have taken hours. Anything else:
+/// nothing to wait for.
+#[cfg(unix)]
+fn wait_for_reader(path: &Path, wait: std::time::Duration) -> Result<Option<std::fs::File>> {
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    if !std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo()) {
+        return Ok(None);
+    }
+    let start = std::time::Instant::now();
+    let mut noted = false;
+    loop {
+        match std::fs::OpenOptions::new().write(true).custom_flags(libc::O_NONBLOCK).open(path) {
+            Ok(f) => return Ok(Some(f)),
+            // ENXIO: no reader yet.
+            Err(e) if e.raw_os_error() == Some(libc::ENXIO) => {
+                if start.elapsed() >= wait {
+                    bail!("{} is a FIFO and nothing read it for {} s: start its reader (e.g. `cat {0} > file`), or write to a file", path.display(), wait.as_secs());
+                }
+                if !noted {
+                    eprintln!("note: waiting up to {} s for a reader of the FIFO {}", wait.as_secs(), path.display());
+                    noted = true;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            Err(e) => bail!("cannot open the FIFO {} for writing: {e}", path.display()),
+        }
+    }
+}
+
+#[cfg(not(unix))]
+fn wait_for_reader(_path: &Path, _wait: std::time::Duration) -> Result<Option<std::fs::File>> {
+    Ok(None)
 }
 
 /// Writes `image` in the format its extension names (.png, .exr or .pfm),
@@ -242,6 +285,30 @@ mod tests {
         }
         write(&dir.join("a.png"), &sample()).unwrap();
         assert!(format!("{:#}", write(&dir.join("a.bmp"), &sample()).unwrap_err()).contains("unknown image format"));
+    }
+
+    /// An output that is a FIFO: with no reader, an error naming it after the
+    /// wait (it used to block for ever); with one, the image reaches it whole.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_output_waits_for_its_reader() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("out.pfm");
+        let name = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0, "mkfifo");
+        let start = std::time::Instant::now();
+        let e = wait_for_reader(&fifo, std::time::Duration::from_millis(300)).unwrap_err().to_string();
+        assert!(e.contains("is a FIFO") && e.contains("out.pfm") && e.contains("nothing read it"), "{e}");
+        assert!(start.elapsed() < std::time::Duration::from_secs(5), "{:?}", start.elapsed());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(&fifo).unwrap())
+        };
+        write(&fifo, &sample()).unwrap();
+        let bytes = reader.join().unwrap();
+        assert_eq!(parse_pfm(&bytes).unwrap(), sample());
+        // A plain file is not waited for.
+        assert!(wait_for_reader(&dir.path().join("new.pfm"), std::time::Duration::ZERO).unwrap().is_none());
     }
 
     #[test]
