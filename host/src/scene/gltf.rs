@@ -249,6 +249,8 @@ struct Loaded {
     meshes: Vec<SceneMesh>,
     /// Per glTF mesh: its index in `meshes`, once a node has placed it.
     mesh_slots: Vec<Option<u32>>,
+    /// Per entry of `meshes`: its vertices' box, to check each placement.
+    mesh_bounds: Vec<(Vec3, Vec3)>,
     instances: Vec<SceneInstance>,
     camera: Option<CameraSpec>,
     /// Per camera of the file, the first node that places it.
@@ -378,12 +380,27 @@ fn visit(node: &gltf::Node, parent: Mat4, buffers: &[Vec<u8>], name: &str, out: 
             Some(slot) => slot,
             None => {
                 let loaded = read_mesh(&mesh, buffers, name, out)?;
+                let corners = loaded.triangles.iter().flat_map(|t| [t.v0, t.v1, t.v2]).map(Vec3::from);
+                out.mesh_bounds.push(corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p))));
                 out.meshes.push(loaded);
                 let slot = out.meshes.len() as u32 - 1;
                 out.mesh_slots[mesh.index()] = Some(slot);
                 slot
             }
         };
+        // A transform finite in itself may still take the mesh's vertices past
+        // f32's range (a scale of 1e30 on coordinates of 1e10): named here, by
+        // node, not later by a triangle of the flattened scene.
+        let (lo, hi) = out.mesh_bounds[slot as usize];
+        let corner = |k: u32| Vec3::new([lo.x, hi.x][k as usize & 1], [lo.y, hi.y][(k as usize >> 1) & 1], [lo.z, hi.z][(k as usize >> 2) & 1]);
+        if lo.cmple(hi).all() && (0..8).any(|k| !world.transform_point3(corner(k)).is_finite()) {
+            bail!(
+                "{name}: node {} places mesh {} past the range of 32-bit floats (its vertices span {lo} to {hi}; the node's transform, with its parents', scales them by up to {:e})",
+                node.index(),
+                mesh.index(),
+                world.x_axis.truncate().length().max(world.y_axis.truncate().length()).max(world.z_axis.truncate().length())
+            );
+        }
         out.instances.push(SceneInstance { mesh: slot, transform: Affine3A::from_mat4(world), material: None });
     }
     if let Some(camera) = node.camera() {
@@ -868,6 +885,14 @@ mod tests {
             ),
             ("narrow.gltf", document(&data_uri(), 4, 6).replace(r#""yfov": 1.0"#, r#""yfov": 1e-40"#), "between 1e-6 and"),
             ("ior.gltf", document(&data_uri(), 4, 6).replace(r#""ior": 1.33"#, r#""ior": 1e30"#), "(it must lie between 0.01 and 100)"),
+            // A transform finite in itself that takes the mesh past f32's range
+            // (the diagonal of the square, turned 45 degrees, reaches 4.2e38):
+            // named by node (it was named by a triangle of the flattened scene).
+            (
+                "overflow.gltf",
+                document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [0, 0, 0.38268343, 0.92387953], "scale": [3e38, 3e38, 3e38]"#),
+                "node 1 places mesh 0 past the range of 32-bit floats",
+            ),
             // A rotation that is no rotation; a camera Treelet cannot make.
             ("quaternion.gltf", document(&data_uri(), 4, 6).replace(r#""scale": [2, 2, 2]"#, r#""rotation": [10, 0, 0, 0]"#), "not a unit quaternion"),
             (
