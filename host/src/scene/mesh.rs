@@ -49,8 +49,56 @@ pub fn load_obj(path: &Path) -> Result<Vec<Triangle>> {
     }
 }
 
+/// `text` as tobj takes it, where it needs changing: lines continued by a
+/// trailing `\\` joined (the OBJ format allows them; tobj refused them), and
+/// vertex colours (`v x y z r g b`, an extension Treelet does not read) cut
+/// off (tobj indexes colours by vertex: colours on some vertices only were
+/// refused as out of bounds). With it, where lines were joined, the line of
+/// `text` (from 1) each line of the result starts on, for error messages.
+fn tobj_text(text: &str) -> (std::borrow::Cow<'_, str>, Option<Vec<usize>>) {
+    let coloured = |l: &str| {
+        let mut words = l.split_whitespace();
+        words.next() == Some("v") && words.count() == 6
+    };
+    let continued = |l: &str| l.trim_end().ends_with('\\');
+    if !text.lines().any(|l| continued(l) || coloured(l)) {
+        return (std::borrow::Cow::Borrowed(text), None);
+    }
+    let (mut out, mut starts, mut joined) = (String::with_capacity(text.len()), Vec::new(), false);
+    let mut logical = String::new();
+    let mut start = None;
+    for (n, line) in text.lines().enumerate() {
+        start.get_or_insert(n + 1);
+        if continued(line) {
+            logical.push_str(line.trim_end().trim_end_matches('\\'));
+            logical.push(' ');
+            joined = true;
+            continue;
+        }
+        logical.push_str(line);
+        if coloured(&logical) {
+            let position: Vec<&str> = logical.split_whitespace().take(4).collect();
+            out.push_str(&position.join(" "));
+        } else {
+            out.push_str(&logical);
+        }
+        out.push('\n');
+        starts.push(start.take().expect("a line began"));
+        logical.clear();
+    }
+    if !logical.is_empty() {
+        out.push_str(&logical);
+        starts.push(start.unwrap_or(1));
+    }
+    (std::borrow::Cow::Owned(out), joined.then_some(starts))
+}
+
 /// Any OBJ through tobj.
 fn parse_obj(text: &str, name: &str) -> Result<Vec<Triangle>> {
+    let (text, starts) = tobj_text(text);
+    let text = text.as_ref();
+    // A line of `text` as the file numbers it.
+    let line_of = |n: usize| starts.as_ref().and_then(|s| s.get(n - 1).copied()).unwrap_or(n);
     // tobj makes a face of two vertices a triangle with one of them twice:
     // a degenerate triangle where the file meant a line (or was cut).
     let short = text.lines().enumerate().find(|(_, l)| {
@@ -58,13 +106,13 @@ fn parse_obj(text: &str, name: &str) -> Result<Vec<Triangle>> {
         words.next() == Some("f") && words.count() < 3
     });
     if let Some((n, line)) = short {
-        bail!("{name}: line {}: a face of fewer than three vertices in `{}`", n + 1, line.trim());
+        bail!("{name}: line {}: a face of fewer than three vertices in `{}`", line_of(n + 1), line.trim());
     }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     // Material libraries are ignored: Treelet assigns its own material.
     let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Ok(Default::default())).map_err(|e| {
         match obj_error_line(text, &e) {
-            Some((line, content)) => anyhow!("{name}: line {line}: {e} in `{}`", content.trim()),
+            Some((line, content)) => anyhow!("{name}: line {}: {e} in `{}`", line_of(line), content.trim()),
             None => anyhow!("{name}: not a valid OBJ file: {e}"),
         }
     })?;
@@ -133,6 +181,8 @@ fn obj_error_line<'t>(text: &'t str, error: &tobj::LoadError) -> Option<(usize, 
             ("v", E::PositionParseError) => !numbers(rest, 3),
             ("vn", E::NormalParseError) => !numbers(rest, 3),
             ("vt", E::TexcoordParseError) => !numbers(rest, 1),
+            // Colours after the position: three, or none (a fourth value is w).
+            ("v", E::ColorParseError) => rest.len() == 5 || rest.len() > 6,
             ("f", E::FaceParseError) => {
                 rest.len() < 3 || rest.iter().any(|v| v.split('/').next().is_none_or(|i| i.parse::<i64>().is_err()))
             }
@@ -444,6 +494,31 @@ mod tests {
             let path = write(&format!("two-{case}.obj"), text.as_bytes());
             let e = format!("{:#}", load(&path).unwrap_err());
             assert!(e.contains("line 4") && e.contains("fewer than three vertices") || e.contains("line 5") && e.contains("fewer than three"), "{case}: {e}");
+        }
+    }
+
+    /// Found by the probe of 2026-12-02: OBJ files tobj refused or named no
+    /// line for. Lines continued by `\\` and colours on some vertices only
+    /// load (as the same file written plainly does); a bad colour is named by
+    /// line, counted in the file's own lines where lines were joined.
+    #[test]
+    fn obj_continuations_and_vertex_colours() {
+        let plain = load(&write("plain.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n")).unwrap();
+        assert_eq!(plain.len(), 2);
+        for (case, text) in [
+            ("continued", "v 0 0 \\\n 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 \\\n  3//1 4//1\n"),
+            ("some-coloured", "v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0 0 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"),
+            ("all-coloured", "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 1 1 0 0 1 0\nv 0 1 0 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n"),
+        ] {
+            assert_eq!(load(&write(&format!("{case}.obj"), text.as_bytes())).unwrap(), plain, "{case}");
+        }
+        for (case, text, at) in [
+            ("bad-colour", "v 0 0 0\nv 1 0 0 1 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n", "line 2: color parse error"),
+            ("bad-colour-continued", "v 0 0 \\\n 0\nv 1 0 0 1 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n", "line 3: color parse error"),
+            ("short-continued", "v 0 0 \\\n 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 \\\n 2//1\n", "line 6: a face of fewer than three"),
+        ] {
+            let e = format!("{:#}", load(&write(&format!("{case}.obj"), text.as_bytes())).unwrap_err());
+            assert!(e.contains(at) && e.contains(&format!("{case}.obj")), "{case}: {e}");
         }
     }
 
