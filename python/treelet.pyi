@@ -26,7 +26,8 @@ class Hits:
     def __len__(self) -> int: ...
 
 class Tracer:
-    """A BVH over a triangle mesh, on a GPU (Vulkan) or the CPU runner.
+    """A BVH over a triangle mesh, on a GPU (Vulkan) or the CPU runner. On a GPU, queries release
+    the GIL while the device works (the ray arrays must not change until they return).
 
     >>> import numpy as np, treelet
     >>> v = np.array([[0, 0, 5], [1, 0, 5], [0, 1, 5]], dtype=np.float32)
