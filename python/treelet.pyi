@@ -1,6 +1,6 @@
 """BVHs built and traced on any Vulkan GPU, or on the CPU with the same kernels: closest hits
 and occlusion queries for NumPy arrays of rays. See python/README.md."""
-from typing import Literal, Optional, Union
+from typing import Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -15,7 +15,7 @@ class Hits:
     primitive: npt.NDArray[np.int64]
     """(n,): the triangle hit (its row of `indices`); -1 for a miss."""
     instance: npt.NDArray[np.int64]
-    """(n,): 0 for a hit, -1 for a miss."""
+    """(n,): the instance hit (0 for a Tracer's hits); -1 for a miss."""
     barycentrics: npt.NDArray[np.float32]
     """(n, 2): of the triangle's second and third vertex (the point is
     (1 - b1 - b2) v0 + b1 v1 + b2 v2); 0 for a miss."""
@@ -73,3 +73,59 @@ class Tracer:
         """Whether each ray hits anything from t_min up to t_max (inclusive)."""
     def refit(self, vertices: npt.ArrayLike, indices: npt.ArrayLike) -> None:
         """Moves the mesh (the same triangles, new vertices) and refits the tree's boxes."""
+
+class InstancedTracer:
+    """Meshes placed many times by transforms (a tree per mesh, a top-level tree over the
+    instances), on a GPU (Vulkan) or the CPU runner. A hit names its instance and the triangle
+    within that instance's mesh. On a GPU, queries release the GIL while the device works.
+
+    >>> import numpy as np, treelet
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float32)
+    >>> moved = np.array([[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, z]] for z in (5, 9)], dtype=np.float32)
+    >>> s = treelet.InstancedTracer([(v, np.array([[0, 1, 2]]))], np.array([0, 0]), moved, device="cpu")
+    >>> hits = s.closest_hits(np.array([[0.2, 0.2, 0.0]]), np.array([[0.0, 0.0, 1.0]]))
+    >>> float(hits.t[0]), int(hits.instance[0]), int(hits.primitive[0])
+    (5.0, 0, 0)
+    """
+
+    def __init__(
+        self,
+        meshes: Sequence[Tuple[npt.ArrayLike, npt.ArrayLike]],
+        mesh: npt.ArrayLike,
+        transforms: npt.ArrayLike,
+        device: Literal["auto", "gpu", "cpu"] = "auto",
+        quality: Literal["fast", "balanced", "high"] = "fast",
+    ) -> None:
+        """Builds a tree for each of `meshes` ((vertices, indices) pairs, as Tracer takes them)
+        and the top-level tree: instance i is mesh `mesh[i]` ((k,) integers) placed by
+        `transforms[i]` ((k, 3, 4) or (k, 4, 4), row-major: a point p goes to T @ [p, 1]).
+        Raises ValueError for a mesh index out of range, a transform that is not finite or
+        projective, or mismatched counts; TypeError for arguments of the wrong kind."""
+    @property
+    def device(self) -> str:
+        """The adapter's name, or "cpu"."""
+    def __len__(self) -> int:
+        """The number of instances."""
+    def closest_hits(
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        t_min: Optional[Union[float, npt.ArrayLike]] = None,
+        t_max: Optional[Union[float, npt.ArrayLike]] = None,
+    ) -> Hits:
+        """As Tracer.closest_hits: `instance` is the instance hit, `primitive` the triangle within
+        its mesh, `normal` in world space."""
+    def occluded(
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        t_min: Optional[Union[float, npt.ArrayLike]] = None,
+        t_max: Optional[Union[float, npt.ArrayLike]] = None,
+    ) -> npt.NDArray[np.bool_]:
+        """Whether each ray hits anything from t_min up to t_max (inclusive)."""
+    def set_instances(self, mesh: npt.ArrayLike, transforms: npt.ArrayLike) -> None:
+        """Places the instances anew (any number, of the same meshes); only the top level is
+        rebuilt."""
+    def refit_mesh(self, index: int, vertices: npt.ArrayLike, indices: npt.ArrayLike) -> None:
+        """Moves mesh `index` (the same triangles, new vertices) and refits its tree; every
+        instance of it moves with it."""

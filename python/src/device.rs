@@ -1,0 +1,100 @@
+//! A tree and the device it lives on (a GPU's backend, or the CPU
+//! runner's), and the queries both kinds of tracer answer through
+//! [`RayQueries`].
+use numpy::{IntoPyArray, PyArray1};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use treelet::runtime::device::{Device, DeviceChoice};
+use treelet::tracer::RayQueries;
+use treelet::{CpuBackend, GpuBackend, Quality};
+
+use crate::arrays::RayArrays;
+use crate::hits::{HitColumns, Hits};
+use crate::py_err;
+
+/// A tracer `G` on a GPU (with its adapter's name), or `C` on the CPU runner.
+pub(crate) enum OnDevice<G, C> {
+    Gpu(GpuBackend, G, String),
+    Cpu(CpuBackend, C),
+}
+
+/// Runs `$body` with the backend `$b` and tracer `$t` of an [`OnDevice`],
+/// the GIL released while a GPU works (the CPU runner's buffers stay on the
+/// thread that holds the GIL: it works with the GIL held).
+macro_rules! on_device {
+    ($inner:expr, $py:expr, |$b:ident, $t:ident| $body:expr) => {
+        match $inner {
+            $crate::device::OnDevice::Gpu($b, $t, _) => $py.allow_threads(|| $body),
+            $crate::device::OnDevice::Cpu($b, $t) => $body,
+        }
+    };
+}
+pub(crate) use on_device;
+
+/// `quality` as the library takes it.
+pub(crate) fn quality(quality: &str) -> PyResult<Quality> {
+    match quality {
+        "fast" => Ok(Quality::Fast),
+        "balanced" => Ok(Quality::Balanced),
+        "high" => Ok(Quality::High),
+        other => Err(PyValueError::new_err(format!("quality `{other}`: use fast, balanced or high"))),
+    }
+}
+
+/// Opens `device` ("auto", "gpu" or "cpu") and builds on it, by `gpu` or `cpu`.
+pub(crate) fn build<G, C>(
+    device: &str,
+    gpu: impl FnOnce(&mut GpuBackend) -> treelet::error::Result<G>,
+    cpu: impl FnOnce(&mut CpuBackend) -> treelet::error::Result<C>,
+) -> PyResult<OnDevice<G, C>> {
+    let choice = match device {
+        "auto" => DeviceChoice::Auto,
+        "gpu" => DeviceChoice::Gpu,
+        "cpu" => DeviceChoice::Cpu,
+        other => return Err(PyValueError::new_err(format!("device `{other}`: use auto, gpu or cpu"))),
+    };
+    let (opened, _note) = choice.open_with_note().map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))?;
+    Ok(match opened {
+        Device::Gpu(ctx) => {
+            let name = ctx.info.name.clone();
+            let mut b = GpuBackend::new(ctx);
+            let tracer = gpu(&mut b).map_err(py_err)?;
+            OnDevice::Gpu(b, tracer, name)
+        }
+        Device::Cpu => {
+            let mut b = CpuBackend::new();
+            let tracer = cpu(&mut b).map_err(py_err)?;
+            OnDevice::Cpu(b, tracer)
+        }
+    })
+}
+
+impl<G, C> OnDevice<G, C>
+where
+    G: RayQueries<GpuBackend> + Sync,
+    C: RayQueries<CpuBackend>,
+{
+    /// The device's name: the adapter's, or "cpu".
+    pub(crate) fn name(&self) -> String {
+        match self {
+            OnDevice::Gpu(_, _, name) => name.clone(),
+            OnDevice::Cpu(..) => "cpu".into(),
+        }
+    }
+
+    /// The closest hits of the rays in the arrays.
+    pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>) -> PyResult<Hits> {
+        let rays = arrays.columns()?;
+        let mut out = HitColumns::zeroed(rays.len());
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| out.set(k, h))).map_err(py_err)?;
+        Ok(out.into_hits(py))
+    }
+
+    /// Whether each ray of the arrays is occluded.
+    pub(crate) fn occluded<'py>(&mut self, py: Python<'py>, arrays: &RayArrays<'_>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let rays = arrays.columns()?;
+        let mut hit = Vec::with_capacity(rays.len());
+        on_device!(self, py, |b, t| t.occluded_with(b, rays.len(), |k| rays.ray(k), |_, o| hit.push(o))).map_err(py_err)?;
+        Ok(hit.into_pyarray(py))
+    }
+}
