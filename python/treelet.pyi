@@ -129,3 +129,25 @@ class InstancedTracer:
     def refit_mesh(self, index: int, vertices: npt.ArrayLike, indices: npt.ArrayLike) -> None:
         """Moves mesh `index` (the same triangles, new vertices) and refits its tree; every
         instance of it moves with it."""
+
+def render(
+    scene: str = "cornell",
+    width: int = 512,
+    height: int = 384,
+    spp: int = 16,
+    seed: int = 0,
+    integrator: Literal["nee", "smallpt", "caustics"] = "nee",
+    sampler: Literal["sobol", "independent"] = "sobol",
+    accel: Literal["auto", "none", "lbvh", "hploc", "trbvh"] = "auto",
+    device: Literal["auto", "gpu", "cpu"] = "auto",
+) -> npt.NDArray[np.float32]:
+    """Renders `scene` (what `treelet render --scene` takes: "cornell", "room_disk", "terrain:N",
+    "city:N", a .json scene file, a .gltf/.glb scene or an .obj/.ply mesh) and returns the linear
+    HDR image, (height, width, 3) float32, row 0 at the top. On a GPU the GIL is released while it
+    renders. Raises ValueError for a bad argument or scene, RuntimeError where the device fails.
+
+    >>> import treelet
+    >>> image = treelet.render("cornell", 32, 24, spp=4, device="cpu")
+    >>> image.shape, bool(image.mean() > 0)
+    ((24, 32, 3), True)
+    """

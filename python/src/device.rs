@@ -41,12 +41,9 @@ pub(crate) fn quality(quality: &str) -> PyResult<Quality> {
     }
 }
 
-/// Opens `device` ("auto", "gpu" or "cpu") and builds on it, by `gpu` or `cpu`.
-pub(crate) fn build<G, C>(
-    device: &str,
-    gpu: impl FnOnce(&mut GpuBackend) -> treelet::error::Result<G>,
-    cpu: impl FnOnce(&mut CpuBackend) -> treelet::error::Result<C>,
-) -> PyResult<OnDevice<G, C>> {
+/// A backend of `device`: "auto" (the first GPU, else the CPU runner),
+/// "gpu" (a Vulkan adapter, or an error) or "cpu" (the CPU runner).
+pub(crate) fn open(device: &str) -> PyResult<OnDevice<(), ()>> {
     let choice = match device {
         "auto" => DeviceChoice::Auto,
         "gpu" => DeviceChoice::Gpu,
@@ -57,12 +54,24 @@ pub(crate) fn build<G, C>(
     Ok(match opened {
         Device::Gpu(ctx) => {
             let name = ctx.info.name.clone();
-            let mut b = GpuBackend::new(ctx);
+            OnDevice::Gpu(GpuBackend::new(ctx), (), name)
+        }
+        Device::Cpu => OnDevice::Cpu(CpuBackend::new(), ()),
+    })
+}
+
+/// Opens `device` (as [`open`]) and builds on it, by `gpu` or `cpu`.
+pub(crate) fn build<G, C>(
+    device: &str,
+    gpu: impl FnOnce(&mut GpuBackend) -> treelet::error::Result<G>,
+    cpu: impl FnOnce(&mut CpuBackend) -> treelet::error::Result<C>,
+) -> PyResult<OnDevice<G, C>> {
+    Ok(match open(device)? {
+        OnDevice::Gpu(mut b, (), name) => {
             let tracer = gpu(&mut b).map_err(py_err)?;
             OnDevice::Gpu(b, tracer, name)
         }
-        Device::Cpu => {
-            let mut b = CpuBackend::new();
+        OnDevice::Cpu(mut b, ()) => {
             let tracer = cpu(&mut b).map_err(py_err)?;
             OnDevice::Cpu(b, tracer)
         }

@@ -3,7 +3,8 @@
 //! Vulkan GPU or on the CPU runner (the same kernels), and answers closest
 //! hits and occlusion queries for arrays of rays; an `InstancedTracer` the
 //! same for meshes placed many times by transforms. Files: `tracer.rs`,
-//! `instanced.rs` (the two classes), `device.rs` (a tree on its device, the
+//! `instanced.rs` (the two classes), `render.rs` (`treelet.render`: an
+//! HDR image of a scene), `device.rs` (a tree on its device, the
 //! queries both answer), `arrays.rs` (arrays in), `hits.rs` (hits out). Wrong shapes and dtypes
 //! are `TypeError`s or `ValueError`s that name the argument; what the
 //! library refuses (NaN coordinates, an index past the vertices) is a
@@ -19,6 +20,7 @@ mod arrays;
 mod device;
 mod hits;
 mod instanced;
+mod render;
 mod tracer;
 
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
@@ -40,6 +42,7 @@ fn treelet_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<tracer::Tracer>()?;
     m.add_class::<instanced::InstancedTracer>()?;
     m.add_class::<hits::Hits>()?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
