@@ -7,6 +7,28 @@ use pyo3::prelude::*;
 use rayon::prelude::*;
 use treelet::{Ray, Triangle};
 
+/// `array` as a NumPy array: an object that exports DLPack (a PyTorch, JAX
+/// or CuPy array) through `numpy.from_dlpack`, which shares its memory
+/// where it is on the CPU; anything else through `numpy.asarray` (NumPy
+/// arrays as they are, nested lists, objects with `__array__`). A tensor on
+/// a GPU is refused by name: its memory is not the host's.
+pub(crate) fn as_numpy<'py>(np: &Bound<'py, PyModule>, array: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyAny>> {
+    if !array.is_instance_of::<numpy::PyUntypedArray>() && array.hasattr("__dlpack__")? {
+        // DLPack's device types: 1 the CPU, 3 CUDA's pinned host memory.
+        if let Ok((device, _)) = array.call_method0("__dlpack_device__").and_then(|d| d.extract::<(i64, i64)>()) {
+            if device != 1 && device != 3 {
+                return Err(PyTypeError::new_err(format!(
+                    "{what}: not readable on the CPU through DLPack (its memory is on a device of DLPack type {device}, not the host's): move it to the CPU first (a tensor's .cpu())"
+                )));
+            }
+        }
+        return np.call_method1("from_dlpack", (array,)).map_err(|e| {
+            PyTypeError::new_err(format!("{what}: not readable on the CPU through DLPack ({}): move it to the CPU first (a tensor's .cpu())", e.value(np.py())))
+        });
+    }
+    np.call_method1("asarray", (array,)).map_err(|_| PyTypeError::new_err(format!("{what}: not an array")))
+}
+
 /// An (n, 3) array as a C-ordered array of `dtype` (no copy where it is
 /// one already), any memory order, its dtype's kind one of `kinds` (`what`
 /// names the argument, `rows` its rows' letter in messages).
@@ -17,7 +39,7 @@ pub(crate) fn rows_of<'py, T: numpy::Element>(
     (kinds, expected, dtype, rows): (&[&str], &str, &str, &str),
 ) -> PyResult<PyReadonlyArray2<'py, T>> {
     let np = py.import("numpy")?;
-    let a = np.call_method1("asarray", (array,)).map_err(|_| PyTypeError::new_err(format!("{what}: not an array")))?;
+    let a = as_numpy(&np, array, what)?;
     let kind: String = a.getattr("dtype")?.getattr("kind")?.extract()?;
     if !kinds.contains(&kind.as_str()) {
         return Err(PyTypeError::new_err(format!("{what}: {expected} expected, got an array of dtype {}", a.getattr("dtype")?)));
@@ -56,11 +78,13 @@ pub(crate) fn per_ray<'py>(py: Python<'py>, value: &Bound<'py, PyAny>, n: usize,
     let np = py.import("numpy")?;
     // One number only where it is one (a size-1 array for many rays is an
     // error, not a value for all).
-    let ndim: usize = np.call_method1("ndim", (value,))?.extract()?;
+    let array = as_numpy(&np, value, what)?;
+    let ndim: usize = array.getattr("ndim")?.extract()?;
     if ndim == 0 {
         return value.extract::<f32>().map(PerRay::All).map_err(|_| PyTypeError::new_err(format!("{what}: a number expected")));
     }
-    let kind: String = np.call_method1("asarray", (value,))?.getattr("dtype")?.getattr("kind")?.extract()?;
+    let value = array;
+    let kind: String = value.getattr("dtype")?.getattr("kind")?.extract()?;
     if !matches!(kind.as_str(), "f" | "i" | "u") {
         return Err(PyTypeError::new_err(format!("{what}: numbers expected")));
     }

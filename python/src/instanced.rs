@@ -6,7 +6,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use treelet::{CpuBackend, GpuBackend, Instance, Triangle};
 
-use crate::arrays::{shape_of, triangles_of, RayArrays};
+use crate::arrays::{as_numpy, shape_of, triangles_of, RayArrays};
 use crate::device::{self, on_device, OnDevice};
 use crate::hits::Hits;
 use crate::py_err;
@@ -36,7 +36,8 @@ pub(crate) struct InstancedTracer {
 /// to `T @ [p, 1]`), checked against the `meshes` meshes.
 fn instances_of(py: Python<'_>, mesh: &Bound<'_, PyAny>, transforms: &Bound<'_, PyAny>, meshes: usize) -> PyResult<Vec<Instance>> {
     let np = py.import("numpy")?;
-    let kind = |a: &Bound<'_, PyAny>| -> PyResult<String> { np.call_method1("asarray", (a,))?.getattr("dtype")?.getattr("kind")?.extract() };
+    let (mesh, transforms) = (&as_numpy(&np, mesh, "mesh")?, &as_numpy(&np, transforms, "transforms")?);
+    let kind = |a: &Bound<'_, PyAny>| -> PyResult<String> { a.getattr("dtype")?.getattr("kind")?.extract() };
     if !matches!(kind(mesh)?.as_str(), "i" | "u") {
         return Err(PyTypeError::new_err("mesh: integers expected (each instance's mesh)"));
     }

@@ -205,3 +205,42 @@ def test_bad_rays_are_named():
         tracer.occluded(o, d, t_min=-1.0)
     with pytest.raises(TypeError, match="origins: numbers expected"):
         tracer.closest_hits(np.array([["x"] * 3] * 2), d)
+
+
+class DLPackOnly:
+    """An array NumPy can read only through DLPack, as it reads a PyTorch, JAX or CuPy CPU array."""
+
+    def __init__(self, a, device=None):
+        self._a, self._device = a, device
+
+    def __dlpack__(self, **kwargs):
+        return self._a.__dlpack__(**kwargs)
+
+    def __dlpack_device__(self):
+        return self._device or self._a.__dlpack_device__()
+
+
+def test_dlpack_arrays_are_read_as_numpy_ones():
+    rng = np.random.default_rng(17)
+    v, idx = random_mesh(rng, 100)
+    o, d = random_rays(rng, 200, v)
+    base = treelet.Tracer(v, idx, device="cpu")
+    want = base.closest_hits(o, d, t_max=np.full(200, 50.0, dtype=np.float32))
+    other = treelet.Tracer(DLPackOnly(v), DLPackOnly(idx), device="cpu")
+    got = other.closest_hits(DLPackOnly(o), DLPackOnly(d), t_max=DLPackOnly(np.full(200, 50.0, dtype=np.float32)))
+    assert np.array_equal(want.primitive, got.primitive) and np.array_equal(want.t, got.t)
+    # A tensor on a GPU (DLPack device type 2, CUDA) is refused by name, not read.
+    with pytest.raises(TypeError, match="origins: not readable on the CPU through DLPack"):
+        base.closest_hits(DLPackOnly(o, device=(2, 0)), d)
+
+
+def test_torch_tensors_where_torch_is_installed():
+    torch = pytest.importorskip("torch")  # not in CI's environment: DLPackOnly stands in there
+    rng = np.random.default_rng(19)
+    v, idx = random_mesh(rng, 100)
+    o, d = random_rays(rng, 200, v)
+    want = treelet.Tracer(v, idx, device="cpu").closest_hits(o, d)
+    got = treelet.Tracer(torch.from_numpy(v), torch.from_numpy(idx), device="cpu").closest_hits(torch.from_numpy(o), torch.from_numpy(d))
+    assert np.array_equal(want.primitive, got.primitive) and np.array_equal(want.t, got.t)
+    # Hits to tensors without a copy.
+    assert torch.from_numpy(got.t).data_ptr() == got.t.ctypes.data
