@@ -12,7 +12,10 @@
 //! ([`RayHit`]) of batches of [`Ray`]s. [`Quality`] trades build time for
 //! faster rays, or ([`Quality::ForRays`]) picks the builder that finishes a
 //! given number of rays per build first, by costs measured per device class.
-//! An [`InstancedTracer`] places meshes many times; [`scene::instanced::InstancedScene::load`]
+//! Rays and hits in an engine's own arrays (columns, say) need no slice of
+//! [`Ray`]s: [`tracer::RayQueries::closest_hits_with`] asks for each ray
+//! and hands back each hit, writing the rays straight into the device's
+//! upload memory. An [`InstancedTracer`] places meshes many times; [`scene::instanced::InstancedScene::load`]
 //! reads a glTF or scene file's meshes once each, with their copies as
 //! instances ([`InstancedTracer::build_scene`]).
 //!
