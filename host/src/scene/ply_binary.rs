@@ -127,7 +127,7 @@ fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] 
     }
     // Written in place on every core (a collect through rayon's lists of
     // vectors would copy them).
-    let mut triangles = match crate::internals::input::room_for(l.faces, "the mesh's triangles") {
+    let mut triangles = match crate::internals::input::room_to_fill(l.faces, "the mesh's triangles") {
         Ok(v) => v,
         Err(e) => return Some(Err(e)),
     };

@@ -103,14 +103,14 @@ fn misses(count: usize, ray: &impl Fn(usize) -> Ray, mut miss: impl FnMut(usize)
 
 /// [`RayQueries::closest_hits`] of a slice, through [`RayQueries::closest_hits_with`].
 pub(super) fn collect_hits<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
-    let mut out = crate::error::typed(|| crate::internals::input::room_for(rays.len(), "hits of a batch"))?;
+    let mut out = crate::error::typed(|| crate::internals::input::room_to_fill(rays.len(), "hits of a batch"))?;
     scene.closest_hits_with(b, rays.len(), |k| rays[k], |_, h| out.push(h))?;
     Ok(out)
 }
 
 /// [`RayQueries::occluded`] of a slice, through [`RayQueries::occluded_with`].
 pub(super) fn collect_occluded<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
-    let mut out = crate::error::typed(|| crate::internals::input::room_for(rays.len(), "answers of a batch"))?;
+    let mut out = crate::error::typed(|| crate::internals::input::room_to_fill(rays.len(), "answers of a batch"))?;
     scene.occluded_with(b, rays.len(), |k| rays[k], |_, o| out.push(o))?;
     Ok(out)
 }
