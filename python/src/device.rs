@@ -94,8 +94,8 @@ where
     /// The closest hits of the rays in the arrays.
     pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>) -> PyResult<Hits> {
         let rays = arrays.columns()?;
-        let mut out = HitColumns::zeroed(rays.len())?;
-        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| out.set(k, h))).map_err(py_err)?;
+        let mut out = HitColumns::with_room(rays.len())?;
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| out.push(h))).map_err(py_err)?;
         Ok(out.into_hits(py))
     }
 
