@@ -2,7 +2,7 @@
 # The engine API's host batches (issues 64, 67): rays written straight into kept upload memory and
 # hits read from kept read-back memory (`closest_hits_with`), against the wheel of main before it
 # (c3560e7), alternately in one call (old, new, old, new), then Mitsuba 3 (OptiX) from Python on the
-# same rays; new is 76168b5 in log_h200.txt, 2948445 (parallel chunked uploads) in log_h200_2.txt and the next commit (timings that drop the last result first, hits into a kept buffer) in log_h200_3.txt. 1M incoherent rays, three meshes: two real scenes of the suite and a 1M-triangle height field.
+# same rays; new is 76168b5 in log_h200.txt, 2948445 (parallel chunked uploads) in log_h200_2.txt and the next commit (timings that drop the last result first, hits into a kept buffer) in log_h200_3.txt, 97c7574 (hit arrays mapped in at once, pushed) in log_h200_4.txt. 1M incoherent rays, three meshes: two real scenes of the suite and a 1M-triangle height field.
 # Carry: .gl (the Vulkan loader's debs), .whl (Mitsuba 3's site, slimmed), .dev/py (pytest's wheels),
 # .dev/wheels.tar.xz (the two wheels' files).
 for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
