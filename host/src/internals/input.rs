@@ -100,7 +100,7 @@ pub fn room_for<T>(n: usize, what: &str) -> Result<Vec<T>> {
 }
 
 /// [`room_for`] `n` elements that the caller fills whole, at once: the
-/// pages are mapped in now ([`populate`]). Not for room sized by untrusted
+/// pages are mapped in now (`MADV_POPULATE_WRITE`). Not for room sized by untrusted
 /// input before its data is seen (a header's count): mapped pages are
 /// memory taken, where untouched room is not.
 pub fn room_to_fill<T>(n: usize, what: &str) -> Result<Vec<T>> {

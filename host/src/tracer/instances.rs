@@ -30,7 +30,7 @@ use treelet_core::trace::hit::STACK_DEPTH;
 
 use super::engine_mesh::MeshBuffers;
 use super::primitives::{Quality, Tracer};
-use super::queries::{collect_hits, collect_occluded};
+use super::queries::{collect_hits, collect_occluded, ray_queries};
 use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::lbvh;
 use crate::runtime::backend::{Backend, StageTimes};
@@ -581,3 +581,5 @@ fn mesh_records<B: Backend>(b: &mut B, bases: &[[u32; 3]], bounds: &[[[f64; 3]; 
     b.keep(&[&buffer]);
     Ok(buffer)
 }
+
+ray_queries!(InstancedTracer);

@@ -7,7 +7,7 @@ use treelet_core::render::integrator::tiled_invocations;
 use treelet_core::render::rays::{CAST_OCCLUDED, CAST_RAYS};
 
 use super::engine_mesh::{gather, MeshBuffers};
-use super::queries::{collect_hits, collect_occluded};
+use super::queries::{collect_hits, collect_occluded, ray_queries};
 use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::choice::{cheaper_builder, Work};
 use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
@@ -328,3 +328,5 @@ impl<B: Backend> Tracer<B> {
         Ok(())
     }
 }
+
+ray_queries!(Tracer);

@@ -1,15 +1,17 @@
 //! What [`Tracer`] and [`InstancedTracer`] share: ray queries on a built
-//! scene, so that an engine's code can take either.
+//! scene, so that an engine's code can take either. (Each implements it in
+//! its own file, by [`ray_queries`]: this file names neither.)
+//!
+//! [`Tracer`]: crate::tracer::Tracer
+//! [`InstancedTracer`]: crate::tracer::InstancedTracer
 use crate::error::Result;
 
-use super::instances::InstancedTracer;
-use super::primitives::Tracer;
 use super::rays::{device_pair, hit_record, trace_batch, Ray, RayHit};
 use crate::runtime::backend::Backend;
 
 /// Ray queries on a built scene of device `B`: closest hits and occlusion,
 /// from host slices or on rays already on the device (see
-/// [`Tracer::closest_hits_on_device`] for their layout), and the device
+/// [`Tracer::closest_hits_on_device`](crate::tracer::Tracer::closest_hits_on_device) for their layout), and the device
 /// time of the last update.
 ///
 /// ```
@@ -118,17 +120,17 @@ pub(super) fn collect_occluded<B: Backend>(scene: &impl RayQueries<B>, b: &mut B
 /// Both implement it by their own methods of the same names.
 macro_rules! ray_queries {
     ($t:ident) => {
-        impl<B: Backend> RayQueries<B> for $t<B> {
-            fn closest_hits(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
+        impl<B: $crate::runtime::backend::Backend> $crate::tracer::queries::RayQueries<B> for $t<B> {
+            fn closest_hits(&self, b: &mut B, rays: &[$crate::tracer::rays::Ray]) -> $crate::error::Result<Vec<$crate::tracer::rays::RayHit>> {
                 $t::closest_hits(self, b, rays)
             }
-            fn occluded(&self, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
+            fn occluded(&self, b: &mut B, rays: &[$crate::tracer::rays::Ray]) -> $crate::error::Result<Vec<bool>> {
                 $t::occluded(self, b, rays)
             }
-            fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+            fn closest_hits_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> $crate::error::Result<()> {
                 $t::closest_hits_on_device(self, b, rays, count)
             }
-            fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> Result<()> {
+            fn occluded_on_device(&self, b: &mut B, rays: &B::Buffer, count: usize) -> $crate::error::Result<()> {
                 $t::occluded_on_device(self, b, rays, count)
             }
             fn last_update_ms(&self) -> f64 {
@@ -140,5 +142,4 @@ macro_rules! ray_queries {
         }
     };
 }
-ray_queries!(Tracer);
-ray_queries!(InstancedTracer);
+pub(super) use ray_queries;
