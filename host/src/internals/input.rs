@@ -152,10 +152,7 @@ pub fn zeroed_vec<T: bytemuck::Pod>(n: usize, what: &str) -> Result<Vec<T>> {
 /// Reads the whole of `path` (see [`check`]); never more than the cap,
 /// even if the file grows while it is read.
 pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
-    check(path, what)?;
-    let file = std::fs::File::open(path).with_context(|| format!("{what} {}: cannot open it", path.display()))?;
-    // What was opened is checked too: the path may have changed since.
-    let len = check_meta(path, what, &file.metadata().with_context(|| format!("{what} {}", path.display()))?)?;
+    let (file, len) = open(path, what)?;
     let mut bytes = room_to_fill(len as usize, &format!("{what} {}", path.display()))?;
     let max = max_input_bytes();
     // In blocks, so that a watcher can show how far a large file has got.
@@ -176,6 +173,16 @@ pub fn read(path: &Path, what: &str) -> Result<Vec<u8>> {
         return decompress_xz(path, what, &bytes, max);
     }
     Ok(bytes)
+}
+
+/// Opens `path` (a `what`) as [`read`] does, for a reader of its own: a
+/// regular file within the cap. Returns it and its size.
+pub fn open(path: &Path, what: &str) -> Result<(std::fs::File, u64)> {
+    check(path, what)?;
+    let file = std::fs::File::open(path).with_context(|| format!("{what} {}: cannot open it", path.display()))?;
+    // What was opened is checked too: the path may have changed since.
+    let len = check_meta(path, what, &file.metadata().with_context(|| format!("{what} {}", path.display()))?)?;
+    Ok((file, len))
 }
 
 /// Whether `path` names an xz-compressed file (`.xz`), which [`read`]

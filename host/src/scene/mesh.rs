@@ -326,8 +326,11 @@ impl ply_rs_bw::ply::PropertyAccess for PlyFace {
 /// are parsed into compact records (other elements are read and dropped),
 /// so a mesh takes little more memory than its triangles.
 pub fn load_ply(path: &Path) -> Result<Vec<Triangle>> {
-    let bytes = crate::internals::input::read(path, "mesh")?;
     let name = path.display().to_string();
+    if let Some(triangles) = super::ply_binary::load_in_blocks(path, &name)? {
+        return Ok(triangles);
+    }
+    let bytes = crate::internals::input::read(path, "mesh")?;
     match super::ply_binary::read(&bytes, &name) {
         Some(triangles) => triangles,
         None => parse_ply(&bytes, &name),
@@ -748,6 +751,69 @@ mod tests {
             b"ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty double x\nproperty double y\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n",
         ] {
             assert!(crate::scene::ply_binary::read(other, "o.ply").is_none());
+        }
+    }
+
+    /// The common binary layout read in blocks (a few bytes to whole files
+    /// at a time) gives the parser's triangles; polygons, bad indices and
+    /// sizes that are not the header's go to the whole-file path, and
+    /// `load_ply` still names their faults.
+    #[test]
+    fn binary_ply_in_blocks_equals_the_parser() {
+        use rand::{Rng, SeedableRng};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.ply");
+        // A fresh seed each run (printed); TREELET_TEST_SEED replays one.
+        let seed: u64 = std::env::var("TREELET_TEST_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(rand::random);
+        eprintln!("seed {seed}");
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let ints = |t: &str| match t {
+            "uchar" => 1,
+            "ushort" => 2,
+            _ => 4,
+        };
+        let in_blocks = |bytes: &[u8], block: usize| {
+            std::fs::write(&path, bytes).unwrap();
+            crate::scene::ply_binary::load_in_blocks_of(&path, "m.ply", block).unwrap()
+        };
+        for (case, (count, index)) in [("uchar", "int"), ("uchar", "uint"), ("ushort", "uint"), ("uchar", "ushort"), ("int", "int")].into_iter().enumerate() {
+            let n = rng.random_range(3..300usize);
+            let positions: Vec<[f32; 3]> = (0..n).map(|_| [rng.random(), rng.random::<f32>() * 1e3, -rng.random::<f32>()]).collect();
+            let faces: Vec<Vec<i64>> = (0..rng.random_range(1..500)).map(|_| (0..3).map(|_| rng.random_range(0..n as i64)).collect()).collect();
+            let order = [[0, 1, 2], [2, 0, 1], [1, 2, 0]][case % 3];
+            let bytes = binary_ply(&positions, &faces, order, count, index);
+            let parsed = parse_ply(&bytes, "m.ply").unwrap();
+            for block in [1, 13, 37, 4096, 1 << 22] {
+                let read = in_blocks(&bytes, block).unwrap_or_else(|| panic!("seed {seed}: {count} {index}: not read in blocks"));
+                assert_eq!(read, parsed, "seed {seed}: {count} {index}, blocks of {block}");
+            }
+            // A polygon, an index past the vertices, a byte too many or too few:
+            // not read in blocks.
+            let mut polygon = faces.clone();
+            polygon[rng.random_range(0..faces.len())].push(0);
+            let mut past = faces.clone();
+            past[rng.random_range(0..faces.len())][rng.random_range(0..3)] = n as i64;
+            for other in [binary_ply(&positions, &polygon, order, count, index), binary_ply(&positions, &past, order, count, index)] {
+                assert!(in_blocks(&other, 64).is_none(), "seed {seed}: {count} {index}");
+            }
+            // Three floats a vertex and nothing else: read straight into the positions.
+            let mut plain = format!(
+                "ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\n\
+                 element face {}\nproperty list {count} {index} vertex_indices\nend_header\n",
+                faces.len()
+            )
+            .into_bytes();
+            plain.extend(positions.iter().flatten().flat_map(|x| x.to_le_bytes()));
+            plain.extend_from_slice(&bytes[bytes.len() - faces.len() * (ints(count) + 3 * ints(index))..]);
+            for block in [1, 7, 4096] {
+                assert_eq!(in_blocks(&plain, block).as_ref(), Some(&parsed), "seed {seed}: plain {count} {index}, blocks of {block}");
+            }
+            let mut longer = bytes.clone();
+            longer.push(0);
+            assert!(in_blocks(&longer, 64).is_none());
+            assert!(in_blocks(&bytes[..bytes.len() - 1], 64).is_none());
+            let e = load_ply(&path).unwrap_err().to_string();
+            assert!(e.contains("truncated"), "{e}");
         }
     }
 

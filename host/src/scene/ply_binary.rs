@@ -5,9 +5,18 @@
 //! the general parser, which makes a record per element); every other PLY
 //! goes to the general parser ([`super::mesh::load_ply`]), and so do files
 //! this reader finds any doubt in, so that their errors are that parser's.
-use anyhow::{anyhow, bail, Result};
+//! A file of triangles alone is read in blocks through one buffer
+//! ([`load_in_blocks`]), never held whole; the others from the bytes of
+//! the whole file ([`read`]). Not memory-mapped: a file cut short by
+//! another process while mapped kills the reader (SIGBUS), where a read
+//! in blocks gets an error that names the file.
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context as _, Result};
 use rayon::prelude::*;
 use treelet_core::geometry::triangle::Triangle;
+
+use crate::internals::input;
 
 /// Size in bytes of a PLY scalar type, and whether it is an integer.
 fn scalar(name: &str) -> Option<(usize, bool)> {
@@ -35,7 +44,7 @@ impl Int {
         integer.then(|| Int { size, signed: matches!(name, "char" | "int8" | "short" | "int16" | "int" | "int32") })
     }
 
-    #[inline]
+    #[inline(always)]
     fn read(self, b: &[u8], at: usize) -> i64 {
         match (self.size, self.signed) {
             (1, false) => b[at] as i64,
@@ -140,6 +149,129 @@ fn all_triangles(faces: &[u8], l: &Layout, position: impl Fn(usize) -> [f32; 3] 
         })
         .collect_into_vec(&mut triangles);
     Some(Ok(triangles))
+}
+
+/// The triangles of the binary PLY at `path`, when it is the common layout
+/// and every face a triangle of indices in range, read in blocks through
+/// one buffer: the file's bytes are never held whole (at 10M triangles that
+/// copy was 490 MB of fresh pages, more than half of the load). `None` for
+/// any other file, or where a block finds any doubt: the caller then reads
+/// the file whole, and the general path names the fault.
+pub fn load_in_blocks(path: &Path, name: &str) -> Result<Option<Vec<Triangle>>> {
+    load_in_blocks_of(path, name, BLOCK_BYTES)
+}
+
+/// [`load_in_blocks`], `block_bytes` at a time (or one record, if larger).
+pub(super) fn load_in_blocks_of(path: &Path, name: &str, block_bytes: usize) -> Result<Option<Vec<Triangle>>> {
+    use std::io::Read;
+    if input::is_xz(path) {
+        return Ok(None);
+    }
+    let (file, len) = input::open(path, "mesh")?;
+    let mut file = file.take(len);
+    // The header: `layout` looks for its end within the first 64 KiB.
+    let mut head = Vec::new();
+    (&mut file).take((1 << 16) + 11).read_to_end(&mut head).with_context(|| format!("{name}: read error"))?;
+    let Some(l) = layout(&head) else { return Ok(None) };
+    let record = l.count.size + 3 * l.index.size;
+    let (Some(vertex_bytes), Some(face_bytes)) = (l.vertices.checked_mul(l.stride), l.faces.checked_mul(record)) else { return Ok(None) };
+    if (l.body as u64).checked_add(vertex_bytes as u64).and_then(|b| b.checked_add(face_bytes as u64)) != Some(len) {
+        return Ok(None);
+    }
+    let progress = crate::internals::progress::track(format!("reading mesh {}", path.display()), len);
+    let mut blocks = Blocks { file, buffer: Vec::new(), carried: head[l.body..].to_vec(), name };
+    // Vertices: their positions alone are kept. Three floats and nothing
+    // else, the common case, are read straight into them (no conversion).
+    let mut positions: Vec<[f32; 3]> = input::room_to_fill(l.vertices, "the mesh's vertices")?;
+    if l.stride == 12 && l.xyz == [0, 4, 8] && cfg!(target_endian = "little") {
+        positions.resize(l.vertices, [0.0; 3]);
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut positions);
+        for chunk in bytes.chunks_mut(block_bytes.max(1)) {
+            blocks.read_into(chunk)?;
+            progress.add(chunk.len() as u64);
+        }
+    } else {
+        let f32_at = |b: &[u8], at: usize| f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+        let mut left = l.vertices;
+        while left > 0 {
+            let n = left.min(block_bytes / l.stride).max(1);
+            let block = blocks.next(n * l.stride)?;
+            positions.par_extend(block.par_chunks_exact(l.stride).map(|v| [f32_at(v, l.xyz[0]), f32_at(v, l.xyz[1]), f32_at(v, l.xyz[2])]));
+            progress.add((n * l.stride) as u64);
+            left -= n;
+        }
+    }
+    // Faces: made into triangles in one pass, which marks any face that is
+    // not a triangle of indices in range (the file then goes to the
+    // whole-file path, which names it).
+    let mut triangles: Vec<Triangle> = input::room_to_fill(l.faces, "the mesh's triangles")?;
+    let index = |b: &[u8], at: usize| usize::try_from(l.index.read(b, at)).ok().filter(|&i| i < l.vertices);
+    let doubt = std::sync::atomic::AtomicBool::new(false);
+    let mut left = l.faces;
+    while left > 0 {
+        let n = left.min(block_bytes / record).max(1);
+        let block = blocks.next(n * record)?;
+        triangles.par_extend(block.par_chunks_exact(record).map(|f| {
+            let corner = |k: usize| index(f, l.count.size + k * l.index.size);
+            match (l.count.read(f, 0), corner(0), corner(1), corner(2)) {
+                (3, Some(a), Some(b), Some(c)) => Triangle::new(positions[a], positions[b], positions[c]),
+                _ => {
+                    doubt.store(true, std::sync::atomic::Ordering::Relaxed);
+                    Triangle::default()
+                }
+            }
+        }));
+        if doubt.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(None);
+        }
+        progress.add((n * record) as u64);
+        left -= n;
+    }
+    blocks.at_end()?;
+    Ok(Some(triangles))
+}
+
+/// Bytes read at a time by [`load_in_blocks`]: large enough that a block's
+/// work spreads over every core, small enough to stay in the caches.
+const BLOCK_BYTES: usize = 4 << 20;
+
+/// A file read in blocks of whole records through one buffer, after the
+/// bytes already read with the header (`carried`).
+struct Blocks<'a> {
+    file: std::io::Take<std::fs::File>,
+    buffer: Vec<u8>,
+    carried: Vec<u8>,
+    name: &'a str,
+}
+
+impl Blocks<'_> {
+    /// The next `n` bytes.
+    fn next(&mut self, n: usize) -> Result<&[u8]> {
+        let mut buffer = std::mem::take(&mut self.buffer);
+        buffer.resize(n, 0);
+        let read = self.read_into(&mut buffer);
+        self.buffer = buffer;
+        read.map(|()| self.buffer.as_slice())
+    }
+
+    /// Fills `out` with the next bytes.
+    fn read_into(&mut self, out: &mut [u8]) -> Result<()> {
+        use std::io::Read;
+        let from_carried = out.len().min(self.carried.len());
+        out[..from_carried].copy_from_slice(&self.carried[..from_carried]);
+        self.carried.drain(..from_carried);
+        self.file.read_exact(&mut out[from_carried..]).with_context(|| format!("{}: the file ended early (truncated while read?)", self.name))
+    }
+
+    /// Checks that nothing is left: the file did not grow while read.
+    fn at_end(self) -> Result<()> {
+        use std::io::Read;
+        let mut rest = self.file.into_inner();
+        if !self.carried.is_empty() || rest.read(&mut [0u8; 1]).with_context(|| format!("{}: read error", self.name))? != 0 {
+            bail!("{}: the file grew while it was read", self.name);
+        }
+        Ok(())
+    }
 }
 
 fn triangles(bytes: &[u8], name: &str, l: &Layout) -> Result<Vec<Triangle>> {
