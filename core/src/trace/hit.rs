@@ -6,6 +6,7 @@ use glam::Vec3;
 use crate::geometry::buffers::Material;
 use crate::geometry::intersect::MISS;
 use crate::geometry::prims::{Origin, Prims};
+use crate::trace::stream::RayStream;
 
 /// A way to find closest hits: the scan, or a tree in one of the traversal
 /// layouts (the seed's 32-byte nodes here; [`crate::trace::bvh2`],
@@ -36,6 +37,31 @@ pub trait ClosestHit {
         stack: &mut [u32; S],
         lane: u32,
     ) -> Hit;
+
+    /// [`ClosestHit::trace`] for the ray `first` and then each ray `stream`
+    /// gives, every hit handed to the stream. Layouts whose walk takes the
+    /// next ray within its loop ([`crate::trace::stream`]) say so here; by
+    /// default the rays are traced one after another.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn trace_stream<const F: u32, const S: usize>(
+        &self,
+        first: (Vec3, Vec3, Origin),
+        stream: &mut impl RayStream,
+        query: Query,
+        prims: &Prims,
+        stack: &mut [u32; S],
+        lane: u32,
+    ) {
+        let (mut o, mut d, mut from) = first;
+        loop {
+            let hit = self.trace::<F, S>(o, d, from, query, prims, stack, lane);
+            stream.finish(hit, u32::MAX);
+            if !stream.next(&mut o, &mut d, &mut from) {
+                return;
+            }
+        }
+    }
 
     /// The material and outward normal (unit length) of the `k`-th
     /// primitive past the scene's own, hit along `d`: a placed copy's

@@ -25,3 +25,4 @@ pub mod cwbvh;
 pub mod hit;
 pub mod instances;
 pub mod placed;
+pub mod stream;

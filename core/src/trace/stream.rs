@@ -1,0 +1,65 @@
+//! Several rays through one walk loop, one after another: a lane whose ray
+//! is done takes its next ray at once, in the same loop iteration, instead
+//! of idling until every lane of its subgroup is done with theirs (Aila &
+//! Laine 2009, "persistent threads" with terminated rays replaced; here
+//! each lane's rays are fixed in advance, every `stride`-th ray, so no
+//! atomic counter is needed and the CPU runner gives the same answers).
+//! Diffuse rays differ in length by orders of magnitude, so the lanes of a
+//! subgroup that start together otherwise spend most of the walk waiting
+//! for the longest of them.
+use glam::Vec3;
+
+use crate::geometry::prims::Origin;
+use crate::trace::hit::{Hit, Query};
+
+/// Where a walk gets its rays and leaves their hits ([`ClosestHit::trace_stream`](crate::trace::hit::ClosestHit::trace_stream)).
+pub trait RayStream {
+    /// Takes `hit` (and the instance it was found in, `u32::MAX` without)
+    /// as the answer for the ray given last.
+    fn finish(&mut self, hit: Hit, instance: u32);
+    /// Sets the next ray into `o`, `d`, `from`; false when none is left.
+    fn next(&mut self, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
+}
+
+/// The stream of one ray (a walk's plain form): its hit is kept.
+pub struct OneRay {
+    pub hit: Hit,
+    pub instance: u32,
+}
+
+impl OneRay {
+    #[inline]
+    pub fn new() -> Self {
+        OneRay { hit: Hit::NONE, instance: u32::MAX }
+    }
+}
+
+impl Default for OneRay {
+    #[inline]
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RayStream for OneRay {
+    #[inline]
+    fn finish(&mut self, hit: Hit, instance: u32) {
+        (self.hit, self.instance) = (hit, instance);
+    }
+
+    #[inline]
+    fn next(&mut self, _: &mut Vec3, _: &mut Vec3, _: &mut Origin) -> bool {
+        false
+    }
+}
+
+/// Every ray of `stream`, `first` included, answered as a miss (a scene
+/// without primitives).
+#[inline]
+pub fn miss_all(first: (Vec3, Vec3, Origin), stream: &mut impl RayStream, query: Query) {
+    let (mut o, mut d, mut from) = first;
+    stream.finish(query.start(), u32::MAX);
+    while stream.next(&mut o, &mut d, &mut from) {
+        stream.finish(query.start(), u32::MAX);
+    }
+}
