@@ -34,7 +34,39 @@ pub fn load(path: &Path) -> Result<Vec<Triangle>> {
         bail!("{}: the mesh has no triangles", path.display());
     }
     Primitives::triangles(&triangles).check().with_context(|| format!("{}", path.display()))?;
+    let (triangles, dropped) = without_zero_area(triangles);
+    if dropped > 0 {
+        eprintln!(
+            "note: {}: {dropped} triangles of zero area dropped (from polygons fanned around a vertex in line with its neighbours, or repeated vertices): no ray can hit them",
+            path.display()
+        );
+    }
+    if triangles.is_empty() {
+        bail!("{}: every triangle of the mesh has zero area", path.display());
+    }
     Ok(triangles)
+}
+
+/// `triangles` without those of zero area (edges whose cross product is
+/// exactly zero, in f64), and how many there were. A polygon fanned around its
+/// first vertex makes one wherever two neighbours lie in line with it; the
+/// watertight test never reports a hit on one, so they would only cost the
+/// tree room and time.
+pub fn without_zero_area(mut triangles: Vec<Triangle>) -> (Vec<Triangle>, usize) {
+    use rayon::prelude::*;
+    // In f64, where a tiny triangle's cross product does not underflow.
+    let zero = |t: &Triangle| {
+        let e = |p: [f32; 3]| [p[0] as f64 - t.v0[0] as f64, p[1] as f64 - t.v0[1] as f64, p[2] as f64 - t.v0[2] as f64];
+        let (u, v) = (e(t.v1), e(t.v2));
+        u[1] * v[2] - u[2] * v[1] == 0.0 && u[2] * v[0] - u[0] * v[2] == 0.0 && u[0] * v[1] - u[1] * v[0] == 0.0
+    };
+    if !triangles.par_iter().any(zero) {
+        return (triangles, 0);
+    }
+    let before = triangles.len();
+    triangles.retain(|t| !zero(t));
+    let dropped = before - triangles.len();
+    (triangles, dropped)
 }
 
 /// Wavefront OBJ: every object's faces, triangulated; materials are not
@@ -815,6 +847,35 @@ mod tests {
             let e = load_ply(&path).unwrap_err().to_string();
             assert!(e.contains("truncated"), "{e}");
         }
+    }
+
+    /// A polygon fanned around a vertex in line with its neighbours gives
+    /// triangles of zero area: dropped, in OBJ and PLY alike; a mesh of
+    /// nothing else is refused by name.
+    #[test]
+    fn zero_area_triangles_are_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        // A pentagon whose first three corners lie on one line: its fan's
+        // first triangle has zero area, the other two do not.
+        let obj = dir.path().join("p.obj");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4 5\n").unwrap();
+        let t = load(&obj).unwrap();
+        assert_eq!(t.len(), 2);
+        assert!(t.iter().all(|t| t.v1 != [1.0, 0.0, 0.0] || t.v2 != [2.0, 0.0, 0.0]));
+        let ply = dir.path().join("p.ply");
+        std::fs::write(
+            &ply,
+            "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n\
+             element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n2 0 0\n2 1 0\n0 1 0\n5 0 1 2 3 4\n3 1 1 3\n",
+        )
+        .unwrap();
+        assert_eq!(load(&ply).unwrap().len(), 2);
+        let flat = dir.path().join("f.obj");
+        std::fs::write(&flat, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
+        let e = load(&flat).unwrap_err().to_string();
+        assert!(e.contains("f.obj") && e.contains("zero area"), "{e}");
+        let (kept, dropped) = without_zero_area(vec![Triangle::new([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1e-30, 0.0])]);
+        assert_eq!((kept.len(), dropped), (1, 0), "a thin triangle is not of zero area");
     }
 
     /// Each bad file gives an error naming the file and the problem; none panics.
