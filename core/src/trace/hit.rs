@@ -6,7 +6,6 @@ use glam::Vec3;
 use crate::geometry::buffers::Material;
 use crate::geometry::intersect::MISS;
 use crate::geometry::prims::{Origin, Prims};
-use crate::trace::stream::RayStream;
 
 /// A way to find closest hits: the scan, or a tree in one of the traversal
 /// layouts (the seed's 32-byte nodes here; [`crate::trace::bvh2`],
@@ -40,7 +39,7 @@ pub trait ClosestHit {
 
     /// [`ClosestHit::trace`] for the ray `first` and then each ray `stream`
     /// gives, every hit handed to the stream. Layouts whose walk takes the
-    /// next ray within its loop ([`crate::trace::stream`]) say so here; by
+    /// next ray within its loop (the `stream` module) say so here; by
     /// default the rays are traced one after another.
     #[allow(clippy::too_many_arguments)]
     #[inline]
@@ -71,6 +70,16 @@ pub trait ClosestHit {
     fn placed_surface(&self, _k: u32, d: Vec3) -> (Material, Vec3) {
         (Material::default(), -d)
     }
+}
+
+/// Where a walk gets its rays and leaves their hits ([`ClosestHit::trace_stream`]; the walks that
+/// take the next ray within their loop, and why: the `stream` module).
+pub trait RayStream {
+    /// Takes `hit` (and the instance it was found in, `u32::MAX` without)
+    /// as the answer for the ray given last.
+    fn finish(&mut self, hit: Hit, instance: u32);
+    /// Sets the next ray into `o`, `d`, `from`; false when none is left.
+    fn next(&mut self, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
 }
 
 /// What a traversal looks for: the closest hit up to `t_max`, or, for an

@@ -10,16 +10,8 @@
 use glam::Vec3;
 
 use crate::geometry::prims::Origin;
+pub use crate::trace::hit::RayStream;
 use crate::trace::hit::{Hit, Query};
-
-/// Where a walk gets its rays and leaves their hits ([`ClosestHit::trace_stream`](crate::trace::hit::ClosestHit::trace_stream)).
-pub trait RayStream {
-    /// Takes `hit` (and the instance it was found in, `u32::MAX` without)
-    /// as the answer for the ray given last.
-    fn finish(&mut self, hit: Hit, instance: u32);
-    /// Sets the next ray into `o`, `d`, `from`; false when none is left.
-    fn next(&mut self, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
-}
 
 /// The stream of one ray (a walk's plain form): its hit is kept.
 pub struct OneRay {
