@@ -100,32 +100,6 @@ mod tests {
         assert!(unpack(&whole[..whole.len() - 4]).is_err(), "a module cut short");
         assert_eq!(unpack(whole).map(|m| m.len()).unwrap_or(0), Kernel::all().len(), "one module per kernel");
     }
-
-    /// No module holds a NaN as a float constant: NVIDIA's SPIR-V compiler
-    /// (driver 580.159.04) segfaulted creating the pipeline of every module
-    /// that did (`f32::from_bits(u32::MAX)` folds to one; see
-    /// `treelet_core::render::rays`).
-    #[test]
-    fn no_module_holds_a_nan_constant() {
-        for m in unpack(SHADERS).unwrap() {
-            let words: Vec<u32> = m.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-            let mut float_types = Vec::new();
-            let mut at = 5;
-            while at < words.len() {
-                let (count, op) = ((words[at] >> 16) as usize, words[at] & 0xFFFF);
-                assert!(count > 0 && at + count <= words.len(), "{}: malformed at word {at}", m.entry_point);
-                let ins = &words[at..at + count];
-                // OpTypeFloat 32, then OpConstant of such a type.
-                if op == 22 && ins[2] == 32 {
-                    float_types.push(ins[1]);
-                }
-                if op == 43 && float_types.contains(&ins[1]) {
-                    assert!(!f32::from_bits(ins[3]).is_nan(), "{}: a NaN constant ({:#x})", m.entry_point, ins[3]);
-                }
-                at += count;
-            }
-        }
-    }
 }
 
 impl Module {
