@@ -282,20 +282,9 @@ pub fn write_engine_hit(params: &RenderParams, rays: &mut [[f32; 4]], id: u32, f
         rays[i] = hit;
         rays[j] = normal;
     } else {
-        let none = no_index_bits(id);
-        rays[i] = [f32::INFINITY, none, 0.0, 0.0];
-        rays[j] = [0.0, 0.0, 0.0, none];
+        rays[i] = [f32::INFINITY, f32::from_bits(u32::MAX), 0.0, 0.0];
+        rays[j] = [0.0, 0.0, 0.0, f32::from_bits(u32::MAX)];
     }
-}
-
-/// `u32::MAX` (no primitive, no instance) as the bits of an f32, made from
-/// `any` at run time: NVIDIA's SPIR-V compiler (driver 580.159.04, seen on
-/// an H200 on 2026-12-03) crashed on every module holding that NaN as a
-/// constant (`OpConstant` 0xFFFFFFFF of a float type), which
-/// `f32::from_bits(u32::MAX)` folds to.
-#[inline]
-fn no_index_bits(any: u32) -> f32 {
-    f32::from_bits(any | !any)
 }
 
 /// The unit geometric normal of primitive `prim` at `x`: a sphere's outward
