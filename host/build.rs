@@ -16,7 +16,11 @@
 //! module count, then per module its name's length in bytes, the name
 //! padded with zeros to whole words, its length in words, its words.
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let committed = concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/treelet_shaders.bin");
+    // The manifest's folder as cargo gives it to this run, not as it was
+    // when this script was compiled: two checkouts sharing one target
+    // folder share the compiled script, and one read the other's shaders.
+    let manifest = std::env::var("CARGO_MANIFEST_DIR")?;
+    let committed = format!("{manifest}/shaders/treelet_shaders.bin");
     println!("cargo:rustc-env=treelet_shaders_committed.bin={committed}");
     println!("cargo:rerun-if-changed={committed}");
     #[cfg(feature = "rebuild-shaders")]
@@ -36,11 +40,11 @@ const GROUPS: [&str; 6] = ["kernels", "render-linear", "render-bvh2", "render-bv
 #[cfg(feature = "rebuild-shaders")]
 fn rebuild() -> Result<(), Box<dyn std::error::Error>> {
     use spirv_builder::{Capability, ModuleResult, SpirvBuilder};
-    let shader = concat!(env!("CARGO_MANIFEST_DIR"), "/../shader");
+    let shader = format!("{}/../shader", std::env::var("CARGO_MANIFEST_DIR")?);
     // Sorted by entry point, so the same sources pack the same bytes.
     let mut modules: std::collections::BTreeMap<String, Vec<u32>> = Default::default();
     for group in GROUPS {
-        let mut builder = SpirvBuilder::new(shader, "spirv-unknown-vulkan1.2")
+        let mut builder = SpirvBuilder::new(&shader, "spirv-unknown-vulkan1.2")
             // u64 Morton codes and radix-sort keys.
             .capability(Capability::Int64)
             // Device-scope atomics (bottom-up fit): needs SPIR-V passthrough in wgpu.

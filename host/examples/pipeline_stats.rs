@@ -8,6 +8,8 @@
 //!
 //! Entry points are named as in the shader crate (`render::cast_cwbvh_cs`);
 //! without names, every kernel of `treelet::runtime::kernels::Kernel::all()`.
+//! A name ending in `.spv` is a SPIR-V file of one entry point instead (a
+//! module cut down by `spirv-reduce`, say, to report a driver's bug).
 use std::ffi::CString;
 
 use anyhow::{bail, Context, Result};
@@ -66,9 +68,15 @@ fn main() -> Result<()> {
         let sets = [set];
         let layout = device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&sets), None)?;
         for name in &names {
-            let cname = CString::new(name.as_str())?;
-            let Some(m) = treelet::runtime::gpu::shaders::module(name) else { bail!("no entry point `{name}`") };
-            let words = ash::util::read_spv(&mut std::io::Cursor::new(m.spirv))?;
+            let (words, cname) = if name.ends_with(".spv") {
+                let bytes = std::fs::read(name).with_context(|| format!("reading {name}"))?;
+                let words = ash::util::read_spv(&mut std::io::Cursor::new(bytes))?;
+                let entry = first_entry_point(&words).with_context(|| format!("{name}: no OpEntryPoint"))?;
+                (words, CString::new(entry)?)
+            } else {
+                let Some(m) = treelet::runtime::gpu::shaders::module(name) else { bail!("no entry point `{name}`") };
+                (ash::util::read_spv(&mut std::io::Cursor::new(m.spirv))?, CString::new(name.as_str())?)
+            };
             let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
             let stage = vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::COMPUTE)
@@ -107,4 +115,24 @@ fn main() -> Result<()> {
         instance.destroy_instance(None);
     }
     Ok(())
+}
+
+/// The name of a SPIR-V module's first entry point: `OpEntryPoint` (opcode
+/// 15) holds the execution model, the function, then the name as a
+/// nul-terminated string packed into words.
+fn first_entry_point(words: &[u32]) -> Option<String> {
+    let mut at = 5; // past the header
+    while at < words.len() {
+        let (count, opcode) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+        if count == 0 {
+            return None;
+        }
+        if opcode == 15 {
+            let bytes: Vec<u8> = words.get(at + 3..at + count)?.iter().flat_map(|w| w.to_le_bytes()).collect();
+            let end = bytes.iter().position(|&b| b == 0)?;
+            return String::from_utf8(bytes[..end].to_vec()).ok();
+        }
+        at += count;
+    }
+    None
 }

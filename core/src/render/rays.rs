@@ -69,8 +69,9 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
     stack: &mut [u32; S],
     lane: u32,
 ) {
+    let mode = params.cast_mode;
     let (w, h) = (params.width, params.height);
-    let diffuse = params.cast_mode == CAST_DIFFUSE || params.cast_mode == CAST_DIFFUSE_OCCLUDED;
+    let diffuse = mode == CAST_DIFFUSE || mode == CAST_DIFFUSE_OCCLUDED;
     if diffuse && params.ray_lanes != 0 {
         if invocation < params.ray_lanes {
             cast_diffuse_lanes::<T, F, S>(invocation, params, scene, rays, stack, lane);
@@ -82,7 +83,7 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         return;
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);
-    if params.cast_mode == CAST_RAYS || params.cast_mode == CAST_OCCLUDED {
+    if mode == CAST_RAYS || mode == CAST_OCCLUDED {
         let EngineRay { o, d, query, marked } = engine_ray(params, rays, id);
         if marked {
             let hit = if query.t_max >= 0.0 { trace::<T, F, S>(o, d, Origin::NONE, query, scene, stack, lane) } else { Hit::NONE };
@@ -96,11 +97,11 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
             };
             write_engine_hit(params, rays, id, found, record);
         }
-    } else if params.cast_mode == CAST_PRIMARY {
+    } else if mode == CAST_PRIMARY {
         let (o, d) = camera_ray(params, id);
         let hit = closest_hit::<T, F, S>(o, d, Origin::NONE, scene, stack, lane);
         rays[i] = [hit.t, f32::from_bits(hit.prim), 0.0, 0.0];
-    } else if params.cast_mode == CAST_BOUNCE {
+    } else if mode == CAST_BOUNCE {
         let (t, prim) = (rays[i][0], rays[i][1].to_bits());
         if prim == u32::MAX {
             rays[i] = [0.0; 4];
@@ -120,7 +121,7 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
         let prim = rays[j][3].to_bits();
         // Leaving the surface outwards: it cannot be hit again.
-        let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
+        let query = if mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
         let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
@@ -138,20 +139,20 @@ fn cast_diffuse_lanes<T: ClosestHit, const F: u32, const S: usize>(
     lane: u32,
 ) {
     let end = tiled_invocations(params.width, params.height);
-    let mut lanes = DiffuseLanes { rays, at: 0, lanes: params.ray_lanes, end, width: params.width, height: params.height, id: 0 };
+    let mut lanes = DiffuseLanes { at: 0, lanes: params.ray_lanes, end, width: params.width, height: params.height, id: 0 };
     let (mut o, mut d, mut from) = (Vec3::ZERO, Vec3::ZERO, Origin::NONE);
-    if !lanes.seek(lane_id, &mut o, &mut d, &mut from) {
+    if !lanes.seek(rays, lane_id, &mut o, &mut d, &mut from) {
         return;
     }
     // Leaving the surface outwards: it cannot be hit again.
     let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
-    scene.tree.trace_stream::<F, S>((o, d, from), &mut lanes, query, &scene.prims, stack, lane);
+    scene.tree.trace_stream::<F, S, _>((o, d, from), &mut lanes, rays, query, &scene.prims, stack, lane);
 }
 
 /// One lane's diffuse rays: every `lanes`-th invocation from its own, up
-/// to `end`, those whose camera ray hit ([`CAST_BOUNCE`] marked them).
-struct DiffuseLanes<'a> {
-    rays: &'a mut [[f32; 4]],
+/// to `end`, those whose camera ray hit ([`CAST_BOUNCE`] marked them), read
+/// from and written to the rays buffer it is handed (its `Io`).
+struct DiffuseLanes {
     /// The invocation of the ray in flight, and its pixel.
     at: u32,
     id: u32,
@@ -161,15 +162,15 @@ struct DiffuseLanes<'a> {
     height: u32,
 }
 
-impl DiffuseLanes<'_> {
+impl DiffuseLanes {
     /// The first marked ray from invocation `k` on (in steps of `lanes`).
     #[inline]
-    fn seek(&mut self, mut k: u32, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
+    fn seek(&mut self, rays: &[[f32; 4]], mut k: u32, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
         while k < self.end {
             let id = tiled_pixel(k, self.width, self.height);
             let i = 2 * id as usize;
-            if id != u32::MAX && self.rays[i][3] != 0.0 {
-                let (a, b) = (self.rays[i], self.rays[i + 1]);
+            if id != u32::MAX && rays[i][3] != 0.0 {
+                let (a, b) = (rays[i], rays[i + 1]);
                 (*o, *d) = (Vec3::new(a[0], a[1], a[2]), Vec3::new(b[0], b[1], b[2]));
                 *from = Origin { prim: b[3].to_bits(), into: false };
                 (self.at, self.id) = (k, id);
@@ -181,15 +182,17 @@ impl DiffuseLanes<'_> {
     }
 }
 
-impl RayStream for DiffuseLanes<'_> {
+impl RayStream for DiffuseLanes {
+    type Io = [[f32; 4]];
+
     #[inline]
-    fn finish(&mut self, hit: Hit, _: u32) {
-        self.rays[2 * self.id as usize][3] = if hit.is_hit() { hit.t } else { -1.0 };
+    fn finish(&mut self, rays: &mut [[f32; 4]], hit: Hit, _: u32) {
+        rays[2 * self.id as usize][3] = if hit.is_hit() { hit.t } else { -1.0 };
     }
 
     #[inline]
-    fn next(&mut self, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
-        self.seek(self.at + self.lanes, o, d, from)
+    fn next(&mut self, rays: &mut [[f32; 4]], o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
+        self.seek(rays, self.at + self.lanes, o, d, from)
     }
 }
 

@@ -49,20 +49,21 @@ impl<N: RecordLoad<Bvh2Node>, P: RecordLoad<LeafPrim>> ClosestHit for Bvh2Tree<N
     }
 
     #[inline]
-    fn trace_stream<const F: u32, const S: usize>(
+    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
         &self,
         first: (Vec3, Vec3, Origin),
-        stream: &mut impl RayStream,
+        stream: &mut R,
+        io: &mut R::Io,
         query: Query,
         prims: &Prims,
         _: &mut [u32; S],
         _: u32,
     ) {
         if prims.count() == 0 {
-            return miss_all(first, stream, query);
+            return miss_all(first, stream, io, query);
         }
         let one = Level { nodes: &self.nodes, leaves: &self.leaf_prims };
-        walk_stream::<F, false, { 2 * STACK_DEPTH }>(first, stream, &query, prims, &NoInstances, &one);
+        walk_stream::<F, false, { 2 * STACK_DEPTH }, _>(first, stream, io, &query, prims, &NoInstances, &one);
     }
 }
 
@@ -177,7 +178,7 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     trees: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized>,
 ) -> (Hit, u32) {
     let mut one = OneRay::new();
-    walk_stream::<F, INSTANCED, STACK>((o, d, from), &mut one, query, prims, instances, trees);
+    walk_stream::<F, INSTANCED, STACK, _>((o, d, from), &mut one, &mut (), query, prims, instances, trees);
     (one.hit, one.instance)
 }
 
@@ -186,9 +187,10 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
 /// starts in the same iteration (see [`crate::trace::stream`]).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize>(
+pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize, R: RayStream + ?Sized>(
     first: (Vec3, Vec3, Origin),
-    stream: &mut impl RayStream,
+    stream: &mut R,
+    io: &mut R::Io,
     query: &Query,
     prims: &Prims,
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
@@ -292,8 +294,8 @@ pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize>(
         }
         if done {
             // This ray's answer; the next ray (if any) starts at the root.
-            stream.finish(hit, found_in);
-            if !stream.next(&mut o, &mut d, &mut from) {
+            stream.finish(io, hit, found_in);
+            if !stream.next(io, &mut o, &mut d, &mut from) {
                 return;
             }
             hit = query.start();

@@ -182,21 +182,22 @@ impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> ClosestHit for WideTree<N
     }
 
     #[inline]
-    fn trace_stream<const F: u32, const S: usize>(
+    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
         &self,
         first: (Vec3, Vec3, Origin),
-        stream: &mut impl RayStream,
+        stream: &mut R,
+        io: &mut R::Io,
         query: Query,
         prims: &Prims,
         stack: &mut [u32; S],
         lane: u32,
     ) {
         if prims.count() == 0 {
-            return miss_all(first, stream, query);
+            return miss_all(first, stream, io, query);
         }
         let mut private = scratch::<u32, { 2 * WIDE_STACK }>();
         let (nodes, leaf_prims) = (&self.nodes, &self.leaf_prims);
-        trace_cwbvh_stream::<F, S>(first, stream, query, prims, nodes, leaf_prims, &mut private, stack, lane as usize);
+        trace_cwbvh_stream::<F, S, _>(first, stream, io, query, prims, nodes, leaf_prims, &mut private, stack, lane as usize);
     }
 }
 
@@ -269,7 +270,7 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
         return query.start();
     }
     let mut one = OneRay::new();
-    trace_cwbvh_stream::<F, SHARED>((o, d, from), &mut one, query, prims, nodes, leaf_prims, private, shared, lane);
+    trace_cwbvh_stream::<F, SHARED, _>((o, d, from), &mut one, &mut (), query, prims, nodes, leaf_prims, private, shared, lane);
     one.hit
 }
 
@@ -278,9 +279,10 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
 /// hold primitives.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn trace_cwbvh_stream<const F: u32, const SHARED: usize>(
+pub fn trace_cwbvh_stream<const F: u32, const SHARED: usize, R: RayStream + ?Sized>(
     first: (Vec3, Vec3, Origin),
-    stream: &mut impl RayStream,
+    stream: &mut R,
+    io: &mut R::Io,
     query: Query,
     prims: &Prims,
     nodes: &(impl RecordLoad<WideNode> + ?Sized),
@@ -346,8 +348,8 @@ pub fn trace_cwbvh_stream<const F: u32, const SHARED: usize>(
         }
         if done {
             // This ray's answer; the next ray (if any) starts at the root.
-            stream.finish(hit, u32::MAX);
-            if !stream.next(&mut o, &mut d, &mut from) {
+            stream.finish(io, hit, u32::MAX);
+            if !stream.next(io, &mut o, &mut d, &mut from) {
                 return;
             }
             hit = query.start();

@@ -43,10 +43,11 @@ pub trait ClosestHit {
     /// default the rays are traced one after another.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn trace_stream<const F: u32, const S: usize>(
+    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
         &self,
         first: (Vec3, Vec3, Origin),
-        stream: &mut impl RayStream,
+        stream: &mut R,
+        io: &mut R::Io,
         query: Query,
         prims: &Prims,
         stack: &mut [u32; S],
@@ -55,8 +56,8 @@ pub trait ClosestHit {
         let (mut o, mut d, mut from) = first;
         loop {
             let hit = self.trace::<F, S>(o, d, from, query, prims, stack, lane);
-            stream.finish(hit, u32::MAX);
-            if !stream.next(&mut o, &mut d, &mut from) {
+            stream.finish(io, hit, u32::MAX);
+            if !stream.next(io, &mut o, &mut d, &mut from) {
                 return;
             }
         }
@@ -75,11 +76,18 @@ pub trait ClosestHit {
 /// Where a walk gets its rays and leaves their hits ([`ClosestHit::trace_stream`]; the walks that
 /// take the next ray within their loop, and why: the `stream` module).
 pub trait RayStream {
+    /// What the stream reads its rays from and writes their hits to (a
+    /// kernel's buffers), handed to each call beside the stream, never kept
+    /// in it: the state a walk carries from ray to ray must be plain values.
+    /// A stream holding a buffer's reference and changing in the loop
+    /// became, through rust-gpu, a loop phi of a struct holding a pointer,
+    /// on which NVIDIA's SPIR-V compiler (driver 580.159) segfaults.
+    type Io: ?Sized;
     /// Takes `hit` (and the instance it was found in, `u32::MAX` without)
     /// as the answer for the ray given last.
-    fn finish(&mut self, hit: Hit, instance: u32);
+    fn finish(&mut self, io: &mut Self::Io, hit: Hit, instance: u32);
     /// Sets the next ray into `o`, `d`, `from`; false when none is left.
-    fn next(&mut self, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
+    fn next(&mut self, io: &mut Self::Io, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
 }
 
 /// What a traversal looks for: the closest hit up to `t_max`, or, for an

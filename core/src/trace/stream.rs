@@ -34,13 +34,15 @@ impl Default for OneRay {
 }
 
 impl RayStream for OneRay {
+    type Io = ();
+
     #[inline]
-    fn finish(&mut self, hit: Hit, instance: u32) {
+    fn finish(&mut self, _: &mut (), hit: Hit, instance: u32) {
         (self.hit, self.instance) = (hit, instance);
     }
 
     #[inline]
-    fn next(&mut self, _: &mut Vec3, _: &mut Vec3, _: &mut Origin) -> bool {
+    fn next(&mut self, _: &mut (), _: &mut Vec3, _: &mut Vec3, _: &mut Origin) -> bool {
         false
     }
 }
@@ -48,10 +50,10 @@ impl RayStream for OneRay {
 /// Every ray of `stream`, `first` included, answered as a miss (a scene
 /// without primitives).
 #[inline]
-pub fn miss_all(first: (Vec3, Vec3, Origin), stream: &mut impl RayStream, query: Query) {
+pub fn miss_all<R: RayStream + ?Sized>(first: (Vec3, Vec3, Origin), stream: &mut R, io: &mut R::Io, query: Query) {
     let (mut o, mut d, mut from) = first;
-    stream.finish(query.start(), u32::MAX);
-    while stream.next(&mut o, &mut d, &mut from) {
-        stream.finish(query.start(), u32::MAX);
+    stream.finish(io, query.start(), u32::MAX);
+    while stream.next(io, &mut o, &mut d, &mut from) {
+        stream.finish(io, query.start(), u32::MAX);
     }
 }

@@ -100,6 +100,38 @@ mod tests {
         assert!(unpack(&whole[..whole.len() - 4]).is_err(), "a module cut short");
         assert_eq!(unpack(whole).map(|m| m.len()).unwrap_or(0), Kernel::all().len(), "one module per kernel");
     }
+
+    /// No module merges pointers at a phi (`OpPhi` of a pointer, or of a
+    /// struct holding one): NVIDIA's SPIR-V compiler (driver 580.159.04)
+    /// segfaulted creating every pipeline that did. rust-gpu makes one of a
+    /// value that holds a buffer's reference and changes in a loop (a
+    /// `RayStream` that kept the rays buffer: see its `Io`).
+    #[test]
+    fn no_module_merges_pointers_at_a_phi() {
+        for m in unpack(SHADERS).unwrap() {
+            let words: Vec<u32> = m.spirv.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+            // Pointer types, and structs with such a member (at any depth:
+            // SPIR-V declares a type before its use).
+            let mut holds_pointer = std::collections::HashSet::new();
+            let mut at = 5;
+            while at < words.len() {
+                let (count, op) = ((words[at] >> 16) as usize, words[at] & 0xFFFF);
+                assert!(count > 0 && at + count <= words.len(), "{}: malformed at word {at}", m.entry_point);
+                let ins = &words[at..at + count];
+                match op {
+                    32 => {
+                        holds_pointer.insert(ins[1]); // OpTypePointer
+                    }
+                    30 if ins[2..].iter().any(|t| holds_pointer.contains(t)) => {
+                        holds_pointer.insert(ins[1]); // OpTypeStruct
+                    }
+                    245 => assert!(!holds_pointer.contains(&ins[1]), "{}: a phi of pointers (%{})", m.entry_point, ins[2]), // OpPhi
+                    _ => {}
+                }
+                at += count;
+            }
+        }
+    }
 }
 
 impl Module {
