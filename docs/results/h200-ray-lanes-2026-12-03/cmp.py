@@ -2,7 +2,7 @@
 and layout: primary (a check: lanes touch only diffuse casts), diffuse and occlusion rays.
 usage: cmp.py DIR"""
 import json, sys, glob, os
-d = sys.argv[1]
+d = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), 'json')
 def rows(f):
     out = {}
     for r in json.load(open(f))['rows']:

@@ -2,7 +2,7 @@
 for primary and for diffuse rays, over OptiX's rates, with the lanes runs' diffuse rates beside
 (the one-lane runs' means and the best lanes run's). usage: table.py DIR"""
 import json, sys, os, glob
-d = sys.argv[1]
+d = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), 'json')
 o = json.load(open(os.path.join(d, 'optix.json')))['rows']
 def rows(f):
     return {(r['scene'], r['view'], r['treelet']['layout']): r['treelet'] for r in json.load(open(f))['rows']}
