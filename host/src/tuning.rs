@@ -129,10 +129,6 @@ pub struct Tuning {
     pub profile_reinsert: bool,
     /// `TREELET_WIDE_COSTS=NODE,PRIM`: the 8-wide layout's cost model.
     pub wide_costs: Option<(f32, f32)>,
-    /// `TREELET_RAY_LANES=N`: diffuse ray casts run on N lanes, each taking
-    /// every N-th ray in one walk loop (`treelet_core::trace::stream`); `0`:
-    /// one lane a ray.
-    pub ray_lanes: Option<u32>,
 }
 
 impl Default for Tuning {
@@ -159,7 +155,6 @@ impl Default for Tuning {
             profile_levels: None,
             profile_reinsert: false,
             wide_costs: None,
-            ray_lanes: None,
         }
     }
 }
@@ -266,12 +261,6 @@ impl Tuning {
                     t.wide_costs = Some((node, prim))
                 }
                 _ => return Err(err(name, &v, "expected NODE,PRIM, two finite numbers >= 0")),
-            }
-        }
-        if let Some((name, v)) = get("TREELET_RAY_LANES") {
-            match v.trim().parse::<u32>() {
-                Ok(n) if n <= 1 << 26 => t.ray_lanes = Some(n),
-                _ => return Err(err(name, &v, "expected a number of lanes from 0 to 67108864")),
             }
         }
         Ok(t)

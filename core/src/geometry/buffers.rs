@@ -270,10 +270,7 @@ pub struct RenderParams {
     /// [`INDEPENDENT`] or [`SOBOL`]: where camera paths draw their sample
     /// points ([`crate::render::sampler`]).
     pub sampler: u32,
-    /// Lanes of a diffuse cast that take every `ray_lanes`-th ray each, in
-    /// one walk loop ([`crate::trace::stream`]); 0: one invocation a ray.
-    pub ray_lanes: u32,
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 3],
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 128);
 

@@ -15,8 +15,7 @@ use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::triangle::{WatertightRay, ray_triangle_barycentrics};
 use crate::geometry::flat::ray_plane_coordinates;
 use crate::gpu::rng::BounceRng;
-use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_invocations, tiled_pixel, trace};
-use crate::trace::stream::RayStream;
+use crate::render::integrator::{SceneRefs, closest_hit, hit_normal_for, tiled_pixel, trace};
 use crate::render::sampling::cosine_direction;
 use crate::trace::hit::{ClosestHit, Hit, Query};
 
@@ -69,21 +68,13 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
     stack: &mut [u32; S],
     lane: u32,
 ) {
-    let mode = params.cast_mode;
     let (w, h) = (params.width, params.height);
-    let diffuse = mode == CAST_DIFFUSE || mode == CAST_DIFFUSE_OCCLUDED;
-    if diffuse && params.ray_lanes != 0 {
-        if invocation < params.ray_lanes {
-            cast_diffuse_lanes::<T, F, S>(invocation, params, scene, rays, stack, lane);
-        }
-        return;
-    }
     let id = tiled_pixel(invocation, w, h);
     if id == u32::MAX {
         return;
     }
     let (i, j) = (2 * id as usize, 2 * id as usize + 1);
-    if mode == CAST_RAYS || mode == CAST_OCCLUDED {
+    if params.cast_mode == CAST_RAYS || params.cast_mode == CAST_OCCLUDED {
         let EngineRay { o, d, query, marked } = engine_ray(params, rays, id);
         if marked {
             let hit = if query.t_max >= 0.0 { trace::<T, F, S>(o, d, Origin::NONE, query, scene, stack, lane) } else { Hit::NONE };
@@ -97,11 +88,11 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
             };
             write_engine_hit(params, rays, id, found, record);
         }
-    } else if mode == CAST_PRIMARY {
+    } else if params.cast_mode == CAST_PRIMARY {
         let (o, d) = camera_ray(params, id);
         let hit = closest_hit::<T, F, S>(o, d, Origin::NONE, scene, stack, lane);
         rays[i] = [hit.t, f32::from_bits(hit.prim), 0.0, 0.0];
-    } else if mode == CAST_BOUNCE {
+    } else if params.cast_mode == CAST_BOUNCE {
         let (t, prim) = (rays[i][0], rays[i][1].to_bits());
         if prim == u32::MAX {
             rays[i] = [0.0; 4];
@@ -121,78 +112,9 @@ pub fn cast_kernel<T: ClosestHit, const F: u32, const S: usize>(
         let d = Vec3::new(rays[j][0], rays[j][1], rays[j][2]);
         let prim = rays[j][3].to_bits();
         // Leaving the surface outwards: it cannot be hit again.
-        let query = if mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
+        let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
         let hit = trace::<T, F, S>(o, d, Origin { prim, into: false }, query, scene, stack, lane);
         rays[i][3] = if hit.is_hit() { hit.t } else { -1.0 };
-    }
-}
-
-/// The diffuse rays of invocations `lane_id`, `lane_id + params.ray_lanes`,
-/// ... (in tile order), through one walk loop ([`crate::trace::stream`]),
-/// each hit written as [`cast_kernel`] writes it.
-fn cast_diffuse_lanes<T: ClosestHit, const F: u32, const S: usize>(
-    lane_id: u32,
-    params: &RenderParams,
-    scene: &SceneRefs<T>,
-    rays: &mut [[f32; 4]],
-    stack: &mut [u32; S],
-    lane: u32,
-) {
-    let end = tiled_invocations(params.width, params.height);
-    let mut lanes = DiffuseLanes { at: 0, lanes: params.ray_lanes, end, width: params.width, height: params.height, id: 0 };
-    let (mut o, mut d, mut from) = (Vec3::ZERO, Vec3::ZERO, Origin::NONE);
-    if !lanes.seek(rays, lane_id, &mut o, &mut d, &mut from) {
-        return;
-    }
-    // Leaving the surface outwards: it cannot be hit again.
-    let query = if params.cast_mode == CAST_DIFFUSE_OCCLUDED { Query::occlusion(MISS, u32::MAX) } else { Query::CLOSEST };
-    scene.tree.trace_stream::<F, S, _>((o, d, from), &mut lanes, rays, query, &scene.prims, stack, lane);
-}
-
-/// One lane's diffuse rays: every `lanes`-th invocation from its own, up
-/// to `end`, those whose camera ray hit ([`CAST_BOUNCE`] marked them), read
-/// from and written to the rays buffer it is handed (its `Io`).
-struct DiffuseLanes {
-    /// The invocation of the ray in flight, and its pixel.
-    at: u32,
-    id: u32,
-    lanes: u32,
-    end: u32,
-    width: u32,
-    height: u32,
-}
-
-impl DiffuseLanes {
-    /// The first marked ray from invocation `k` on (in steps of `lanes`).
-    #[inline]
-    fn seek(&mut self, rays: &[[f32; 4]], mut k: u32, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
-        while k < self.end {
-            let id = tiled_pixel(k, self.width, self.height);
-            let i = 2 * id as usize;
-            if id != u32::MAX && rays[i][3] != 0.0 {
-                let (a, b) = (rays[i], rays[i + 1]);
-                (*o, *d) = (Vec3::new(a[0], a[1], a[2]), Vec3::new(b[0], b[1], b[2]));
-                *from = Origin { prim: b[3].to_bits(), into: false };
-                (self.at, self.id) = (k, id);
-                return true;
-            }
-            k += self.lanes;
-        }
-        false
-    }
-}
-
-impl RayStream for DiffuseLanes {
-    type Io = [[f32; 4]];
-
-    #[inline]
-    fn finish(&mut self, rays: &mut [[f32; 4]], hit: Hit, _: u32) {
-        rays[2 * self.id as usize][3] = if hit.is_hit() { hit.t } else { -1.0 };
-    }
-
-    #[inline]
-    fn next(&mut self, rays: &mut [[f32; 4]], o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool {
-        self.seek(rays, self.at + self.lanes, o, d, from)
     }
 }
 

@@ -22,7 +22,6 @@ use crate::geometry::triangle::WatertightRay;
 use crate::gpu::unchecked::{get, scratch, set};
 use crate::geometry::records::RecordLoad;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
-use crate::trace::stream::{OneRay, RayStream, miss_all};
 
 /// A tree in the layout of this module: its nodes and leaf primitives as
 /// records (`[Bvh2Node]`, `[LeafPrim]`) or as the 16-byte vectors of their
@@ -46,24 +45,6 @@ impl<N: RecordLoad<Bvh2Node>, P: RecordLoad<LeafPrim>> ClosestHit for Bvh2Tree<N
     #[inline]
     fn trace<const F: u32, const S: usize>(&self, o: Vec3, d: Vec3, from: Origin, query: Query, prims: &Prims, _: &mut [u32; S], _: u32) -> Hit {
         trace_bvh2::<F>(o, d, from, query, prims, &self.nodes, &self.leaf_prims)
-    }
-
-    #[inline]
-    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
-        &self,
-        first: (Vec3, Vec3, Origin),
-        stream: &mut R,
-        io: &mut R::Io,
-        query: Query,
-        prims: &Prims,
-        _: &mut [u32; S],
-        _: u32,
-    ) {
-        if prims.count() == 0 {
-            return miss_all(first, stream, io, query);
-        }
-        let one = Level { nodes: &self.nodes, leaves: &self.leaf_prims };
-        walk_stream::<F, false, { 2 * STACK_DEPTH }, _>(first, stream, io, &query, prims, &NoInstances, &one);
     }
 }
 
@@ -177,26 +158,6 @@ pub fn walk<const F: u32, const INSTANCED: bool, const STACK: usize>(
     instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
     trees: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized>,
 ) -> (Hit, u32) {
-    let mut one = OneRay::new();
-    walk_stream::<F, INSTANCED, STACK, _>((o, d, from), &mut one, &mut (), query, prims, instances, trees);
-    (one.hit, one.instance)
-}
-
-/// [`walk`] over the rays of `stream`, `first` and then each it gives,
-/// in one loop: a ray done hands its hit to the stream and the next ray
-/// starts in the same iteration (see [`crate::trace::stream`]).
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize, R: RayStream + ?Sized>(
-    first: (Vec3, Vec3, Origin),
-    stream: &mut R,
-    io: &mut R::Io,
-    query: &Query,
-    prims: &Prims,
-    instances: &(impl RecordLoad<InstanceRecord> + ?Sized),
-    trees: &Level<impl RecordLoad<Bvh2Node> + ?Sized, impl RecordLoad<LeafPrim> + ?Sized>,
-) {
-    let (mut o, mut d, mut from) = first;
     let mut hit = query.start();
     let mut found_in = u32::MAX;
     // The bases of the nodes and leaf primitives of the mesh the walk is
@@ -219,7 +180,12 @@ pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize, R: R
     let mut stack = scratch::<u32, STACK>();
     let entries = if INSTANCED { (STACK - WORLD) / 2 } else { STACK / 2 };
     if INSTANCED {
-        keep_world_ray::<STACK>(&mut stack, o, d);
+        let w = [o.x, o.y, o.z, d.x, d.y, d.z];
+        let mut k = 0;
+        while k < 6 {
+            set(&mut stack, STACK - WORLD + k, w[k].to_bits());
+            k += 1;
+        }
     }
     let (mut top_len, mut floor) = (0usize, usize::MAX);
     let mut node = 0u32;
@@ -254,72 +220,46 @@ pub fn walk_stream<const F: u32, const INSTANCED: bool, const STACK: usize, R: R
         if INSTANCED && (hit.t != before.t || hit.prim != before.prim) {
             found_in = get(&stack, STACK - 1);
         }
-        let mut done = query.done(&hit);
-        if !done {
-            let (left, right) = (n.left, n.right);
-            if go_left && go_right {
-                let (near, far, far_t) = if ln <= rn { (left, right, rn) } else { (right, left, ln) };
-                if top_len < entries {
-                    set(&mut stack, 2 * top_len, far);
-                    set(&mut stack, 2 * top_len + 1, far_t.to_bits());
-                    top_len += 1;
-                }
-                node = near;
-            } else if go_left {
-                node = left;
-            } else if go_right {
-                node = right;
-            } else {
-                // Back to the nearest pushed child still worth entering; out of
-                // the mesh when its entries are all taken.
-                let mut next = u32::MAX;
-                while next == u32::MAX {
-                    if INSTANCED && top_len == floor {
-                        floor = usize::MAX;
-                        node_base = 0;
-                        let (wo, wd) = world_ray::<STACK>(&stack);
-                        slabs = SlabRay::new(wo, wd);
-                    }
-                    if top_len == 0 {
-                        break;
-                    }
-                    top_len -= 1;
-                    if f32::from_bits(get(&stack, 2 * top_len + 1)) <= hit.reach() {
-                        next = get(&stack, 2 * top_len);
-                    }
-                }
-                done = next == u32::MAX;
-                node = next;
-            }
+        if query.done(&hit) {
+            return (hit, found_in);
         }
-        if done {
-            // This ray's answer; the next ray (if any) starts at the root.
-            stream.finish(io, hit, found_in);
-            if !stream.next(io, &mut o, &mut d, &mut from) {
-                return;
+        let (left, right) = (n.left, n.right);
+        if go_left && go_right {
+            let (near, far, far_t) = if ln <= rn { (left, right, rn) } else { (right, left, ln) };
+            if top_len < entries {
+                set(&mut stack, 2 * top_len, far);
+                set(&mut stack, 2 * top_len + 1, far_t.to_bits());
+                top_len += 1;
             }
-            hit = query.start();
-            found_in = u32::MAX;
-            (node_base, leaf_base) = (0, 0);
-            slabs = if INSTANCED { SlabRay::new(o, d) } else { slab_ray(o, d, trees.nodes, 0) };
-            (ray, at_ray) = (WatertightRay::new(o, d), (o, d, from));
-            if INSTANCED {
-                keep_world_ray::<STACK>(&mut stack, o, d);
+            node = near;
+        } else if go_left {
+            node = left;
+        } else if go_right {
+            node = right;
+        } else {
+            // Back to the nearest pushed child still worth entering; out of
+            // the mesh when its entries are all taken.
+            let mut next = u32::MAX;
+            while next == u32::MAX {
+                if INSTANCED && top_len == floor {
+                    floor = usize::MAX;
+                    node_base = 0;
+                    let (wo, wd) = world_ray::<STACK>(&stack);
+                    slabs = SlabRay::new(wo, wd);
+                }
+                if top_len == 0 {
+                    break;
+                }
+                top_len -= 1;
+                if f32::from_bits(get(&stack, 2 * top_len + 1)) <= hit.reach() {
+                    next = get(&stack, 2 * top_len);
+                }
             }
-            (top_len, floor) = (0, usize::MAX);
-            node = 0;
+            if next == u32::MAX {
+                return (hit, found_in);
+            }
+            node = next;
         }
-    }
-}
-
-/// Keeps the world ray at the end of an instanced walk's stack.
-#[inline]
-fn keep_world_ray<const STACK: usize>(stack: &mut [u32; STACK], o: Vec3, d: Vec3) {
-    let w = [o.x, o.y, o.z, d.x, d.y, d.z];
-    let mut k = 0;
-    while k < 6 {
-        set(stack, STACK - WORLD + k, w[k].to_bits());
-        k += 1;
     }
 }
 

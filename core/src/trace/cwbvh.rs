@@ -44,7 +44,6 @@ use crate::geometry::triangle::WatertightRay;
 use crate::gpu::unchecked::{get, scratch, set};
 use crate::layouts::cwbvh::grid_step;
 use crate::trace::hit::{ClosestHit, Hit, Query, STACK_DEPTH};
-use crate::trace::stream::{OneRay, RayStream, miss_all};
 
 
 /// Grid cells each plane is pushed out by in the traversal (see the module
@@ -180,25 +179,6 @@ impl<N: RecordLoad<WideNode>, P: RecordLoad<LeafPrim>> ClosestHit for WideTree<N
         let mut private = scratch::<u32, { 2 * WIDE_STACK }>();
         trace_cwbvh_with::<F, S>(o, d, from, query, prims, &self.nodes, &self.leaf_prims, &mut private, stack, lane as usize)
     }
-
-    #[inline]
-    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
-        &self,
-        first: (Vec3, Vec3, Origin),
-        stream: &mut R,
-        io: &mut R::Io,
-        query: Query,
-        prims: &Prims,
-        stack: &mut [u32; S],
-        lane: u32,
-    ) {
-        if prims.count() == 0 {
-            return miss_all(first, stream, io, query);
-        }
-        let mut private = scratch::<u32, { 2 * WIDE_STACK }>();
-        let (nodes, leaf_prims) = (&self.nodes, &self.leaf_prims);
-        trace_cwbvh_stream::<F, S, _>(first, stream, io, query, prims, nodes, leaf_prims, &mut private, stack, lane as usize);
-    }
 }
 
 /// Stack layouts measured for this traversal on the H100 (`treelet bench
@@ -266,39 +246,17 @@ pub fn trace_cwbvh_with<const F: u32, const SHARED: usize>(
     shared: &mut [u32; SHARED],
     lane: usize,
 ) -> Hit {
-    if prims.count() == 0 {
-        return query.start();
-    }
-    let mut one = OneRay::new();
-    trace_cwbvh_stream::<F, SHARED, _>((o, d, from), &mut one, &mut (), query, prims, nodes, leaf_prims, private, shared, lane);
-    one.hit
-}
-
-/// [`trace_cwbvh_with`] over the rays of `stream`, `first` and then each
-/// it gives, in one loop (see [`crate::trace::stream`]). The scene must
-/// hold primitives.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn trace_cwbvh_stream<const F: u32, const SHARED: usize, R: RayStream + ?Sized>(
-    first: (Vec3, Vec3, Origin),
-    stream: &mut R,
-    io: &mut R::Io,
-    query: Query,
-    prims: &Prims,
-    nodes: &(impl RecordLoad<WideNode> + ?Sized),
-    leaf_prims: &(impl RecordLoad<LeafPrim> + ?Sized),
-    private: &mut [u32; 2 * WIDE_STACK],
-    shared: &mut [u32; SHARED],
-    lane: usize,
-) {
-    let (mut o, mut d, mut from) = first;
     let mut hit = query.start();
+    if prims.count() == 0 {
+        return hit;
+    }
     // Parallel axes need no far bias here: the planes' slack keeps a ray
     // lying in a face inside the slab (see the module doc).
-    let mut inv = SlabRay::new(Vec3::ZERO, d).inv;
-    let mut ray = WatertightRay::new(o, d);
-    let mut oct_inv = 7 - octant(inv);
-    let mut oct_inv4 = oct_inv * 0x0101_0101;
+    let inv = SlabRay::new(Vec3::ZERO, d).inv;
+    let ray = WatertightRay::new(o, d);
+    let octant = ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32;
+    let oct_inv = 7 - octant;
+    let oct_inv4 = oct_inv * 0x0101_0101;
     // Shared entries per lane (0 when the stack is all private).
     let shared_entries = if SHARED > 1 { SHARED / crate::gpu::workgroup::WG / 2 } else { 0 };
     // The root's group: one hit internal child at base 0.
@@ -338,35 +296,16 @@ pub fn trace_cwbvh_stream<const F: u32, const SHARED: usize, R: RayStream + ?Siz
                 hit = Hit { t, prim: p.prim };
             }
         }
-        let mut done = query.done(&hit);
-        if !done && node_hits <= 0x00FF_FFFF {
-            if top == 0 {
-                done = true;
-            } else {
-                (node_base, node_hits) = pop(private, shared, lane, shared_entries, &mut top);
-            }
+        if query.done(&hit) {
+            return hit;
         }
-        if done {
-            // This ray's answer; the next ray (if any) starts at the root.
-            stream.finish(io, hit, u32::MAX);
-            if !stream.next(io, &mut o, &mut d, &mut from) {
-                return;
+        if node_hits <= 0x00FF_FFFF {
+            if top == 0 {
+                return hit;
             }
-            hit = query.start();
-            inv = SlabRay::new(Vec3::ZERO, d).inv;
-            ray = WatertightRay::new(o, d);
-            oct_inv = 7 - octant(inv);
-            oct_inv4 = oct_inv * 0x0101_0101;
-            (node_base, node_hits) = (0, 0x8000_0000);
-            top = 0;
+            (node_base, node_hits) = pop(private, shared, lane, shared_entries, &mut top);
         }
     }
-}
-
-/// The ray's octant: bit 2 for a negative x, 1 for y, 0 for z.
-#[inline]
-fn octant(inv: [f32; 3]) -> u32 {
-    ((inv[0] < 0.0) as u32) << 2 | ((inv[1] < 0.0) as u32) << 1 | (inv[2] < 0.0) as u32
 }
 
 #[inline]

@@ -37,32 +37,6 @@ pub trait ClosestHit {
         lane: u32,
     ) -> Hit;
 
-    /// [`ClosestHit::trace`] for the ray `first` and then each ray `stream`
-    /// gives, every hit handed to the stream. Layouts whose walk takes the
-    /// next ray within its loop (the `stream` module) say so here; by
-    /// default the rays are traced one after another.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn trace_stream<const F: u32, const S: usize, R: RayStream + ?Sized>(
-        &self,
-        first: (Vec3, Vec3, Origin),
-        stream: &mut R,
-        io: &mut R::Io,
-        query: Query,
-        prims: &Prims,
-        stack: &mut [u32; S],
-        lane: u32,
-    ) {
-        let (mut o, mut d, mut from) = first;
-        loop {
-            let hit = self.trace::<F, S>(o, d, from, query, prims, stack, lane);
-            stream.finish(io, hit, u32::MAX);
-            if !stream.next(io, &mut o, &mut d, &mut from) {
-                return;
-            }
-        }
-    }
-
     /// The material and outward normal (unit length) of the `k`-th
     /// primitive past the scene's own, hit along `d`: a placed copy's
     /// triangle ([`crate::trace::placed`]). Only a tree over copies finds
@@ -71,23 +45,6 @@ pub trait ClosestHit {
     fn placed_surface(&self, _k: u32, d: Vec3) -> (Material, Vec3) {
         (Material::default(), -d)
     }
-}
-
-/// Where a walk gets its rays and leaves their hits ([`ClosestHit::trace_stream`]; the walks that
-/// take the next ray within their loop, and why: the `stream` module).
-pub trait RayStream {
-    /// What the stream reads its rays from and writes their hits to (a
-    /// kernel's buffers), handed to each call beside the stream, never kept
-    /// in it: the state a walk carries from ray to ray must be plain values.
-    /// A stream holding a buffer's reference and changing in the loop
-    /// became, through rust-gpu, a loop phi of a struct holding a pointer,
-    /// on which NVIDIA's SPIR-V compiler (driver 580.159) segfaults.
-    type Io: ?Sized;
-    /// Takes `hit` (and the instance it was found in, `u32::MAX` without)
-    /// as the answer for the ray given last.
-    fn finish(&mut self, io: &mut Self::Io, hit: Hit, instance: u32);
-    /// Sets the next ray into `o`, `d`, `from`; false when none is left.
-    fn next(&mut self, io: &mut Self::Io, o: &mut Vec3, d: &mut Vec3, from: &mut Origin) -> bool;
 }
 
 /// What a traversal looks for: the closest hit up to `t_max`, or, for an

@@ -25,4 +25,3 @@ pub mod cwbvh;
 pub mod hit;
 pub mod instances;
 pub mod placed;
-pub mod stream;

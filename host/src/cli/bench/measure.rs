@@ -412,9 +412,6 @@ pub(crate) fn time_casts<B: Backend>(
         ..Default::default()
     };
     let groups = groups_for(treelet_core::render::integrator::tiled_invocations(width, height), kernel.workgroup_size());
-    // Diffuse casts on a fixed number of lanes, each taking every N-th ray
-    // (`TREELET_RAY_LANES`), rounded up to whole workgroups.
-    let lanes = treelet::tuning::Tuning::current().ray_lanes.filter(|&n| n > 0).map(|n| n.div_ceil(kernel.workgroup_size()) * kernel.workgroup_size());
     let (mut primary, mut diffuse, mut occlusion) = (Vec::new(), Vec::new(), Vec::new());
     let mut diffuse_rays = 0;
     // Warm-up passes for half a second first (pipelines, and GPU clocks,
@@ -442,12 +439,7 @@ pub(crate) fn time_casts<B: Backend>(
         ];
         for (stage, mode) in passes {
             b.stage(stage);
-            let diffuse = mode == CAST_DIFFUSE || mode == CAST_DIFFUSE_OCCLUDED;
-            let (ray_lanes, groups) = match lanes {
-                Some(n) if diffuse => (n, n.div_ceil(kernel.workgroup_size())),
-                _ => (0, groups),
-            };
-            let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ray_lanes, ..base }])?;
+            let p = b.upload("cast params", &[treelet_core::RenderParams { cast_mode: mode, first_sample: r as u32, ..base }])?;
             let [spheres, materials, nodes, prims, rays, triangles] = *bindings;
             b.dispatch(kernel, &[&p, spheres, materials, nodes, prims, rays, triangles], groups);
         }

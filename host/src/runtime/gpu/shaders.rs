@@ -104,8 +104,9 @@ mod tests {
     /// No module merges pointers at a phi (`OpPhi` of a pointer, or of a
     /// struct holding one): NVIDIA's SPIR-V compiler (driver 580.159.04)
     /// segfaulted creating every pipeline that did. rust-gpu makes one of a
-    /// value that holds a buffer's reference and changes in a loop (a
-    /// `RayStream` that kept the rays buffer: see its `Io`).
+    /// value that holds a buffer's reference and changes in a loop: keep
+    /// what a loop carries plain values, buffers beside it
+    /// (`docs/results/h200-cast-crash-2026-12-03/`).
     #[test]
     fn no_module_merges_pointers_at_a_phi() {
         for m in unpack(SHADERS).unwrap() {
