@@ -59,10 +59,12 @@ class Tracer:
         directions: npt.ArrayLike,
         t_min: Optional[Union[float, npt.ArrayLike]] = None,
         t_max: Optional[Union[float, npt.ArrayLike]] = None,
+        out: Optional[Hits] = None,
     ) -> Hits:
         """The closest hit of each ray origins[k] + t directions[k] ((n, 3) each; directions of
         any length, one of length 0 hitting nothing), from t_min (default 0) to t_max (default
-        inf): numbers, or one per ray."""
+        inf): numbers, or one per ray. out, the Hits of an earlier batch of as many rays, is
+        filled in place and returned."""
     def occluded(
         self,
         origins: npt.ArrayLike,
@@ -112,9 +114,10 @@ class InstancedTracer:
         directions: npt.ArrayLike,
         t_min: Optional[Union[float, npt.ArrayLike]] = None,
         t_max: Optional[Union[float, npt.ArrayLike]] = None,
+        out: Optional[Hits] = None,
     ) -> Hits:
-        """As Tracer.closest_hits: `instance` is the instance hit, `primitive` the triangle within
-        its mesh, `normal` in world space."""
+        """As Tracer.closest_hits (out included): `instance` is the instance hit, `primitive` the
+        triangle within its mesh, `normal` in world space."""
     def occluded(
         self,
         origins: npt.ArrayLike,

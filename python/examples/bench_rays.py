@@ -1,6 +1,7 @@
 """The Python package's time for a batch of rays, NumPy arrays in and NumPy hits out, against
 the Rust API's `closest_hits` on the same tree and rays (timed inside the module, the rays
-already made: `Tracer._rust_api_ms`) and, with --mitsuba, Mitsuba 3's
+already made: `Tracer._rust_api_ms`), the same into the first batch's arrays (`out=`) and,
+with --mitsuba, Mitsuba 3's
 `scene.ray_intersect_preliminary` (OptiX on NVIDIA) from Python, transfers included.
 Incoherent rays: origins uniform in the mesh's box, directions uniform on the sphere.
 
@@ -78,6 +79,12 @@ def main():
     print(json.dumps({"api": "python", "adapter": tracer.device, "python_over_rust": round(ms / rust_ms, 3), "triangles": len(tracer), "rays": a.rays,
                       "hit": int(hits.hit.sum()), "build_ms": round(build_ms, 3), "median_ms": round(ms, 3),
                       "mrays_per_s": round(a.rays / ms / 1e3, 1)}))
+    try:  # batch after batch into the same arrays (out=)
+        out_ms, _ = median_ms(lambda: tracer.closest_hits(o, d, out=hits), a.repeats)
+        print(json.dumps({"api": "python, out=", "adapter": tracer.device, "python_over_rust": round(out_ms / rust_ms, 3), "rays": a.rays,
+                          "median_ms": round(out_ms, 3), "mrays_per_s": round(a.rays / out_ms / 1e3, 1)}))
+    except TypeError:  # a wheel from before `out`
+        pass
 
     if a.mitsuba:
         import drjit as dr

@@ -9,7 +9,7 @@ use treelet::tracer::RayQueries;
 use treelet::{CpuBackend, GpuBackend, Quality};
 
 use crate::arrays::RayArrays;
-use crate::hits::{HitColumns, Hits};
+use crate::hits::{HitArrays, HitColumns, Hits};
 use crate::py_err;
 
 /// A tracer `G` on a GPU (with its adapter's name), or `C` on the CPU runner.
@@ -97,6 +97,15 @@ where
         let mut out = HitColumns::with_room(rays.len())?;
         on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| out.push(h))).map_err(py_err)?;
         Ok(out.into_hits(py))
+    }
+
+    /// The closest hits of the rays in the arrays, written into `out`'s
+    /// arrays in place (a [`Hits`] of as many rays, from an earlier call).
+    pub(crate) fn closest_hits_into(&mut self, py: Python<'_>, arrays: &RayArrays<'_>, out: &Bound<'_, Hits>) -> PyResult<()> {
+        let rays = arrays.columns()?;
+        let mut held = HitArrays::borrow(py, out, rays.len())?;
+        let mut into = held.slices()?;
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| into.write(k, h))).map_err(py_err)
     }
 
     /// Whether each ray of the arrays is occluded.

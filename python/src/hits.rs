@@ -64,7 +64,6 @@ impl HitColumns {
 
     /// The next hit (hits arrive in order).
     pub(crate) fn push(&mut self, h: RayHit) {
-        let signed = |x: u32| if x == u32::MAX { -1 } else { i64::from(x) };
         self.t.push(h.t);
         self.primitive.push(signed(h.prim));
         self.instance.push(signed(h.instance));
@@ -89,3 +88,78 @@ impl HitColumns {
     }
 }
 
+
+/// A triangle or instance index as NumPy gets it: -1 for none.
+fn signed(x: u32) -> i64 {
+    if x == u32::MAX { -1 } else { i64::from(x) }
+}
+
+/// The arrays of a [`Hits`] given back as `out=`, borrowed writable for one
+/// batch and written in place: no new memory (a million hits' six arrays
+/// are 41 MB, and filling fresh ones took half of Python's time on the
+/// H200).
+pub(crate) struct HitArrays<'py> {
+    t: numpy::PyReadwriteArray1<'py, f32>,
+    primitive: numpy::PyReadwriteArray1<'py, i64>,
+    instance: numpy::PyReadwriteArray1<'py, i64>,
+    barycentrics: numpy::PyReadwriteArray2<'py, f32>,
+    normal: numpy::PyReadwriteArray2<'py, f32>,
+    hit: numpy::PyReadwriteArray1<'py, bool>,
+}
+
+impl<'py> HitArrays<'py> {
+    /// `out`'s arrays for a batch of `n` rays: a `ValueError` where it holds
+    /// another number of hits, or where one of its arrays is in use
+    /// elsewhere in the call (given as the rays, say).
+    pub(crate) fn borrow(py: Python<'py>, out: &Bound<'py, Hits>, n: usize) -> PyResult<Self> {
+        let h = out.borrow();
+        let held = h.t.bind(py).len();
+        if held != n {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!("out: holds {held} hits, but {n} rays were given")));
+        }
+        let busy = |what: &str| pyo3::exceptions::PyValueError::new_err(format!("out.{what}: the array is in use elsewhere in this call (given as rays?)"));
+        Ok(HitArrays {
+            t: h.t.bind(py).try_readwrite().map_err(|_| busy("t"))?,
+            primitive: h.primitive.bind(py).try_readwrite().map_err(|_| busy("primitive"))?,
+            instance: h.instance.bind(py).try_readwrite().map_err(|_| busy("instance"))?,
+            barycentrics: h.barycentrics.bind(py).try_readwrite().map_err(|_| busy("barycentrics"))?,
+            normal: h.normal.bind(py).try_readwrite().map_err(|_| busy("normal"))?,
+            hit: h.hit.bind(py).try_readwrite().map_err(|_| busy("hit"))?,
+        })
+    }
+
+    /// The arrays as slices, to be written from any thread.
+    pub(crate) fn slices(&mut self) -> PyResult<HitSlices<'_>> {
+        let whole = |what: &str| pyo3::exceptions::PyValueError::new_err(format!("out.{what}: not contiguous"));
+        Ok(HitSlices {
+            t: self.t.as_slice_mut().map_err(|_| whole("t"))?,
+            primitive: self.primitive.as_slice_mut().map_err(|_| whole("primitive"))?,
+            instance: self.instance.as_slice_mut().map_err(|_| whole("instance"))?,
+            barycentrics: self.barycentrics.as_slice_mut().map_err(|_| whole("barycentrics"))?,
+            normal: self.normal.as_slice_mut().map_err(|_| whole("normal"))?,
+            hit: self.hit.as_slice_mut().map_err(|_| whole("hit"))?,
+        })
+    }
+}
+
+/// [`HitArrays`] as slices.
+pub(crate) struct HitSlices<'a> {
+    t: &'a mut [f32],
+    primitive: &'a mut [i64],
+    instance: &'a mut [i64],
+    barycentrics: &'a mut [f32],
+    normal: &'a mut [f32],
+    hit: &'a mut [bool],
+}
+
+impl HitSlices<'_> {
+    /// Hit `k` of the batch.
+    pub(crate) fn write(&mut self, k: usize, h: RayHit) {
+        self.t[k] = h.t;
+        self.primitive[k] = signed(h.prim);
+        self.instance[k] = signed(h.instance);
+        self.hit[k] = h.is_hit();
+        self.barycentrics[2 * k..2 * k + 2].copy_from_slice(&h.barycentrics);
+        self.normal[3 * k..3 * k + 3].copy_from_slice(&h.normal);
+    }
+}

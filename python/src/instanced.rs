@@ -117,8 +117,8 @@ impl InstancedTracer {
 
     /// The closest hit of each ray, as `Tracer.closest_hits`: `instance` is
     /// the instance hit, `primitive` the triangle within its mesh (a row of
-    /// that mesh's indices), `normal` in world space.
-    #[pyo3(signature = (origins, directions, t_min = None, t_max = None))]
+    /// that mesh's indices), `normal` in world space; `out` as there.
+    #[pyo3(signature = (origins, directions, t_min = None, t_max = None, out = None))]
     fn closest_hits(
         &mut self,
         py: Python<'_>,
@@ -126,8 +126,16 @@ impl InstancedTracer {
         directions: &Bound<'_, PyAny>,
         t_min: Option<&Bound<'_, PyAny>>,
         t_max: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Hits> {
-        self.inner.closest_hits(py, &RayArrays::new(py, origins, directions, t_min, t_max)?)
+        out: Option<&Bound<'_, Hits>>,
+    ) -> PyResult<Py<Hits>> {
+        let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
+        match out {
+            Some(out) => {
+                self.inner.closest_hits_into(py, &arrays, out)?;
+                Ok(out.clone().unbind())
+            }
+            None => Py::new(py, self.inner.closest_hits(py, &arrays)?),
+        }
     }
 
     /// Whether each ray hits anything from `t_min` up to `t_max`, as `Tracer.occluded`.

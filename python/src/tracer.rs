@@ -55,7 +55,9 @@ impl Tracer {
     /// (n, 3); directions of any length, one of length 0 hitting nothing),
     /// from `t_min` to `t_max`
     /// (numbers, or one per ray), `t` along the normalized direction.
-    #[pyo3(signature = (origins, directions, t_min = None, t_max = None))]
+    /// `out`, the `Hits` of an earlier batch of as many rays, is filled in
+    /// place and returned (no new arrays: for batch after batch).
+    #[pyo3(signature = (origins, directions, t_min = None, t_max = None, out = None))]
     fn closest_hits(
         &mut self,
         py: Python<'_>,
@@ -63,8 +65,16 @@ impl Tracer {
         directions: &Bound<'_, PyAny>,
         t_min: Option<&Bound<'_, PyAny>>,
         t_max: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Hits> {
-        self.inner.closest_hits(py, &RayArrays::new(py, origins, directions, t_min, t_max)?)
+        out: Option<&Bound<'_, Hits>>,
+    ) -> PyResult<Py<Hits>> {
+        let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
+        match out {
+            Some(out) => {
+                self.inner.closest_hits_into(py, &arrays, out)?;
+                Ok(out.clone().unbind())
+            }
+            None => Py::new(py, self.inner.closest_hits(py, &arrays)?),
+        }
     }
 
     /// Whether each ray hits anything from `t_min` up to `t_max`

@@ -66,7 +66,9 @@ def test_instances_hit_what_the_flattened_scene_hits(device):
     scene.set_instances(mesh2, transforms2)
     assert len(scene) == 9
     o, d = random_rays(rng, 300, flattened(meshes, mesh2, transforms2)[0].astype(np.float32), spread=20.0)
-    check(scene.closest_hits(o, d), meshes, mesh2, transforms2, o, d)
+    # Into the first batch's arrays (out=), in place.
+    assert scene.closest_hits(o, d, out=hits) is hits
+    check(hits, meshes, mesh2, transforms2, o, d)
     moved = (meshes[1][0] * 1.3 + 0.2).astype(np.float32), meshes[1][1]
     scene.refit_mesh(1, *moved)
     o, d = random_rays(rng, 300, flattened([meshes[0], moved], mesh2, transforms2)[0].astype(np.float32), spread=20.0)

@@ -100,6 +100,33 @@ def test_closest_hits_equal_brute_force(device, quality):
 
 
 @pytest.mark.parametrize("device", devices())
+def test_out_is_filled_in_place_with_the_same_hits(device):
+    rng = np.random.default_rng(7 + ["cpu", "gpu"].index(device))
+    v, idx = random_mesh(rng, 300)
+    tracer = treelet.Tracer(v, idx, device=device)
+    o1, d1 = random_rays(rng, 500, v)
+    o2, d2 = random_rays(rng, 500, v)
+    out = tracer.closest_hits(o1, d1)
+    arrays = [out.t, out.primitive, out.instance, out.barycentrics, out.normal, out.hit]
+    again = tracer.closest_hits(o2, d2, out=out)
+    assert again is out, "out is returned"
+    fresh = tracer.closest_hits(o2, d2)
+    assert fresh.hit.sum() > 150, f"too few hits to test anything: {fresh}"
+    assert not np.array_equal(fresh.primitive, tracer.closest_hits(o1, d1).primitive), "two batches alike"
+    for name, before in zip(["t", "primitive", "instance", "barycentrics", "normal", "hit"], arrays):
+        now = getattr(out, name)
+        assert np.shares_memory(now, before), f"out.{name} is a new array"
+        np.testing.assert_array_equal(now, getattr(fresh, name), err_msg=f"out.{name}")
+    # Refused by name: another number of rays; out's own array as the rays.
+    with pytest.raises(ValueError, match="out: holds 500 hits, but 3 rays were given"):
+        tracer.closest_hits(o2[:3], d2[:3], out=out)
+    with pytest.raises(ValueError, match="out.normal: the array is in use"):
+        tracer.closest_hits(o2, out.normal, out=out)
+    with pytest.raises(TypeError):
+        tracer.closest_hits(o2, d2, out=np.zeros(500))
+
+
+@pytest.mark.parametrize("device", devices())
 def test_occluded_agrees_with_closest_hits(device):
     rng = np.random.default_rng(7)
     v, idx = random_mesh(rng, 200)
