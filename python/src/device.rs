@@ -91,21 +91,20 @@ where
         }
     }
 
-    /// The closest hits of the rays in the arrays.
-    pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>) -> PyResult<Hits> {
+    /// The closest hits of the rays in the arrays: new arrays, or those of
+    /// `out` (a [`Hits`] of as many rays, from an earlier call) written in
+    /// place and handed back.
+    pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>, out: Option<&Bound<'_, Hits>>) -> PyResult<Py<Hits>> {
         let rays = arrays.columns()?;
-        let mut out = HitColumns::with_room(rays.len())?;
-        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| out.push(h))).map_err(py_err)?;
-        Ok(out.into_hits(py))
-    }
-
-    /// The closest hits of the rays in the arrays, written into `out`'s
-    /// arrays in place (a [`Hits`] of as many rays, from an earlier call).
-    pub(crate) fn closest_hits_into(&mut self, py: Python<'_>, arrays: &RayArrays<'_>, out: &Bound<'_, Hits>) -> PyResult<()> {
-        let rays = arrays.columns()?;
+        let Some(out) = out else {
+            let mut fresh = HitColumns::with_room(rays.len())?;
+            on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| fresh.push(h))).map_err(py_err)?;
+            return Py::new(py, fresh.into_hits(py));
+        };
         let mut held = HitArrays::borrow(py, out, rays.len())?;
         let mut into = held.slices()?;
-        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| into.write(k, h))).map_err(py_err)
+        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| into.write(k, h))).map_err(py_err)?;
+        Ok(out.clone().unbind())
     }
 
     /// Whether each ray of the arrays is occluded.

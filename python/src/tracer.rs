@@ -67,14 +67,7 @@ impl Tracer {
         t_max: Option<&Bound<'_, PyAny>>,
         out: Option<&Bound<'_, Hits>>,
     ) -> PyResult<Py<Hits>> {
-        let arrays = RayArrays::new(py, origins, directions, t_min, t_max)?;
-        match out {
-            Some(out) => {
-                self.inner.closest_hits_into(py, &arrays, out)?;
-                Ok(out.clone().unbind())
-            }
-            None => Py::new(py, self.inner.closest_hits(py, &arrays)?),
-        }
+        self.inner.closest_hits(py, &RayArrays::new(py, origins, directions, t_min, t_max)?, out)
     }
 
     /// Whether each ray hits anything from `t_min` up to `t_max`
