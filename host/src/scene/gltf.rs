@@ -59,8 +59,8 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
     // glTF readers may ignore a byte-order mark before the JSON.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     precheck(bytes, &name)?;
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
-    let buffers = buffers(&gltf, path.parent().unwrap_or(Path::new(".")), &name)?;
+    let mut gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("{name}: not a valid glTF 2.0 file: {e}"))?;
+    let buffers = buffers(&mut gltf, path.parent().unwrap_or(Path::new(".")), &name)?;
     check_ranges(&gltf.document, &name)?;
     check_node_transforms(&gltf.document, &name)?;
     let document = &gltf.document;
@@ -264,17 +264,22 @@ struct Loaded {
 /// chain of a hundred thousand nodes is an attack on the reader.
 const MAX_NODE_DEPTH: usize = 1000;
 
-/// Each buffer's bytes: the `.glb` binary chunk, a base64 data URI, or a
+/// Each buffer's bytes: the `.glb` binary chunk (moved, not copied: only
+/// the first buffer may be it, glTF 2.0, 4.4.3.2), a base64 data URI, or a
 /// file beside the scene.
-fn buffers(gltf: &gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
+fn buffers(gltf: &mut gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
     use base64::Engine as _;
     let mut out = Vec::new();
+    let mut blob = gltf.blob.take();
+    let had_blob = blob.is_some();
     for buffer in gltf.document.buffers() {
         let i = buffer.index();
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => {
-                gltf.blob.clone().with_context(|| format!("{name}: buffer {i}: no binary chunk"))?
-            }
+            gltf::buffer::Source::Bin => match blob.take() {
+                Some(bytes) => bytes,
+                None if had_blob => bail!("{name}: buffer {i}: the binary chunk is an earlier buffer's (glTF gives it to the first alone)"),
+                None => bail!("{name}: buffer {i}: no binary chunk"),
+            },
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let (_, encoded) = uri
                     .split_once(";base64,")
@@ -674,6 +679,34 @@ mod tests {
         glb.extend(b"BIN\0");
         glb.extend(&bin);
         (glb, json.len())
+    }
+
+    /// Only the first buffer may be a GLB's binary chunk (it is moved into
+    /// that buffer, not copied): a second that names none is refused by name.
+    #[test]
+    fn a_second_buffer_without_a_uri_is_refused() {
+        let (glb, json_len) = square_glb();
+        let json = std::str::from_utf8(&glb[20..20 + json_len]).unwrap();
+        let two = json.replace(r#""buffers": [{"byteLength": 60}]"#, r#""buffers": [{"byteLength": 60}, {"byteLength": 60}]"#);
+        let two = two.replace(r#"{"buffer": 0, "byteOffset": 48"#, r#"{"buffer": 1, "byteOffset": 48"#);
+        assert_ne!(two, json, "the document changed");
+        let mut two = two.into_bytes();
+        two.resize(two.len().div_ceil(4) * 4, b' ');
+        let bin = &glb[20 + json_len..];
+        let mut file = Vec::new();
+        file.extend(b"glTF");
+        file.extend(2u32.to_le_bytes());
+        file.extend(((12 + 8 + two.len() + bin.len()) as u32).to_le_bytes());
+        file.extend((two.len() as u32).to_le_bytes());
+        file.extend(b"JSON");
+        file.extend(&two);
+        file.extend(bin);
+        let d = dir();
+        let path = d.join("twobuffers.glb");
+        std::fs::write(&path, file).unwrap();
+        let e = format!("{:#}", load(&path).unwrap_err());
+        assert!(e.contains("buffer 1: the binary chunk is an earlier buffer's"), "{e}");
+        std::fs::remove_dir_all(&d).ok();
     }
 
     fn data_uri() -> String {
