@@ -9,7 +9,9 @@ use treelet::tracer::RayQueries;
 use treelet::{CpuBackend, GpuBackend, Quality};
 
 use crate::arrays::RayArrays;
-use crate::hits::{HitArrays, HitColumns, Hits};
+use crate::hits::{HitArrays, Hits};
+use rayon::prelude::*;
+use treelet::internals::input::zeroed_vec;
 use crate::py_err;
 
 /// A tracer `G` on a GPU (with its adapter's name), or `C` on the CPU runner.
@@ -96,22 +98,25 @@ where
     /// place and handed back.
     pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>, out: Option<&Bound<'_, Hits>>) -> PyResult<Py<Hits>> {
         let rays = arrays.columns()?;
-        let Some(out) = out else {
-            let mut fresh = HitColumns::with_room(rays.len())?;
-            on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |_, h| fresh.push(h))).map_err(py_err)?;
-            return Py::new(py, fresh.into_hits(py));
+        let out = match out {
+            Some(out) => out.clone(),
+            None => Bound::new(py, Hits::zeroed(py, rays.len())?)?,
         };
-        let mut held = HitArrays::borrow(py, out, rays.len())?;
-        let mut into = held.slices()?;
-        on_device!(self, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays.ray(k), |k, h| into.write(k, h))).map_err(py_err)?;
-        Ok(out.clone().unbind())
+        let mut held = HitArrays::borrow(py, &out, rays.len())?;
+        let into = held.slices()?;
+        on_device!(self, py, |b, t| t.closest_hits_batch(b, rays.len(), |k| rays.ray(k), |hits| into.fill(hits))).map_err(py_err)?;
+        drop(held);
+        Ok(out.unbind())
     }
 
     /// Whether each ray of the arrays is occluded.
     pub(crate) fn occluded<'py>(&mut self, py: Python<'py>, arrays: &RayArrays<'_>) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let rays = arrays.columns()?;
-        let mut hit = Vec::with_capacity(rays.len());
-        on_device!(self, py, |b, t| t.occluded_with(b, rays.len(), |k| rays.ray(k), |_, o| hit.push(o))).map_err(py_err)?;
+        let mut hit = zeroed_vec::<bool>(rays.len(), "occluded").map_err(|e| pyo3::exceptions::PyMemoryError::new_err(format!("{e:#}")))?;
+        on_device!(self, py, |b, t| t.occluded_batch(b, rays.len(), |k| rays.ray(k), |answers| {
+            hit.par_iter_mut().enumerate().for_each(|(k, h)| *h = answers.get(k))
+        }))
+        .map_err(py_err)?;
         Ok(hit.into_pyarray(py))
     }
 }

@@ -2,8 +2,9 @@
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use treelet::internals::input::room_to_fill;
-use treelet::RayHit;
+use treelet::internals::input::zeroed_vec;
+use treelet::tracer::BatchHits;
+use treelet::{Ray, RayHit};
 
 /// The closest hit of each ray: `t` (distance along the normalized
 /// direction; inf for a miss), `primitive` (the triangle, -1 for a miss),
@@ -32,62 +33,28 @@ impl Hits {
     }
 }
 
-/// The arrays of [`Hits`], filled in one pass as the hits are read back.
-pub(crate) struct HitColumns {
-    t: Vec<f32>,
-    primitive: Vec<i64>,
-    instance: Vec<i64>,
-    barycentrics: Vec<f32>,
-    normal: Vec<f32>,
-    hit: Vec<bool>,
-}
-
-impl HitColumns {
-    /// Room for `n` hits in each array, its pages mapped in at once
-    /// (`room_to_fill`), filled by [`HitColumns::push`]. On the H200, a
-    /// million hits took 18 ms so against 21 ms written in place into zeroed
-    /// arrays (their pages faulted in one at a time) and 9 ms with no
-    /// arrays at all. A `MemoryError` where the memory cannot hold them.
-    pub(crate) fn with_room(n: usize) -> PyResult<Self> {
-        fn room<T>(n: usize, what: &str) -> PyResult<Vec<T>> {
-            room_to_fill(n, what).map_err(|e| pyo3::exceptions::PyMemoryError::new_err(format!("{e:#}")))
+impl Hits {
+    /// New arrays for `n` hits, zeroed, their pages mapped in on every core
+    /// (`zeroed_vec`: on the H200's virtual machine, fresh memory taken a
+    /// page fault at a time cost more than tracing the rays), handed to
+    /// NumPy without a copy; filled as `out=` arrays are. A `MemoryError`
+    /// where the memory cannot hold them.
+    pub(crate) fn zeroed(py: Python<'_>, n: usize) -> PyResult<Self> {
+        fn zeroed<T: bytemuck::Zeroable>(n: usize, what: &str) -> PyResult<Vec<T>> {
+            zeroed_vec(n, what).map_err(|e| pyo3::exceptions::PyMemoryError::new_err(format!("{e:#}")))
         }
-        Ok(HitColumns {
-            t: room(n, "t")?,
-            primitive: room(n, "primitive")?,
-            instance: room(n, "instance")?,
-            barycentrics: room(2 * n, "barycentrics")?,
-            normal: room(3 * n, "normal")?,
-            hit: room(n, "hit")?,
-        })
-    }
-
-    /// The next hit (hits arrive in order).
-    pub(crate) fn push(&mut self, h: RayHit) {
-        self.t.push(h.t);
-        self.primitive.push(signed(h.prim));
-        self.instance.push(signed(h.instance));
-        self.hit.push(h.is_hit());
-        self.barycentrics.extend_from_slice(&h.barycentrics);
-        self.normal.extend_from_slice(&h.normal);
-    }
-
-    /// The arrays handed to NumPy without a copy.
-    pub(crate) fn into_hits(self, py: Python<'_>) -> Hits {
-        let n = self.t.len();
-        let barycentrics = Array2::from_shape_vec((n, 2), self.barycentrics).expect("n rows of 2");
-        let normal = Array2::from_shape_vec((n, 3), self.normal).expect("n rows of 3");
-        Hits {
-            t: self.t.into_pyarray(py).unbind(),
-            primitive: self.primitive.into_pyarray(py).unbind(),
-            instance: self.instance.into_pyarray(py).unbind(),
+        let barycentrics = Array2::from_shape_vec((n, 2), zeroed(2 * n, "barycentrics")?).expect("n rows of 2");
+        let normal = Array2::from_shape_vec((n, 3), zeroed(3 * n, "normal")?).expect("n rows of 3");
+        Ok(Hits {
+            t: zeroed::<f32>(n, "t")?.into_pyarray(py).unbind(),
+            primitive: zeroed::<i64>(n, "primitive")?.into_pyarray(py).unbind(),
+            instance: zeroed::<i64>(n, "instance")?.into_pyarray(py).unbind(),
             barycentrics: barycentrics.into_pyarray(py).unbind(),
             normal: normal.into_pyarray(py).unbind(),
-            hit: self.hit.into_pyarray(py).unbind(),
-        }
+            hit: zeroed::<bool>(n, "hit")?.into_pyarray(py).unbind(),
+        })
     }
 }
-
 
 /// A triangle or instance index as NumPy gets it: -1 for none.
 fn signed(x: u32) -> i64 {
@@ -153,8 +120,40 @@ pub(crate) struct HitSlices<'a> {
 }
 
 impl HitSlices<'_> {
-    /// Hit `k` of the batch.
-    pub(crate) fn write(&mut self, k: usize, h: RayHit) {
+    /// Fills the arrays with the batch's hits on every core (in parts of
+    /// [`PART`] rays: a million hits are 41 MB of arrays, which one core
+    /// writes slower than the GPU traces them).
+    pub(crate) fn fill<R: Fn(usize) -> Ray + Sync>(self, hits: &BatchHits<'_, R>) {
+        self.fill_from(hits, 0);
+    }
+
+    /// [`HitSlices::fill`] of the arrays that hold hits `first..`.
+    fn fill_from<R: Fn(usize) -> Ray + Sync>(mut self, hits: &BatchHits<'_, R>, first: usize) {
+        let n = self.t.len();
+        if n <= PART {
+            (0..n).for_each(|k| self.write(k, hits.get(first + k)));
+            return;
+        }
+        let (a, b) = self.split_at(n / 2);
+        rayon::join(|| a.fill_from(hits, first), || b.fill_from(hits, first + n / 2));
+    }
+
+    /// The arrays of hits `..mid` and `mid..`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        let (t, t2) = self.t.split_at_mut(mid);
+        let (primitive, primitive2) = self.primitive.split_at_mut(mid);
+        let (instance, instance2) = self.instance.split_at_mut(mid);
+        let (barycentrics, barycentrics2) = self.barycentrics.split_at_mut(2 * mid);
+        let (normal, normal2) = self.normal.split_at_mut(3 * mid);
+        let (hit, hit2) = self.hit.split_at_mut(mid);
+        (
+            HitSlices { t, primitive, instance, barycentrics, normal, hit },
+            HitSlices { t: t2, primitive: primitive2, instance: instance2, barycentrics: barycentrics2, normal: normal2, hit: hit2 },
+        )
+    }
+
+    /// Hit `k` of these arrays.
+    fn write(&mut self, k: usize, h: RayHit) {
         self.t[k] = h.t;
         self.primitive[k] = signed(h.prim);
         self.instance[k] = signed(h.instance);
@@ -163,3 +162,6 @@ impl HitSlices<'_> {
         self.normal[3 * k..3 * k + 3].copy_from_slice(&h.normal);
     }
 }
+
+/// Hits a core writes at a time ([`HitSlices::fill`]).
+const PART: usize = 1 << 14;

@@ -2,6 +2,7 @@
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use rayon::prelude::*;
 use treelet::tracer::RayQueries;
 use treelet::{CpuBackend, GpuBackend, Ray, RayHit};
 
@@ -88,8 +89,8 @@ impl Tracer {
     /// wall milliseconds of the Rust API on these rays, taken `repeats`
     /// times, the rays already made (what an engine calling the Rust API
     /// pays, without this module's conversions): `closest_hits` into a new
-    /// vector of hits, or with `kept`, `closest_hits_with` into one kept
-    /// between calls (an engine's own buffer). Each result is dropped after
+    /// vector of hits, or with `kept`, `closest_hits_batch` into one kept
+    /// between calls (an engine's own buffer, written on every core). Each result is dropped after
     /// its time is taken, as `bench_rays.py` drops the module's.
     #[pyo3(signature = (origins, directions, repeats = 7, kept = false))]
     fn _rust_api_ms(&mut self, py: Python<'_>, origins: &Bound<'_, PyAny>, directions: &Bound<'_, PyAny>, repeats: usize, kept: bool) -> PyResult<f64> {
@@ -101,7 +102,10 @@ impl Tracer {
         for _ in 0..repeats.max(1) {
             let start = std::time::Instant::now();
             let hits = if kept {
-                on_device!(&mut self.inner, py, |b, t| t.closest_hits_with(b, rays.len(), |k| rays[k], |k, h| own[k] = h)).map_err(py_err)?;
+                on_device!(&mut self.inner, py, |b, t| t.closest_hits_batch(b, rays.len(), |k| rays[k], |hits| {
+                    own.par_iter_mut().enumerate().for_each(|(k, h)| *h = hits.get(k))
+                }))
+                .map_err(py_err)?;
                 Vec::new()
             } else {
                 on_device!(&mut self.inner, py, |b, t| t.closest_hits(b, &rays)).map_err(py_err)?

@@ -127,6 +127,31 @@ def test_out_is_filled_in_place_with_the_same_hits(device):
 
 
 @pytest.mark.parametrize("device", devices())
+def test_a_large_batch_equals_the_same_rays_in_small_ones(device):
+    """A batch of many rays is written on every core, in parts (`HitSlices::fill`); batches of a
+    few hundred are one part. Both give the same arrays, fresh or through `out=`, and the same
+    occlusion answers."""
+    rng = np.random.default_rng([5, ["cpu", "gpu"].index(device)])
+    v, idx = random_mesh(rng, 400)
+    n = 70_001  # more than four parts of 16 384, and not a multiple of one
+    o, d = random_rays(rng, n, v)
+    t_max = rng.uniform(0.0, 30.0, n).astype(np.float32)
+    tracer = treelet.Tracer(v, idx, device=device)
+    whole = tracer.closest_hits(o, d)
+    again = tracer.closest_hits(o[::-1].copy(), d[::-1].copy())
+    again = tracer.closest_hits(o, d, out=again)
+    occluded = tracer.occluded(o, d, t_max=t_max)
+    assert 0.3 * n < whole.hit.sum() < n, f"hits to test: {whole}"
+    step = 997
+    for start in range(0, n, step):
+        part = tracer.closest_hits(o[start:start + step], d[start:start + step])
+        for name in ["t", "primitive", "instance", "barycentrics", "normal", "hit"]:
+            np.testing.assert_array_equal(getattr(whole, name)[start:start + step], getattr(part, name), err_msg=name)
+            np.testing.assert_array_equal(getattr(again, name)[start:start + step], getattr(part, name), err_msg=f"out= {name}")
+        np.testing.assert_array_equal(occluded[start:start + step], tracer.occluded(o[start:start + step], d[start:start + step], t_max=t_max[start:start + step]))
+
+
+@pytest.mark.parametrize("device", devices())
 def test_occluded_agrees_with_closest_hits(device):
     rng = np.random.default_rng(7)
     v, idx = random_mesh(rng, 200)

@@ -92,11 +92,14 @@ fn check_meta(path: &Path, what: &str, meta: &std::fs::Metadata) -> Result<u64> 
 /// allocation that fails would abort the process).
 pub fn room_for<T>(n: usize, what: &str) -> Result<Vec<T>> {
     let mut v = Vec::new();
-    v.try_reserve_exact(n).map_err(|_| {
-        let bytes = n as f64 * std::mem::size_of::<T>() as f64;
-        anyhow::anyhow!("not enough memory for {what}: {n} of {} bytes ({:.2} GB)", std::mem::size_of::<T>(), bytes / 1e9)
-    })?;
+    v.try_reserve_exact(n).map_err(|_| no_memory::<T>(n, what))?;
     Ok(v)
+}
+
+/// The error of `n` elements of `T` for `what` that the memory cannot hold.
+fn no_memory<T>(n: usize, what: &str) -> anyhow::Error {
+    let bytes = n as f64 * std::mem::size_of::<T>() as f64;
+    anyhow::anyhow!("not enough memory for {what}: {n} of {} bytes ({:.2} GB)", std::mem::size_of::<T>(), bytes / 1e9)
 }
 
 /// [`room_for`] `n` elements that the caller fills whole, at once: the
@@ -112,15 +115,17 @@ pub fn room_to_fill<T>(n: usize, what: &str) -> Result<Vec<T>> {
 /// Room of at least this many bytes is mapped in at once by [`populate`].
 const POPULATE_MIN_BYTES: usize = 4 << 20;
 
-/// Maps in the pages of `v`'s room now, in one call (Linux 5.14's
-/// `MADV_POPULATE_WRITE`), where it is large: fresh memory taken a page
-/// fault at a time cost more than the copies into it (on the H200's virtual
-/// machine a million rays' 40 MB of hits took longer to fault in than to
-/// trace; here 64 MB in 33-43 ms by faults, 18-21 ms mapped at once). Where
-/// the kernel does not have it, the pages fault in as before.
+/// Maps in the pages of `v`'s room now (Linux 5.14's
+/// `MADV_POPULATE_WRITE`), where it is large, in parts on every core: fresh
+/// memory taken a page fault at a time cost more than the copies into it
+/// (on the H200's virtual machine a million rays' 40 MB of hits took longer
+/// to fault in than to trace; here 64 MB in 33-43 ms by faults, 18-21 ms
+/// mapped at once). Where the kernel does not have it, the pages fault in
+/// as before.
 fn populate<T>(v: &Vec<T>) {
     #[cfg(target_os = "linux")]
     {
+        use rayon::prelude::*;
         const MADV_POPULATE_WRITE: libc::c_int = 23;
         let bytes = v.capacity().saturating_mul(std::mem::size_of::<T>());
         if bytes < POPULATE_MIN_BYTES {
@@ -130,22 +135,31 @@ fn populate<T>(v: &Vec<T>) {
         let (start, end) = (v.as_ptr() as usize, v.as_ptr() as usize + bytes);
         let first = start.next_multiple_of(page);
         let len = (end - first) / page * page;
-        // SAFETY: the range lies within `v`'s allocation (whole pages inside
-        // it); MADV_POPULATE_WRITE only maps pages in, as writes would,
-        // and changes no byte; a failure (an older kernel) changes nothing.
-        unsafe {
-            libc::madvise(first as *mut libc::c_void, len, MADV_POPULATE_WRITE);
-        }
+        // Parts of 2 MiB: the kernel zeroes each page it maps, which one
+        // core does at a few GB/s.
+        let part = 2 << 20;
+        (0..len.div_ceil(part)).into_par_iter().for_each(|k| {
+            let at = first + k * part;
+            // SAFETY: the range lies within `v`'s allocation (whole pages
+            // inside it); MADV_POPULATE_WRITE only maps pages in, as writes
+            // would, and changes no byte; a failure (an older kernel)
+            // changes nothing.
+            unsafe {
+                libc::madvise(at as *mut libc::c_void, part.min(first + len - at), MADV_POPULATE_WRITE);
+            }
+        });
     }
     #[cfg(not(target_os = "linux"))]
     let _ = v;
 }
 
 /// `n` zeroed elements, or an error naming `what` where the memory cannot
-/// hold them ([`room_for`]): read-backs and the CPU runner's buffers.
-pub fn zeroed_vec<T: bytemuck::Pod>(n: usize, what: &str) -> Result<Vec<T>> {
-    let mut v = room_to_fill(n, what)?;
-    v.resize(n, T::zeroed());
+/// hold them ([`room_for`]), their pages mapped in ([`populate`]; fresh
+/// memory comes zeroed from the system, so nothing is written twice):
+/// read-backs, the CPU runner's buffers, Python's arrays of hits.
+pub fn zeroed_vec<T: bytemuck::Zeroable>(n: usize, what: &str) -> Result<Vec<T>> {
+    let v = bytemuck::allocation::try_zeroed_vec(n).map_err(|()| no_memory::<T>(n, what))?;
+    populate(&v);
     Ok(v)
 }
 

@@ -32,5 +32,5 @@ mod rays;
 pub use engine_mesh::{IndexBuffer, IndexFormat, MeshBuffers};
 pub use instances::{Instance, InstancedTracer};
 pub use primitives::{Quality, Tracer};
-pub use queries::RayQueries;
+pub use queries::{BatchHits, BatchOccluded, RayQueries};
 pub use rays::{batch_slots, device_rays, Ray, RayHit};

@@ -6,6 +6,8 @@
 //! [`InstancedTracer`]: crate::tracer::InstancedTracer
 use crate::error::Result;
 
+use rayon::prelude::*;
+
 use super::rays::{device_pair, hit_record, trace_batch, Ray, RayHit};
 use crate::runtime::backend::Backend;
 
@@ -69,11 +71,40 @@ pub trait RayQueries<B: Backend> {
     where
         Self: Sized,
     {
+        self.closest_hits_batch(b, count, ray, |hits| (0..hits.len()).for_each(|k| hit(k, hits.get(k))))
+    }
+
+    /// [`RayQueries::closest_hits_with`], the hits handed over all at once
+    /// as a [`BatchHits`] (read where they lie in the device's read-back
+    /// memory), so that the caller may take them on every core: on the
+    /// H200's host, writing a million hits one by one took longer than
+    /// tracing them. Returns what `take` returns.
+    ///
+    /// ```
+    /// use rayon::prelude::*;
+    /// use treelet::tracer::RayQueries;
+    /// use treelet::{CpuBackend, Quality, Ray, Tracer, Triangle};
+    /// let b = &mut CpuBackend::new();
+    /// let tracer = Tracer::build(b, &[], &[Triangle::new([0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0])], Quality::Fast)?;
+    /// let xs: Vec<f32> = (0..1000).map(|k| k as f32 / 500.0).collect();
+    /// let ray = |k: usize| Ray::new([xs[k], 0.05, 0.0], [0.0, 0.0, 1.0]);
+    /// // The distances, taken on every core.
+    /// let t: Vec<f32> = tracer.closest_hits_batch(b, xs.len(), ray, |hits| (0..hits.len()).into_par_iter().map(|k| hits.get(k).t).collect())?;
+    /// assert_eq!((t[0], t[999]), (5.0, f32::INFINITY));
+    /// # anyhow::Ok(())
+    /// ```
+    fn closest_hits_batch<T, R: Fn(usize) -> Ray + Sync>(&self, b: &mut B, count: usize, ray: R, take: impl FnOnce(&BatchHits<'_, R>) -> T) -> Result<T>
+    where
+        Self: Sized,
+    {
         crate::error::typed(|| {
             if self.is_empty() {
-                return misses(count, &ray, |k| hit(k, RayHit::MISS));
+                check_rays(count, &ray)?;
+                return Ok(take(&BatchHits { records: None, ray: &ray, count }));
             }
-            trace_batch(b, count, &ray, |b, rays| Ok(self.closest_hits_on_device(b, rays, count)?), |k, record| hit(k, hit_record(&ray(k), record)))
+            trace_batch(b, count, &ray, |b, rays| Ok(self.closest_hits_on_device(b, rays, count)?), |records| {
+                take(&BatchHits { records: Some(records), ray: &ray, count })
+            })
         })
     }
 
@@ -84,36 +115,100 @@ pub trait RayQueries<B: Backend> {
     where
         Self: Sized,
     {
+        self.occluded_batch(b, count, ray, |answers| (0..answers.len()).for_each(|k| occluded(k, answers.get(k))))
+    }
+
+    /// [`RayQueries::occluded_with`], the answers handed over all at once
+    /// (see [`RayQueries::closest_hits_batch`]).
+    fn occluded_batch<T, R: Fn(usize) -> Ray + Sync>(&self, b: &mut B, count: usize, ray: R, take: impl FnOnce(&BatchOccluded<'_>) -> T) -> Result<T>
+    where
+        Self: Sized,
+    {
         crate::error::typed(|| {
             if self.is_empty() {
-                return misses(count, &ray, |k| occluded(k, false));
+                check_rays(count, &ray)?;
+                return Ok(take(&BatchOccluded { records: None, count }));
             }
-            trace_batch(b, count, &ray, |b, rays| Ok(self.occluded_on_device(b, rays, count)?), |k, [first, _]| occluded(k, first[0] != 0.0))
+            trace_batch(b, count, &ray, |b, rays| Ok(self.occluded_on_device(b, rays, count)?), |records| {
+                take(&BatchOccluded { records: Some(records), count })
+            })
         })
     }
 }
 
-/// A scene with nothing to hit: every ray checked as a traced one would be
-/// (its `t_min`), then each handed to `miss`.
-fn misses(count: usize, ray: &impl Fn(usize) -> Ray, mut miss: impl FnMut(usize)) -> anyhow::Result<()> {
+/// The closest hits of a batch ([`RayQueries::closest_hits_batch`]): the
+/// device's records, read where they lie, made into [`RayHit`]s as asked
+/// for, from any thread.
+pub struct BatchHits<'a, R> {
+    /// Two `[f32; 4]` a ray; `None` for a scene with nothing to hit.
+    records: Option<&'a [[[f32; 4]; 2]]>,
+    ray: &'a R,
+    count: usize,
+}
+
+impl<R: Fn(usize) -> Ray + Sync> BatchHits<'_, R> {
+    /// The number of rays.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether the batch has no rays.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// The hit of ray `k` (`k < len()`).
+    pub fn get(&self, k: usize) -> RayHit {
+        match self.records {
+            Some(records) => hit_record(&(self.ray)(k), records[k]),
+            None => RayHit::MISS,
+        }
+    }
+}
+
+/// The answers of an occlusion batch ([`RayQueries::occluded_batch`]).
+pub struct BatchOccluded<'a> {
+    records: Option<&'a [[[f32; 4]; 2]]>,
+    count: usize,
+}
+
+impl BatchOccluded<'_> {
+    /// The number of rays.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether the batch has no rays.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Whether ray `k` hits anything up to its `t_max` (`k < len()`).
+    pub fn get(&self, k: usize) -> bool {
+        self.records.is_some_and(|records| records[k][0][0] != 0.0)
+    }
+}
+
+/// The rays of a batch on a scene with nothing to hit, checked as a traced
+/// batch checks them (each `t_min`).
+fn check_rays(count: usize, ray: &impl Fn(usize) -> Ray) -> anyhow::Result<()> {
     for k in 0..count {
         device_pair(k, &ray(k))?;
     }
-    (0..count).for_each(&mut miss);
     Ok(())
 }
 
 /// [`RayQueries::closest_hits`] of a slice, through [`RayQueries::closest_hits_with`].
 pub(super) fn collect_hits<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<RayHit>> {
     let mut out = crate::error::typed(|| crate::internals::input::room_to_fill(rays.len(), "hits of a batch"))?;
-    scene.closest_hits_with(b, rays.len(), |k| rays[k], |_, h| out.push(h))?;
+    scene.closest_hits_batch(b, rays.len(), |k| rays[k], |hits| (0..hits.len()).into_par_iter().map(|k| hits.get(k)).collect_into_vec(&mut out))?;
     Ok(out)
 }
 
 /// [`RayQueries::occluded`] of a slice, through [`RayQueries::occluded_with`].
 pub(super) fn collect_occluded<B: Backend>(scene: &impl RayQueries<B>, b: &mut B, rays: &[Ray]) -> Result<Vec<bool>> {
     let mut out = crate::error::typed(|| crate::internals::input::room_to_fill(rays.len(), "answers of a batch"))?;
-    scene.occluded_with(b, rays.len(), |k| rays[k], |_, o| out.push(o))?;
+    scene.occluded_batch(b, rays.len(), |k| rays[k], |answers| (0..answers.len()).into_par_iter().map(|k| answers.get(k)).collect_into_vec(&mut out))?;
     Ok(out)
 }
 

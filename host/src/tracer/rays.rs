@@ -65,23 +65,17 @@ pub(super) fn hit_record(r: &Ray, [[t, prim, b1, b2], [nx, ny, nz, instance]]: [
 
 /// Uploads the rays `ray(k)`, `k < count` (made in parallel, written
 /// straight into the device's upload memory), has `cast` trace them on the device in place,
-/// and hands each ray's two records, read where they lie, to `take(k, ..)`.
-pub(super) fn trace_batch<B: Backend>(
+/// and hands the rays' records (two a ray), read where they lie, to `take`.
+pub(super) fn trace_batch<B: Backend, T>(
     b: &mut B,
     count: usize,
     ray: &(impl Fn(usize) -> Ray + Sync),
     cast: impl FnOnce(&mut B, &B::Buffer) -> Result<()>,
-    mut take: impl FnMut(usize, [[f32; 4]; 2]),
-) -> Result<()> {
+    take: impl FnOnce(&[[[f32; 4]; 2]]) -> T,
+) -> Result<T> {
     let slots = batch_slots(count)?;
     let buffer = b.upload_indexed("rays", slots, |k| if k < count { device_pair(k, &ray(k)) } else { Ok([[0.0; 4]; 2]) })?;
-    let traced = cast(b, &buffer).and_then(|()| {
-        b.read_with(&buffer, count, |records: &[[[f32; 4]; 2]]| {
-            for (k, &pair) in records.iter().enumerate() {
-                take(k, pair);
-            }
-        })
-    });
+    let traced = cast(b, &buffer).and_then(|()| b.read_with(&buffer, count, take));
     // Waited for: the buffer serves the next batch (without this, every
     // batch took a new one until the next build: 66 MB a 1080p frame).
     b.release(&[&buffer]);
