@@ -2,15 +2,18 @@
 the Rust API's `closest_hits` on the same tree and rays (timed inside the module, the rays
 already made: `Tracer._rust_api_ms`), the same into the first batch's arrays (`out=`) and,
 with --mitsuba, Mitsuba 3's
-`scene.ray_intersect_preliminary` (OptiX on NVIDIA) from Python, transfers included.
+`scene.ray_intersect_preliminary` (OptiX on NVIDIA) from Python, transfers included; with
+--embree, embreex's `EmbreeScene.run` (Embree on the CPU, the same outputs: distance, triangle,
+barycentrics, normal).
 Incoherent rays: origins uniform in the mesh's box, directions uniform on the sphere.
 
-    python python/examples/bench_rays.py MESH.ply[.xz] [--rays 1000000] [--device gpu] [--mitsuba]
+    python python/examples/bench_rays.py MESH.ply[.xz] [--rays 1000000] [--device gpu] [--mitsuba] [--embree]
 
 MESH.ply: a binary PLY as `treelet export` writes it (scenes/real/*.ply.xz are). Prints one
 JSON line a method."""
 import argparse
 import json
+import os
 import time
 
 import numpy as np
@@ -54,6 +57,8 @@ def main():
     p.add_argument("--device", default="gpu")
     p.add_argument("--repeats", type=int, default=7)
     p.add_argument("--mitsuba", action="store_true")
+    p.add_argument("--embree", action="store_true")
+    p.add_argument("--quality", default="fast", help="Treelet's build: fast, balanced or high")
     a = p.parse_args()
     v, idx = read_ply(a.mesh)
     rng = np.random.default_rng(1)
@@ -63,7 +68,7 @@ def main():
     d /= np.linalg.norm(d, axis=1, keepdims=True)
 
     start = time.perf_counter()
-    tracer = treelet.Tracer(v, idx, device=a.device, quality="fast")
+    tracer = treelet.Tracer(v, idx, device=a.device, quality=a.quality)
     build_ms = (time.perf_counter() - start) * 1e3
     ms, hits = median_ms(lambda: tracer.closest_hits(o, d), a.repeats)
     rust_ms = tracer._rust_api_ms(o, d, a.repeats)
@@ -113,6 +118,25 @@ def main():
                           "rays": a.rays, "hit": int(np.isfinite(t).sum()), "build_ms": round(mi_build_ms, 3),
                           "median_ms": round(ms, 3), "mrays_per_s": round(a.rays / ms / 1e3, 1)}))
         same = np.isfinite(t) == hits.hit
+        print(json.dumps({"agree_hit_or_miss": float(same.mean()),
+                          "agree_primitive": float((prim[hits.hit & same] == hits.primitive[hits.hit & same]).mean())}))
+
+    if a.embree:
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+        start = time.perf_counter()
+        scene = rtcore_scene.EmbreeScene()
+        TriangleMesh(scene, np.ascontiguousarray(v[idx], dtype=np.float32))
+        # Embree builds on the first query: the build is timed with a one-ray query.
+        scene.run(o[:1], d[:1])
+        embree_build_ms = (time.perf_counter() - start) * 1e3
+        ms, res = median_ms(lambda: scene.run(o, d, output=1), a.repeats)
+        prim = np.asarray(res["primID"])
+        hit = prim >= 0
+        print(json.dumps({"api": "embreex", "adapter": f"Embree (embreex), {os.cpu_count()} cores", "triangles": len(idx),
+                          "rays": a.rays, "hit": int(hit.sum()), "build_ms": round(embree_build_ms, 3),
+                          "median_ms": round(ms, 3), "mrays_per_s": round(a.rays / ms / 1e3, 1)}))
+        same = hit == hits.hit
         print(json.dumps({"agree_hit_or_miss": float(same.mean()),
                           "agree_primitive": float((prim[hits.hit & same] == hits.primitive[hits.hit & same]).mean())}))
 
