@@ -15,7 +15,8 @@
 //! Rays and hits in an engine's own arrays (columns, say) need no slice of
 //! [`Ray`]s: [`tracer::RayQueries::closest_hits_with`] asks for each ray
 //! and hands back each hit, writing the rays straight into the device's
-//! upload memory. An [`InstancedTracer`] places meshes many times; [`scene::instanced::InstancedScene::load`]
+//! upload memory ([`tracer::RayQueries::closest_hits_batch`] hands the
+//! whole batch's hits over at once, to be taken on every core). An [`InstancedTracer`] places meshes many times; [`scene::instanced::InstancedScene::load`]
 //! reads a glTF or scene file's meshes once each, with their copies as
 //! instances ([`InstancedTracer::build_scene`]).
 //!
