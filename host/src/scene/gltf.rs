@@ -264,8 +264,8 @@ struct Loaded {
 /// chain of a hundred thousand nodes is an attack on the reader.
 const MAX_NODE_DEPTH: usize = 1000;
 
-/// Each buffer's bytes: the `.glb` binary chunk (moved, not copied: only
-/// the first buffer may be it, glTF 2.0, 4.4.3.2), a base64 data URI, or a
+/// Each buffer's bytes: the `.glb` binary chunk (moved, not copied: glTF
+/// gives it to the first buffer alone), a base64 data URI, or a
 /// file beside the scene.
 fn buffers(gltf: &mut gltf::Gltf, dir: &Path, name: &str) -> Result<Vec<Vec<u8>>> {
     use base64::Engine as _;
@@ -668,42 +668,40 @@ mod tests {
         let mut json = json.into_bytes();
         json.resize(json.len().div_ceil(4) * 4, b' ');
         let bin = square_buffer(); // 60 bytes, a multiple of 4
+        let mut chunk = (bin.len() as u32).to_le_bytes().to_vec();
+        chunk.extend(b"BIN\0");
+        chunk.extend(&bin);
+        (glb(&json, &chunk), json.len())
+    }
+
+    /// A GLB file of a JSON chunk (padded with spaces) and `rest`, the
+    /// chunks after it, as they are.
+    fn glb(json: &[u8], rest: &[u8]) -> Vec<u8> {
+        let mut json = json.to_vec();
+        json.resize(json.len().div_ceil(4) * 4, b' ');
         let mut glb = Vec::new();
         glb.extend(b"glTF");
         glb.extend(2u32.to_le_bytes());
-        glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+        glb.extend(((12 + 8 + json.len() + rest.len()) as u32).to_le_bytes());
         glb.extend((json.len() as u32).to_le_bytes());
         glb.extend(b"JSON");
         glb.extend(&json);
-        glb.extend((bin.len() as u32).to_le_bytes());
-        glb.extend(b"BIN\0");
-        glb.extend(&bin);
-        (glb, json.len())
+        glb.extend(rest);
+        glb
     }
 
     /// Only the first buffer may be a GLB's binary chunk (it is moved into
     /// that buffer, not copied): a second that names none is refused by name.
     #[test]
     fn a_second_buffer_without_a_uri_is_refused() {
-        let (glb, json_len) = square_glb();
-        let json = std::str::from_utf8(&glb[20..20 + json_len]).unwrap();
+        let (square, json_len) = square_glb();
+        let json = std::str::from_utf8(&square[20..20 + json_len]).unwrap();
         let two = json.replace(r#""buffers": [{"byteLength": 60}]"#, r#""buffers": [{"byteLength": 60}, {"byteLength": 60}]"#);
         let two = two.replace(r#"{"buffer": 0, "byteOffset": 48"#, r#"{"buffer": 1, "byteOffset": 48"#);
         assert_ne!(two, json, "the document changed");
-        let mut two = two.into_bytes();
-        two.resize(two.len().div_ceil(4) * 4, b' ');
-        let bin = &glb[20 + json_len..];
-        let mut file = Vec::new();
-        file.extend(b"glTF");
-        file.extend(2u32.to_le_bytes());
-        file.extend(((12 + 8 + two.len() + bin.len()) as u32).to_le_bytes());
-        file.extend((two.len() as u32).to_le_bytes());
-        file.extend(b"JSON");
-        file.extend(&two);
-        file.extend(bin);
         let d = dir();
         let path = d.join("twobuffers.glb");
-        std::fs::write(&path, file).unwrap();
+        std::fs::write(&path, glb(two.as_bytes(), &square[20 + json_len..])).unwrap();
         let e = format!("{:#}", load(&path).unwrap_err());
         assert!(e.contains("buffer 1: the binary chunk is an earlier buffer's"), "{e}");
         std::fs::remove_dir_all(&d).ok();
