@@ -215,24 +215,33 @@ impl SlabRay {
     }
 }
 
-/// How much a slab test widens its far distance, and a traversal the
-/// closest hit so far it culls boxes by ([`crate::trace::hit::Hit::reach`]):
-/// `1 + 2^-14`. Two reasons:
-/// * rounding: Ize ("Robust BVH Ray Traversal", 2013) needs `1 + 2γ(3)`
-///   (about `1 + 2^-22`) for three roundings of `(plane - o) * inv`, so that
-///   no box the ray touches is culled;
-/// * ties: a ray through a vertex or edge that several primitives share
-///   hits them all at one distance, and the lowest index must win, as in
-///   the scan ([`crate::trace::hit::Hit::is_beaten_by`]); the winner's box
-///   is entered exactly at that distance, but the slab test computes the
-///   entry apart from the primitive test's distance, and it may round a
-///   few ulps above it. (Rays along an axis through a mesh's vertices lost
-///   such ties in every layout.)
+/// How much a slab test widens its far distance: `1 + 2^-21`, above the
+/// `1 + 2γ(3)` (about `1 + 2^-22`) that Ize ("Robust BVH Ray Traversal",
+/// 2013) needs for three roundings of `(plane - o) * inv`, so that no box
+/// the ray touches is culled. Kept that small because it widens every box
+/// sideways by the distance times itself: at `2^-14` (779c44d, one
+/// constant for this and [`TIE_WIDENING`]) primary rays through a grid of
+/// 1 024 scanned bunnies, a hundred bunnies away, entered leaves they
+/// missed by that much and lost a third of their speed on the H200
+/// (docs/results/h200-instances-fix-2026-12-03). Ties need none of it:
+/// `tests/layouts.rs` passes with it and fails without [`TIE_WIDENING`].
+pub const FAR_WIDENING: f32 = 1.0 + 1.0 / 2_097_152.0;
+
+/// How much a traversal widens the closest hit's distance before it culls
+/// boxes by it ([`crate::trace::hit::Hit::reach`]): `1 + 2^-14`, for ties.
+/// A ray through a vertex or edge that several primitives share hits them
+/// all at one distance, and the lowest index must win, as in the scan
+/// ([`crate::trace::hit::Hit::is_beaten_by`]); the winner's box is entered
+/// exactly at that distance, but the slab test computes the entry apart
+/// from the primitive test's distance, and it may round a few ulps above
+/// it. (Rays along an axis through a mesh's vertices lost such ties in
+/// every layout.) It only lets in boxes that start just behind the hit,
+/// so it may be generous.
 ///
-/// (Folding the two into one multiply of the clipped far distance, as
-/// `ray_box` does, made the `bvh2` walk 1-3% slower on the H200 than a
-/// multiply a node: docs/results/h200-axis-rays-2026-12-02.)
-pub const FAR_WIDENING: f32 = 1.0 + 1.0 / 16384.0;
+/// (Folding this and [`FAR_WIDENING`] into one multiply of the clipped far
+/// distance, as `ray_box` does, made the `bvh2` walk 1-3% slower on the
+/// H200 than a multiply a node: docs/results/h200-axis-rays-2026-12-02.)
+pub const TIE_WIDENING: f32 = 1.0 + 1.0 / 16384.0;
 
 /// The interval `[near, far]` over which the ray is inside the box
 /// `lo..hi` (far widened by [`FAR_WIDENING`]), clipped to `0..=t_max`; the
@@ -253,13 +262,14 @@ pub fn slab_interval(lo: [f32; 3], hi: [f32; 3], ray: &SlabRay, t_max: f32) -> (
 /// Slab test of a node's box against a ray, hits between 0 and `t_max`.
 /// An axis the ray runs parallel to (zero in `inv_d`) admits every `t` when
 /// the origin lies within the slab, boundaries included, and none otherwise.
-/// The far distance, `t_max` included, is widened by [`FAR_WIDENING`].
+/// The far distance is widened by [`FAR_WIDENING`], `t_max` by
+/// [`TIE_WIDENING`].
 #[inline]
 pub fn ray_box(node: &Node, o: Vec3, inv_d: Vec3, t_max: f32) -> bool {
     // Arrays, not `Vec3` indexing (which rust-gpu lowers to pointer phis).
     let (lo, hi, o, inv_d) = (node.min, node.max, o.to_array(), inv_d.to_array());
     let mut near = 0.0f32;
-    let mut far = t_max * FAR_WIDENING;
+    let mut far = t_max * TIE_WIDENING;
     for k in 0..3 {
         if inv_d[k] == 0.0 {
             if o[k] < lo[k] || o[k] > hi[k] {

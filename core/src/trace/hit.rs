@@ -119,13 +119,12 @@ impl Hit {
     }
 
     /// How far a traversal still enters boxes: this hit's distance widened
-    /// as a slab test widens it
-    /// ([`FAR_WIDENING`](crate::geometry::intersect::FAR_WIDENING): for
+    /// by [`TIE_WIDENING`](crate::geometry::intersect::TIE_WIDENING) (for
     /// ties between primitives that share an edge or vertex), for the tests
     /// that compare a box's entry with the hit (a child pushed, a cwbvh
     /// node's children); infinite for no hit.
     #[inline]
     pub fn reach(&self) -> f32 {
-        self.t * crate::geometry::intersect::FAR_WIDENING
+        self.t * crate::geometry::intersect::TIE_WIDENING
     }
 }
