@@ -9,7 +9,7 @@ use treelet::tracer::RayQueries;
 use treelet::{CpuBackend, GpuBackend, Quality};
 
 use crate::arrays::RayArrays;
-use crate::hits::{HitArrays, Hits};
+use crate::hits::{FreshHits, HitArrays, Hits};
 use rayon::prelude::*;
 use treelet::internals::input::zeroed_vec;
 use crate::py_err;
@@ -98,15 +98,17 @@ where
     /// place and handed back.
     pub(crate) fn closest_hits(&mut self, py: Python<'_>, arrays: &RayArrays<'_>, out: Option<&Bound<'_, Hits>>) -> PyResult<Py<Hits>> {
         let rays = arrays.columns()?;
-        let out = match out {
-            Some(out) => out.clone(),
-            None => Bound::new(py, Hits::zeroed(py, rays.len())?)?,
+        let Some(out) = out else {
+            let mut fresh = FreshHits::new(rays.len())?;
+            let into = fresh.slices();
+            let filled = on_device!(self, py, |b, t| t.closest_hits_batch(b, rays.len(), |k| rays.ray(k), |hits| into.fill(hits))).map_err(py_err)?;
+            return Py::new(py, fresh.into_hits(py, filled));
         };
-        let mut held = HitArrays::borrow(py, &out, rays.len())?;
+        let mut held = HitArrays::borrow(py, out, rays.len())?;
         let into = held.slices()?;
         on_device!(self, py, |b, t| t.closest_hits_batch(b, rays.len(), |k| rays.ray(k), |hits| into.fill(hits))).map_err(py_err)?;
         drop(held);
-        Ok(out.unbind())
+        Ok(out.clone().unbind())
     }
 
     /// Whether each ray of the arrays is occluded.

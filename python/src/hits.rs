@@ -1,8 +1,10 @@
 //! The closest hits of a batch, as NumPy arrays.
+use std::mem::MaybeUninit;
+
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use treelet::internals::input::zeroed_vec;
+use treelet::internals::input::room_to_fill;
 use treelet::tracer::BatchHits;
 use treelet::{Ray, RayHit};
 
@@ -33,26 +35,79 @@ impl Hits {
     }
 }
 
-impl Hits {
-    /// New arrays for `n` hits, zeroed, their pages mapped in on every core
-    /// (`zeroed_vec`: on the H200's virtual machine, fresh memory taken a
-    /// page fault at a time cost more than tracing the rays), handed to
-    /// NumPy without a copy; filled as `out=` arrays are. A `MemoryError`
-    /// where the memory cannot hold them.
-    pub(crate) fn zeroed(py: Python<'_>, n: usize) -> PyResult<Self> {
-        fn zeroed<T: bytemuck::Zeroable>(n: usize, what: &str) -> PyResult<Vec<T>> {
-            zeroed_vec(n, what).map_err(|e| pyo3::exceptions::PyMemoryError::new_err(format!("{e:#}")))
+/// New arrays for a batch's hits: their room mapped in on every core
+/// (`room_to_fill`: on the H200's virtual machine, fresh memory taken a
+/// page fault at a time cost more than tracing the rays) and written once,
+/// by [`HitSlices::fill`], then handed to NumPy without a copy. Not zeroed
+/// first: that pass over a million hits' 41 MB made fresh arrays cost
+/// 1.3x the Rust API's time on the H200, against 1.1x for `out=` ones.
+pub(crate) struct FreshHits {
+    n: usize,
+    t: Vec<f32>,
+    primitive: Vec<i64>,
+    instance: Vec<i64>,
+    barycentrics: Vec<f32>,
+    normal: Vec<f32>,
+    hit: Vec<bool>,
+}
+
+/// Made only by [`HitSlices::fill`] once every hit of its arrays is written:
+/// what [`FreshHits::into_hits`] needs to hand them over.
+pub(crate) struct Filled(());
+
+impl FreshHits {
+    /// Room for `n` hits; a `MemoryError` where the memory cannot hold it.
+    pub(crate) fn new(n: usize) -> PyResult<Self> {
+        fn room<T>(n: usize, what: &str) -> PyResult<Vec<T>> {
+            room_to_fill(n, what).map_err(|e| pyo3::exceptions::PyMemoryError::new_err(format!("{e:#}")))
         }
-        let barycentrics = Array2::from_shape_vec((n, 2), zeroed(2 * n, "barycentrics")?).expect("n rows of 2");
-        let normal = Array2::from_shape_vec((n, 3), zeroed(3 * n, "normal")?).expect("n rows of 3");
-        Ok(Hits {
-            t: zeroed::<f32>(n, "t")?.into_pyarray(py).unbind(),
-            primitive: zeroed::<i64>(n, "primitive")?.into_pyarray(py).unbind(),
-            instance: zeroed::<i64>(n, "instance")?.into_pyarray(py).unbind(),
+        Ok(FreshHits {
+            n,
+            t: room(n, "t")?,
+            primitive: room(n, "primitive")?,
+            instance: room(n, "instance")?,
+            barycentrics: room(2 * n, "barycentrics")?,
+            normal: room(3 * n, "normal")?,
+            hit: room(n, "hit")?,
+        })
+    }
+
+    /// The room, to be filled.
+    pub(crate) fn slices(&mut self) -> HitSlices<'_> {
+        let n = self.n;
+        HitSlices {
+            t: &mut self.t.spare_capacity_mut()[..n],
+            primitive: &mut self.primitive.spare_capacity_mut()[..n],
+            instance: &mut self.instance.spare_capacity_mut()[..n],
+            barycentrics: &mut self.barycentrics.spare_capacity_mut()[..2 * n],
+            normal: &mut self.normal.spare_capacity_mut()[..3 * n],
+            hit: &mut self.hit.spare_capacity_mut()[..n],
+        }
+    }
+
+    /// The filled arrays as NumPy's.
+    pub(crate) fn into_hits(mut self, py: Python<'_>, _: Filled) -> Hits {
+        let n = self.n;
+        // SAFETY: `Filled` is made only by a fill of `slices()`, which
+        // writes every element of the first `n` (`2n`, `3n`) of each.
+        unsafe {
+            self.t.set_len(n);
+            self.primitive.set_len(n);
+            self.instance.set_len(n);
+            self.barycentrics.set_len(2 * n);
+            self.normal.set_len(3 * n);
+            self.hit.set_len(n);
+        }
+        let barycentrics = Array2::from_shape_vec((n, 2), self.barycentrics).expect("n rows of 2");
+        let normal = Array2::from_shape_vec((n, 3), self.normal).expect("n rows of 3");
+        Hits {
+            t: self.t.into_pyarray(py).unbind(),
+            primitive: self.primitive.into_pyarray(py).unbind(),
+            instance: self.instance.into_pyarray(py).unbind(),
             barycentrics: barycentrics.into_pyarray(py).unbind(),
             normal: normal.into_pyarray(py).unbind(),
-            hit: zeroed::<bool>(n, "hit")?.into_pyarray(py).unbind(),
-        })
+            hit: self.hit.into_pyarray(py).unbind(),
+        }
     }
 }
 
@@ -99,32 +154,42 @@ impl<'py> HitArrays<'py> {
     pub(crate) fn slices(&mut self) -> PyResult<HitSlices<'_>> {
         let whole = |what: &str| pyo3::exceptions::PyValueError::new_err(format!("out.{what}: not contiguous"));
         Ok(HitSlices {
-            t: self.t.as_slice_mut().map_err(|_| whole("t"))?,
-            primitive: self.primitive.as_slice_mut().map_err(|_| whole("primitive"))?,
-            instance: self.instance.as_slice_mut().map_err(|_| whole("instance"))?,
-            barycentrics: self.barycentrics.as_slice_mut().map_err(|_| whole("barycentrics"))?,
-            normal: self.normal.as_slice_mut().map_err(|_| whole("normal"))?,
-            hit: self.hit.as_slice_mut().map_err(|_| whole("hit"))?,
+            t: written(self.t.as_slice_mut().map_err(|_| whole("t"))?),
+            primitive: written(self.primitive.as_slice_mut().map_err(|_| whole("primitive"))?),
+            instance: written(self.instance.as_slice_mut().map_err(|_| whole("instance"))?),
+            barycentrics: written(self.barycentrics.as_slice_mut().map_err(|_| whole("barycentrics"))?),
+            normal: written(self.normal.as_slice_mut().map_err(|_| whole("normal"))?),
+            hit: written(self.hit.as_slice_mut().map_err(|_| whole("hit"))?),
         })
     }
 }
 
-/// [`HitArrays`] as slices.
+/// Initialized elements seen as room that [`HitSlices`] writes: it only
+/// ever writes whole values into it, so they stay initialized.
+fn written<T>(s: &mut [T]) -> &mut [MaybeUninit<T>] {
+    // SAFETY: same layout; every write through the result is a whole `T`
+    // (`HitSlices::write`), never an uninitialized value.
+    unsafe { &mut *(s as *mut [T] as *mut [MaybeUninit<T>]) }
+}
+
+/// The arrays of a batch's hits, [`HitArrays`] or [`FreshHits`], as room
+/// to write every hit into.
 pub(crate) struct HitSlices<'a> {
-    t: &'a mut [f32],
-    primitive: &'a mut [i64],
-    instance: &'a mut [i64],
-    barycentrics: &'a mut [f32],
-    normal: &'a mut [f32],
-    hit: &'a mut [bool],
+    t: &'a mut [MaybeUninit<f32>],
+    primitive: &'a mut [MaybeUninit<i64>],
+    instance: &'a mut [MaybeUninit<i64>],
+    barycentrics: &'a mut [MaybeUninit<f32>],
+    normal: &'a mut [MaybeUninit<f32>],
+    hit: &'a mut [MaybeUninit<bool>],
 }
 
 impl HitSlices<'_> {
     /// Fills the arrays with the batch's hits on every core (in parts of
     /// [`PART`] rays: a million hits are 41 MB of arrays, which one core
     /// writes slower than the GPU traces them).
-    pub(crate) fn fill<R: Fn(usize) -> Ray + Sync>(self, hits: &BatchHits<'_, R>) {
+    pub(crate) fn fill<R: Fn(usize) -> Ray + Sync>(self, hits: &BatchHits<'_, R>) -> Filled {
         self.fill_from(hits, 0);
+        Filled(())
     }
 
     /// [`HitSlices::fill`] of the arrays that hold hits `first..`.
@@ -154,12 +219,16 @@ impl HitSlices<'_> {
 
     /// Hit `k` of these arrays.
     fn write(&mut self, k: usize, h: RayHit) {
-        self.t[k] = h.t;
-        self.primitive[k] = signed(h.prim);
-        self.instance[k] = signed(h.instance);
-        self.hit[k] = h.is_hit();
-        self.barycentrics[2 * k..2 * k + 2].copy_from_slice(&h.barycentrics);
-        self.normal[3 * k..3 * k + 3].copy_from_slice(&h.normal);
+        self.t[k].write(h.t);
+        self.primitive[k].write(signed(h.prim));
+        self.instance[k].write(signed(h.instance));
+        self.hit[k].write(h.is_hit());
+        for (j, &b) in h.barycentrics.iter().enumerate() {
+            self.barycentrics[2 * k + j].write(b);
+        }
+        for (j, &x) in h.normal.iter().enumerate() {
+            self.normal[3 * k + j].write(x);
+        }
     }
 }
 
