@@ -387,15 +387,15 @@ fn block_means(p: &[[f32; 3]], w: usize, h: usize) -> Vec<f64> {
     out
 }
 
-/// Several seeds' block means: their mean per block, and the variance of
-/// that mean (each block's sample variance over the seeds, pooled over the
-/// blocks, over the number of seeds).
-fn mean_and_variance(images: &[Vec<f64>]) -> (Vec<f64>, f64) {
+/// Several seeds' block means: their mean per block, and that mean's
+/// variance per block (the block's sample variance over the seeds, over
+/// the number of seeds).
+fn mean_and_variance(images: &[Vec<f64>]) -> (Vec<f64>, Vec<f64>) {
     let k = images.len() as f64;
     let n = images[0].len();
     let mean: Vec<f64> = (0..n).map(|i| images.iter().map(|b| b[i]).sum::<f64>() / k).collect();
-    let pooled = (0..n).map(|i| images.iter().map(|b| (b[i] - mean[i]).powi(2)).sum::<f64>() / (k - 1.0)).sum::<f64>() / n as f64;
-    (mean, pooled / k)
+    let var = (0..n).map(|i| images.iter().map(|b| (b[i] - mean[i]).powi(2)).sum::<f64>() / (k - 1.0) / k).collect();
+    (mean, var)
 }
 
 /// Next-event estimation, alone and with light paths for caustics, is
@@ -407,24 +407,33 @@ fn mean_and_variance(images: &[Vec<f64>]) -> (Vec<f64>, f64) {
 /// or 2), a light behind glass left dark, or sample points that are not
 /// uniform all fail this.
 ///
-/// Each side's noise is measured from its own seeds (two for next-event
-/// estimation; four for smallpt and for light paths, whose noise is
-/// heavy-tailed where a light is small), and the blocks may differ by up to
-/// twice the noise of the difference. The bound was 1.5x smallpt's noise
-/// alone, which failed by chance in CI (the light in glass, where shadow
-/// rays cannot help and next-event estimation is as noisy as smallpt:
-/// 1.57x); with two smallpt seeds the small octahedron lamp's reference
-/// came out 1.73x in one of five seeds (two seeds that both missed its rare
-/// paths agree with each other and understate their noise).
+/// Each side is 16 seeds of 256 samples a pixel, so that each block has its
+/// own noise, measured with 15 degrees of freedom a side: each block's
+/// difference over that noise is a z-score, and their root mean square must
+/// stay under 2 (about 1 when unbiased). Earlier forms pooled one noise
+/// over all blocks from four seeds of 1 024 samples, and failed by chance
+/// in CI (seed 4573351399162283677: the small octahedron lamp with
+/// independent numbers, 2.29x): a few blocks around a small light carry
+/// most of the variance, so the pooled figure had few degrees of freedom.
+/// On that lamp with independent numbers, eleven seeds' renders measured
+/// both ways gave a pooled ratio of 0.80-1.46 (four seeds of 1 024) and
+/// 0.77-1.80 (sixteen of 256), and this form 0.95-1.35. Power, one seed:
+/// one side scaled by 1.03 reaches 2 on cornell, the room and the disk
+/// lights, by 1.05 on every lit scene but the lamp (1.39-1.59); the
+/// whole-image means fail anything past 3% everywhere. Highest over five
+/// seeds of the whole test: cornell with light paths, 1.16-1.69, its mean
+/// 0.2-1.2% under smallpt's in four of them (every other pair 0.83-1.36): a
+/// small bias of the light paths on cornell is suspected, not yet found.
 #[test]
 fn nee_converges_to_the_smallpt_estimate() {
     let seed = treelet_tests::fresh_seed() as u32;
-    let (w, h, spp) = (32usize, 24usize, 1024);
-    let blocks_of = |scene: &Scene, integrator, sampler, seeds: &[u32], name: &str| -> Vec<Vec<f64>> {
+    let (w, h, spp) = (32usize, 24usize, 256);
+    let seeds: Vec<u32> = (0..16u32).map(|k| k.wrapping_mul(0x9e37_79b9)).collect();
+    let blocks_of = |scene: &Scene, integrator, sampler, salt: u32, name: &str| -> Vec<Vec<f64>> {
         seeds
             .iter()
             .map(|&k| {
-                let s = RenderSettings { sampler, ..with_integrator(settings(w as u32, h as u32, spp, seed ^ k, Accel::None), integrator) };
+                let s = RenderSettings { sampler, ..with_integrator(settings(w as u32, h as u32, spp, seed ^ salt ^ k, Accel::None), integrator) };
                 let image = pixels(&mut CpuBackend::new(), scene, &s);
                 assert!(image.iter().flatten().all(|v| v.is_finite() && *v >= 0.0), "{} {name}: NaN, infinite or negative pixels", scene.name);
                 block_means(&image, w, h)
@@ -433,25 +442,17 @@ fn nee_converges_to_the_smallpt_estimate() {
     };
     let mut failures = Vec::new();
     for scene in light_scenes() {
-        let (bp, var_p) = mean_and_variance(&blocks_of(&scene, Integrator::Smallpt, Sampler::Independent, &[0x1111, 0x2222, 0x4444, 0x8888], "smallpt"));
+        let (bp, var_p) = mean_and_variance(&blocks_of(&scene, Integrator::Smallpt, Sampler::Independent, 0x1111_0000, "smallpt"));
         let mp = bp.iter().sum::<f64>() / bp.len() as f64;
-        for (integrator, sampler) in [(Integrator::Nee, Sampler::Sobol), (Integrator::Nee, Sampler::Independent), (Integrator::Caustics, Sampler::Sobol)] {
+        for (k, (integrator, sampler)) in [(Integrator::Nee, Sampler::Sobol), (Integrator::Nee, Sampler::Independent), (Integrator::Caustics, Sampler::Sobol)].into_iter().enumerate() {
             let name = format!("{} ({})", integrator.name(), sampler.name());
-            // Four seeds a side: with two, the noise of next-event
-            // estimation's mean was under-estimated for the small lamp
-            // (seed 5000679523681914735: blocks 2.38x the noise, means equal to 0.1%).
-            let seeds: &[u32] = &[0, 0x5555, 0xaaaa, 0x3333];
-            let (bn, var_n) = mean_and_variance(&blocks_of(&scene, integrator, sampler, seeds, &name));
+            let (bn, var_n) = mean_and_variance(&blocks_of(&scene, integrator, sampler, 0x2222_0000 + k as u32, &name));
             let mn = bn.iter().sum::<f64>() / bn.len() as f64;
-            let diff = (bp.iter().zip(&bn).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / bp.len() as f64).sqrt();
-            let noise = (var_p + var_n).sqrt();
-            eprintln!(
-                "{}: mean luminance {name} {mn:.4}, smallpt {mp:.4}; blocks differ by {diff:.4} (rms), {:.2}x the noise ({noise:.4}: smallpt's {:.4}, its own {:.4})",
-                scene.name,
-                diff / noise.max(1e-30),
-                var_p.sqrt(),
-                var_n.sqrt()
-            );
+            // A block both sides see without noise (a light filling it)
+            // still gets a floor of a thousandth of the mean.
+            let z2 = (0..bp.len()).map(|i| (bp[i] - bn[i]).powi(2) / (var_p[i] + var_n[i] + (1e-3 * mp).powi(2)).max(1e-30));
+            let z = (z2.sum::<f64>() / bp.len() as f64).sqrt();
+            eprintln!("{}: mean luminance {name} {mn:.4}, smallpt {mp:.4}; blocks differ by {z:.2} standard deviations (rms)", scene.name);
             if scene.name == "no light" {
                 if !(mn == 0.0 && mp == 0.0) {
                     failures.push(format!("no light: the image must be black ({name} {mn}, smallpt {mp})"));
@@ -461,8 +462,8 @@ fn nee_converges_to_the_smallpt_estimate() {
             if (mn / mp - 1.0).abs() >= 0.03 {
                 failures.push(format!("{} {name}: mean luminance {mn}, smallpt {mp}", scene.name));
             }
-            if diff >= 2.0 * noise + 1e-3 * mp {
-                failures.push(format!("{} {name}: blocks differ by {diff} (rms), the noise {noise}", scene.name));
+            if z >= 2.0 {
+                failures.push(format!("{} {name}: blocks differ by {z:.2} standard deviations (rms)", scene.name));
             }
         }
     }
