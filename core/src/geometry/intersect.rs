@@ -216,7 +216,7 @@ impl SlabRay {
 }
 
 /// How much a slab test widens its far distance: `1 + 2^-21`, above the
-/// `1 + 2γ(3)` (about `1 + 2^-22`) that Ize ("Robust BVH Ray Traversal",
+/// `1 + 2γ(3)` (`1 + 3.6e-7`, about `1 + 2^-21.4`) that Ize ("Robust BVH Ray Traversal",
 /// 2013) needs for three roundings of `(plane - o) * inv`, so that no box
 /// the ray touches is culled. Kept that small because it widens every box
 /// sideways by the distance times itself: at `2^-14` (779c44d, one
