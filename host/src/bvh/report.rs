@@ -63,6 +63,10 @@ pub struct BuildReport {
     pub sah_after: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub round_ms: Option<Vec<f64>>,
+    /// Every stage of the rounds in order, with `TREELET_PROFILE_LEVELS`
+    /// (each height of each round a stage of its own), for profiling.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stage_ms: Option<Vec<(String, f64)>>,
 }
 
 /// A CPU build (`sweep`, or `reference`: the quality reference), its
@@ -106,6 +110,7 @@ pub fn run_build_cpu(scene: &Scene, builder: Builder, max_leaf: u32) -> Result<(
         sah_before: None,
         sah_after: None,
         round_ms: None,
+        stage_ms: None,
     };
     Ok((bvh, report))
 }
@@ -162,7 +167,7 @@ pub fn run_build_with<B: Backend>(
     let mut ms: serde_json::Map<String, serde_json::Value> =
         STAGES.iter().map(|s| (s.to_string(), serde_json::json!(times.get(s)))).collect();
     let mut total_ms = times.total();
-    let (mut sah_before, mut round_ms) = (None, None);
+    let (mut sah_before, mut round_ms, mut stage_ms) = (None, None, None);
     if let Some(config) = treelets {
         sah_before = Some(sah_cost(&bvh.nodes, SahCosts::KARRAS_AILA));
         let root = bvh.nodes.first().map(|n| n.aabb()).unwrap_or(Aabb::EMPTY);
@@ -177,6 +182,9 @@ pub fn run_build_with<B: Backend>(
             ms.insert("reinsert".into(), serde_json::json!(rounds.get("reinsert")));
         }
         round_ms = Some(per_round);
+        if crate::tuning::Tuning::current().profile_levels.is_some() {
+            stage_ms = Some(rounds.order.iter().map(|s| (s.to_string(), rounds.get(s))).collect());
+        }
         bvh = device_bvh.read(backend)?;
     } else if builder != Builder::Lbvh {
         backend.take_times()?;
@@ -223,6 +231,7 @@ pub fn run_build_with<B: Backend>(
         sah_before,
         sah_after: sah_before.map(|_| sah),
         round_ms,
+        stage_ms,
     };
     Ok((bvh, report))
 }
