@@ -215,7 +215,8 @@ pub struct Material {
 }
 const _: () = assert!(core::mem::size_of::<Material>() == 32);
 
-/// A pinhole camera as smallpt builds it. repr(C), Pod, 64 bytes.
+/// A camera as smallpt builds it, a pinhole unless it has a lens (a thin
+/// lens: depth of field). repr(C), Pod, 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
@@ -226,10 +227,13 @@ pub struct Camera {
     pub near: f32,
     /// Unit view direction.
     pub dir: [f32; 3],
-    pub _pad0: u32,
+    /// Radius of the thin lens, in scene units (0: a pinhole, every ray
+    /// from `origin`).
+    pub lens_radius: f32,
     /// Image-plane x axis, scaled by the aspect ratio and field of view.
     pub cx: [f32; 3],
-    pub _pad1: u32,
+    /// Distance along `dir` of the plane in focus (used with a lens).
+    pub focus_distance: f32,
     /// Image-plane y axis, scaled by the field of view.
     pub cy: [f32; 3],
     pub _pad2: u32,
@@ -270,7 +274,10 @@ pub struct RenderParams {
     /// [`INDEPENDENT`] or [`SOBOL`]: where camera paths draw their sample
     /// points ([`crate::render::sampler`]).
     pub sampler: u32,
-    pub _pad: [u32; 3],
+    /// Radiance of the constant environment that rays leaving the scene
+    /// see, from every direction (black: none). Read by kernels with
+    /// [`crate::geometry::features::ENVIRONMENT`].
+    pub environment: [f32; 3],
 }
 const _: () = assert!(core::mem::size_of::<RenderParams>() == 128);
 

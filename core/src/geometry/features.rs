@@ -21,8 +21,17 @@ pub const GLASS: u32 = 8;
 /// every flat primitive as a triangle, without [`TRIANGLES`] as a disk or
 /// parallelogram.
 pub const SHAPES: u32 = 16;
+/// The scene has an environment: rays that leave it see a constant
+/// radiance (`RenderParams::environment`) instead of black. Without it a
+/// kernel has no code for that.
+pub const ENVIRONMENT: u32 = 256;
+/// The camera has a thin lens (`Camera::lens_radius` above 0): depth of
+/// field. Without it a kernel's camera rays are a pinhole's, with no lens
+/// code (on the H200 that code, in the loop that starts paths, cost the
+/// specialized kernels 2-4%).
+pub const LENS: u32 = 512;
 /// Everything a scene can have: the general kernel.
-pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES;
+pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES | ENVIRONMENT | LENS;
 /// Not of the scene but of the render: camera paths that leave caustics to
 /// light paths (`--integrator caustics`, [`crate::render::caustics`]), and
 /// the light paths' kernel. Outside [`ALL`], so that the kernels of every

@@ -41,7 +41,7 @@ use crate::geometry::triangle::{Triangle, WatertightRay};
 use crate::gpu::rng::BounceRng;
 use crate::render::lights::{Light, light_pdf, light_pmf, power_heuristic, sample_light, select_light};
 use crate::render::sampler::{BounceSamples, PathSampler, uses_sobol};
-use crate::render::sampling::{cosine_direction, luminance};
+use crate::render::sampling::{cosine_direction, luminance, sin_cos_turns};
 use crate::trace::hit::{ClosestHit, Hit, Query};
 
 /// Hard cap on path length.
@@ -71,9 +71,37 @@ impl Camera {
 
     /// Ray through pixel (`x`, `y`; y up from the bottom row, as smallpt),
     /// subpixel `sub` (0..4), with the tent-filter offsets drawn from the
-    /// uniform numbers `u`.
+    /// uniform numbers `u`, from the pinhole at `origin` (the lens is
+    /// [`Camera::lens_ray`]'s).
     #[inline]
     pub fn primary_ray(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, u: (f32, f32)) -> (Vec3, Vec3) {
+        let d = self.image_plane(x, y, sub, width, height, u);
+        (Vec3::from_array(self.origin) + d * self.near, d.normalize())
+    }
+
+    /// [`Camera::primary_ray`] through the thin lens: from the point of the
+    /// lens disk (radius `lens_radius`, across `cx` and `cy`) that the
+    /// uniform numbers `lens` pick (Shirley and Chiu's concentric map), to
+    /// where the pinhole's ray meets the plane in focus, `focus_distance`
+    /// along `dir` (pbrt-v4's `PerspectiveCamera`). Points on that plane
+    /// stay sharp; nearer and farther ones blur.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn lens_ray(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, u: (f32, f32), lens: (f32, f32)) -> (Vec3, Vec3) {
+        let d = self.image_plane(x, y, sub, width, height, u);
+        let (lx, ly) = concentric_disk(lens.0, lens.1);
+        let offset = (Vec3::from_array(self.cx).normalize() * lx + Vec3::from_array(self.cy).normalize() * ly) * self.lens_radius;
+        // `d` has unit length along `dir` (`cx` and `cy` are across it): the
+        // pinhole's ray meets the plane in focus at `focus_distance * d`,
+        // and the lens's ray, scaled alike, starts on the near plane.
+        let d = d - offset / self.focus_distance;
+        (Vec3::from_array(self.origin) + offset + d * self.near, d.normalize())
+    }
+
+    /// The unnormalized direction of [`Camera::primary_ray`] (its component
+    /// along `dir` is one).
+    #[inline]
+    fn image_plane(&self, x: u32, y: u32, sub: u32, width: u32, height: u32, u: (f32, f32)) -> Vec3 {
         let tent = |u: f32| {
             let r = 2.0 * u;
             if r < 1.0 {
@@ -86,9 +114,25 @@ impl Camera {
         let (dx, dy) = (tent(u.0), tent(u.1));
         let fx = ((sx + 0.5 + dx) / 2.0 + x as f32) / width as f32 - 0.5;
         let fy = ((sy + 0.5 + dy) / 2.0 + y as f32) / height as f32 - 0.5;
-        let d = Vec3::from_array(self.cx) * fx + Vec3::from_array(self.cy) * fy + Vec3::from_array(self.dir);
-        (Vec3::from_array(self.origin) + d * self.near, d.normalize())
+        Vec3::from_array(self.cx) * fx + Vec3::from_array(self.cy) * fy + Vec3::from_array(self.dir)
     }
+}
+
+/// A point of the unit disk from two uniform numbers, by Shirley and Chiu's
+/// concentric map (uniform in area, and neighbouring numbers stay
+/// neighbours, which keeps Sobol points stratified on the lens). Its angle,
+/// in turns, goes through [`sin_cos_turns`]: `libm`'s `sinf` and `cosf`
+/// (a range reduction in f64) made every render kernel slower.
+#[inline]
+pub fn concentric_disk(u: f32, v: f32) -> (f32, f32) {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    // pi/4 (b/a), or pi/2 - pi/4 (a/b), as turns of 2 pi.
+    let (r, turns) = if a.abs() > b.abs() { (a, 0.125 * (b / a)) } else { (b, 0.25 - 0.125 * (a / b)) };
+    let (sin, cos) = sin_cos_turns(turns);
+    (r * cos, r * sin)
 }
 
 
@@ -231,7 +275,11 @@ impl Path {
         let (w, h) = (params.width, params.height);
         let (x, y) = (pixel % w, h - 1 - pixel / w);
         let (sub, u) = camera_sample::<F>(params, pixel, sample);
-        let (o, d) = params.camera.primary_ray(x, y, sub, w, h, u);
+        let (o, d) = if has(F, features::LENS) && params.camera.lens_radius > 0.0 {
+            params.camera.lens_ray(x, y, sub, w, h, u, lens_sample::<F>(params, pixel, sample))
+        } else {
+            params.camera.primary_ray(x, y, sub, w, h, u)
+        };
         Path::new(o, d, sample)
     }
 
@@ -272,6 +320,11 @@ impl Path {
             return true;
         }
         if !hit.is_hit() {
+            // The environment, at full weight: next-event estimation never
+            // samples it, so only this strategy finds it.
+            if has(F, features::ENVIRONMENT) {
+                self.result += self.throughput * Vec3::from_array(params.environment);
+            }
             return false;
         }
         let x = self.o + self.d * hit.t;
@@ -488,6 +541,19 @@ pub fn camera_sample<const F: u32>(params: &RenderParams, pixel: u32, sample: u3
     } else {
         let rng = BounceRng::new(params.seed, pixel, sample, 0);
         (sample % 4, (rng.uniform(0), rng.uniform(1)))
+    }
+}
+
+/// The lens numbers of sample `sample` of `pixel` (see [`Camera::lens_ray`]):
+/// the camera bounce's second pair (its first is [`camera_sample`]'s), a
+/// Sobol point or two independent numbers as that one.
+#[inline]
+pub fn lens_sample<const F: u32>(params: &RenderParams, pixel: u32, sample: u32) -> (f32, f32) {
+    if uses_sobol::<F>(params) {
+        PathSampler::new(params.seed, pixel, sample, 0).pair(2)
+    } else {
+        let rng = BounceRng::new(params.seed, pixel, sample, 0);
+        (rng.uniform(2), rng.uniform(3))
     }
 }
 

@@ -81,6 +81,10 @@ pub fn choose(devices: &[Device], scene: &Scene, settings: &RenderSettings) -> R
         let reason = "the scene has no mirrors or glass with lights, so no caustics for light paths".to_string();
         return Ok(Choice { integrator: Integrator::Nee, reason, measured: Vec::new() });
     }
+    if scene.camera.lens_radius > 0.0 {
+        let reason = "light paths link to a pinhole camera, and this camera has a lens".to_string();
+        return Ok(Choice { integrator: Integrator::Nee, reason, measured: Vec::new() });
+    }
     let Some(spp) = pilot_spp(settings) else {
         let reason = format!(
             "a pilot of both (four images of {} paths or more) would take over 1/{PILOT_SHARE} of this render's samples",

@@ -183,6 +183,7 @@ impl<B: Backend> Prepared<B> {
             prims: scene.spheres.len() as u32,
             triangles: scene.triangles.len() as u32,
             camera: scene.camera.camera(width, height),
+            environment: scene.environment,
             integrator: integrator.code(),
             light_count: table.len() as u32,
             sampler: sampler.code(),
@@ -218,6 +219,9 @@ impl<B: Backend> Prepared<B> {
             Some(sums) => b.upload("accumulation", sums)?,
             None => b.zeroed("accumulation", pixels * 16)?,
         };
+        if integrator == Integrator::Caustics && scene.camera.lens_radius > 0.0 {
+            bail!("--integrator caustics links light paths to a pinhole camera; {}'s camera has a lens (lens_radius {}): use --integrator nee", scene.name, scene.camera.lens_radius);
+        }
         if integrator == Integrator::Caustics && plan.method() == crate::runtime::kernels::Method::Classic {
             bail!("--integrator caustics traces light paths through the scan and the bvh2 and cwbvh layouts, not the seed's classic layout");
         }

@@ -2,7 +2,9 @@
 //!
 //! ```json
 //! {
-//!   "camera": { "origin": [50, 52, 295.6], "direction": [0, -0.042612, -1], "near": 140, "fov": 0.5135 },
+//!   "camera": { "origin": [50, 52, 295.6], "direction": [0, -0.042612, -1], "near": 140, "fov": 0.5135,
+//!               "lens_radius": 0, "focus_distance": 150 },
+//!   "environment": [0, 0, 0],
 //!   "materials": {
 //!     "white": { "type": "diffuse", "color": [0.75, 0.75, 0.75] },
 //!     "lamp":  { "type": "diffuse", "color": [0, 0, 0], "emission": [12, 12, 12] },
@@ -26,6 +28,10 @@
 //!   ]
 //! }
 //! ```
+//! A camera with a `lens_radius` above 0 is a thin lens: points
+//! `focus_distance` away along its direction are sharp, others blur (depth
+//! of field). `environment` (optional, black by default) is the radiance
+//! that rays leaving the scene see from every direction: a uniform sky.
 //! A disk or a parallelogram (a rectangle when its edges are square) is one
 //! primitive (intersected, bounded and, as a lamp, sampled as one shape:
 //! `treelet_core::geometry::flat`), not a fan or a pair of triangles; both
@@ -56,6 +62,8 @@ use super::primitives::validate_spheres;
 #[serde(deny_unknown_fields)]
 struct SceneFile {
     camera: CameraSpec,
+    #[serde(default)]
+    environment: [f32; 3],
     materials: BTreeMap<String, MaterialSpec>,
     #[serde(default)]
     spheres: Vec<SphereSpec>,
@@ -363,9 +371,23 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     if c.near < 0.0 {
         bail!("scene file {name}: camera near {}: rays would start behind the camera (use 0 or more)", c.near);
     }
+    if !(c.lens_radius >= 0.0 && c.lens_radius.is_finite()) {
+        bail!("scene file {name}: camera lens_radius {}: use 0 (a pinhole) or a finite positive radius", c.lens_radius);
+    }
+    if c.lens_radius > 0.0 && !(c.focus_distance > 0.0 && c.focus_distance.is_finite()) {
+        bail!(
+            "scene file {name}: camera focus_distance {}: a camera with a lens (lens_radius {}) needs the distance of the plane in focus, finite and positive",
+            c.focus_distance,
+            c.lens_radius
+        );
+    }
+    if !file.environment.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        bail!("scene file {name}: environment {:?}: radiance must be finite and not negative", file.environment);
+    }
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
-    let loose = Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, triangles, placed: None };
+    let loose =
+        Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, environment: file.environment, triangles, placed: None };
     Ok(InstancedScene { loose, meshes, instances })
 }
 
@@ -381,6 +403,28 @@ mod tests {
         assert_eq!(file.spheres, builtin.spheres);
         assert_eq!(file.materials, builtin.materials);
         assert_eq!(file.camera, builtin.camera);
+    }
+
+    #[test]
+    fn lenses_and_environments_are_read_and_bad_ones_are_errors() {
+        let scene = |camera_extra: &str, top_extra: &str| {
+            format!(r#"{{"camera": {{"origin": [0,0,0], "direction": [0,0,1]{camera_extra}}}{top_extra}, "materials": {{"m": {{"type": "diffuse", "color": [1, 1, 1]}}}}, "spheres": [{{"center": [0,0,5], "radius": 1, "material": "m"}}]}}"#)
+        };
+        let ok = parse(&scene(r#", "lens_radius": 0.25, "focus_distance": 5"#, r#", "environment": [0.5, 0.6, 0.7]"#), "ok.json").unwrap();
+        assert_eq!((ok.camera.lens_radius, ok.camera.focus_distance), (0.25, 5.0));
+        assert_eq!(ok.environment, [0.5, 0.6, 0.7]);
+        let plain = parse(&scene("", ""), "plain.json").unwrap();
+        assert_eq!((plain.camera.lens_radius, plain.environment), (0.0, [0.0; 3]));
+        for (camera, top, expected) in [
+            (r#", "lens_radius": 1"#, "", "focus_distance 0"),
+            (r#", "lens_radius": 1, "focus_distance": -2"#, "", "focus_distance -2"),
+            (r#", "lens_radius": -1, "focus_distance": 2"#, "", "lens_radius -1"),
+            ("", r#", "environment": [1, -1, 0]"#, "environment"),
+            ("", r#", "environment": [1, 2]"#, "expected an array of length 3"),
+        ] {
+            let e = format!("{:#}", parse(&scene(camera, top), "bad.json").unwrap_err());
+            assert!(e.contains("bad.json") && e.contains(expected), "{camera} {top}: {e}");
+        }
     }
 
     #[test]

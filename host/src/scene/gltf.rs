@@ -100,7 +100,7 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
         ),
         (None, None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
     };
-    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, triangles: Vec::new(), placed: None };
+    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, environment: [0.0; 3], triangles: Vec::new(), placed: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
 }
 
@@ -450,14 +450,9 @@ fn camera_spec(name: &str, node: usize, world: Mat4, yfov: f32) -> Result<Camera
     if !(direction.length_squared() > 0.0 && direction.is_finite()) {
         bail!("{name}: node {node}: the camera's transform gives it no direction to look in");
     }
-    Ok(CameraSpec {
-        origin: origin.into(),
-        direction: direction.into(),
-        near: 0.0,
-        // `fov` is the image plane's full height at unit distance
-        // (`Camera::look`); glTF's `yfov` the whole vertical angle.
-        fov: 2.0 * (yfov / 2.0).tan(),
-    })
+    // `fov` is the image plane's full height at unit distance
+    // (`Camera::look`); glTF's `yfov` the whole vertical angle.
+    Ok(CameraSpec::pinhole(origin.into(), direction.into(), 0.0, 2.0 * (yfov / 2.0).tan()))
 }
 
 /// Camera `index` of the file (its `cameras` array), where the first node
@@ -581,7 +576,7 @@ fn framing((lo, hi): (Vec3, Vec3)) -> CameraSpec {
     // 4.4 times its half-size, fills it with a margin of a tenth.
     let fov = 0.5;
     let distance = 1.1 * half.x.max(half.y) / (fov / 2.0) + half.z;
-    CameraSpec { origin: (center + Vec3::Z * distance.max(1e-3)).into(), direction: [0.0, 0.0, -1.0], near: 0.0, fov }
+    CameraSpec::pinhole((center + Vec3::Z * distance.max(1e-3)).into(), [0.0, 0.0, -1.0], 0.0, fov)
 }
 
 /// A URI's path with its `%XX` escapes decoded (`my%20data.bin` names

@@ -28,6 +28,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub room: usize,
     pub camera: CameraSpec,
+    /// Radiance that rays leaving the scene see from every direction (a
+    /// constant environment; black: none, as in smallpt's closed room).
+    pub environment: [f32; 3],
     /// Triangles of a mesh scene (`treelet build` builds over them; they
     /// are not rendered yet).
     pub triangles: Vec<Triangle>,
@@ -51,6 +54,12 @@ pub struct CameraSpec {
     /// Half-height of the image plane at unit distance.
     #[serde(default = "default_fov")]
     pub fov: f32,
+    /// Radius of a thin lens (0: a pinhole): depth of field.
+    #[serde(default)]
+    pub lens_radius: f32,
+    /// Distance along `direction` of the plane in focus (with a lens).
+    #[serde(default)]
+    pub focus_distance: f32,
 }
 
 impl CameraSpec {
@@ -61,7 +70,7 @@ impl CameraSpec {
         if !eye.iter().chain(&target).all(|x| x.is_finite()) || direction.length_squared() == 0.0 || !direction.is_finite() {
             bail!("camera from {eye:?} to {target:?}: both points must be finite and apart");
         }
-        Ok(CameraSpec { origin: eye, direction: direction.to_array(), near: 0.0, fov: SMALLPT_FOV })
+        Ok(CameraSpec::pinhole(eye, direction.to_array(), 0.0, SMALLPT_FOV))
     }
 }
 
@@ -71,18 +80,23 @@ fn default_fov() -> f32 {
 
 impl CameraSpec {
     /// smallpt's camera.
-    pub const SMALLPT: CameraSpec =
-        CameraSpec { origin: [50.0, 52.0, 295.6], direction: [0.0, -0.042612, -1.0], near: 140.0, fov: SMALLPT_FOV };
+    pub const SMALLPT: CameraSpec = CameraSpec::pinhole([50.0, 52.0, 295.6], [0.0, -0.042612, -1.0], 140.0, SMALLPT_FOV);
+
+    /// A camera without a lens.
+    pub const fn pinhole(origin: [f32; 3], direction: [f32; 3], near: f32, fov: f32) -> CameraSpec {
+        CameraSpec { origin, direction, near, fov, lens_radius: 0.0, focus_distance: 0.0 }
+    }
 
     pub fn camera(&self, width: u32, height: u32) -> Camera {
-        Camera::look(
+        let camera = Camera::look(
             Vec3::from_array(self.origin),
             Vec3::from_array(self.direction),
             self.near,
             self.fov,
             width,
             height,
-        )
+        );
+        Camera { lens_radius: self.lens_radius, focus_distance: self.focus_distance, ..camera }
     }
 }
 
@@ -106,7 +120,7 @@ pub fn cornell() -> Scene {
             light,
         ])
         .unzip();
-    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, triangles: Vec::new(), placed: None }
+    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), placed: None }
 }
 
 /// `terrain:N`: a height field of about N triangles (a square grid, two per
@@ -148,7 +162,7 @@ pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
     let (spheres, mut materials): (Vec<_>, Vec<_>) = cornell_room().into_iter().unzip();
     let room = spheres.len();
     materials.extend(std::iter::repeat_n(diffuse([0.8, 0.78, 0.72]), triangles.len()));
-    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, triangles, placed: None }
+    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles, placed: None }
 }
 
 /// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
@@ -223,18 +237,14 @@ impl Scene {
         let bounds = self.triangles.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
         let (center, size) = (bounds.centroid(), bounds.extent().max_element().max(f32::MIN_POSITIVE));
         let origin = center + Vec3::new(0.0, 0.6, 0.8) * size;
-        let camera = CameraSpec {
-            origin: origin.to_array(),
-            direction: (center - origin).to_array(),
-            near: 0.0,
-            fov: SMALLPT_FOV,
-        };
+        let camera = CameraSpec::pinhole(origin.to_array(), (center - origin).to_array(), 0.0, SMALLPT_FOV);
         Ok(Scene {
             name: format!("{} (mesh only)", self.name),
             spheres: Vec::new(),
             materials: self.materials[self.spheres.len()..].to_vec(),
             room: 0,
             camera,
+            environment: [0.0; 3],
             triangles: self.triangles.clone(),
             placed: None,
         })
@@ -272,7 +282,7 @@ pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
         spheres.push(s);
         materials.push(m);
     }
-    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, triangles: Vec::new(), placed: None }
+    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), placed: None }
 }
 
 /// `n` spheres with uniform random centres inside the Cornell box and random
