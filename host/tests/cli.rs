@@ -92,6 +92,42 @@ fn render_bad_input_names_the_problem() {
 }
 
 #[test]
+fn render_adds_a_sky_and_a_lens_to_any_scene() {
+    let dir = std::env::temp_dir().join(format!("treelet-cli-sky-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // One white ball under a sky of 0.5 and nothing else: the background
+    // is the sky, the ball 0.75 of it.
+    let ball = dir.join("ball.json");
+    std::fs::write(
+        &ball,
+        r#"{"camera": {"origin": [0,0,0], "direction": [0,0,-1], "fov": 0.6}, "materials": {"w": {"type": "diffuse", "color": [0.75, 0.75, 0.75]}},
+            "spheres": [{"center": [0,0,-5], "radius": 1, "material": "w"}]}"#,
+    )
+    .unwrap();
+    let out_path = dir.join("ball.exr");
+    let args = ["render", "--device", "cpu", "--scene", ball.to_str().unwrap(), "--width", "32", "--height", "24", "--spp", "16"];
+    let out = treelet(&[&args[..], &["--environment", "0.5,0.5,0.5", "--lens", "0.2,5", "--explain", "--out", out_path.to_str().unwrap()]].concat());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let all = String::from_utf8_lossy(&out.stdout).to_string() + &stderr;
+    assert!(all.contains("environment") && all.contains("thin lens"), "the kernel should have both: {all}");
+    assert!(!stderr.contains("nothing in the scene emits light"), "{stderr}");
+    let image = image::open(&out_path).unwrap().into_rgb32f();
+    let corner = image.get_pixel(0, 0).0;
+    assert!(corner.iter().all(|&c| (c - 0.5).abs() < 1e-5), "the corner sees the sky: {corner:?}");
+    // A convex ball's every bounce leaves for the sky: 0.75 of it, exactly.
+    let centre = image.get_pixel(16, 12).0;
+    assert!(centre.iter().all(|&c| (c - 0.375).abs() < 1e-4), "the ball: {centre:?}");
+    // Bad values are named.
+    let e = stderr_of(&[&args[..], &["--environment", "1,-1,0"]].concat());
+    assert!(e.contains("--environment") && e.contains("negative"), "{e}");
+    let e = stderr_of(&[&args[..], &["--lens", "0.5"]].concat());
+    assert!(e.contains("--lens") && e.contains("RADIUS,FOCUS"), "{e}");
+    let e = stderr_of(&[&args[..], &["--lens", "0.5,0"]].concat());
+    assert!(e.contains("focus distance positive"), "{e}");
+}
+
+#[test]
 fn render_writes_image_report_and_plot() {
     let dir = std::env::temp_dir().join(format!("treelet-render-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -132,6 +132,14 @@ struct RenderArgs {
     /// perspective camera the scene places, else one framing the scene.
     #[arg(long, value_name = "N")]
     camera: Option<usize>,
+    /// A uniform sky of radiance R,G,B around the scene (over a scene
+    /// file's `environment`): what rays that leave the scene see.
+    #[arg(long, value_name = "R,G,B", value_parser = parse_sky)]
+    environment: Option<[f32; 3]>,
+    /// A thin lens on the scene's camera (over a scene file's): its radius,
+    /// and the distance along the view of the plane kept sharp.
+    #[arg(long, value_name = "RADIUS,FOCUS", value_parser = parse_lens)]
+    lens: Option<(f32, f32)>,
     #[arg(long, default_value_t = 512, value_parser = positive)]
     width: u32,
     #[arg(long, default_value_t = 384, value_parser = positive)]
@@ -237,6 +245,33 @@ fn positive(s: &str) -> std::result::Result<u32, String> {
         Ok(v) => Err(format!("{v} is not a positive whole number below 2^32")),
         Err(_) => Err(format!("`{s}` is not a whole number")),
     }
+}
+
+/// Comma-separated finite numbers, `n` of them.
+fn numbers(s: &str, n: usize, what: &str) -> std::result::Result<Vec<f32>, String> {
+    let v: Vec<f32> = s.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().map_err(|_| format!("`{s}`: expected {what}"))?;
+    if v.len() != n || !v.iter().all(|x| x.is_finite()) {
+        return Err(format!("`{s}`: expected {what}, {n} finite numbers"));
+    }
+    Ok(v)
+}
+
+/// `R,G,B`, none negative.
+fn parse_sky(s: &str) -> std::result::Result<[f32; 3], String> {
+    let v = numbers(s, 3, "R,G,B")?;
+    if v.iter().any(|&x| x < 0.0) {
+        return Err(format!("`{s}`: a sky's radiance cannot be negative"));
+    }
+    Ok([v[0], v[1], v[2]])
+}
+
+/// `RADIUS,FOCUS`: a radius of 0 or more, a positive focus distance.
+fn parse_lens(s: &str) -> std::result::Result<(f32, f32), String> {
+    let v = numbers(s, 2, "RADIUS,FOCUS")?;
+    if v[0] < 0.0 || v[1] <= 0.0 {
+        return Err(format!("`{s}`: the lens radius must be 0 or more and the focus distance positive"));
+    }
+    Ok((v[0], v[1]))
 }
 
 /// `A..B` (B excluded) with A < B.
@@ -369,13 +404,19 @@ fn run_render(mut args: RenderArgs) -> Result<()> {
     // The devices open (Vulkan's instance and device: a tenth of a second
     // each on an H100) while the scene and any parts load.
     let opening = OpenDevices::start(args.devices.clone(), args.device);
-    let scene = match args.camera {
+    let mut scene = match args.camera {
         Some(camera) => Scene::with_gltf_camera(&args.scene, camera, args.flatten)?,
         None if args.flatten => Scene::from_spec(&args.scene)?,
         None => Scene::for_render(&args.scene)?,
     };
+    if let Some(sky) = args.environment {
+        scene.environment = sky;
+    }
+    if let Some((radius, focus)) = args.lens {
+        (scene.camera.lens_radius, scene.camera.focus_distance) = (radius, focus);
+    }
     treelet::runtime::timeline::mark("scene");
-    if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) {
+    if scene.materials.iter().all(|m| m.emission.iter().all(|&e| e == 0.0)) && scene.environment == [0.0; 3] {
         eprintln!("warning: {}: nothing in the scene emits light, so the image will be black", scene.name);
     }
     let first_sample = part.as_ref().map_or(0, |r| r.start);

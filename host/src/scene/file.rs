@@ -415,6 +415,13 @@ mod tests {
         assert_eq!(ok.environment, [0.5, 0.6, 0.7]);
         let plain = parse(&scene("", ""), "plain.json").unwrap();
         assert_eq!((plain.camera.lens_radius, plain.environment), (0.0, [0.0; 3]));
+        // Parts of renders merge by the scene's hash: a lens or a sky makes
+        // another scene, and a pinhole without a sky hashes as before both.
+        let lens_only = parse(&scene(r#", "lens_radius": 0.25, "focus_distance": 5"#, ""), "l.json").unwrap();
+        let sky_only = parse(&scene("", r#", "environment": [0.5, 0.6, 0.7]"#), "s.json").unwrap();
+        let hashes = [&ok, &plain, &lens_only, &sky_only].map(|s| s.content_hash());
+        assert!((0..4).all(|i| (0..i).all(|j| hashes[i] != hashes[j])), "{hashes:x?}");
+        assert_eq!(serde_json::to_string(&plain.camera).unwrap(), r#"{"origin":[0.0,0.0,0.0],"direction":[0.0,0.0,1.0],"near":0.0,"fov":0.5135}"#);
         for (camera, top, expected) in [
             (r#", "lens_radius": 1"#, "", "focus_distance 0"),
             (r#", "lens_radius": 1, "focus_distance": -2"#, "", "focus_distance -2"),

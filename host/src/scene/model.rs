@@ -55,10 +55,10 @@ pub struct CameraSpec {
     #[serde(default = "default_fov")]
     pub fov: f32,
     /// Radius of a thin lens (0: a pinhole): depth of field.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub lens_radius: f32,
     /// Distance along `direction` of the plane in focus (with a lens).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub focus_distance: f32,
 }
 
@@ -72,6 +72,12 @@ impl CameraSpec {
         }
         Ok(CameraSpec::pinhole(eye, direction.to_array(), 0.0, SMALLPT_FOV))
     }
+}
+
+/// Left out of the camera's JSON (and so of [`Scene::content_hash`]) where
+/// 0, so that a pinhole hashes as it did before lenses.
+fn is_zero(x: &f32) -> bool {
+    *x == 0.0
 }
 
 fn default_fov() -> f32 {
@@ -182,7 +188,7 @@ pub fn cornell_room() -> Vec<(Sphere, Material)> {
 
 impl Scene {
     /// A hash of everything a render of the scene reads (spheres,
-    /// materials, triangles, camera), whatever its name or the path it was
+    /// materials, triangles, camera, sky), whatever its name or the path it was
     /// loaded from: parts of one render must agree on it. FNV-1a.
     pub fn content_hash(&self) -> u64 {
         use std::hash::Hasher;
@@ -195,6 +201,10 @@ impl Scene {
         field(bytemuck::cast_slice(&self.materials));
         field(bytemuck::cast_slice(&self.triangles));
         field(serde_json::to_string(&self.camera).unwrap_or_default().as_bytes());
+        // Only a sky that shines, so that scenes without one hash as before.
+        if self.environment != [0.0; 3] {
+            field(bytemuck::cast_slice(&self.environment));
+        }
         // Copies kept placed: each mesh, then each copy's mesh, transform
         // and material.
         if let Some(placed) = &self.placed {
