@@ -133,7 +133,7 @@ struct RenderArgs {
     #[arg(long, value_name = "N")]
     camera: Option<usize>,
     /// A uniform sky of radiance R,G,B around the scene (over a scene
-    /// file's `environment`): what rays that leave the scene see.
+    /// file's environment): what rays that leave the scene see.
     #[arg(long, value_name = "R,G,B", value_parser = parse_sky)]
     environment: Option<[f32; 3]>,
     /// A thin lens on the scene's camera (over a scene file's): its radius,

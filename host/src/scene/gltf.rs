@@ -100,9 +100,26 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
         ),
         (None, None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
     };
-    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, environment: [0.0; 3], triangles: Vec::new(), placed: None };
+    // A file without lights would render black: a uniform sky lights it,
+    // as glTF viewers light such files by a default environment.
+    let emits = |m: &Material| m.emission.iter().any(|&e| e > 0.0);
+    let lit = out.instances.iter().any(|i| match &i.material {
+        Some(m) => emits(m),
+        None => out.meshes[i.mesh as usize].materials.iter().any(emits),
+    });
+    let environment = if lit {
+        [0.0; 3]
+    } else {
+        eprintln!("note: {name}: nothing in it emits light; a uniform white sky lights it (render --environment R,G,B sets another)");
+        DEFAULT_SKY
+    };
+    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, environment, triangles: Vec::new(), placed: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
 }
+
+/// The sky of a glTF scene in which nothing emits light: a white one of
+/// radiance 1 (a diffuse surface open to it shows its colour).
+pub const DEFAULT_SKY: [f32; 3] = [1.0; 3];
 
 /// The box of every instance's mesh box, placed (each placed box's eight
 /// corners; the triangles' own box where the transforms keep axes).
@@ -1019,6 +1036,12 @@ mod tests {
         assert_eq!(scene.instances[1].rows()[2][3], 9.0);
         let flat = load(&path).unwrap();
         assert_eq!(flat.triangles.len(), 12);
+        // Its first material emits: no sky. Without it, the default one.
+        assert_eq!(flat.environment, [0.0; 3]);
+        let dark = text.replace(r#""emissiveFactor": [1, 1, 0.5],"#, "");
+        let path_dark = d.join("dark.gltf");
+        std::fs::write(&path_dark, dark).unwrap();
+        assert_eq!(load(&path_dark).unwrap().environment, DEFAULT_SKY);
         assert_eq!(flat.triangles[6], Triangle::new([0.0, 0.0, 9.0], [1.0, 0.0, 9.0], [1.0, 1.0, 9.0]));
         // A matrix whose last row is not (0, 0, 0, 1) places nothing affinely.
         let projective = text.replace(r#""translation": [0, 0, 9], "camera": 0, "mesh": 0"#, r#""matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0.5, 0,0,0,1], "camera": 0, "mesh": 0"#);
