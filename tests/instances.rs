@@ -89,19 +89,27 @@ fn rays(rng: &mut impl Rng, n: usize) -> Vec<Ray> {
 }
 
 /// The instanced hits against the flattened scene's: the same instance and
-/// triangle and the same distance within rounding, but for at most 0.3% of
-/// the rays (the flattened triangles are rounded after the transform, the
+/// triangle (or another at the same distance, a tie, for at most 1%) and
+/// the same distance within rounding, but for at most 0.3% of the rays (the flattened triangles are rounded after the transform, the
 /// instanced ray before its mesh's test: a ray within rounding of an edge
 /// may pass on either side). Each hit's barycentrics give its point on the
 /// placed triangle, and its normal is the placed triangle's.
 fn check(what: &str, hits: &[RayHit], flat: &[RayHit], scene: &(Vec<Triangle>, Vec<(u32, u32)>), rays: &[Ray], min_hits: usize) {
     assert_eq!(hits.len(), rays.len());
-    let (mut differ, mut hit) = (0, 0);
+    let (mut differ, mut ties, mut hit) = (0, 0, 0);
     for ((r, h), f) in rays.iter().zip(hits).zip(flat) {
         let expected = f.is_hit().then(|| scene.1[f.prim as usize]);
         let got = h.is_hit().then_some((h.instance, h.prim));
         if got != expected {
-            differ += 1;
+            // Another triangle at the same distance: a squashed copy's
+            // triangles lie within rounding of one plane, and which one a
+            // ray meets first is the rounding's (seed 8323507393793727333:
+            // 13 rays in 4 000, each within 3e-7 of the other's distance).
+            if h.is_hit() && f.is_hit() && (h.t - f.t).abs() <= 1e-5 * f.t.max(1.0) {
+                ties += 1;
+            } else {
+                differ += 1;
+            }
             continue;
         }
         if !h.is_hit() {
@@ -125,6 +133,7 @@ fn check(what: &str, hits: &[RayHit], flat: &[RayHit], scene: &(Vec<Triangle>, V
         assert!((n - (b - a).cross(c - a).normalize()).length() < 1e-3, "{what}: ray {r:?}: normal of {h:?}");
     }
     assert!(differ * 1000 <= 3 * rays.len(), "{what}: {differ} of {} rays differ from the flattened scene", rays.len());
+    assert!(ties * 100 <= rays.len(), "{what}: {ties} of {} rays hit another triangle at the same distance", rays.len());
     assert!(hit >= min_hits, "{what}: only {hit} of {} rays hit: the test would prove little", rays.len());
 }
 
@@ -568,8 +577,11 @@ fn placed_copies_render_what_the_flattened_scene_renders() {
     let dir = std::env::temp_dir().join(format!("treelet-copies-alone-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let gltf = write_gltf(&dir, &m, &nodes);
-    let alone = treelet::scene::Scene::for_render(gltf.to_str().unwrap()).unwrap();
+    let mut alone = treelet::scene::Scene::for_render(gltf.to_str().unwrap()).unwrap();
     assert!(alone.placed.is_some() && alone.spheres.is_empty() && alone.triangles.is_empty());
+    // Nothing in the file emits: it comes with the default sky, taken away here.
+    assert_eq!(alone.environment, treelet::scene::gltf::DEFAULT_SKY);
+    alone.environment = [0.0; 3];
     let black = render(&mut cpu, &alone, &RenderSettings { spp: 2, ..settings }, None, |_| {}).unwrap();
     assert!(black.image.pixels.iter().all(|p| p.iter().all(|&c| c == 0.0)));
     std::fs::remove_dir_all(&dir).ok();
