@@ -124,7 +124,9 @@ fn render_adds_a_sky_and_a_lens_to_any_scene() {
     let e = stderr_of(&[&args[..], &["--lens", "0.5"]].concat());
     assert!(e.contains("--lens") && e.contains("RADIUS,FOCUS"), "{e}");
     let e = stderr_of(&[&args[..], &["--lens", "0.5,0"]].concat());
-    assert!(e.contains("focus distance positive"), "{e}");
+    assert!(e.contains("--lens") && e.contains("focus_distance 0"), "{e}");
+    let e = stderr_of(&[&args[..], &["--environment", "1e30,0,0"]].concat());
+    assert!(e.contains("--environment") && e.contains("at most"), "{e}");
 }
 
 #[test]

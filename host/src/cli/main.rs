@@ -256,21 +256,18 @@ fn numbers(s: &str, n: usize, what: &str) -> std::result::Result<Vec<f32>, Strin
     Ok(v)
 }
 
-/// `R,G,B`, none negative.
+/// `R,G,B`, as scene files' `environment` is checked.
 fn parse_sky(s: &str) -> std::result::Result<[f32; 3], String> {
     let v = numbers(s, 3, "R,G,B")?;
-    if v.iter().any(|&x| x < 0.0) {
-        return Err(format!("`{s}`: a sky's radiance cannot be negative"));
-    }
-    Ok([v[0], v[1], v[2]])
+    let sky = [v[0], v[1], v[2]];
+    treelet::scene::file::check_sky(sky).map_err(|e| format!("`{s}`: {e}"))?;
+    Ok(sky)
 }
 
-/// `RADIUS,FOCUS`: a radius of 0 or more, a positive focus distance.
+/// `RADIUS,FOCUS`, as scene files' lenses are checked.
 fn parse_lens(s: &str) -> std::result::Result<(f32, f32), String> {
     let v = numbers(s, 2, "RADIUS,FOCUS")?;
-    if v[0] < 0.0 || v[1] <= 0.0 {
-        return Err(format!("`{s}`: the lens radius must be 0 or more and the focus distance positive"));
-    }
+    treelet::scene::file::check_lens(v[0], v[1]).map_err(|e| format!("`{s}`: {e}"))?;
     Ok((v[0], v[1]))
 }
 

@@ -190,6 +190,31 @@ struct SphereSpec {
 /// luminance over 2^16 samples of it stays far below `f32::MAX`.
 pub const MAX_EMISSION: f32 = 1e6;
 
+/// A thin lens's radius (0: a pinhole) and, with a lens, the distance of
+/// the plane in focus: what scene files and `render --lens` accept.
+pub fn check_lens(radius: f32, focus_distance: f32) -> std::result::Result<(), String> {
+    if !(radius >= 0.0 && radius.is_finite()) {
+        return Err(format!("lens_radius {radius}: use 0 (a pinhole) or a finite positive radius"));
+    }
+    if radius > 0.0 && !(focus_distance > 0.0 && focus_distance.is_finite()) {
+        return Err(format!(
+            "focus_distance {focus_distance}: a camera with a lens (lens_radius {radius}) needs the distance of the plane in focus, finite and positive"
+        ));
+    }
+    Ok(())
+}
+
+/// A sky's radiance: finite, not negative, and no more than a lamp's
+/// [`MAX_EMISSION`] (what scene files and `render --environment` accept).
+pub fn check_sky(environment: [f32; 3]) -> std::result::Result<(), String> {
+    if !environment.iter().all(|v| v.is_finite() && (0.0..=MAX_EMISSION).contains(v)) {
+        return Err(format!(
+            "environment {environment:?}: radiance must be finite, not negative and at most {MAX_EMISSION:e} (a pixel's sums of squares would overflow f32)"
+        ));
+    }
+    Ok(())
+}
+
 /// Reads a scene file, its instances flattened; errors name the file and
 /// the line and column, or the sphere or material at fault.
 pub fn load(path: &Path) -> Result<Scene> {
@@ -371,18 +396,11 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     if c.near < 0.0 {
         bail!("scene file {name}: camera near {}: rays would start behind the camera (use 0 or more)", c.near);
     }
-    if !(c.lens_radius >= 0.0 && c.lens_radius.is_finite()) {
-        bail!("scene file {name}: camera lens_radius {}: use 0 (a pinhole) or a finite positive radius", c.lens_radius);
+    if let Err(e) = check_lens(c.lens_radius, c.focus_distance) {
+        bail!("scene file {name}: camera {e}");
     }
-    if c.lens_radius > 0.0 && !(c.focus_distance > 0.0 && c.focus_distance.is_finite()) {
-        bail!(
-            "scene file {name}: camera focus_distance {}: a camera with a lens (lens_radius {}) needs the distance of the plane in focus, finite and positive",
-            c.focus_distance,
-            c.lens_radius
-        );
-    }
-    if !file.environment.iter().all(|v| v.is_finite() && *v >= 0.0) {
-        bail!("scene file {name}: environment {:?}: radiance must be finite and not negative", file.environment);
+    if let Err(e) = check_sky(file.environment) {
+        bail!("scene file {name}: {e}");
     }
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
@@ -428,6 +446,7 @@ mod tests {
             (r#", "lens_radius": -1, "focus_distance": 2"#, "", "lens_radius -1"),
             ("", r#", "environment": [1, -1, 0]"#, "environment"),
             ("", r#", "environment": [1, 2]"#, "expected an array of length 3"),
+            ("", r#", "environment": [1, 1e30, 0]"#, "at most"),
         ] {
             let e = format!("{:#}", parse(&scene(camera, top), "bad.json").unwrap_err());
             assert!(e.contains("bad.json") && e.contains(expected), "{camera} {top}: {e}");
