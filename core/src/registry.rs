@@ -4,19 +4,24 @@
 //! of a one-dimensional dispatch in workgroups of
 //! [`WORKGROUP_SIZE`](crate::gpu::workgroup::WORKGROUP_SIZE), its parameter struct at
 //! binding 0, then storage buffers) are declared once, in
-//! [`per_invocation_kernels!`](crate::per_invocation_kernels). From that
+//! [`per_invocation_kernels!`](crate::per_invocation_kernels); kernels that
+//! run a core function phase by phase over each workgroup, with workgroup
+//! memory and a barrier between phases, in
+//! [`per_workgroup_kernels!`](crate::per_workgroup_kernels). From that
 //! one declaration:
 //!
 //! - the shader crate makes each kernel's entry point (`treelet-shader`'s
-//!   `per_invocation` module),
+//!   `per_invocation` and `per_workgroup` modules),
 //! - the host makes its `Kernel` variant, entry-point name, binding
 //!   accesses and split bindings (`treelet::runtime::kernels`),
 //! - the CPU runner makes its dispatch (`treelet::runtime::cpu_runner`).
 //!
 //! So the GPU and the CPU run the same call on the same bindings, and
-//! adding such a kernel is one entry here. Kernels with workgroup memory,
-//! phases or subgroup operations are still written out in the shader crate
-//! and the CPU runner.
+//! adding such a kernel is one entry here. Kernels with subgroup
+//! operations, teams within a workgroup, workgroup sizes of their own or
+//! compile-time variants (the sort passes, H-PLOC, the treelet teams, the
+//! ray kernels) are still written out in the shader crate and the CPU
+//! runner.
 //!
 //! An entry reads:
 //!
@@ -224,6 +229,18 @@ macro_rules! per_invocation_kernels {
                 9 queued: read [u32],
             } |id, params| $crate::construct::treelet::kernels::treelet_init_climb_kernel::<ORDERED, _>(id, params, &nodes, parents, flags, (&mut *counts, &mut *costs, &mut *heights, &mut *tree_leaves), queue, queued);
 
+            /// Restructures the treelets of one height, one invocation each
+            /// (heights of many small treelets).
+            TreeletRestructureSingle = treelet_restructure_single_cs($crate::geometry::buffers::TreeletParams) {
+                1 roots: read [u32],
+                2 nodes: write [$crate::geometry::buffers::Node] | 8 nodes_hi,
+                3 parents: write [u32],
+                4 counts: write [u32],
+                5 costs: write [f32],
+                6 heights: write [u32],
+                7 marks: write [u32],
+            } |id, params| $crate::construct::treelet::kernels::treelet_restructure_single(id, params, roots, &mut nodes, parents, counts, costs, heights, marks);
+
             /// SAH leaf collapse and depth-first compaction into fresh arrays.
             Collapse = collapse_cs($crate::geometry::buffers::TreeletParams) {
                 1 nodes: read [$crate::geometry::buffers::Node] | 9 nodes_hi,
@@ -346,6 +363,156 @@ macro_rules! per_invocation_kernels {
                 5 positions: write [u32],
                 6 slots: write [u32],
             } |id, params| $crate::layouts::cwbvh::build::wide_place_kernel(id, params, nodes, decisions, is_wide, child_offsets, positions, slots);
+        }
+    };
+}
+
+/// The kernels that run a core function phase by phase over each workgroup
+/// (a barrier between phases; workgroup memory shared within the
+/// workgroup); see [`crate::registry`]. An entry reads:
+///
+/// ```text
+/// /// What it does.
+/// Name = entry_point_cs(Params) phases(PHASES, [0 1 2]) shared { local: [u32; WG] } {
+///     1 input: read [T],
+///     2 output: write [U],
+/// } |phase, lid, group, params| $crate::path::to::name_phase(phase, lid, group, params, input, output, local);
+/// ```
+///
+/// - `phases`: the constant that counts them, and each phase's number
+///   written out: the shader unrolls the phases, each with its number a
+///   constant, so that the driver's compiler keeps only that phase's
+///   branch of the function (a loop over phases pays for all of it in
+///   every phase); the shader checks the two agree.
+/// - `shared`: the workgroup arrays (uninitialized on the GPU: a phase
+///   writes before another reads; zeroed on the CPU runner).
+/// - The call sees the phase, the invocation's index in its workgroup
+///   (`lid`), the workgroup's index (`group`), the parameters (a private
+///   copy on the GPU, kept in registers across the barriers: 1% off the
+///   H200's sort), the bindings as in [`per_invocation_kernels!`](crate::per_invocation_kernels)
+///   and the shared arrays (`&mut [T; N]`).
+///
+/// Given `{ tokens }` after the callback, the callback gets them first
+/// (so that one callback can take both registries' entries).
+#[macro_export]
+macro_rules! per_workgroup_kernels {
+    ($callback:ident $({ $($carried:tt)* })?) => {
+        $callback! {
+            $({ $($carried)* })?
+
+            /// Exclusive scan: each tile's sum.
+            ScanReduce = scan_reduce_cs($crate::geometry::buffers::ScanParams)
+                phases($crate::construct::sort::scan::SCAN_REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9])
+                shared { sums: [u32; $crate::gpu::workgroup::WG] } {
+                1 data: read [u32],
+                2 partials: write [u32],
+            } |phase, lid, group, params| $crate::construct::sort::scan::scan_reduce_phase(phase, lid, group, params, data, partials, sums);
+
+            /// Exclusive scan: the tiles' sums scanned by one workgroup.
+            ScanSpine = scan_spine_cs($crate::geometry::buffers::ScanParams)
+                phases($crate::construct::sort::scan::SCAN_SWEEP_PHASES, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17])
+                shared { a: [u32; $crate::gpu::workgroup::WG], b: [u32; $crate::gpu::workgroup::WG] } {
+                1 partials: write [u32],
+            } |phase, lid, group, params| $crate::construct::sort::scan::scan_spine_phase(phase, lid, params, partials, a, b);
+
+            /// Exclusive scan: each tile scanned from its offset.
+            ScanDownsweep = scan_downsweep_cs($crate::geometry::buffers::ScanParams)
+                phases($crate::construct::sort::scan::SCAN_SWEEP_PHASES, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17])
+                shared { a: [u32; $crate::gpu::workgroup::WG], b: [u32; $crate::gpu::workgroup::WG] } {
+                1 data: write [u32],
+                2 partials: read [u32],
+            } |phase, lid, group, params| $crate::construct::sort::scan::scan_downsweep_phase(phase, lid, group, params, data, partials, a, b);
+
+            /// Radix sort: digit counts of every pass.
+            SortHistogram = sort_histogram_cs($crate::geometry::buffers::SortParams)
+                phases($crate::construct::sort::HISTOGRAM_PHASES, [0 1 2])
+                shared { counts: [u32; ($crate::construct::sort::MAX_PASSES * $crate::construct::sort::RADIX) as usize] } {
+                1 keys: read [u64],
+                2 sort_state: write [u32],
+            } |phase, lid, group, params| $crate::construct::sort::histogram_phase(phase, lid, group, params, keys, sort_state, counts);
+
+            /// Radix sort: where each digit starts, per pass (a workgroup a pass).
+            SortOffsets = sort_offsets_cs($crate::geometry::buffers::SortParams)
+                phases($crate::construct::sort::OFFSETS_PHASES, [0 1 2 3 4])
+                shared { values: [u32; $crate::gpu::workgroup::WG], out: [u32; $crate::gpu::workgroup::WG], sums: [u32; 16] } {
+                1 sort_state: write [u32],
+            } |phase, lid, group, params| $crate::construct::sort::offsets_phase(phase, lid, group, params, sort_state, values, out, sums);
+
+            /// Radix sort without look-back: each tile's digit counts.
+            SortTileCounts = sort_tile_counts_cs($crate::geometry::buffers::SortParams)
+                phases($crate::construct::sort::TILE_COUNTS_PHASES, [0 1 2])
+                shared { counts: [u32; $crate::gpu::workgroup::WG] } {
+                1 keys: read [u64],
+                2 tile_counts: write [u32],
+            } |phase, lid, group, params| $crate::construct::sort::tile_counts_phase(phase, lid, group, params, keys, tile_counts, counts);
+
+            /// Counts treelet roots per height (a local histogram per workgroup first).
+            TreeletHistogram = treelet_histogram_cs($crate::geometry::buffers::TreeletParams)
+                phases($crate::construct::treelet::kernels::HISTOGRAM_PHASES, [0 1 2])
+                shared { local: [u32; $crate::gpu::workgroup::WG] } {
+                1 counts: read [u32],
+                2 heights: read [u32],
+                3 level_counts: write [u32],
+            } |phase, lid, group, params| $crate::construct::treelet::kernels::treelet_histogram_phase(phase, lid, group, params, counts, heights, level_counts, local);
+
+            /// Lists treelet roots by height (a range per workgroup and height).
+            TreeletScatter = treelet_scatter_cs($crate::geometry::buffers::TreeletParams)
+                phases($crate::construct::treelet::kernels::SCATTER_PHASES, [0 1 2 3])
+                shared { local: [u32; $crate::gpu::workgroup::WG], ranks: [u32; $crate::gpu::workgroup::WG] } {
+                1 counts: read [u32],
+                2 heights: read [u32],
+                3 cursors: write [u32],
+                4 roots: write [u32],
+            } |phase, lid, group, params| $crate::construct::treelet::kernels::treelet_scatter_phase(phase, lid, group, params, counts, heights, cursors, roots, local, ranks);
+
+            /// The primitive boxes (spheres, then triangles), and their centroid bounds.
+            PrimitiveBounds = primitive_bounds_cs($crate::geometry::buffers::BuildParams)
+                phases($crate::construct::bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9])
+                shared { shared: [$crate::geometry::aabb::Aabb; $crate::gpu::workgroup::WG] } {
+                1 spheres: read [$crate::geometry::buffers::Sphere],
+                2 triangles: read [$crate::geometry::triangle::Triangle] | 5 triangles_hi,
+                3 boxes: write [$crate::geometry::records::Vec4 as $crate::geometry::aabb::Aabb],
+                4 bounds: write [u32],
+            } |phase, lid, group, params| {
+                let mut source = $crate::construct::bounds::PrimitiveBoxes { spheres: params.spheres, sphere_data: spheres, triangles };
+                $crate::construct::bounds::primitive_bounds_phase(phase, lid, group, params.n, &mut source, boxes, bounds, shared)
+            };
+
+            /// An instanced scene's top level: each instance's record and world
+            /// box (`construct::instances`), and their centroid bounds.
+            InstanceBounds = instance_bounds_cs($crate::geometry::buffers::BuildParams)
+                phases($crate::construct::bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9])
+                shared { shared: [$crate::geometry::aabb::Aabb; $crate::gpu::workgroup::WG] } {
+                1 placed: read [$crate::geometry::records::Vec4 as $crate::geometry::buffers::PlacedMesh],
+                2 meshes: read [$crate::geometry::records::Vec4 as $crate::geometry::buffers::MeshRecord],
+                3 records: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::InstanceRecord],
+                4 boxes: write [$crate::geometry::records::Vec4 as $crate::geometry::aabb::Aabb],
+                5 bounds: write [u32],
+            } |phase, lid, group, params| {
+                let mut source = $crate::construct::instances::InstanceBoxes { placed, meshes, records: &mut *records };
+                $crate::construct::bounds::primitive_bounds_phase(phase, lid, group, params.n, &mut source, boxes, bounds, shared)
+            };
+
+            /// Triangle splitting: each primitive's priority, and their sum per workgroup.
+            SplitPriority = split_priority_cs($crate::geometry::buffers::SplitParams)
+                phases($crate::construct::presplit::PRIORITY_PHASES, [0 1 2 3 4 5 6 7 8 9])
+                shared { shared: [f32; $crate::gpu::workgroup::WG] } {
+                1 triangles: read [$crate::geometry::triangle::Triangle] | 4 triangles_hi,
+                2 priorities: write [f32],
+                3 partials: write [f32],
+            } |phase, lid, group, params| $crate::construct::presplit::priority_phase(phase, lid, group, params, triangles, priorities, partials, shared);
+
+            /// Triangle splitting: the pieces' boxes as the build's, with their centroid bounds.
+            SplitBounds = split_bounds_cs($crate::geometry::buffers::BuildParams)
+                phases($crate::construct::bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9])
+                shared { shared: [$crate::geometry::aabb::Aabb; $crate::gpu::workgroup::WG] } {
+                1 ref_boxes: read [$crate::geometry::aabb::Aabb],
+                2 boxes: write [$crate::geometry::records::Vec4 as $crate::geometry::aabb::Aabb],
+                3 bounds: write [u32],
+            } |phase, lid, group, params| {
+                let mut source = $crate::construct::presplit::StoredBoxes { boxes: ref_boxes };
+                $crate::construct::bounds::primitive_bounds_phase(phase, lid, group, params.n, &mut source, boxes, bounds, shared)
+            };
         }
     };
 }

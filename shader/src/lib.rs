@@ -25,24 +25,38 @@ macro_rules! unrolled_phases {
     }};
 }
 
+/// A binding's type in a registry's entry point (`treelet_core::registry`):
+/// `read` a shared slice, `write` a mutable one.
+macro_rules! slice {
+    (read, $t:ty) => { &[$t] };
+    (write, $t:ty) => { &mut [$t] };
+}
+
+/// A buffer a registry's entry point binds in two parts, as one view.
+macro_rules! join {
+    (read, $lo:ident, $hi:ident) => {
+        let $lo = treelet_core::geometry::split::Split::new($lo, $hi);
+    };
+    (write, $lo:ident, $hi:ident) => {
+        #[allow(unused_mut)]
+        let mut $lo = treelet_core::geometry::split::SplitMut::new($lo, $hi);
+    };
+}
+
 // The entry points come in groups, one per feature of this crate, so that
 // the SPIR-V is built one group per rust-gpu run: its linker holds a whole
 // run's kernels at once, and all of them in one run peaked at 22 GB
 // (host/build.rs lists the groups).
 #[cfg(feature = "kernels")]
-pub mod bounds;
-#[cfg(feature = "kernels")]
 pub mod fit;
-#[cfg(feature = "kernels")]
-pub mod presplit;
 #[cfg(feature = "kernels")]
 pub mod multisplit;
 #[cfg(feature = "kernels")]
 pub mod per_invocation;
+#[cfg(feature = "kernels")]
+pub mod per_workgroup;
 #[cfg(any(feature = "render-linear", feature = "render-bvh2", feature = "render-bvh2-light", feature = "render-bvh4", feature = "render-cwbvh"))]
 pub mod render;
-#[cfg(feature = "kernels")]
-pub mod scan;
 #[cfg(feature = "kernels")]
 pub mod sort;
 #[cfg(feature = "kernels")]

@@ -5,24 +5,6 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::gpu::workgroup::linear_id;
 
-/// A binding's type in an entry point: `read` a shared slice, `write` a
-/// mutable one.
-macro_rules! slice {
-    (read, $t:ty) => { &[$t] };
-    (write, $t:ty) => { &mut [$t] };
-}
-
-/// A buffer bound in two parts, as one view.
-macro_rules! join {
-    (read, $lo:ident, $hi:ident) => {
-        let $lo = treelet_core::geometry::split::Split::new($lo, $hi);
-    };
-    (write, $lo:ident, $hi:ident) => {
-        #[allow(unused_mut)]
-        let mut $lo = treelet_core::geometry::split::SplitMut::new($lo, $hi);
-    };
-}
-
 macro_rules! entry_points {
     ($(
         $(#[doc = $doc:expr])*

@@ -9,43 +9,6 @@ use treelet_core::gpu::subgroup::{Lane, apply_with};
 use treelet_core::geometry::buffers::SortParams;
 use treelet_core::gpu::workgroup::{WG, barrier, linear_group};
 
-#[spirv(compute(threads(256)))]
-pub fn sort_histogram_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] sort_state: &mut [u32],
-    #[spirv(workgroup)] counts: &mut [u32; (sort::MAX_PASSES * sort::RADIX) as usize],
-) {
-    // A private copy, kept in registers across the barriers instead of
-    // read from the storage buffer again in each phase (H200: 1% off the sort).
-    let params = &{ *params };
-    let tile = linear_group(group.x, group.y, groups.x);
-    unrolled_phases!(sort::HISTOGRAM_PHASES, [0 1 2], |phase| {
-        sort::histogram_phase(phase, lid, tile, params, keys, sort_state, counts)
-    });
-}
-
-#[spirv(compute(threads(256)))]
-pub fn sort_offsets_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] sort_state: &mut [u32],
-    #[spirv(workgroup)] values: &mut [u32; WG],
-    #[spirv(workgroup)] out: &mut [u32; WG],
-    #[spirv(workgroup)] sums: &mut [u32; 16],
-) {
-    // A private copy, kept in registers across the barriers instead of
-    // read from the storage buffer again in each phase (H200: 1% off the sort).
-    let params = &{ *params };
-    unrolled_phases!(sort::OFFSETS_PHASES, [0 1 2 3 4], |phase| {
-        sort::offsets_phase(phase, lid, group.x, params, sort_state, values, out, sums)
-    });
-}
-
 /// A sort pass's entry point; `$look_back` and `$items` as in
 /// `treelet_core::construct::sort::onesweep_phase` (entry points cannot be
 /// generic). The phases are unrolled, each with its number a constant
@@ -189,21 +152,3 @@ multisplit_kernel!(sort_multisplit_partitioned_cs, MULTISPLIT_SORT_ITEMS, true, 
 multisplit_kernel!(sort_multisplit_small_partitioned_cs, SMALL_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
 multisplit_kernel!(sort_multisplit_medium_partitioned_cs, MEDIUM_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21]);
 
-#[spirv(compute(threads(256)))]
-pub fn sort_tile_counts_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &SortParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] keys: &[u64],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] tile_counts: &mut [u32],
-    #[spirv(workgroup)] counts: &mut [u32; WG],
-) {
-    // A private copy, kept in registers across the barriers instead of
-    // read from the storage buffer again in each phase (H200: 1% off the sort).
-    let params = &{ *params };
-    let tile = linear_group(group.x, group.y, groups.x);
-    unrolled_phases!(sort::TILE_COUNTS_PHASES, [0 1 2], |phase| {
-        sort::tile_counts_phase(phase, lid, tile, params, keys, tile_counts, counts)
-    });
-}

@@ -1,49 +1,11 @@
 use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::treelet::SUBSETS;
-use treelet_core::construct::treelet::kernels::{HISTOGRAM_PHASES, RESTRUCTURE_PHASES, SCATTER_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_histogram_phase, treelet_restructure_phase, treelet_restructure_single, treelet_scatter_phase};
+use treelet_core::construct::treelet::kernels::{RESTRUCTURE_PHASES, TEAM, TEAM_COSTS, TEAM_PARTS, TEAM_STAGE, TEAM_VOTES, treelet_restructure_phase};
 use treelet_core::geometry::buffers::{Node, TreeletParams};
 use treelet_core::geometry::split::SplitMut;
 use treelet_core::gpu::subgroup::subgroup_barrier;
-use treelet_core::gpu::workgroup::{WG, barrier, linear_group, linear_id};
-
-/// Counts treelet roots per height (a local histogram per workgroup first).
-#[spirv(compute(threads(256)))]
-pub fn treelet_histogram_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] level_counts: &mut [u32],
-    #[spirv(workgroup)] local: &mut [u32; WG],
-) {
-    let group = linear_group(group.x, group.y, groups.x);
-    unrolled_phases!(HISTOGRAM_PHASES, [0 1 2], |phase| {
-        treelet_histogram_phase(phase, lid, group, params, counts, heights, level_counts, local)
-    });
-}
-
-/// Lists treelet roots by height (a range per workgroup and height).
-#[spirv(compute(threads(256)))]
-pub fn treelet_scatter_cs(
-    #[spirv(local_invocation_index)] lid: u32,
-    #[spirv(workgroup_id)] group: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] counts: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] heights: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] cursors: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] roots: &mut [u32],
-    #[spirv(workgroup)] local: &mut [u32; WG],
-    #[spirv(workgroup)] ranks: &mut [u32; WG],
-) {
-    let group = linear_group(group.x, group.y, groups.x);
-    unrolled_phases!(SCATTER_PHASES, [0 1 2 3], |phase| {
-        treelet_scatter_phase(phase, lid, group, params, counts, heights, cursors, roots, local, ranks)
-    });
-}
+use treelet_core::gpu::workgroup::{barrier, linear_group};
 
 /// Restructures the treelets of one height, a team of 32 lanes each.
 #[spirv(compute(threads(128)))]
@@ -97,25 +59,4 @@ pub fn treelet_restructure_cs(
         };
     }
     phases!(0 1 2 3 4 5 6 7 8);
-}
-
-/// Restructures the treelets of one height, one invocation each (heights
-/// of many small treelets).
-#[spirv(compute(threads(256)))]
-pub fn treelet_restructure_single_cs(
-    #[spirv(global_invocation_id)] gid: UVec3,
-    #[spirv(num_workgroups)] groups: UVec3,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &TreeletParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] roots: &[u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] nodes: &mut [Node],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] parents: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] counts: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] costs: &mut [f32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] heights: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] marks: &mut [u32],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &mut [Node],
-) {
-    let id = linear_id(gid.x, gid.y, groups.x);
-    let nodes = &mut SplitMut::new(nodes, nodes_hi);
-    treelet_restructure_single(id, params, roots, nodes, parents, counts, costs, heights, marks);
 }

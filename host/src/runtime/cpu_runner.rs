@@ -12,7 +12,6 @@ use anyhow::Result;
 use bytemuck::Pod;
 use rayon::prelude::*;
 use treelet_core::geometry::split::{Split, SplitMut};
-use treelet_core::geometry::aabb::Aabb;
 use treelet_core::construct::sort::multisplit_rank::{multisplit_op, multisplit_phase, MultisplitLane, MULTISPLIT_PHASES};
 use treelet_core::gpu::subgroup::{self, Lane};
 use treelet_core::gpu::workgroup::{WG, WORKGROUP_SIZE, groups_for};
@@ -25,9 +24,8 @@ use treelet_core::trace::placed::PlacedScene;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
-use treelet_core::construct::sort::{self, scan};
+use treelet_core::construct::sort;
 use treelet_core::construct::treelet::kernels as treelet_kernels;
-use treelet_core::construct::{bounds, presplit};
 
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernels::{Kernel, Method};
@@ -462,6 +460,18 @@ macro_rules! cpu_type {
     };
 }
 
+/// A registered kernel's parameters (`$p`, a reference) and bindings (each
+/// by its name) as its call takes them, from the dispatch's buffers `b`.
+macro_rules! cpu_bindings {
+    ($kernel:ident, $buffers:ident, $params:ty, $p:ident, $($access:ident $b:ident [$t:ty $(as $cpu:ty)?] $(| $hi:ident)?),*) => {
+        let [params_words, $($b),*] = $buffers else { panic!("{:?}: wrong number of bindings", $kernel) };
+        let params_value: $params = params(params_words);
+        let $p = &params_value;
+        $(cpu_view!($access, $b, cpu_type!($t $(, $cpu)?));)*
+        $($(cpu_whole!($access, $b, $hi);)?)*
+    };
+}
+
 // The registry's kernels (`treelet_core::registry`): each one's call, made
 // from its one declaration, for every invocation.
 macro_rules! run_registered {
@@ -475,11 +485,7 @@ macro_rules! run_registered {
         fn run_registered(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) -> bool {
             match kernel {
                 $(Kernel::$name => {
-                    let [params_words, $($b),*] = b else { panic!("{kernel:?}: wrong number of bindings") };
-                    let params_value: $params = params(params_words);
-                    let $p = &params_value;
-                    $(cpu_view!($access, $b, cpu_type!($t $(, $cpu)?));)*
-                    $($(cpu_whole!($access, $b, $hi);)?)*
+                    cpu_bindings!(kernel, b, $params, $p, $($access $b [$t $(as $cpu)?] $(| $hi)?),*);
                     for $id in ids(groups) {
                         $call;
                     }
@@ -492,9 +498,39 @@ macro_rules! run_registered {
 }
 treelet_core::per_invocation_kernels!(run_registered);
 
+// The per-workgroup registry's kernels: each one's call, made from its one
+// declaration, for every invocation of each workgroup, phase by phase.
+macro_rules! run_per_workgroup {
+    ($(
+        $(#[doc = $doc:expr])*
+        $name:ident = $entry:ident($params:ty) phases($count:expr, [$($phase:literal)*]) shared { $($s:ident : [$st:ty; $sn:expr]),* $(,)? } {
+            $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
+        } |$ph:ident, $lid:ident, $group:ident, $p:ident| $call:expr;
+    )*) => {
+        /// Runs `kernel` if it is one of the per-workgroup registry's (and
+        /// says whether it was).
+        fn run_per_workgroup(kernel: Kernel, b: &mut [&mut [u64]], groups: u32) -> bool {
+            match kernel {
+                $(Kernel::$name => {
+                    cpu_bindings!(kernel, b, $params, $p, $($access $b [$t $(as $cpu)?] $(| $hi)?),*);
+                    $(let mut $s: [$st; $sn] = [bytemuck::Zeroable::zeroed(); $sn];)*
+                    $(let $s = &mut $s;)*
+                    workgroups(groups, $count, |$group, $ph, $lid| {
+                        let _ = $group;
+                        $call;
+                    });
+                    true
+                })*
+                _ => false,
+            }
+        }
+    };
+}
+treelet_core::per_workgroup_kernels!(run_per_workgroup);
+
 /// Calls the core function of `kernel` for every invocation of the dispatch.
 fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: u32) {
-    if run_registered(kernel, b, groups) {
+    if run_registered(kernel, b, groups) || run_per_workgroup(kernel, b, groups) {
         return;
     }
     match (kernel, b) {
@@ -512,62 +548,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             for id in ids(groups) {
                 treelet_core::render::rays::cast_instances_kernel(id, &p, instances, nodes, leaves, &prims, rays);
             }
-        }
-        (Kernel::InstanceBounds, [p, placed, meshes, records, boxes, bounds_words]) => {
-            use treelet_core::geometry::buffers::{InstanceRecord, MeshRecord, PlacedMesh};
-            let p: treelet_core::BuildParams = params(p);
-            let (placed, meshes): (&[PlacedMesh], &[MeshRecord]) = (view(placed), view(meshes));
-            let (records, boxes, bounds_words) = (view::<InstanceRecord>(records), view::<Aabb>(boxes), view(bounds_words));
-            let mut source = treelet_core::construct::instances::InstanceBoxes { placed, meshes, records };
-            let mut shared = [Aabb::EMPTY; WG];
-            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
-            });
-        }
-        (Kernel::PrimitiveBounds, [p, spheres, triangles, boxes, bounds_words]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (spheres, triangles) = (view(spheres), view(triangles));
-            let (boxes, bounds_words) = (view::<Aabb>(boxes), view(bounds_words));
-            let mut shared = [Aabb::EMPTY; WG];
-            let triangles = Split::whole(triangles);
-            let mut source = bounds::PrimitiveBoxes { spheres: p.spheres, sphere_data: spheres, triangles };
-            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
-            });
-        }
-        (Kernel::SplitPriority, [p, triangles, priorities, partials]) => {
-            let p: treelet_core::SplitParams = params(p);
-            let (triangles, priorities, partials) = (view(triangles), view(priorities), view(partials));
-            let triangles = Split::whole(triangles);
-            let mut shared = [0f32; WG];
-            workgroups(groups, presplit::PRIORITY_PHASES, |g, phase, lid| {
-                presplit::priority_phase(phase, lid, g, &p, triangles, priorities, partials, &mut shared)
-            });
-        }
-        (Kernel::SplitBounds, [p, ref_boxes, boxes, bounds_words]) => {
-            let p: treelet_core::BuildParams = params(p);
-            let (ref_boxes, boxes, bounds_words) = (view::<Aabb>(ref_boxes), view::<Aabb>(boxes), view(bounds_words));
-            let mut shared = [Aabb::EMPTY; WG];
-            let mut source = presplit::StoredBoxes { boxes: ref_boxes };
-            workgroups(groups, bounds::REDUCE_PHASES, |g, phase, lid| {
-                bounds::primitive_bounds_phase(phase, lid, g, p.n, &mut source, boxes, bounds_words, &mut shared)
-            });
-        }
-        (Kernel::SortHistogram, [p, keys, sort_state]) => {
-            let p: treelet_core::SortParams = params(p);
-            let (keys, sort_state) = (view(keys), view(sort_state));
-            let mut counts = [0u32; (sort::MAX_PASSES * sort::RADIX) as usize];
-            workgroups(groups, sort::HISTOGRAM_PHASES, |g, phase, lid| {
-                sort::histogram_phase(phase, lid, g, &p, keys, sort_state, &mut counts)
-            });
-        }
-        (Kernel::SortOffsets, [p, sort_state]) => {
-            let p: treelet_core::SortParams = params(p);
-            let sort_state = view(sort_state);
-            let (mut values, mut out, mut sums) = ([0u32; WG], [0u32; WG], [0u32; 16]);
-            workgroups(groups, sort::OFFSETS_PHASES, |g, phase, lid| {
-                sort::offsets_phase(phase, lid, g, &p, sort_state, &mut values, &mut out, &mut sums)
-            });
         }
         (Kernel::Multisplit, [p, keys, ranks, counts, sizes]) => {
             let p: treelet_core::SortParams = params(p);
@@ -609,14 +589,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let partitioned = kernel == Kernel::SortMultisplitMediumPartitioned;
             multisplit_sort_pass::<MEDIUM_MULTISPLIT_SORT_ITEMS>(&p, io, groups, subgroup_size, partitioned);
         }
-        (Kernel::SortTileCounts, [p, keys, tile_counts]) => {
-            let p: treelet_core::SortParams = params(p);
-            let (keys, tile_counts) = (view(keys), view(tile_counts));
-            let mut counts = [0u32; WG];
-            workgroups(groups, sort::TILE_COUNTS_PHASES, |g, phase, lid| {
-                sort::tile_counts_phase(phase, lid, g, &p, keys, tile_counts, &mut counts)
-            });
-        }
         (
             kernel @ (Kernel::SortOnesweep | Kernel::SortOnesweepSmall | Kernel::SortOnesweepScanned),
             [p, keys_in, values_in, keys_out, values_out, sort_state],
@@ -632,30 +604,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
                 _ => onesweep::<false, { sort::SORT_ITEMS }, { sort::SORT_TILE as usize }>(&p, io, groups),
             }
-        }
-        (Kernel::ScanReduce, [p, data, partials]) => {
-            let p: treelet_core::ScanParams = params(p);
-            let (data, partials) = (view(data), view(partials));
-            let mut sums = [0u32; WG];
-            workgroups(groups, scan::SCAN_REDUCE_PHASES, |g, phase, lid| {
-                scan::scan_reduce_phase(phase, lid, g, &p, data, partials, &mut sums)
-            });
-        }
-        (Kernel::ScanSpine, [p, partials]) => {
-            let p: treelet_core::ScanParams = params(p);
-            let partials = view(partials);
-            let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
-            workgroups(groups, scan::SCAN_SWEEP_PHASES, |_, phase, lid| {
-                scan::scan_spine_phase(phase, lid, &p, partials, &mut a, &mut b)
-            });
-        }
-        (Kernel::ScanDownsweep, [p, data, partials]) => {
-            let p: treelet_core::ScanParams = params(p);
-            let (data, partials) = (view(data), view(partials));
-            let (mut a, mut b) = ([0u32; WG], [0u32; WG]);
-            workgroups(groups, scan::SCAN_SWEEP_PHASES, |g, phase, lid| {
-                scan::scan_downsweep_phase(phase, lid, g, &p, data, partials, &mut a, &mut b)
-            });
         }
         (Kernel::AgglomerateSubgroup, [p, keys, prims, boxes, nodes, parents, ends, queue, queued]) => {
             use treelet_core::construct::agglomerate_subgroup::*;
@@ -687,33 +635,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                 }
             }
         }
-        (Kernel::TreeletHistogram, [p, counts, heights, level_counts]) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (counts, heights, level_counts) = (view(counts), view(heights), view(level_counts));
-            let mut local = [0u32; WG];
-            workgroups(groups, treelet_kernels::HISTOGRAM_PHASES, |group, phase, lid| {
-                treelet_kernels::treelet_histogram_phase(
-                    phase,
-                    lid,
-                    group,
-                    &p,
-                    counts,
-                    heights,
-                    level_counts,
-                    &mut local,
-                );
-            });
-        }
-        (Kernel::TreeletScatter, [p, counts, heights, cursors, roots]) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (counts, heights, cursors, roots) = (view(counts), view(heights), view(cursors), view(roots));
-            let (mut local, mut ranks) = ([0u32; WG], [0u32; WG]);
-            workgroups(groups, treelet_kernels::SCATTER_PHASES, |group, phase, lid| {
-                treelet_kernels::treelet_scatter_phase(
-                    phase, lid, group, &p, counts, heights, cursors, roots, &mut local, &mut ranks,
-                );
-            });
-        }
         (Kernel::TreeletRestructure, [p, roots, subsets, nodes, parents, counts, costs, heights, marks]) => {
             let p: treelet_core::geometry::buffers::TreeletParams = params(p);
             let (roots, subsets, parents) = (view(roots), view(subsets), view(parents));
@@ -730,15 +651,6 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
                     &mut cost, &mut parts, &mut order, &mut votes,
                 );
             });
-        }
-        (Kernel::TreeletRestructureSingle, [p, roots, nodes, parents, counts, costs, heights, marks]) => {
-            let p: treelet_core::geometry::buffers::TreeletParams = params(p);
-            let (roots, parents) = (view(roots), view(parents));
-            let nodes = &mut SplitMut::whole(view(nodes));
-            let (counts, costs, heights, marks) = (view(counts), view(costs), view(heights), view(marks));
-            for id in ids(groups) {
-                treelet_kernels::treelet_restructure_single(id, &p, roots, nodes, parents, counts, costs, heights, marks);
-            }
         }
         (Kernel::Cast(..) | Kernel::CastWideWorkgroupStack, [p, spheres, materials, nodes, prims, rays, triangles]) => {
             let p: treelet_core::RenderParams = params(p);

@@ -102,29 +102,39 @@ macro_rules! access {
     };
 }
 
+/// A registered kernel's facts: its entry point in the shader's `$module`
+/// and each binding's access, number and second part's number, if any.
+macro_rules! registration {
+    ($module:literal, $entry:ident, $($access:ident $binding:literal $(| $hi_binding:literal)?),*) => {
+        Some(Registration {
+            entry_point: concat!($module, stringify!($entry)),
+            bindings: &[Read, $(access!($access)),*],
+            numbers: &[0, $($binding),*],
+            split: &[$($([$binding, $hi_binding][0],)?)*],
+            second_parts: &[$($($hi_binding,)?)*],
+        })
+    };
+}
+
 // The enum: the kernels written out by hand below, then every kernel of
-// the registry (`treelet_core::per_invocation_kernels!`), with their facts.
+// the two registries (`treelet_core::per_invocation_kernels!`, then
+// `treelet_core::per_workgroup_kernels!`), with their facts.
 macro_rules! kernel_table {
-    ($(
+    ({$(
         $(#[doc = $doc:expr])*
         $name:ident = $entry:ident($params:ty) {
             $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
         } |$id:ident, $p:ident| $call:expr;
+    )*}
+    $(
+        $(#[doc = $wdoc:expr])*
+        $wname:ident = $wentry:ident($wparams:ty) phases($count:expr, [$($phase:literal)*]) shared { $($s:ident : [$st:ty; $sn:expr]),* $(,)? } {
+            $($wbinding:literal $wb:ident : $waccess:ident [$wt:ty $(as $wcpu:ty)?] $(| $whi_binding:literal $whi:ident)?),* $(,)?
+        } |$ph:ident, $lid:ident, $group:ident, $wp:ident| $wcall:expr;
     )*) => {
         /// Every compute kernel of Treelet.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
         pub enum Kernel {
-    /// [`Kernel::PrimitiveBoxes`] fused with the centroid bounds.
-    PrimitiveBounds,
-    /// Triangle splitting (`treelet_core::construct::presplit`): each
-    /// primitive's priority and their sums per workgroup.
-    SplitPriority,
-    /// Triangle splitting: the pieces' boxes as the build's, with their centroid bounds.
-    SplitBounds,
-    /// Radix sort: digit counts of every pass.
-    SortHistogram,
-    /// Radix sort: where each digit starts, per pass.
-    SortOffsets,
     /// Radix sort: one pass (one sweep with decoupled look-back).
     SortOnesweep,
     /// [`Kernel::SortOnesweep`] with small tiles (`treelet_core::construct::sort::SMALL_SORT_TILE`).
@@ -145,16 +155,11 @@ macro_rules! kernel_table {
     SortMultisplitSmallPartitioned,
     /// [`Kernel::SortMultisplitMedium`] likewise.
     SortMultisplitMediumPartitioned,
-    /// Radix sort without look-back: this pass's digit counts per tile.
-    SortTileCounts,
     /// Radix sort without look-back: one pass, offsets from the scanned tile counts.
     SortOnesweepScanned,
     /// Ranks keys by digit within their subgroup with ballots (Onesweep's
     /// warp-level multisplit; `treelet_core::construct::sort::multisplit_rank`).
     Multisplit,
-    ScanReduce,
-    ScanSpine,
-    ScanDownsweep,
     /// The agglomerative build's lowest levels merged within each subgroup,
     /// the rest queued for [`Kernel::ClimbQueued`].
     AgglomerateSubgroup,
@@ -163,14 +168,8 @@ macro_rules! kernel_table {
     Hploc,
     /// [`Kernel::Hploc`] with relaxed exchanges, for CPU adapters.
     HplocRelaxed,
-    /// Treelet optimization: count treelet roots per height.
-    TreeletHistogram,
-    /// Treelet optimization: list treelet roots by height.
-    TreeletScatter,
     /// Treelet optimization: restructure the treelets of one height, a team of lanes each.
     TreeletRestructure,
-    /// Treelet optimization: restructure the treelets of one height, one invocation each.
-    TreeletRestructureSingle,
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
@@ -194,43 +193,37 @@ macro_rules! kernel_table {
     /// An engine's rays through an instanced scene (a top-level tree over
     /// instances of meshes, `bvh2` layout at both levels).
     CastInstances,
-    /// An instanced scene's top level: each instance's record and world
-    /// box, and the first pass of their centroid bounds.
-    InstanceBounds,
     $($(#[doc = $doc])* $name,)*
+    $($(#[doc = $wdoc])* $wname,)*
         }
 
         impl Kernel {
-            /// The kernels of the registry.
-            pub const REGISTERED: &'static [Kernel] = &[$(Kernel::$name),*];
+            /// The kernels of the registries.
+            pub const REGISTERED: &'static [Kernel] = &[$(Kernel::$name,)* $(Kernel::$wname,)*];
 
             /// The facts of a kernel of the registry (`None` for the others).
             pub fn registration(self) -> Option<Registration> {
                 match self {
-                    $(Kernel::$name => Some(Registration {
-                        entry_point: concat!("per_invocation::", stringify!($entry)),
-                        bindings: &[Read, $(access!($access)),*],
-                        numbers: &[0, $($binding),*],
-                        split: &[$($([$binding, $hi_binding][0],)?)*],
-                        second_parts: &[$($($hi_binding,)?)*],
-                    }),)*
+                    $(Kernel::$name => registration!("per_invocation::", $entry, $($access $binding $(| $hi_binding)?),*),)*
+                    $(Kernel::$wname => registration!("per_workgroup::", $wentry, $($waccess $wbinding $(| $whi_binding)?),*),)*
                     _ => None,
                 }
             }
         }
     };
 }
-treelet_core::per_invocation_kernels!(kernel_table);
+// The per-invocation entries, carried into the per-workgroup registry's
+// call of `kernel_table`, so that one table takes both.
+macro_rules! with_per_workgroup {
+    ($($per_invocation:tt)*) => {
+        treelet_core::per_workgroup_kernels!(kernel_table { $($per_invocation)* });
+    };
+}
+treelet_core::per_invocation_kernels!(with_per_workgroup);
 
 impl Kernel {
-    const FIXED: [Kernel; 36] = [
+    const FIXED: [Kernel; 23] = [
         Kernel::CastInstances,
-        Kernel::InstanceBounds,
-        Kernel::PrimitiveBounds,
-        Kernel::SplitPriority,
-        Kernel::SplitBounds,
-        Kernel::SortHistogram,
-        Kernel::SortOffsets,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
         Kernel::SortMultisplit,
@@ -239,19 +232,12 @@ impl Kernel {
         Kernel::SortMultisplitPartitioned,
         Kernel::SortMultisplitSmallPartitioned,
         Kernel::SortMultisplitMediumPartitioned,
-        Kernel::SortTileCounts,
         Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
-        Kernel::ScanReduce,
-        Kernel::ScanSpine,
-        Kernel::ScanDownsweep,
         Kernel::AgglomerateSubgroup,
         Kernel::Hploc,
         Kernel::HplocRelaxed,
-        Kernel::TreeletHistogram,
-        Kernel::TreeletScatter,
         Kernel::TreeletRestructure,
-        Kernel::TreeletRestructureSingle,
         Kernel::Cast(Method::Classic, false),
         Kernel::Cast(Method::Bvh2, false),
         Kernel::Cast(Method::Bvh4, false),
@@ -293,12 +279,6 @@ impl Kernel {
         }
         match self {
             Kernel::CastInstances => "render::cast_instances_cs",
-            Kernel::InstanceBounds => "bounds::instance_bounds_cs",
-            Kernel::PrimitiveBounds => "bounds::primitive_bounds_cs",
-            Kernel::SplitPriority => "presplit::split_priority_cs",
-            Kernel::SplitBounds => "presplit::split_bounds_cs",
-            Kernel::SortHistogram => "sort::sort_histogram_cs",
-            Kernel::SortOffsets => "sort::sort_offsets_cs",
             Kernel::SortOnesweep => "sort::sort_onesweep_cs",
             Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
             Kernel::SortMultisplit => "sort::sort_multisplit_cs",
@@ -307,19 +287,12 @@ impl Kernel {
             Kernel::SortMultisplitPartitioned => "sort::sort_multisplit_partitioned_cs",
             Kernel::SortMultisplitSmallPartitioned => "sort::sort_multisplit_small_partitioned_cs",
             Kernel::SortMultisplitMediumPartitioned => "sort::sort_multisplit_medium_partitioned_cs",
-            Kernel::SortTileCounts => "sort::sort_tile_counts_cs",
             Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit::multisplit_cs",
-            Kernel::ScanReduce => "scan::scan_reduce_cs",
-            Kernel::ScanSpine => "scan::scan_spine_cs",
-            Kernel::ScanDownsweep => "scan::scan_downsweep_cs",
             Kernel::AgglomerateSubgroup => "fit::agglomerate_subgroup_cs",
             Kernel::Hploc => "fit::hploc_cs",
             Kernel::HplocRelaxed => "fit::hploc_relaxed_cs",
-            Kernel::TreeletHistogram => "treelet::treelet_histogram_cs",
-            Kernel::TreeletScatter => "treelet::treelet_scatter_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
-            Kernel::TreeletRestructureSingle => "treelet::treelet_restructure_single_cs",
             Kernel::Render(method, v) => render_entry_point(method, v, false),
             Kernel::RenderPlaced => "render::render_placed_cs",
             Kernel::RenderPlacedCaustics => "render::render_placed_caustics_cs",
@@ -349,11 +322,8 @@ impl Kernel {
             return r.split;
         }
         match self {
-            Kernel::PrimitiveBounds => &[2],
-            Kernel::SplitPriority => &[1],
             Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletRestructure => &[3],
-            Kernel::TreeletRestructureSingle => &[2],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
             Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
@@ -386,15 +356,6 @@ impl Kernel {
         }
         match self {
             Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
-            Kernel::InstanceBounds => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::PrimitiveBounds => &[Read, Read, Read, ReadWrite, ReadWrite],
-            Kernel::SplitPriority => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::SplitBounds => &[Read, Read, ReadWrite, ReadWrite],
-            Kernel::SortHistogram => &[Read, Read, ReadWrite],
-            Kernel::ScanReduce => &[Read, Read, ReadWrite],
-            Kernel::ScanSpine => &[Read, ReadWrite],
-            Kernel::ScanDownsweep => &[Read, ReadWrite, Read],
-            Kernel::SortOffsets => &[Read, ReadWrite],
             Kernel::SortOnesweep
             | Kernel::SortOnesweepSmall
             | Kernel::SortOnesweepScanned
@@ -404,17 +365,11 @@ impl Kernel {
             | Kernel::SortMultisplitPartitioned
             | Kernel::SortMultisplitSmallPartitioned
             | Kernel::SortMultisplitMediumPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::SortTileCounts => &[Read, Read, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Hploc | Kernel::HplocRelaxed => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
-            Kernel::TreeletHistogram => &[Read, Read, Read, ReadWrite],
-            Kernel::TreeletScatter => &[Read, Read, Read, ReadWrite, ReadWrite],
             Kernel::TreeletRestructure => {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
-            }
-            Kernel::TreeletRestructureSingle => {
-                &[Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
             // The render's, then the copies' (`render::render_placed_cs`).

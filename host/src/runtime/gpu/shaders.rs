@@ -208,7 +208,7 @@ mod workgroup_tests {
         let largest = every.iter().map(|m| (m.workgroup_bytes(), m.entry_point)).max().unwrap();
         assert!(largest.0 >= 4096 && largest.0 <= 65536, "{largest:?}");
         // Two arrays of 256 words at least (the scan's `a` and `b`).
-        let scan = every.iter().find(|m| m.entry_point == "scan::scan_spine_cs").unwrap();
+        let scan = every.iter().find(|m| m.entry_point == "per_workgroup::scan_spine_cs").unwrap();
         assert!(scan.workgroup_bytes() >= 2048, "{}: {}", scan.entry_point, scan.workgroup_bytes());
     }
 }
