@@ -436,6 +436,81 @@ mod tests {
         }
     }
 
+    /// The slab test culls no box the ray meets: random rays (near and far
+    /// from the coordinate origin, at small and large scales, some
+    /// parallel or nearly parallel to axes) against boxes with faces
+    /// through a point of the ray (touching it, or holding it in a face),
+    /// beside it and around it, judged in f64 (whose error is 2^-29 of
+    /// f32's: a box it finds met is met, or misses by far less than the
+    /// slab test's slack).
+    #[test]
+    fn slab_test_culls_no_box_the_ray_meets() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut met, mut checked) = (0, 0);
+        for trial in 0..200_000 {
+            let scale = 10f64.powf(next() * 9.0 - 3.0) as f32;
+            let far = 10f64.powf(next() * 8.0) as f32 * (next() < 0.5) as u32 as f32;
+            let mut unit = || Vec3::new(next() as f32 * 2.0 - 1.0, next() as f32 * 2.0 - 1.0, next() as f32 * 2.0 - 1.0);
+            let o = unit() * far + unit() * scale;
+            let mut d = unit().normalize_or(Vec3::X);
+            for k in 0..3 {
+                match (trial + k) % 7 {
+                    0 => d[k] = 0.0,
+                    1 => d[k] *= 1e-25,
+                    _ => {}
+                }
+            }
+            let d = d.normalize_or(Vec3::Z);
+            let q = o + d * (next() as f32 * 10.0 * scale);
+            let (mut lo, mut hi) = ([0f32; 3], [0f32; 3]);
+            for k in 0..3 {
+                let r = next();
+                // A face through the point, or the point inside or beside.
+                let (a, b) = (next() as f32 * scale, next() as f32 * scale);
+                (lo[k], hi[k]) = match (r * 6.0) as u32 {
+                    0 => (q[k], q[k] + a),
+                    1 => (q[k] - a, q[k]),
+                    2 => (q[k], q[k]),
+                    3 => (q[k] + a * 1e-3, q[k] + a + b),
+                    _ => (q[k] - a, q[k] + b),
+                };
+            }
+            let t_max = if next() < 0.5 { MISS } else { (next() * 20.0) as f32 * scale };
+            // The f64 slab test of the same ray and box, clipped to 0..t_max.
+            let (mut near, mut farthest) = (0f64, t_max as f64);
+            for k in 0..3 {
+                let (o, d, lo, hi) = (o[k] as f64, d[k] as f64, lo[k] as f64, hi[k] as f64);
+                if d == 0.0 {
+                    if o < lo || o > hi {
+                        farthest = -1.0;
+                    }
+                } else {
+                    let (t0, t1) = ((lo - o) / d, (hi - o) / d);
+                    near = near.max(t0.min(t1));
+                    farthest = farthest.min(t0.max(t1));
+                }
+            }
+            checked += 1;
+            if near > farthest {
+                continue;
+            }
+            met += 1;
+            let root = ([lo[0].min(o.x) - scale, lo[1].min(o.y) - scale, lo[2].min(o.z) - scale], [hi[0].max(o.x) + scale, hi[1].max(o.y) + scale, hi[2].max(o.z) + scale]);
+            for ray in [SlabRay::new(o, d), SlabRay::new(o, d).within(root.0, root.1)] {
+                let (n, f) = slab_interval(lo, hi, &ray, t_max);
+                assert!(n <= f, "trial {trial}: o {o:?} d {d:?} box {lo:?}..{hi:?} t_max {t_max}: culled ({n} > {f}); f64 {near}..{farthest}");
+            }
+        }
+        // Most boxes are met (the check has teeth).
+        assert!(met > checked / 4, "{met} of {checked}");
+    }
+
     /// A ray along z, parallel to x and y: lying in a box's far face it
     /// stays in the box at any distance the root allows, while a box half a
     /// unit beside it, which the bias of `f32::MAX` let through, is culled.
