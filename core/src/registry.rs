@@ -54,7 +54,9 @@
 //!   [`crate::gpu::atomics`]).
 //!
 //! The macro hands the entries to a macro of the caller's (`$callback`),
-//! which makes what its side needs of them.
+//! which makes what its side needs of them; the second kernel of a pair
+//! comes marked `#[relaxed_of(Name)]` (the host maps each kernel to its
+//! relaxed twin from it).
 
 /// The per-invocation kernels; see [`crate::registry`].
 #[macro_export]
@@ -535,6 +537,7 @@ macro_rules! __kernel_pairs {
             $(#[doc = $doc])*
             $name = $entry($params) { $($bindings)* } |$id, $p| { const ORDERED: bool = true; $call };
             #[doc = concat!("`", stringify!($name), "` with relaxed atomics, for CPU adapters (lavapipe).")]
+            #[relaxed_of($name)]
             $relaxed = $relaxed_entry($params) { $($bindings)* } |$id, $p| { const ORDERED: bool = false; $call };
         ] $($rest)* }
     };

@@ -8,6 +8,7 @@ use treelet_core::gpu::workgroup::linear_id;
 macro_rules! entry_points {
     ($(
         $(#[doc = $doc:expr])*
+        $(#[relaxed_of($ordered:ident)])?
         $name:ident = $entry:ident($params:ty) {
             $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
         } |$id:ident, $p:ident| $call:expr;

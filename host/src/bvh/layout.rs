@@ -239,7 +239,7 @@ fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -
 pub fn kernels<B: Backend>(b: &B, layout: Layout) -> Vec<Kernel> {
     match layout {
         Layout::Cwbvh => {
-            let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
+            let dp = b.atomics_for(Kernel::WideDp);
             let mut k = vec![Kernel::Fill, Kernel::TreeDepth, dp, Kernel::WideCount, Kernel::WidePlace, Kernel::WideEmit];
             k.extend([Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep]);
             k
@@ -333,7 +333,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let counts = b.scratch("wide DP counts", nodes * 4)?;
     let costs = b.scratch("wide DP costs", nodes * 32)?;
     let decisions = b.scratch("wide DP decisions", nodes * 8)?;
-    let dp = if b.ordered_atomics_in_divergent_flow() { Kernel::WideDp } else { Kernel::WideDpRelaxed };
+    let dp = b.atomics_for(Kernel::WideDp);
     // A stage per step, so that `bench rays` shows where the time goes.
     b.stage("wide dp");
     b.dispatch(dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));

@@ -127,19 +127,18 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 /// The kernels [`build_primitives_on_device`] dispatches on `b` (the same
 /// questions of `b` as it asks), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let ordered = b.ordered_atomics_in_divergent_flow();
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
     if split_override().is_some_and(|b| b > 0.0) {
         k.extend(SPLIT_KERNELS);
     }
     k.extend(crate::bvh::sort::kernels(b));
     match Hierarchy::from_env() {
-        Some(h) => k.extend(h.kernels(ordered)),
+        Some(h) => k.extend(h.kernels(b)),
         // Which one runs depends on the primitive count.
         None => {
-            k.extend(Hierarchy::Agglomerative.kernels(ordered));
+            k.extend(Hierarchy::Agglomerative.kernels(b));
             if !b.runs_on_cpu() {
-                k.extend(Hierarchy::AgglomerativeSubgroup.kernels(ordered));
+                k.extend(Hierarchy::AgglomerativeSubgroup.kernels(b));
             }
         }
     }
@@ -153,7 +152,7 @@ pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
         k.extend(SPLIT_KERNELS);
     }
     k.extend(crate::bvh::sort::kernels(b));
-    k.extend(hierarchy.kernels(b.ordered_atomics_in_divergent_flow()));
+    k.extend(hierarchy.kernels(b));
     k
 }
 
@@ -411,19 +410,18 @@ fn build_from_first_pass<B: Backend>(
 
     let nodes = b.scratch("nodes", node_count * 32)?;
     let parents = b.scratch("parents", node_count * 4)?;
-    let ordered = b.ordered_atomics_in_divergent_flow();
     match hierarchy {
         Hierarchy::RadixTreeThenFit => {
             b.stage("tree");
             b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
             b.stage("fit");
-            let fit = if ordered { Kernel::Fit } else { Kernel::FitRelaxed };
+            let fit = b.atomics_for(Kernel::Fit);
             b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Agglomerative => {
             // One kernel makes both: its time is the fit's, the tree's is none.
             b.stage("fit");
-            let k = if ordered { Kernel::Agglomerate } else { Kernel::AgglomerateRelaxed };
+            let k = b.atomics_for(Kernel::Agglomerate);
             b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Hploc => {
@@ -437,7 +435,7 @@ fn build_from_first_pass<B: Backend>(
             }
             let words = treelet_core::construct::hploc::lists_words(n) as u64;
             let lists = b.scratch("hploc clusters", words * 4)?;
-            let k = if ordered { Kernel::Hploc } else { Kernel::HplocRelaxed };
+            let k = b.atomics_for(Kernel::Hploc);
             b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots, &lists], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::AgglomerativeSubgroup => {
@@ -453,7 +451,7 @@ fn build_from_first_pass<B: Backend>(
             let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
             let all = [&p, &keys, &values, &boxes, &nodes, &parents, &slots, &queue, &queued];
             b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));
-            let climb = if ordered { Kernel::ClimbQueued } else { Kernel::ClimbQueuedRelaxed };
+            let climb = b.atomics_for(Kernel::ClimbQueued);
             b.dispatch(climb, &[&p, &keys, &nodes, &parents, &slots, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
         }
     }
@@ -538,19 +536,16 @@ impl Hierarchy {
         })
     }
 
-    /// The kernels of a hierarchy (`ordered` as the device allows: see
-    /// `Backend::ordered_atomics_in_divergent_flow`).
-    fn kernels(self, ordered: bool) -> Vec<Kernel> {
-        match (self, ordered) {
-            (Hierarchy::RadixTreeThenFit, true) => vec![Kernel::RadixTree, Kernel::Fit],
-            (Hierarchy::RadixTreeThenFit, false) => vec![Kernel::RadixTree, Kernel::FitRelaxed],
-            (Hierarchy::Agglomerative, true) => vec![Kernel::Agglomerate],
-            (Hierarchy::Agglomerative, false) => vec![Kernel::AgglomerateRelaxed],
-            (Hierarchy::AgglomerativeSubgroup, true) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueued],
-            (Hierarchy::AgglomerativeSubgroup, false) => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueuedRelaxed],
-            (Hierarchy::Hploc, true) => vec![Kernel::Hploc],
-            (Hierarchy::Hploc, false) => vec![Kernel::HplocRelaxed],
-        }
+    /// The kernels of a hierarchy, as `b` runs them (relaxed atomics where
+    /// it needs them: `Backend::atomics_for`).
+    fn kernels<B: Backend>(self, b: &B) -> Vec<Kernel> {
+        let kernels = match self {
+            Hierarchy::RadixTreeThenFit => vec![Kernel::RadixTree, Kernel::Fit],
+            Hierarchy::Agglomerative => vec![Kernel::Agglomerate],
+            Hierarchy::AgglomerativeSubgroup => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueued],
+            Hierarchy::Hploc => vec![Kernel::Hploc],
+        };
+        kernels.into_iter().map(|k| b.atomics_for(k)).collect()
     }
 }
 

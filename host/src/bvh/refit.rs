@@ -44,7 +44,7 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
     b.dispatch(Kernel::PrimitiveBoxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
     b.stage("fit");
     let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
-    let fit = if b.ordered_atomics_in_divergent_flow() { Kernel::Fit } else { Kernel::FitRelaxed };
+    let fit = b.atomics_for(Kernel::Fit);
     b.dispatch(fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
     b.take_times()
 }
@@ -93,7 +93,7 @@ pub fn refit_bvh2<B: Backend>(
             made
         }
     };
-    let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::RefitLeaves } else { Kernel::RefitLeavesRelaxed };
+    let refit = b.atomics_for(Kernel::RefitLeaves);
     b.dispatch(
         refit,
         &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &climb, &tree.prims, &tree.nodes],

@@ -61,6 +61,6 @@ pub fn moves_made<B: Backend>(b: &mut B, made: Option<&B::Buffer>, iterations: u
 /// The kernels [`reinsert`] dispatches on `b` (relaxed refit counters where
 /// the device needs them), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let refit = if b.ordered_atomics_in_divergent_flow() { Kernel::ReinsertRefit } else { Kernel::ReinsertRefitRelaxed };
+    let refit = b.atomics_for(Kernel::ReinsertRefit);
     vec![Kernel::ReinsertSearch, Kernel::ReinsertBid, Kernel::ReinsertClaim, Kernel::ReinsertApply, refit]
 }

@@ -340,11 +340,7 @@ fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &T
 /// The two kernels of [`init_pass`] on `b` (relaxed counters where the
 /// device needs them).
 fn init_kernels<B: Backend>(b: &B) -> [Kernel; 2] {
-    if b.ordered_atomics_in_divergent_flow() {
-        [Kernel::TreeletInit, Kernel::TreeletInitClimb]
-    } else {
-        [Kernel::TreeletInitRelaxed, Kernel::TreeletInitClimbRelaxed]
-    }
+    [Kernel::TreeletInit, Kernel::TreeletInitClimb].map(|k| b.atomics_for(k))
 }
 
 /// Checks the counts, costs and heights in `s` against a fresh climb.

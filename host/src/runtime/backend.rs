@@ -73,6 +73,12 @@ pub trait Backend: Send {
     fn ordered_atomics_in_divergent_flow(&self) -> bool {
         true
     }
+    /// `kernel` as this device runs it: its relaxed twin
+    /// ([`Kernel::relaxed`]) where ordered atomics in divergent flow are
+    /// not to be trusted, else itself.
+    fn atomics_for(&self, kernel: Kernel) -> Kernel {
+        if self.ordered_atomics_in_divergent_flow() { kernel } else { kernel.relaxed() }
+    }
     /// False where the radix sort's decoupled look-back was seen to give
     /// wrong offsets (lavapipe: see `treelet_core::construct::sort`); the sort runs
     /// without it there.

@@ -477,6 +477,7 @@ macro_rules! cpu_bindings {
 macro_rules! run_registered {
     ($(
         $(#[doc = $doc:expr])*
+        $(#[relaxed_of($ordered:ident)])?
         $name:ident = $entry:ident($params:ty) {
             $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
         } |$id:ident, $p:ident| $call:expr;

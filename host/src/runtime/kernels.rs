@@ -122,6 +122,7 @@ macro_rules! registration {
 macro_rules! kernel_table {
     ({$(
         $(#[doc = $doc:expr])*
+        $(#[relaxed_of($ordered:ident)])?
         $name:ident = $entry:ident($params:ty) {
             $($binding:literal $b:ident : $access:ident [$t:ty $(as $cpu:ty)?] $(| $hi_binding:literal $hi:ident)?),* $(,)?
         } |$id:ident, $p:ident| $call:expr;
@@ -200,6 +201,17 @@ macro_rules! kernel_table {
         impl Kernel {
             /// The kernels of the registries.
             pub const REGISTERED: &'static [Kernel] = &[$(Kernel::$name,)* $(Kernel::$wname,)*];
+
+            /// The twin of an ordered-atomics kernel with relaxed atomics
+            /// (for devices that need them: `Backend::atomics_for`), or
+            /// the kernel itself where it has none.
+            pub fn relaxed(self) -> Kernel {
+                match self {
+                    $($(Kernel::$ordered => Kernel::$name,)?)*
+                    Kernel::Hploc => Kernel::HplocRelaxed,
+                    other => other,
+                }
+            }
 
             /// The facts of a kernel of the registry (`None` for the others).
             pub fn registration(self) -> Option<Registration> {
@@ -383,6 +395,25 @@ impl Kernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each kernel with relaxed atomics is the twin of the kernel of its
+    /// name without `Relaxed`, and no other kernel has a twin.
+    #[test]
+    fn relaxed_twins_pair_by_name() {
+        let all = Kernel::all();
+        let name = |k: Kernel| format!("{k:?}");
+        let mut twins = 0;
+        for &k in &all {
+            let r = k.relaxed();
+            if r != k {
+                assert_eq!(name(r), format!("{}Relaxed", name(k)), "{k:?}");
+                twins += 1;
+            } else if let Some(base) = name(k).strip_suffix("Relaxed") {
+                assert!(all.iter().all(|&o| name(o) != base || o.relaxed() == k), "{k:?} is not {base}'s twin");
+            }
+        }
+        assert_eq!(twins, all.iter().filter(|&&k| name(k).ends_with("Relaxed")).count());
+    }
 
     /// The registry writes binding numbers out (the shader's attributes
     /// take literals): they must be the order the host binds in, and the
