@@ -48,9 +48,11 @@ macro_rules! join {
 // run's kernels at once, and all of them in one run peaked at 22 GB
 // (host/build.rs lists the groups).
 #[cfg(feature = "kernels")]
-pub mod fit;
+pub mod agglomerate_subgroup;
 #[cfg(feature = "kernels")]
-pub mod multisplit;
+pub mod hploc;
+#[cfg(feature = "kernels")]
+pub mod multisplit_rank;
 #[cfg(feature = "kernels")]
 pub mod per_invocation;
 #[cfg(feature = "kernels")]

@@ -9,7 +9,7 @@ use treelet_core::gpu::workgroup::{linear_group, linear_id};
 /// state stays in registers, and the ballots between phases need no barrier.
 #[spirv(compute(threads(256)))]
 #[allow(clippy::too_many_arguments)]
-pub fn multisplit_cs(
+pub fn multisplit_rank_cs(
     #[spirv(global_invocation_id)] gid: UVec3,
     #[spirv(workgroup_id)] group: UVec3,
     #[spirv(num_workgroups)] groups: UVec3,
