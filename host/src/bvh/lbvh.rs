@@ -124,24 +124,22 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
     device_bvh.read(b)
 }
 
-/// The kernels [`build_primitives_on_device`] dispatches on `b` (the same
-/// questions of `b` as it asks), for building their pipelines ahead.
+/// The kernels [`build_primitives_on_device`] dispatches on `b`, for
+/// building their pipelines ahead (the hierarchies as
+/// [`Hierarchy::for_device`] picks them).
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
     if split_override().is_some_and(|b| b > 0.0) {
         k.extend(SPLIT_KERNELS);
     }
     k.extend(crate::bvh::sort::kernels(b));
-    match Hierarchy::from_env() {
-        Some(h) => k.extend(h.kernels(b)),
-        // Which one runs depends on the primitive count.
-        None => {
-            k.extend(Hierarchy::Agglomerative.kernels(b));
-            if !b.runs_on_cpu() {
-                k.extend(Hierarchy::AgglomerativeSubgroup.kernels(b));
-            }
-        }
+    // Which hierarchy runs depends on the primitive count: one count from
+    // each class of `Hierarchy::for_device`.
+    for n in [1, SUBGROUP_HIERARCHY_MIN] {
+        k.extend(Hierarchy::for_device(b, n).kernels(b));
     }
+    k.sort();
+    k.dedup();
     k
 }
 

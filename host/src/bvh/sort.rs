@@ -12,28 +12,21 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use crate::runtime::backend::Backend;
 use crate::runtime::kernels::Kernel;
 
-/// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b` (the
-/// same question of `b` as they ask), for building their pipelines ahead.
+/// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b`, for
+/// building their pipelines ahead: the pass kernel of each size class as
+/// [`pass_kernel`] picks it (so a new choice there is prepared too).
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep, Kernel::SortSettleTies];
     if b.look_back_works() {
-        k.extend([Kernel::SortHistogram, Kernel::SortOffsets, Kernel::SortOnesweepSmall]);
-        if multisplit_by_default(b) {
-            k.extend(if b.subgroup_partitioned() {
-                [
-                    Kernel::SortMultisplitSmallPartitioned,
-                    Kernel::SortMultisplitMediumPartitioned,
-                    Kernel::SortMultisplitPartitioned,
-                ]
-            } else {
-                [Kernel::SortMultisplitSmall, Kernel::SortMultisplitMedium, Kernel::SortMultisplit]
-            });
-        } else {
-            k.push(Kernel::SortOnesweep);
-        }
+        k.extend([Kernel::SortHistogram, Kernel::SortOffsets]);
+        // One size from each class of `SortTiles::resolve`.
+        let sizes = [1, SMALL_TILES_BESIDE_MULTISPLIT_UP_TO, SMALL_TILES_UP_TO, SMALL_MULTISPLIT_UP_TO, MEDIUM_MULTISPLIT_UP_TO];
+        k.extend(sizes.iter().filter_map(|&n| pass_kernel(b, n.saturating_add(1), SortTiles::Auto).ok().map(|(pass, _)| pass)));
     } else {
         k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
     }
+    k.sort();
+    k.dedup();
     k
 }
 
