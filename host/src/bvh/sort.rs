@@ -14,7 +14,7 @@ use crate::runtime::kernels::Kernel;
 
 /// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b`, for
 /// building their pipelines ahead: the pass kernel of each size class as
-/// [`pass_kernel`] picks it (so a new choice there is prepared too).
+/// `pass_kernel` picks it (so a new choice there is prepared too).
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
     let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep, Kernel::SortSettleTies];
     if b.look_back_works() {
