@@ -13,6 +13,7 @@ use treelet_core::trace::hit::STACK_DEPTH;
 use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
 use crate::bvh::trbvh;
 use crate::runtime::backend::{check_fits, Backend, DeviceClass};
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::{Kernel, Method};
 use crate::scene::primitives::Primitives;
 
@@ -210,7 +211,7 @@ pub fn tree_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<u32> {
     let params = LayoutParams { n: bvh.n, nodes: bvh.node_count, ..Default::default() };
     let p = b.upload("depth params", &[params])?;
     let deepest = b.zeroed("tree depth", 4)?;
-    b.dispatch(Kernel::TreeDepth, &[&p, &bvh.nodes, &bvh.parents, &deepest], groups_for(bvh.node_count, WORKGROUP_SIZE));
+    b.dispatch(DepthKernels::of(b).depth, &[&p, &bvh.nodes, &bvh.parents, &deepest], groups_for(bvh.node_count, WORKGROUP_SIZE));
     Ok(b.read::<u32>(&deepest, 1)?[0])
 }
 
@@ -234,21 +235,49 @@ fn params<B: Backend>(bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>, root: &Aabb) -
     }
 }
 
+kernel_set! {
+    /// The kernel of [`tree_depth`], run before every layout.
+    pub struct DepthKernels for b {
+        depth: Kernel::TreeDepth,
+    }
+}
+
+kernel_set! {
+    /// The kernels of the two-box layout.
+    pub struct Bvh2Kernels for b {
+        nodes: Kernel::Bvh2Nodes,
+        leaf_prims: Kernel::LeafPrims,
+    }
+}
+
+kernel_set! {
+    /// The kernel of the 4-wide layout, made from the two-box one.
+    pub struct Bvh4Kernels for b {
+        nodes: Kernel::Bvh4Nodes,
+    }
+}
+
+kernel_set! {
+    /// The kernels of the compressed wide layout (and the scans between
+    /// them: `crate::bvh::sort::ScanKernels`).
+    pub struct WideKernels for b {
+        dp: b.atomics_for(Kernel::WideDp),
+        count: Kernel::WideCount,
+        place: Kernel::WidePlace,
+        emit: Kernel::WideEmit,
+    }
+}
+
 /// The kernels laying a tree out in `layout` dispatches on `b` (the same
 /// question of `b` as it asks), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B, layout: Layout) -> Vec<Kernel> {
+    let depth = DepthKernels::of(b).all();
     match layout {
-        Layout::Cwbvh => {
-            let dp = b.atomics_for(Kernel::WideDp);
-            let mut k = vec![Kernel::Fill, Kernel::TreeDepth, dp, Kernel::WideCount, Kernel::WidePlace, Kernel::WideEmit];
-            k.extend([Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep]);
-            k
-        }
+        Layout::Cwbvh => [depth, WideKernels::of(b).all(), crate::bvh::sort::ScanKernels::of(b).all()].concat(),
         // Classic and bvh2 collapse the tree's leaves first (classic only when it has leaves to collapse).
-        Layout::Classic | Layout::Auto => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth]].concat(),
-        Layout::Bvh2 => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth, Kernel::Bvh2Nodes, Kernel::LeafPrims]].concat(),
-        Layout::Bvh4 => [trbvh::collapse_kernels(b), vec![Kernel::TreeDepth, Kernel::Bvh2Nodes, Kernel::LeafPrims, Kernel::Bvh4Nodes]]
-            .concat(),
+        Layout::Classic | Layout::Auto => [trbvh::collapse_kernels(b), depth].concat(),
+        Layout::Bvh2 => [trbvh::collapse_kernels(b), depth, Bvh2Kernels::of(b).all()].concat(),
+        Layout::Bvh4 => [trbvh::collapse_kernels(b), depth, Bvh2Kernels::of(b).all(), Bvh4Kernels::of(b).all()].concat(),
     }
 }
 
@@ -261,7 +290,7 @@ fn bvh4<B: Backend>(b: &mut B, two: TracedTree<B>) -> Result<TracedTree<B>> {
     check_fits(b, "4-wide nodes", bytes)?;
     let nodes = b.scratch("4-wide nodes", bytes)?;
     let p = b.upload("4-wide params", &[LayoutParams { nodes: two.node_count, ..Default::default() }])?;
-    b.dispatch(Kernel::Bvh4Nodes, &[&p, &two.nodes, &nodes], groups_for(two.node_count, WORKGROUP_SIZE));
+    b.dispatch(Bvh4Kernels::of(b).nodes, &[&p, &two.nodes, &nodes], groups_for(two.node_count, WORKGROUP_SIZE));
     Ok(TracedTree { layout: Layout::Bvh4, nodes, prims: two.prims, node_count: two.node_count, collapsed: None })
 }
 
@@ -288,7 +317,7 @@ fn write_bvh2<B: Backend>(
     let p = write_bvh2_nodes(b, collapsed, prims, nodes)?;
     let n = collapsed.n;
     b.dispatch(
-        Kernel::LeafPrims,
+        Bvh2Kernels::of(b).leaf_prims,
         &[&p, &collapsed.prim_indices, &prims.spheres, &prims.triangles, leaf_prims],
         groups_for(n, WORKGROUP_SIZE),
     );
@@ -305,7 +334,7 @@ fn write_bvh2_nodes<B: Backend>(
 ) -> Result<B::Buffer> {
     let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
     b.dispatch(
-        Kernel::Bvh2Nodes,
+        Bvh2Kernels::of(b).nodes,
         &[&p, &collapsed.nodes, &collapsed.parents, nodes],
         groups_for(collapsed.node_count, WORKGROUP_SIZE),
     );
@@ -333,10 +362,10 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let counts = b.scratch("wide DP counts", nodes * 4)?;
     let costs = b.scratch("wide DP costs", nodes * 32)?;
     let decisions = b.scratch("wide DP decisions", nodes * 8)?;
-    let dp = b.atomics_for(Kernel::WideDp);
+    let k = WideKernels::of(b);
     // A stage per step, so that `bench rays` shows where the time goes.
     b.stage("wide dp");
-    b.dispatch(dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(k.dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));
 
     let is_wide = b.scratch("wide node flags", internal as u64 * 4)?;
     let child_offsets = b.scratch("wide child offsets", internal as u64 * 4)?;
@@ -344,7 +373,7 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let groups = groups_for(internal, WORKGROUP_SIZE);
     b.stage("wide count");
     b.dispatch(
-        Kernel::WideCount,
+        k.count,
         &[&p, &bvh.nodes, &bvh.parents, &counts, &decisions, &is_wide, &child_offsets, &prim_offsets],
         groups,
     );
@@ -354,12 +383,12 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let positions = b.scratch("wide node positions", internal as u64 * 4)?;
     let slots = b.scratch("wide node slots", internal as u64 * 32)?;
     b.stage("wide place");
-    b.dispatch(Kernel::WidePlace, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions, &slots], groups);
+    b.dispatch(k.place, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions, &slots], groups);
     let out_nodes = b.scratch("wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
     let out_prims = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
     b.stage("wide emit");
     b.dispatch(
-        Kernel::WideEmit,
+        k.emit,
         &[
             &p,
             &bvh.nodes,

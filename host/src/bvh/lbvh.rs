@@ -10,11 +10,65 @@ use treelet_core::geometry::buffers::{BuildParams, Node, Sphere};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
 use crate::runtime::backend::{check_fits, Backend, StageTimes};
+use crate::bvh::sort::ScanKernels;
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
 use crate::scene::primitives::Primitives;
 
 /// The stages of a build, in order, as named in timings and reports.
 pub const STAGES: [&str; 5] = ["bounds", "morton", "sort", "tree", "fit"];
+
+kernel_set! {
+    /// The kernels of a build's first stages: boxes with their centroid
+    /// bounds, Morton codes (the sort's: `crate::bvh::sort`).
+    pub struct LbvhKernels for b {
+        bounds: Kernel::PrimitiveBounds,
+        morton: Kernel::Morton,
+    }
+}
+
+kernel_set! {
+    /// The kernels [`Hierarchy::RadixTreeThenFit`] dispatches.
+    pub struct RadixTreeKernels for b {
+        tree: Kernel::RadixTree,
+        fit: b.atomics_for(Kernel::Fit),
+    }
+}
+
+kernel_set! {
+    /// The kernel [`Hierarchy::Agglomerative`] dispatches.
+    pub struct AgglomerateKernels for b {
+        agglomerate: b.atomics_for(Kernel::Agglomerate),
+    }
+}
+
+kernel_set! {
+    /// The kernels [`Hierarchy::AgglomerativeSubgroup`] dispatches.
+    pub struct AgglomerateSubgroupKernels for b {
+        agglomerate: Kernel::AgglomerateSubgroup,
+        climb: b.atomics_for(Kernel::ClimbQueued),
+    }
+}
+
+kernel_set! {
+    /// The kernel [`Hierarchy::Hploc`] dispatches.
+    pub struct HplocKernels for b {
+        hploc: b.atomics_for(Kernel::Hploc),
+    }
+}
+
+kernel_set! {
+    /// The kernels triangle splitting adds to a build (and the scan's:
+    /// [`split_kernels`]).
+    pub struct SplitKernels for b {
+        bounds: Kernel::PrimitiveBounds,
+        priority: Kernel::SplitPriority,
+        count: Kernel::SplitCount,
+        emit: Kernel::SplitEmit,
+        piece_bounds: Kernel::SplitBounds,
+        remap: Kernel::SplitRemap,
+    }
+}
 
 /// A built BVH, read back from the device.
 #[derive(Clone, Debug, Default)]
@@ -128,9 +182,9 @@ pub fn build_with<B: Backend>(b: &mut B, spheres: &[Sphere], hierarchy: Hierarch
 /// building their pipelines ahead (the hierarchies as
 /// [`Hierarchy::for_device`] picks them).
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
+    let mut k = LbvhKernels::of(b).all();
     if split_override().is_some_and(|b| b > 0.0) {
-        k.extend(SPLIT_KERNELS);
+        k.extend(split_kernels(b));
     }
     k.extend(crate::bvh::sort::kernels(b));
     // Which hierarchy runs depends on the primitive count: one count from
@@ -145,9 +199,9 @@ pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
 
 /// The kernels [`build_primitives_with`] dispatches on `b` for `hierarchy`.
 pub fn kernels_with<B: Backend>(b: &B, hierarchy: Hierarchy) -> Vec<Kernel> {
-    let mut k = vec![Kernel::Fill, Kernel::PrimitiveBounds, Kernel::Morton];
+    let mut k = LbvhKernels::of(b).all();
     if split_override().is_some_and(|b| b > 0.0) {
-        k.extend(SPLIT_KERNELS);
+        k.extend(split_kernels(b));
     }
     k.extend(crate::bvh::sort::kernels(b));
     k.extend(hierarchy.kernels(b));
@@ -219,7 +273,7 @@ pub fn build_uploaded_split<B: Backend>(
     }
     // The boxes and their centroid bounds in one kernel.
     let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
-        b.dispatch(Kernel::PrimitiveBounds, &[p, &spheres, &triangles, boxes, bounds], groups);
+        b.dispatch(LbvhKernels::of(b).bounds, &[p, &spheres, &triangles, boxes, bounds], groups);
         Ok(())
     };
     params.n = n;
@@ -237,9 +291,10 @@ pub fn split_override() -> Option<f32> {
     crate::tuning::Tuning::current().splits
 }
 
-/// The kernels splitting adds to a build.
-pub const SPLIT_KERNELS: [Kernel; 7] =
-    [Kernel::SplitPriority, Kernel::SplitCount, Kernel::SplitEmit, Kernel::SplitBounds, Kernel::SplitRemap, Kernel::CopyWords, Kernel::PrimitiveBounds];
+/// The kernels splitting adds to a build on `b`.
+pub fn split_kernels<B: Backend>(b: &B) -> Vec<Kernel> {
+    [SplitKernels::of(b).all(), ScanKernels::of(b).all()].concat()
+}
 
 /// The build over pieces of the triangles (Karras & Aila 2013, section
 /// 5.1; `treelet_core::construct::presplit`): at most `budget` times the
@@ -256,15 +311,16 @@ fn build_split<B: Backend>(
     triangles: &B::Buffer,
 ) -> Result<(DeviceBvh<B>, StageTimes)> {
     use treelet_core::construct::presplit::PRIORITY_TILE;
-    use treelet_core::geometry::buffers::{CopyParams, SplitParams};
+    use treelet_core::geometry::buffers::SplitParams;
     let n = sphere_count + triangle_count;
+    let k = SplitKernels::of(b);
     b.stage("split");
     // The primitives' centroid bounds: the Morton grid the pieces follow.
     let params = BuildParams { n, spheres: sphere_count, ..Default::default() };
     let p = b.upload("build params", &[params])?;
     let prim_boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let bounds = b.upload("centroid bounds", &BOUNDS_START)?;
-    b.dispatch(Kernel::PrimitiveBounds, &[&p, spheres, triangles, &prim_boxes, &bounds], groups_for(n, REDUCE_TILE));
+    b.dispatch(k.bounds, &[&p, spheres, triangles, &prim_boxes, &bounds], groups_for(n, REDUCE_TILE));
     let words: [u32; BOUNDS_WORDS] = b.read::<u32>(&bounds, BOUNDS_WORDS)?.try_into().expect("six words read");
     b.release(&[&prim_boxes]);
     let frame = MortonFrame::new(&bounds_from_words(&words));
@@ -280,18 +336,17 @@ fn build_split<B: Backend>(
     let priorities = b.scratch("split priorities", n as u64 * 4)?;
     let tiles = groups_for(n, PRIORITY_TILE);
     let partials = b.scratch("split priority sums", tiles as u64 * 4)?;
-    b.dispatch(Kernel::SplitPriority, &[&sp, triangles, &priorities, &partials], tiles);
+    b.dispatch(k.priority, &[&sp, triangles, &priorities, &partials], tiles);
     let sum: f64 = b.read::<f32>(&partials, tiles as usize)?.iter().map(|&s| s as f64).sum();
     let extra = (budget as f64 * triangle_count as f64).min((MAX_PRIMITIVES - n) as f64);
     split.scale = if sum > 0.0 && sum.is_finite() { (extra / sum) as f32 } else { 0.0 };
     // Pieces per primitive, scanned into offsets; the total after the last.
     let sp = b.upload("split params", &[split])?;
     let offsets = b.scratch("split offsets", (n as u64 + 1) * 4)?;
-    b.dispatch(Kernel::SplitCount, &[&sp, &priorities, &offsets], groups_for(n + 1, WORKGROUP_SIZE));
+    b.dispatch(k.count, &[&sp, &priorities, &offsets], groups_for(n + 1, WORKGROUP_SIZE));
     crate::bvh::sort::exclusive_scan(b, &offsets, n + 1)?;
-    let copy = b.upload("copy params", &[CopyParams { len: 1, src_offset: n, dst_offset: 0, _pad0: 0 }])?;
     let total = b.scratch("split total", 4)?;
-    b.dispatch(Kernel::CopyWords, &[&copy, &offsets, &total], 1);
+    b.copy_words((&offsets, n), (&total, 0), 1)?;
     let refs = b.read::<u32>(&total, 1)?[0];
     anyhow::ensure!(
         refs >= n && refs <= MAX_PRIMITIVES,
@@ -300,17 +355,17 @@ fn build_split<B: Backend>(
     b.release(&[&priorities, &partials]);
     let ref_boxes = b.scratch("split boxes", refs as u64 * 32)?;
     let ref_prims = b.scratch("split primitives", refs as u64 * 4)?;
-    b.dispatch(Kernel::SplitEmit, &[&sp, spheres, triangles, &offsets, &ref_boxes, &ref_prims], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(k.emit, &[&sp, spheres, triangles, &offsets, &ref_boxes, &ref_prims], groups_for(n, WORKGROUP_SIZE));
     let build = BuildParams { n: refs, spheres: params.spheres, ..Default::default() };
     let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
-        b.dispatch(Kernel::SplitBounds, &[p, &ref_boxes, boxes, bounds], groups);
+        b.dispatch(k.piece_bounds, &[p, &ref_boxes, boxes, bounds], groups);
         Ok(())
     };
     let (bvh, mut times) = build_from_first_pass(b, build, hierarchy, first_pass)?;
     // Leaf slots name primitives from here on.
     b.stage("split");
     let p = b.upload("build params", &[build])?;
-    b.dispatch(Kernel::SplitRemap, &[&p, &ref_prims, &bvh.prim_indices], groups_for(refs, WORKGROUP_SIZE));
+    b.dispatch(k.remap, &[&p, &ref_prims, &bvh.prim_indices], groups_for(refs, WORKGROUP_SIZE));
     let more = b.take_times()?;
     for s in &more.order {
         times.add(s, more.get(s));
@@ -387,7 +442,8 @@ fn build_from_first_pass<B: Backend>(
     };
     let p = b.upload("build params", &[params])?;
     let morton = [&p, &boxes, &keys, &values, &slots, &zeroed];
-    b.dispatch(Kernel::Morton, &morton, groups_for(n, WORKGROUP_SIZE));
+    let morton_kernel = LbvhKernels::of(b).morton;
+    b.dispatch(morton_kernel, &morton, groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
     let sorted = if high_first {
@@ -400,7 +456,7 @@ fn build_from_first_pass<B: Backend>(
         None => {
             if high_first {
                 // Ties too long to settle: codes again, and every digit sorted.
-                b.dispatch(Kernel::Morton, &morton, groups_for(n, WORKGROUP_SIZE));
+                b.dispatch(morton_kernel, &morton, groups_for(n, WORKGROUP_SIZE));
             }
             crate::bvh::sort::radix_sort(b, &keys, &values, n, key_bits)?
         }
@@ -411,16 +467,15 @@ fn build_from_first_pass<B: Backend>(
     match hierarchy {
         Hierarchy::RadixTreeThenFit => {
             b.stage("tree");
-            b.dispatch(Kernel::RadixTree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
+            let k = RadixTreeKernels::of(b);
+            b.dispatch(k.tree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
             b.stage("fit");
-            let fit = b.atomics_for(Kernel::Fit);
-            b.dispatch(fit, &[&p, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(k.fit, &[&p, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Agglomerative => {
             // One kernel makes both: its time is the fit's, the tree's is none.
             b.stage("fit");
-            let k = b.atomics_for(Kernel::Agglomerate);
-            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(AgglomerateKernels::of(b).agglomerate, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Hploc => {
             b.stage("fit");
@@ -433,8 +488,7 @@ fn build_from_first_pass<B: Backend>(
             }
             let words = treelet_core::construct::hploc::lists_words(n) as u64;
             let lists = b.scratch("hploc clusters", words * 4)?;
-            let k = b.atomics_for(Kernel::Hploc);
-            b.dispatch(k, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots, &lists], groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(HplocKernels::of(b).hploc, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots, &lists], groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::AgglomerativeSubgroup => {
             b.stage("fit");
@@ -448,9 +502,9 @@ fn build_from_first_pass<B: Backend>(
             let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
             let queued = b.zeroed("agglomerate queue counts", (queues * stride) as u64 * 4)?;
             let all = [&p, &keys, &values, &boxes, &nodes, &parents, &slots, &queue, &queued];
-            b.dispatch(Kernel::AgglomerateSubgroup, &all, groups_for(n, WORKGROUP_SIZE));
-            let climb = b.atomics_for(Kernel::ClimbQueued);
-            b.dispatch(climb, &[&p, &keys, &nodes, &parents, &slots, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
+            let k = AgglomerateSubgroupKernels::of(b);
+            b.dispatch(k.agglomerate, &all, groups_for(n, WORKGROUP_SIZE));
+            b.dispatch(k.climb, &[&p, &keys, &nodes, &parents, &slots, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
         }
     }
 
@@ -537,13 +591,12 @@ impl Hierarchy {
     /// The kernels of a hierarchy, as `b` runs them (relaxed atomics where
     /// it needs them: `Backend::atomics_for`).
     fn kernels<B: Backend>(self, b: &B) -> Vec<Kernel> {
-        let kernels = match self {
-            Hierarchy::RadixTreeThenFit => vec![Kernel::RadixTree, Kernel::Fit],
-            Hierarchy::Agglomerative => vec![Kernel::Agglomerate],
-            Hierarchy::AgglomerativeSubgroup => vec![Kernel::AgglomerateSubgroup, Kernel::ClimbQueued],
-            Hierarchy::Hploc => vec![Kernel::Hploc],
-        };
-        kernels.into_iter().map(|k| b.atomics_for(k)).collect()
+        match self {
+            Hierarchy::RadixTreeThenFit => RadixTreeKernels::of(b).all(),
+            Hierarchy::Agglomerative => AgglomerateKernels::of(b).all(),
+            Hierarchy::AgglomerativeSubgroup => AgglomerateSubgroupKernels::of(b).all(),
+            Hierarchy::Hploc => HplocKernels::of(b).all(),
+        }
     }
 }
 

@@ -11,7 +11,24 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels of [`refit`]: the primitives' boxes, then the fit's climb.
+    pub struct RefitKernels for b {
+        boxes: Kernel::PrimitiveBoxes,
+        fit: b.atomics_for(Kernel::Fit),
+    }
+}
+
+kernel_set! {
+    /// The kernels of [`refit_bvh2`]: its climb's state (once), then the climb.
+    pub struct RefitBvh2Kernels for b {
+        state: Kernel::RefitState,
+        leaves: b.atomics_for(Kernel::RefitLeaves),
+    }
+}
 use crate::scene::primitives::Primitives;
 
 /// Rewrites the boxes of `bvh`'s nodes for `prims`, which must be the
@@ -41,11 +58,10 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
     let params = BuildParams { n, spheres: prims.sphere_count, ..Default::default() };
     let p = b.upload("refit params", &[params])?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
-    b.dispatch(Kernel::PrimitiveBoxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(RefitKernels::of(b).boxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
     b.stage("fit");
     let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
-    let fit = b.atomics_for(Kernel::Fit);
-    b.dispatch(fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(RefitKernels::of(b).fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
     b.take_times()
 }
 
@@ -89,13 +105,12 @@ pub fn refit_bvh2<B: Backend>(
         Some(kept) => kept,
         None => {
             let made = b.scratch("refit state", nodes as u64 * 8 + n as u64 * 4)?;
-            b.dispatch(Kernel::RefitState, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups_for(nodes, WORKGROUP_SIZE));
+            b.dispatch(RefitBvh2Kernels::of(b).state, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups_for(nodes, WORKGROUP_SIZE));
             made
         }
     };
-    let refit = b.atomics_for(Kernel::RefitLeaves);
     b.dispatch(
-        refit,
+        RefitBvh2Kernels::of(b).leaves,
         &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &climb, &tree.prims, &tree.nodes],
         groups_for(n, WORKGROUP_SIZE),
     );

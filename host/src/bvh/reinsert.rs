@@ -11,7 +11,21 @@ use treelet_core::Aabb;
 
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::Backend;
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels [`reinsert`] dispatches (relaxed refit counters where the
+    /// device needs them).
+    pub struct ReinsertKernels for b {
+        search: Kernel::ReinsertSearch,
+        fill: Kernel::Fill,
+        bid: Kernel::ReinsertBid,
+        claim: Kernel::ReinsertClaim,
+        apply: Kernel::ReinsertApply,
+        refit: b.atomics_for(Kernel::ReinsertRefit),
+    }
+}
 
 /// Runs `iterations` iterations over `bvh` in place, searches climbing at
 /// most `max_climb` ancestors (0: to the root). Returns the buffer of the
@@ -32,7 +46,7 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let flags = b.scratch("reinsertion refit flags", (n as u64 - 1) * 4)?;
     let made = b.zeroed("reinsertion moves made", iterations as u64 * 4)?;
     let unowned = b.upload("reinsertion owners fill", &[FillParams { len: node_count, value: u32::MAX, _pad0: [0; 2] }])?;
-    let [_, _, _, _, refit] = kernels(b)[..] else { unreachable!() };
+    let k = ReinsertKernels::of(b);
     // Developers' switch: `TREELET_REINSERT_LEAVES=0` moves internal nodes only (nodes
     // 1 to n - 2 in the LBVH layout: the first n - 2 moves), half the searches.
     let leaves = crate::tuning::Tuning::current().reinsert_leaves;
@@ -40,14 +54,14 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let (move_groups, node_groups) = (groups_for(searched, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
     for iteration in 0..iterations {
         let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, max_climb }])?;
-        b.dispatch(Kernel::ReinsertSearch, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);
+        b.dispatch(k.search, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);
         b.zero_words(&bids, node_count)?;
-        b.dispatch(Kernel::Fill, &[&unowned, &owners], node_groups);
-        b.dispatch(Kernel::ReinsertBid, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids], move_groups);
-        b.dispatch(Kernel::ReinsertClaim, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners], move_groups);
-        b.dispatch(Kernel::ReinsertApply, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners, &made], move_groups);
+        b.dispatch(k.fill, &[&unowned, &owners], node_groups);
+        b.dispatch(k.bid, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids], move_groups);
+        b.dispatch(k.claim, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners], move_groups);
+        b.dispatch(k.apply, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners, &made], move_groups);
         b.zero_words(&flags, n - 1)?;
-        b.dispatch(refit, &[&p, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+        b.dispatch(k.refit, &[&p, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
     }
     Ok(Some(made))
 }
@@ -58,9 +72,7 @@ pub fn moves_made<B: Backend>(b: &mut B, made: Option<&B::Buffer>, iterations: u
     made.map_or(Ok(Vec::new()), |m| b.read::<u32>(m, iterations as usize))
 }
 
-/// The kernels [`reinsert`] dispatches on `b` (relaxed refit counters where
-/// the device needs them), for building their pipelines ahead.
+/// The kernels [`reinsert`] dispatches on `b`, for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let refit = b.atomics_for(Kernel::ReinsertRefit);
-    vec![Kernel::ReinsertSearch, Kernel::ReinsertBid, Kernel::ReinsertClaim, Kernel::ReinsertApply, refit]
+    ReinsertKernels::of(b).all()
 }

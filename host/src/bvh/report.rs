@@ -157,7 +157,7 @@ pub fn run_build_with<B: Backend>(
     }
     let budget = crate::bvh::tree::split_budget(builder);
     if budget > 0.0 {
-        kernels.extend(lbvh::SPLIT_KERNELS);
+        kernels.extend(lbvh::split_kernels(backend));
     }
     backend.prepare_kernels(&kernels);
     let start = Instant::now();

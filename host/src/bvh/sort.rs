@@ -10,20 +10,54 @@ use treelet_core::geometry::buffers::{ScanParams, SortParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
 use crate::runtime::backend::Backend;
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels of [`exclusive_scan`].
+    pub struct ScanKernels for b {
+        reduce: Kernel::ScanReduce,
+        spine: Kernel::ScanSpine,
+        downsweep: Kernel::ScanDownsweep,
+    }
+}
+
+kernel_set! {
+    /// The kernels of the sort with look-back, but its passes' ([`pass_kernel`]).
+    pub struct LookBackKernels for b {
+        histogram: Kernel::SortHistogram,
+        offsets: Kernel::SortOffsets,
+    }
+}
+
+kernel_set! {
+    /// The kernels of the sort without look-back (each pass's digit counts
+    /// scanned, then ranked in workgroup memory).
+    pub struct ScannedSortKernels for b {
+        tile_counts: Kernel::SortTileCounts,
+        pass: Kernel::SortOnesweepScanned,
+    }
+}
+
+kernel_set! {
+    /// The kernel ending a sort by the high digits ([`radix_sort_high_first`]).
+    pub struct SettleKernels for b {
+        settle_ties: Kernel::SortSettleTies,
+    }
+}
 
 /// The kernels [`radix_sort`] and [`exclusive_scan`] dispatch on `b`, for
 /// building their pipelines ahead: the pass kernel of each size class as
 /// `pass_kernel` picks it (so a new choice there is prepared too).
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let mut k = vec![Kernel::Fill, Kernel::ScanReduce, Kernel::ScanSpine, Kernel::ScanDownsweep, Kernel::SortSettleTies];
+    let mut k = [ScanKernels::of(b).all(), SettleKernels::of(b).all()].concat();
     if b.look_back_works() {
-        k.extend([Kernel::SortHistogram, Kernel::SortOffsets]);
+        k.extend(LookBackKernels::of(b).all());
         // One size from each class of `SortTiles::resolve`.
         let sizes = [1, SMALL_TILES_BESIDE_MULTISPLIT_UP_TO, SMALL_TILES_UP_TO, SMALL_MULTISPLIT_UP_TO, MEDIUM_MULTISPLIT_UP_TO];
         k.extend(sizes.iter().filter_map(|&n| pass_kernel(b, n.saturating_add(1), SortTiles::Auto).ok().map(|(pass, _)| pass)));
     } else {
-        k.extend([Kernel::SortTileCounts, Kernel::SortOnesweepScanned]);
+        k.extend(ScannedSortKernels::of(b).all());
     }
     k.sort();
     k.dedup();
@@ -38,9 +72,10 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
     }
     let params = b.upload("scan params", &[ScanParams { len, tiles, _pad0: [0; 2] }])?;
     let partials = b.scratch("scan partials", tiles as u64 * 4)?;
-    b.dispatch(Kernel::ScanReduce, &[&params, data, &partials], tiles);
-    b.dispatch(Kernel::ScanSpine, &[&params, &partials], 1);
-    b.dispatch(Kernel::ScanDownsweep, &[&params, data, &partials], tiles);
+    let k = ScanKernels::of(b);
+    b.dispatch(k.reduce, &[&params, data, &partials], tiles);
+    b.dispatch(k.spine, &[&params, &partials], 1);
+    b.dispatch(k.downsweep, &[&params, data, &partials], tiles);
     Ok(())
 }
 
@@ -272,7 +307,7 @@ fn high_first<B: Backend>(
         None => b.zeroed("sort tie overflow", flag_words as u64 * 4)?,
     };
     let params = b.upload("sort params", &[SortParams { n, tiles: 0, pass: first, passes }])?;
-    b.dispatch(Kernel::SortSettleTies, &[&params, &sorted.0, &sorted.1, &sort_state], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(SettleKernels::of(b).settle_ties, &[&params, &sorted.0, &sorted.1, &sort_state], groups_for(n, WORKGROUP_SIZE));
     let flags = b.read::<u32>(&sort_state, flag_words as usize)?;
     Ok((flags[state::TIE_OVERFLOW as usize] == 0).then_some(sorted))
 }
@@ -308,12 +343,13 @@ fn sort_passes<B: Backend>(
     let params = |pass| SortParams { n, tiles, pass, passes };
     if !b.look_back_works() {
         // Reduce, then scan, then the same pass kernel without look-back.
+        let k = ScannedSortKernels::of(b);
         let tile_counts = b.scratch("sort tile counts", RADIX as u64 * tiles as u64 * 4)?;
         for pass in first..passes {
             let p = b.upload("sort params", &[params(pass)])?;
-            b.dispatch(Kernel::SortTileCounts, &[&p, &src.0, &tile_counts], tiles);
+            b.dispatch(k.tile_counts, &[&p, &src.0, &tile_counts], tiles);
             exclusive_scan(b, &tile_counts, RADIX * tiles)?;
-            b.dispatch(Kernel::SortOnesweepScanned, &[&p, &src.0, &src.1, &dst.0, &dst.1, &tile_counts], tiles);
+            b.dispatch(k.pass, &[&p, &src.0, &src.1, &dst.0, &dst.1, &tile_counts], tiles);
             std::mem::swap(&mut src, &mut dst);
         }
         return Ok((src, None));
@@ -334,8 +370,9 @@ fn sort_passes<B: Backend>(
     };
     // The histogram counts the digits of passes `first..` (its `pass`).
     let p = b.upload("sort params", &[params(first)])?;
-    b.dispatch(Kernel::SortHistogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
-    b.dispatch(Kernel::SortOffsets, &[&p, &sort_state], passes);
+    let k = LookBackKernels::of(b);
+    b.dispatch(k.histogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
+    b.dispatch(k.offsets, &[&p, &sort_state], passes);
     for pass in first..passes {
         let p = b.upload("sort params", &[params(pass)])?;
         b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);

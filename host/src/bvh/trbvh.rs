@@ -19,7 +19,30 @@ use treelet_core::{Aabb, Node};
 
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, DeviceClass, StageTimes};
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels of the treelet rounds ([`optimize`]).
+    pub struct TreeletKernels for b {
+        histogram: Kernel::TreeletHistogram,
+        scatter: Kernel::TreeletScatter,
+        /// A team of lanes per treelet.
+        team: Kernel::TreeletRestructure,
+        /// A lane per treelet, for the lowest heights.
+        single: Kernel::TreeletRestructureSingle,
+    }
+}
+
+kernel_set! {
+    /// The kernels of the bottom-up pass (counts, costs, heights) and the
+    /// SAH leaf collapse (relaxed counters where the device needs them).
+    pub struct CollapseKernels for b {
+        init: b.atomics_for(Kernel::TreeletInit),
+        climb: b.atomics_for(Kernel::TreeletInitClimb),
+        collapse: Kernel::Collapse,
+    }
+}
 
 /// How the optimization runs; defaults after Karras & Aila 2013.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
@@ -196,6 +219,7 @@ fn rounds<B: Backend>(
     // ... and with `empty`, an empty launch after each height.
     let profile_empty = profile == Some(crate::tuning::ProfileLevels::WithEmptyLaunches);
     let single_heights = config.single_heights;
+    let k = TreeletKernels::of(b);
     for round in 0..config.rounds.min(ROUND_NAMES.len() as u32) {
         b.stage(ROUND_NAMES[round as usize]);
         if round == 0 {
@@ -206,7 +230,7 @@ fn rounds<B: Backend>(
         let p = b.upload("treelet params", &[TreeletParams { gamma, ..base }])?;
         let level_counts = b.zeroed("treelet level counts", MAX_LEVELS as u64 * 4)?;
         let (s, internal_groups) = (&scratch, groups_for(n - 1, WORKGROUP_SIZE));
-        b.dispatch(Kernel::TreeletHistogram, &[&p, &s.counts, &s.heights, &level_counts], internal_groups);
+        b.dispatch(k.histogram, &[&p, &s.counts, &s.heights, &level_counts], internal_groups);
         let per_level = b.read::<u32>(&level_counts, MAX_LEVELS)?;
         if per_level[MAX_LEVELS - 1] > 0 {
             bail!("the BVH is deeper than {} levels: treelet optimization refuses it", MAX_LEVELS - 2);
@@ -225,7 +249,7 @@ fn rounds<B: Backend>(
         }
         let cursors = b.upload("treelet cursors", &offsets)?;
         let roots = b.scratch("treelet roots", total as u64 * 4)?;
-        b.dispatch(Kernel::TreeletScatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
+        b.dispatch(k.scatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
         // ...then restructured height by height, bottom up: the treelets of
         // one height are disjoint, and each sees its subtrees finished.
         for (level, &count) in per_level.iter().enumerate().skip(1) {
@@ -249,11 +273,11 @@ fn rounds<B: Backend>(
             let restructure = |b: &mut B, p: &B::Buffer| {
                 if single {
                     let buffers = [p, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
-                    b.dispatch(Kernel::TreeletRestructureSingle, &buffers, groups_for(count, WORKGROUP_SIZE));
+                    b.dispatch(k.single, &buffers, groups_for(count, WORKGROUP_SIZE));
                 } else {
                     let buffers =
                         [p, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
-                    b.dispatch(Kernel::TreeletRestructure, &buffers, count.div_ceil(TEAMS));
+                    b.dispatch(k.team, &buffers, count.div_ceil(TEAMS));
                 }
             };
             restructure(b, &lp);
@@ -323,7 +347,7 @@ fn scratch<B: Backend>(b: &mut B, n: u32) -> Result<Scratch<B>> {
 /// Every node's count, cost, height and output leaf count, bottom up.
 fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &TreeletParams) -> Result<()> {
     let n = bvh.n;
-    let [init, climb] = init_kernels(b);
+    let CollapseKernels { init, climb, .. } = CollapseKernels::of(b);
     let flags = b.zeroed("treelet flags", (n as u64 - 1) * 4)?;
     let p = b.upload("treelet params", &[*base])?;
     // The lowest levels, then the climbs that go on, from queues.
@@ -335,12 +359,6 @@ fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &T
     b.dispatch(init, &all, groups_for(n, WORKGROUP_SIZE));
     b.dispatch(climb, &all, groups_for(queues * capacity, WORKGROUP_SIZE));
     Ok(())
-}
-
-/// The two kernels of [`init_pass`] on `b` (relaxed counters where the
-/// device needs them).
-fn init_kernels<B: Backend>(b: &B) -> [Kernel; 2] {
-    [Kernel::TreeletInit, Kernel::TreeletInitClimb].map(|k| b.atomics_for(k))
 }
 
 /// Checks the counts, costs and heights in `s` against a fresh climb.
@@ -379,7 +397,7 @@ fn collapse_pass<B: Backend>(
     let prims = b.scratch("collapsed primitive indices", n as u64 * 4)?;
     let p = b.upload("treelet params", &[*base])?;
     b.dispatch(
-        Kernel::Collapse,
+        CollapseKernels::of(b).collapse,
         &[&p, &bvh.nodes, &bvh.parents, &s.counts, &s.tree_leaves, &bvh.prim_indices, &nodes, &parents, &prims],
         groups_for(n, WORKGROUP_SIZE),
     );
@@ -398,24 +416,17 @@ fn collapse_pass<B: Backend>(
 /// The kernels [`restructure`] and [`collapse`] dispatch on `b` (the same
 /// question of `b` as they ask), for building their pipelines ahead.
 pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let mut k = collapse_kernels(b);
+    let mut k = [collapse_kernels(b), TreeletKernels::of(b).all()].concat();
     if TreeletConfig::default().with_default_reinsert(trbvh_reinsert(b.class())).reinsert_iterations() > 0 {
         k.extend(crate::bvh::reinsert::kernels(b));
     }
-    k.extend([
-        Kernel::TreeletHistogram,
-        Kernel::TreeletScatter,
-        Kernel::TreeletRestructure,
-        Kernel::TreeletRestructureSingle,
-    ]);
     k
 }
 
 /// The kernels [`collapse`] dispatches on `b` (its counts come from the
 /// treelet pass's init kernel).
 pub fn collapse_kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let [init, climb] = init_kernels(b);
-    vec![Kernel::Fill, init, climb, Kernel::Collapse]
+    CollapseKernels::of(b).all()
 }
 
 /// The root box of a device BVH (one node read back).

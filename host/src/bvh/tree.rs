@@ -180,7 +180,7 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
         Builder::Sweep | Builder::Reference => Vec::new(),
     };
     if split_budget(builder) > 0.0 {
-        k.extend(lbvh::SPLIT_KERNELS);
+        k.extend(lbvh::split_kernels(b));
     }
     k.extend(crate::bvh::layout::kernels(b, layout));
     k.sort();

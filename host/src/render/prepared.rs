@@ -76,7 +76,7 @@ pub struct Prepared<B: Backend> {
 /// ([`Backend::prepare_kernels`]).
 pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
     let mut k = crate::bvh::tree::kernels_of(b, plan.accel, plan.layout);
-    k.extend([Kernel::Fill, render_kernel(plan)]);
+    k.push(render_kernel(plan));
     k
 }
 

@@ -7,10 +7,21 @@ use std::collections::BTreeMap;
 use anyhow::Result;
 use bytemuck::Pod;
 
-use treelet_core::geometry::buffers::FillParams;
+use treelet_core::geometry::buffers::{CopyParams, FillParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels a backend dispatches of its own, for [`Backend::zeroed`],
+    /// [`Backend::zero_words`] and [`Backend::copy_words`]: built ahead with every list
+    /// ([`Backend::prepare_kernels`]).
+    pub struct BackendKernels for b {
+        fill: Kernel::Fill,
+        copy: Kernel::CopyWords,
+    }
+}
 
 /// Milliseconds per named stage, in the order the stages first ran.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -151,7 +162,7 @@ pub trait Backend: Send {
     /// current stage.
     fn zero_words(&mut self, buffer: &Self::Buffer, len: u32) -> Result<()> {
         let params = self.upload("fill params", &[FillParams { len, value: 0, _pad0: [0; 2] }])?;
-        self.dispatch(Kernel::Fill, &[&params, buffer], groups_for(len, WORKGROUP_SIZE));
+        self.dispatch(BackendKernels::of(self).fill, &[&params, buffer], groups_for(len, WORKGROUP_SIZE));
         Ok(())
     }
     /// Starts a new build: buffers handed out for the previous one may be
@@ -163,6 +174,14 @@ pub trait Backend: Send {
     /// them, so they are freed when the caller drops them.
     fn keep(&mut self, _buffers: &[&Self::Buffer]) {}
 
+    /// Copies `len` u32 words of `src`, from word `src_offset`, into `dst`
+    /// at word `dst_offset`, by a dispatch in the current stage.
+    fn copy_words(&mut self, (src, src_offset): (&Self::Buffer, u32), (dst, dst_offset): (&Self::Buffer, u32), len: u32) -> Result<()> {
+        let params = self.upload("copy params", &[CopyParams { len, src_offset, dst_offset, _pad0: 0 }])?;
+        self.dispatch(BackendKernels::of(self).copy, &[&params, src, dst], groups_for(len, WORKGROUP_SIZE));
+        Ok(())
+    }
+
     /// Hands `buffers` (taken since the last build, and no longer needed by
     /// any dispatch not yet waited for) back to the pool now, rather than at
     /// the next build: what a caller that traces batch after batch without
@@ -170,9 +189,9 @@ pub trait Backend: Send {
     /// grow with every batch.
     fn release(&mut self, _buffers: &[&Self::Buffer]) {}
     /// Builds the pipelines of `kernels` ahead of the work that uses them,
-    /// several at once where the device compiles them (a GPU's driver);
-    /// returns the wall seconds it took. Kernels left out are built when
-    /// first used, as always.
+    /// with the backend's own ([`BackendKernels`]), several at once where
+    /// the device compiles them (a GPU's driver); returns the wall seconds
+    /// it took. Kernels left out are built when first used, as always.
     fn prepare_kernels(&mut self, _kernels: &[Kernel]) -> f64 {
         0.0
     }

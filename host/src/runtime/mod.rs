@@ -9,5 +9,6 @@ pub mod cpu_runner;
 pub mod device;
 pub mod gpu;
 pub mod kernels;
+pub(crate) mod kernel_set;
 pub mod memory;
 pub mod timeline;

@@ -8,12 +8,20 @@
 //! past the vertices, coordinates that are not finite), the first bad
 //! triangle named.
 use anyhow::Result;
-use treelet_core::geometry::buffers::{CopyParams, GatherParams, Sphere};
+use treelet_core::geometry::buffers::{GatherParams, Sphere};
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
 use crate::bvh::layout::PrimBuffers;
 use crate::runtime::backend::Backend;
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernel gathering an engine's mesh into triangles.
+    pub struct GatherKernels for b {
+        gather: Kernel::GatherTriangles,
+    }
+}
 use crate::scene::primitives::MAX_PRIMITIVES;
 
 /// The integer type of an index buffer's entries.
@@ -137,16 +145,15 @@ pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>, into: Option<
         Some(i) if b.same_buffer(i.buffer, mesh.vertices) => {
             let first = i.offset / 4;
             let words = (i.offset + 3 * n as u64 * i.format.bytes()).div_ceil(4) - first;
-            let copy = b.upload("copy params", &[CopyParams { len: words as u32, src_offset: first as u32, dst_offset: 0, _pad0: 0 }])?;
             let own = b.scratch("engine indices", words * 4)?;
-            b.dispatch(Kernel::CopyWords, &[&copy, i.buffer, &own], groups_for(words as u32, WORKGROUP_SIZE));
+            b.copy_words((i.buffer, first as u32), (&own, 0), words as u32)?;
             (own, first * 4)
         }
         Some(i) => (i.buffer.clone(), 0),
     };
     let p = b.upload("gather params", &[mesh.params(b, index_base)?])?;
     let flags = b.upload("gather flags", &[u32::MAX; 2])?;
-    b.dispatch(Kernel::GatherTriangles, &[&p, mesh.vertices, &indices, &triangles, &flags], groups_for(n, WORKGROUP_SIZE));
+    b.dispatch(GatherKernels::of(b).gather, &[&p, mesh.vertices, &indices, &triangles, &flags], groups_for(n, WORKGROUP_SIZE));
     let flags = b.read::<u32>(&flags, 2)?;
     if flags[0] != u32::MAX {
         return Err(crate::error::input(format!("engine mesh: triangle {} names a vertex past the {} vertices", flags[0], mesh.vertex_count)));

@@ -21,7 +21,7 @@
 //! # anyhow::Ok(())
 //! ```
 use anyhow::{Context, Result};
-use treelet_core::geometry::buffers::{CopyParams, LayoutParams, MeshRecord, PlacedMesh, RenderParams};
+use treelet_core::geometry::buffers::{LayoutParams, MeshRecord, PlacedMesh, RenderParams};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
@@ -34,7 +34,20 @@ use super::queries::{collect_hits, collect_occluded, ray_queries};
 use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::lbvh;
 use crate::runtime::backend::{Backend, StageTimes};
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::Kernel;
+
+kernel_set! {
+    /// The kernels of an instanced world's top level and walk (the meshes'
+    /// trees are built as any tree).
+    pub struct InstanceKernels for b {
+        /// The instances' records and world boxes: the top level's first pass.
+        bounds: Kernel::InstanceBounds,
+        /// The top level's nodes, with its depth.
+        top_nodes: Kernel::TopLevelNodes,
+        cast: Kernel::CastInstances,
+    }
+}
 
 /// A placed copy of mesh `mesh` (its index in the list given to
 /// [`InstancedTracer::build`]): `transform` takes the mesh's points into
@@ -375,10 +388,11 @@ impl<B: Backend> InstancedTracer<B> {
         // With no instances, the instances' binding is never read.
         let records = top.map_or(&self.no_instances, |t| &t.records);
         b.stage("trace");
+        let cast = InstanceKernels::of(b).cast;
         b.dispatch(
-            Kernel::CastInstances,
+            cast,
             &[&params, records, &g.nodes, &g.leaves, &self.no_spheres, &g.triangles, rays],
-            groups_for(tiled_invocations(p.width, p.height), Kernel::CastInstances.workgroup_size()),
+            groups_for(tiled_invocations(p.width, p.height), cast.workgroup_size()),
         );
         Ok(())
     }
@@ -429,7 +443,7 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>
     let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, bounds, groups| {
         let input = b.upload("placed meshes", placed)?;
         let out = b.scratch("instance records", n as u64 * 64)?;
-        b.dispatch(Kernel::InstanceBounds, &[p, &input, &g.meshes, &out, boxes, bounds], groups);
+        b.dispatch(InstanceKernels::of(b).bounds, &[p, &input, &g.meshes, &out, boxes, bounds], groups);
         records = Some(out);
         Ok(())
     })?;
@@ -442,7 +456,7 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>
     let p = b.upload("layout params", &[LayoutParams { n, nodes: bvh.node_count, ..Default::default() }])?;
     let deepest = b.zeroed("tree depth", 4)?;
     let bindings = [&p, &bvh.nodes, &bvh.prim_indices, &g.nodes, &bvh.parents, &deepest];
-    b.dispatch(Kernel::TopLevelNodes, &bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
+    b.dispatch(InstanceKernels::of(b).top_nodes, &bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
     let deepest = b.read::<u32>(&deepest, 1)?[0];
     if deepest as usize + 1 > STACK_DEPTH {
         return Err(crate::error::too_large(format!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1)));
@@ -554,10 +568,7 @@ fn copy_mesh<B: Backend>(b: &mut B, t: &Tracer<B>, g: &Gathered<B>, m: usize) ->
         (&tree.prims, &g.leaves, leaf_base, 12, triangles),
         (&t.prims.triangles, &g.triangles, triangle_base, 12, triangles),
     ] {
-        let len = count * words_each;
-        let p =
-            b.upload("copy params", &[CopyParams { len, src_offset: 0, dst_offset: base * words_each, _pad0: 0 }])?;
-        b.dispatch(Kernel::CopyWords, &[&p, src, dst], groups_for(len, WORKGROUP_SIZE));
+        b.copy_words((src, 0), (dst, base * words_each), count * words_each)?;
     }
     Ok(())
 }

@@ -15,11 +15,8 @@ use treelet_core::render::variants::VARIANTS;
 use treelet_core::Sphere;
 use std::time::Instant;
 use treelet::runtime::backend::DeviceClass;
-use treelet::runtime::kernels::Kernel;
 use treelet::tracer::{batch_slots, device_rays};
 use treelet::Ray;
-use treelet_core::geometry::buffers::CopyParams;
-use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 
 /// One device build of `builder` (`config`: the treelet rounds of trbvh,
 /// and of hploc where it has any; the leaf collapse of both), the tree left
@@ -478,12 +475,11 @@ pub(crate) fn traced_in_place_ms<B: Backend>(
     let pristine = b.upload("bench rays", &device_rays(rays)?)?;
     let work = b.scratch("bench rays in place", 2 * batch_slots(rays.len())? as u64 * 16)?;
     let words = 2 * batch_slots(rays.len())? as u32 * 4;
-    let copy = b.upload("bench copy", &[CopyParams { len: words, ..Default::default() }])?;
     let cpu = b.class() == DeviceClass::CpuRunner;
     let once = |b: &mut B| -> Result<f64> {
         b.take_times()?;
         b.stage("copy");
-        b.dispatch(Kernel::CopyWords, &[&copy, &pristine, &work], groups_for(words, WORKGROUP_SIZE));
+        b.copy_words((&pristine, 0), (&work, 0), words)?;
         let start = Instant::now();
         on_device(b, &work, rays.len())?;
         let stages = b.take_times()?;

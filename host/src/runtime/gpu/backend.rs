@@ -369,7 +369,8 @@ impl Backend for GpuBackend {
         }
     }
     fn prepare_kernels(&mut self, kernels: &[Kernel]) -> f64 {
-        self.ctx.prepare(kernels)
+        let own = crate::runtime::backend::BackendKernels::of(self).all();
+        self.ctx.prepare(&[kernels, &own].concat())
     }
 
     fn upload<T: Pod>(&mut self, label: &'static str, data: &[T]) -> Result<wgpu::Buffer> {
