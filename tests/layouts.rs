@@ -683,15 +683,16 @@ fn tight_boxes(nodes: &[Bvh2Node], leaf: &[LeafPrim], boxes: &[treelet_core::Aab
 }
 
 /// The kernels a render's pipelines are built ahead for
-/// (`treelet::render::prepared::kernels`) are every kernel the render
-/// dispatches, for each tree and layout: on the CPU runner, which asks the
-/// same questions of the device as a GPU (ordered atomics, look-back) and
-/// records what it ran. A kernel left out would be compiled in the middle
-/// of the timed render on a fresh machine.
+/// (`treelet::render::prepared::prepare_pipelines`) are every kernel the
+/// render dispatches, for each tree and layout: on the CPU runner, which
+/// asks the same questions of the device as a GPU (ordered atomics,
+/// look-back) and records what it ran and what it was asked to prepare. A
+/// kernel left out would be compiled in the middle of the timed render on
+/// a fresh machine.
 #[test]
 fn pipelines_built_ahead_cover_what_a_render_dispatches() {
     use treelet::render::{render, Integrator, RenderSettings};
-    use treelet::render::variant::{plan, KernelChoice};
+    use treelet::render::variant::KernelChoice;
     use treelet::runtime::cpu_runner::CpuBackend;
     use treelet::bvh::tree::Accel;
     use treelet::bvh::layout::Layout;
@@ -712,12 +713,34 @@ fn pipelines_built_ahead_cover_what_a_render_dispatches() {
                     first_sample: 0,
                 };
                 let mut b = CpuBackend::new();
-                let p = plan(&scene, settings.paths(), accel, layout, KernelChoice::Auto, treelet::runtime::backend::Backend::class(&b), settings.integrator == treelet::render::Integrator::Caustics, settings.sampler == treelet::render::Sampler::Independent);
-                let own = treelet::runtime::backend::BackendKernels::of(&b).all();
-                let ahead: std::collections::BTreeSet<_> = treelet::render::prepared::kernels(&b, &p).into_iter().chain(own).collect();
                 render(&mut b, &scene, &settings, None, |_| {}).unwrap();
-                let missing: Vec<_> = b.kernels_dispatched().difference(&ahead).collect();
+                assert!(!b.kernels_dispatched().is_empty());
+                let missing = b.kernels_not_prepared();
                 assert!(missing.is_empty(), "{} with {accel:?} in {layout:?}: not built ahead: {missing:?}", scene.name);
+            }
+        }
+    }
+}
+
+/// The same for `treelet build` (`treelet::bvh::report::run_build_with`):
+/// each device builder, as configured by default and with reinsertion
+/// (what GPUs run by default, the CPU runner only when asked), over
+/// spheres and over triangles (which are split).
+#[test]
+fn pipelines_built_ahead_cover_what_a_build_dispatches() {
+    use treelet::bvh::report::run_build_with;
+    use treelet::bvh::trbvh::TreeletConfig;
+    use treelet::bvh::tree::Builder;
+    use treelet::runtime::cpu_runner::CpuBackend;
+    for scene in [treelet::scene::random_scene("random:3000", 3000, 7), treelet::scene::mesh_scene("terrain", &treelet::scene::terrain(5000))] {
+        for builder in [Builder::Lbvh, Builder::Trbvh, Builder::Hploc] {
+            for reinsert in [None, Some(2)] {
+                let config = TreeletConfig { reinsert, ..TreeletConfig::default() };
+                let mut b = CpuBackend::new();
+                run_build_with(&mut b, &scene, builder, config).unwrap();
+                assert!(!b.kernels_dispatched().is_empty());
+                let missing = b.kernels_not_prepared();
+                assert!(missing.is_empty(), "{} by {builder:?}, reinsertion {reinsert:?}: not built ahead: {missing:?}", scene.name);
             }
         }
     }

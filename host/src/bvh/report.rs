@@ -148,17 +148,12 @@ pub fn run_build_with<B: Backend>(
     crate::bvh::tree::check_build_memory(prims.len() as u64, backend.class())?;
     // Pipelines first, all at once: a fresh machine's driver compiles each for
     // long, and a build timed around that compile runs on a cooled-down GPU.
-    let mut kernels = match hierarchy {
-        Some(h) => [lbvh::kernels_with(backend, h), trbvh::collapse_kernels(backend)].concat(),
-        None => lbvh::kernels(backend),
-    };
-    if treelets.is_some() {
-        kernels.extend(crate::bvh::trbvh::kernels(backend));
-    }
     let budget = crate::bvh::tree::split_budget(builder);
-    if budget > 0.0 {
-        kernels.extend(lbvh::split_kernels(backend));
-    }
+    let mut kernels = crate::bvh::tree::build_kernels(backend, builder, budget, &config);
+    kernels.extend(match treelets {
+        Some(config) => trbvh::kernels(backend, config),
+        None => trbvh::collapse_kernels(backend),
+    });
     backend.prepare_kernels(&kernels);
     let start = Instant::now();
     let hierarchy = hierarchy.unwrap_or_else(|| lbvh::Hierarchy::for_device(backend, prims.len()));

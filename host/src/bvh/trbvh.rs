@@ -413,11 +413,14 @@ fn collapse_pass<B: Backend>(
     })
 }
 
-/// The kernels [`restructure`] and [`collapse`] dispatch on `b` (the same
-/// question of `b` as they ask), for building their pipelines ahead.
-pub fn kernels<B: Backend>(b: &B) -> Vec<Kernel> {
-    let mut k = [collapse_kernels(b), TreeletKernels::of(b).all()].concat();
-    if TreeletConfig::default().with_default_reinsert(trbvh_reinsert(b.class())).reinsert_iterations() > 0 {
+/// The kernels [`restructure`] with `config` (reinsertion settled) and
+/// [`collapse`] dispatch on `b`, for building their pipelines ahead.
+pub fn kernels<B: Backend>(b: &B, config: &TreeletConfig) -> Vec<Kernel> {
+    let mut k = collapse_kernels(b);
+    if config.rounds > 0 {
+        k.extend(TreeletKernels::of(b).all());
+    }
+    if config.reinsert_iterations() > 0 {
         k.extend(crate::bvh::reinsert::kernels(b));
     }
     k

@@ -173,18 +173,34 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
         Ok(Some(builder)) => builder,
         _ => return Vec::new(),
     };
-    let mut k = match builder {
-        Builder::Lbvh => lbvh::kernels(b),
-        Builder::Trbvh => [lbvh::kernels(b), trbvh::kernels(b)].concat(),
-        Builder::Hploc => lbvh::kernels_with(b, lbvh::Hierarchy::Hploc),
-        Builder::Sweep | Builder::Reference => Vec::new(),
-    };
-    if split_budget(builder) > 0.0 {
-        k.extend(lbvh::split_kernels(b));
-    }
+    let mut k = build_kernels(b, builder, split_budget(builder), &TreeletConfig::default());
     k.extend(crate::bvh::layout::kernels(b, layout));
     k.sort();
     k.dedup();
+    k
+}
+
+/// The kernels a device build of `builder` over pieces within `budget`,
+/// optimized as `config` says, dispatches on `b` (as [`optimize_built`]
+/// and [`built_within_stack`] choose them), before any layout.
+pub fn build_kernels<B: Backend>(b: &B, builder: Builder, budget: f32, config: &TreeletConfig) -> Vec<crate::runtime::kernels::Kernel> {
+    let config = settled(config, builder, b.class());
+    let mut k = match builder {
+        Builder::Lbvh => lbvh::kernels(b),
+        Builder::Trbvh => [lbvh::kernels(b), trbvh::kernels(b, &config)].concat(),
+        Builder::Hploc if config.reinsert_iterations() > 0 => {
+            [lbvh::kernels_with(b, lbvh::Hierarchy::Hploc), trbvh::kernels(b, &TreeletConfig { rounds: 0, ..config })].concat()
+        }
+        Builder::Hploc => lbvh::kernels_with(b, lbvh::Hierarchy::Hploc),
+        Builder::Sweep | Builder::Reference => return Vec::new(),
+    };
+    if budget > 0.0 {
+        k.extend(lbvh::split_kernels(b));
+    }
+    if config.reinsert_iterations() > 0 {
+        // The depth check after reinsertion.
+        k.extend(crate::bvh::layout::DepthKernels::of(b).all());
+    }
     k
 }
 

@@ -41,11 +41,20 @@ pub struct CpuBackend {
     subgroup_size: u32,
     /// Every kernel dispatched so far (what a GPU would need pipelines for).
     dispatched: std::collections::BTreeSet<Kernel>,
+    /// Every kernel listed to [`Backend::prepare_kernels`] so far, with the
+    /// backend's own (what a GPU would have built ahead).
+    prepared: std::collections::BTreeSet<Kernel>,
 }
 
 impl Default for CpuBackend {
     fn default() -> Self {
-        CpuBackend { times: StageTimes::default(), current: None, subgroup_size: DEFAULT_SUBGROUP_SIZE, dispatched: Default::default() }
+        CpuBackend {
+            times: StageTimes::default(),
+            current: None,
+            subgroup_size: DEFAULT_SUBGROUP_SIZE,
+            dispatched: Default::default(),
+            prepared: Default::default(),
+        }
     }
 }
 
@@ -71,6 +80,13 @@ impl CpuBackend {
     /// Every kernel dispatched on this backend so far.
     pub fn kernels_dispatched(&self) -> &std::collections::BTreeSet<Kernel> {
         &self.dispatched
+    }
+
+    /// The kernels dispatched so far that no call of
+    /// [`Backend::prepare_kernels`] listed: on a GPU, pipelines built in the
+    /// middle of timed work.
+    pub fn kernels_not_prepared(&self) -> Vec<Kernel> {
+        self.dispatched.difference(&self.prepared).copied().collect()
     }
 
     fn close_stage(&mut self) {
@@ -340,6 +356,14 @@ fn ids(groups: u32) -> std::ops::Range<u32> {
 
 impl Backend for CpuBackend {
     type Buffer = CpuBuffer;
+
+    /// Builds nothing (the runner calls functions); notes the kernels, as
+    /// a GPU's list, for [`CpuBackend::kernels_not_prepared`].
+    fn prepare_kernels(&mut self, kernels: &[Kernel]) -> f64 {
+        let own = crate::runtime::backend::BackendKernels::of(self).all();
+        self.prepared.extend(kernels.iter().chain(&own));
+        0.0
+    }
 
     fn adapter(&self) -> String {
         "cpu".into()
