@@ -524,13 +524,13 @@ fn image_difference(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) -> (f64, f64) {
 /// runner does, within the rounding that sends a few paths elsewhere. A
 /// scene of copies alone (no primitives of its own) renders too.
 #[test]
-fn placed_copies_render_what_the_flattened_scene_renders() {
+fn instances_render_what_the_flattened_scene_renders() {
     use treelet::render::{render, Integrator, RenderSettings};
     let seed = fresh_seed() as u32;
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/pyramids.json");
     let placed = treelet::scene::Scene::for_render(path).unwrap();
     let flat = treelet::scene::Scene::from_spec(path).unwrap();
-    let copies = placed.placed.as_ref().expect("the repeated pyramid is kept placed");
+    let copies = placed.instances.as_ref().expect("the repeated pyramid is kept as instances");
     assert_eq!((copies.meshes.len(), copies.instances.len()), (1, 5));
     assert_eq!(placed.triangles.len() as u64 + copies.triangles(), flat.triangles.len() as u64, "the flattened file has every copy's triangles");
     let settings = RenderSettings {
@@ -552,7 +552,7 @@ fn placed_copies_render_what_the_flattened_scene_renders() {
     for integrator in [Integrator::Nee, Integrator::Caustics] {
         let settings = RenderSettings { integrator, ..settings };
         let placed_cpu = render(&mut cpu, &placed, &settings, None, |_| {}).unwrap();
-        assert!(placed_cpu.plan.placed && placed_cpu.plan.kernel == "placed", "{:?}", placed_cpu.plan.kernel);
+        assert!(placed_cpu.plan.instanced && placed_cpu.plan.kernel == "instanced", "{:?}", placed_cpu.plan.kernel);
         let flat_cpu = render(&mut cpu, &flat, &settings, None, |_| {}).unwrap();
         let brightness = flat_cpu.image.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / (3 * flat_cpu.image.pixels.len()) as f64;
         assert!(brightness > 0.05, "the room is lit: mean {brightness}");
@@ -578,7 +578,7 @@ fn placed_copies_render_what_the_flattened_scene_renders() {
     std::fs::create_dir_all(&dir).unwrap();
     let gltf = write_gltf(&dir, &m, &nodes);
     let mut alone = treelet::scene::Scene::for_render(gltf.to_str().unwrap()).unwrap();
-    assert!(alone.placed.is_some() && alone.spheres.is_empty() && alone.triangles.is_empty());
+    assert!(alone.instances.is_some() && alone.spheres.is_empty() && alone.triangles.is_empty());
     // Nothing in the file emits: it comes with the default sky, taken away here.
     assert_eq!(alone.environment, treelet::scene::gltf::DEFAULT_SKY);
     alone.environment = [0.0; 3];

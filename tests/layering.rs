@@ -24,7 +24,7 @@ const CORE_FLOORS: &[(&str, u32)] =
 
 /// Floors of the host library's top-level folders; a top-level file (`tracer.rs`) is a folder named by its stem.
 /// The engine API (`tracer`) sits below the renderer, which traces a scene's
-/// placed copies of meshes through its `InstancedTracer`.
+/// instances of meshes through its `InstancedTracer`.
 const HOST_LIB_FLOORS: &[(&str, u32)] =
     &[("error", 0), ("internals", 0), ("tuning", 0), ("runtime", 0), ("scene", 1), ("bvh", 2), ("tracer", 3), ("render", 4)];
 

@@ -112,7 +112,7 @@ fn edge_scene(camera: CameraSpec, depth: f32) -> Scene {
         camera,
         environment: [0.0; 3],
         triangles: vec![square],
-        placed: None,
+        instances: None,
     }
 }
 

@@ -305,7 +305,7 @@ fn room_with(name: &str, extra: Vec<(Sphere, Material)>, triangles: Vec<(Triangl
     let (spheres, mut materials): (Vec<_>, Vec<_>) = room.into_iter().chain(extra).unzip();
     let (triangles, tri_materials): (Vec<_>, Vec<_>) = triangles.into_iter().unzip();
     materials.extend(tri_materials);
-    Scene { name: name.into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles, placed: None }
+    Scene { name: name.into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles, instances: None }
 }
 
 fn emitter(e: f32) -> Material {

@@ -13,7 +13,8 @@
 //! - the shader crate makes each kernel's entry point (`treelet-shader`'s
 //!   `per_invocation` and `per_workgroup` modules),
 //! - the host makes its `Kernel` variant, entry-point name, binding
-//!   accesses and split bindings (`treelet::runtime::kernels`),
+//!   accesses and split bindings, and a struct of its bindings by name
+//!   that a dispatch fills (`treelet::runtime::kernels::bind`),
 //! - the CPU runner makes its dispatch (`treelet::runtime::cpu_runner`).
 //!
 //! So the GPU and the CPU run the same call on the same bindings, and
@@ -485,13 +486,13 @@ macro_rules! per_workgroup_kernels {
             InstanceBounds = instance_bounds_cs($crate::geometry::buffers::BuildParams)
                 phases($crate::construct::bounds::REDUCE_PHASES, [0 1 2 3 4 5 6 7 8 9])
                 shared { shared: [$crate::geometry::aabb::Aabb; $crate::gpu::workgroup::WG] } {
-                1 placed: read [$crate::geometry::records::Vec4 as $crate::geometry::buffers::PlacedMesh],
+                1 descs: read [$crate::geometry::records::Vec4 as $crate::geometry::buffers::InstanceDesc],
                 2 meshes: read [$crate::geometry::records::Vec4 as $crate::geometry::buffers::MeshRecord],
                 3 records: write [$crate::geometry::records::Vec4 as $crate::geometry::buffers::InstanceRecord],
                 4 boxes: write [$crate::geometry::records::Vec4 as $crate::geometry::aabb::Aabb],
                 5 bounds: write [u32],
             } |phase, lid, group, params| {
-                let mut source = $crate::construct::instances::InstanceBoxes { placed, meshes, records: &mut *records };
+                let mut source = $crate::construct::instances::InstanceBoxes { descs, meshes, records: &mut *records };
                 $crate::construct::bounds::primitive_bounds_phase(phase, lid, group, params.n, &mut source, boxes, bounds, shared)
             };
 

@@ -1072,11 +1072,11 @@ fn scene_file_instances_are_flattened_with_a_note() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `render` keeps a file's copies placed (`--explain` says so, with the
+/// `render` keeps a file's copies as instances (`--explain` says so, with the
 /// counts), so that copies whose flattening `build` refuses for memory
 /// render; `--integrator caustics` traces its light paths through them.
 #[test]
-fn render_keeps_copies_placed() {
+fn render_keeps_copies_as_instances() {
     let dir = std::env::temp_dir().join(format!("treelet-cli-render-placed-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("pyramids.png");
@@ -1084,15 +1084,15 @@ fn render_keeps_copies_placed() {
     let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", "16", "--height", "12", "--spp", "2", "--explain", "--out", out.to_str().unwrap()]);
     let (stdout, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("5 copies of 1 mesh kept placed (30 triangles"), "{err}");
+    assert!(err.contains("5 instances of 1 mesh (30 triangles"), "{err}");
     let text = format!("{stdout}{err}");
-    assert!(text.contains("kernel     placed") && text.contains("5 placed copies of meshes (30 triangles)"), "{text}");
+    assert!(text.contains("kernel     instanced") && text.contains("5 instances of meshes (30 triangles)"), "{text}");
     assert!(out.exists());
     let o = treelet(&["render", "--device", "cpu", "--scene", scene, "--width", "8", "--height", "8", "--spp", "1", "--integrator", "caustics", "--explain", "--out", out.to_str().unwrap()]);
     let (stdout, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(o.status.success(), "{err}");
     let text = format!("{stdout}{err}");
-    assert!(text.contains("kernel     placed") && text.contains("light paths for caustics, placed copies of meshes"), "{text}");
+    assert!(text.contains("kernel     instanced") && text.contains("light paths for caustics, instances of meshes"), "{text}");
     std::fs::remove_dir_all(&dir).ok();
 
     let copies: Vec<String> = (0..2000).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}]}}"#, (k % 50) * 2, (k / 50) * 2)).collect();
@@ -1107,20 +1107,20 @@ fn render_keeps_copies_placed() {
     let o = with_cap(&["render", "--device", "cpu", "--scene", scene, "--width", "16", "--height", "12", "--spp", "1", "--out", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("2001 copies of 1 mesh kept placed (12006 triangles"), "{err}");
+    assert!(err.contains("2001 instances of 1 mesh (12006 triangles"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `bench placed` traces a file's own instances against the same scene
+/// `bench file-instances` traces a file's own instances against the same scene
 /// flattened, with the same hits; a file whose own shapes are not
 /// triangles is refused by name.
 #[test]
-fn bench_placed_traces_a_files_instances() {
+fn bench_file_instances_traces_a_files_instances() {
     let copies: Vec<String> =
         (0..24).map(|k| format!(r#"{{"mesh": "p", "translate": [{}, 0, {}], "rotate": [0, {}, 0]}}"#, (k % 6) * 3, (k / 6) * 3, k * 7)).collect();
     let (dir, file) = pyramid_copies("placed", "grid.json", &copies);
     let json = dir.join("out.json");
-    let args = ["bench", "placed", "--device", "cpu", "--repeats", "1", "--width", "32", "--height", "24"];
+    let args = ["bench", "file-instances", "--device", "cpu", "--repeats", "1", "--width", "32", "--height", "24"];
     let out = treelet(&[&args[..], &["--scene", file.to_str().unwrap(), "--json", json.to_str().unwrap()]].concat());
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();

@@ -6,7 +6,7 @@
 )]
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-use treelet_core::geometry::buffers::{Material, Node, PlacedInfo, RenderParams, Sphere};
+use treelet_core::geometry::buffers::{Material, Node, InstanceInfo, RenderParams, Sphere};
 use treelet_core::geometry::prims::Prims;
 use treelet_core::geometry::features::{ALL, CAUSTICS, INDEPENDENT_NUMBERS, INSTANCES, TRIANGLES};
 use treelet_core::geometry::split::Split;
@@ -19,7 +19,7 @@ use treelet_core::trace::bvh2::{Bvh2Tree, Level};
 use treelet_core::trace::bvh4::Bvh4Tree;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
-use treelet_core::trace::placed::PlacedScene;
+use treelet_core::trace::with_instances::SceneWithInstances;
 
 /// What a pass of the render kernels adds to: the pixel sums (camera
 /// paths), or the light paths' landings (f32 bits, added with atomics).
@@ -249,16 +249,16 @@ pub fn cast_instances_cs(
     );
 }
 
-/// The render of a scene with placed copies of meshes: its own primitives
+/// The render of a scene with instances of meshes: its own primitives
 /// through their `bvh2` tree, the copies through the instanced walk
-/// (`treelet_core::trace::placed`); every feature, camera paths
-/// (`render_placed_cs`, and `render_placed_caustics_cs` beside light paths)
-/// and light paths for caustics (`light_placed_cs`).
+/// (`treelet_core::trace::with_instances`); every feature, camera paths
+/// (`render_instanced_cs`, and `render_instanced_caustics_cs` beside light paths)
+/// and light paths for caustics (`light_instanced_cs`).
 /// The own tree's bindings as `render::<variant>::bvh2_cs`'s, then the
-/// copies': instance records, their `PlacedInfo`s, the top level and mesh
+/// copies': instance records, their `InstanceInfo`s, the top level and mesh
 /// trees, their leaf primitives, every mesh's triangles, and the materials
 /// of mesh triangles and copies.
-macro_rules! placed_kernel {
+macro_rules! instanced_kernel {
     ($pass:ident $name:ident, $features:expr) => {
         #[spirv(compute(threads(64)))]
         pub fn $name(
@@ -273,11 +273,11 @@ macro_rules! placed_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] lights: &[Light],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] instances: &[Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] info: &[PlacedInfo],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] placed_nodes: &[Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] placed_leaves: &[Vec4],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] placed_triangles: &[Triangle],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] placed_materials: &[Material],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] info: &[InstanceInfo],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 10)] instance_nodes: &[Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 11)] instance_leaves: &[Vec4],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 12)] instance_triangles: &[Triangle],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 13)] instance_materials: &[Material],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 14)] triangles_hi: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 15)] nodes_hi: &[Vec4],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 16)] prims_hi: &[Vec4],
@@ -289,17 +289,17 @@ macro_rules! placed_kernel {
                 let meshes = Prims {
                     spheres,
                     sphere_count: 0,
-                    triangles: Split::new(placed_triangles, placed_triangles),
-                    triangle_count: params.placed_triangles,
+                    triangles: Split::new(instance_triangles, instance_triangles),
+                    triangle_count: params.instance_triangles,
                 };
-                let tree = PlacedScene {
+                let tree = SceneWithInstances {
                     own,
                     instances,
                     info,
                     count: params.instances,
-                    trees: Level { nodes: placed_nodes, leaves: placed_leaves },
+                    trees: Level { nodes: instance_nodes, leaves: instance_leaves },
                     meshes,
-                    materials: placed_materials,
+                    materials: instance_materials,
                 };
                 let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
                 pass_body!($pass, pixel, params, scene, lights, accum, $features);
@@ -312,8 +312,8 @@ macro_rules! placed_kernel {
 // it made the placed render 1.7% slower with NEE (H100).
 // Placed copies' kernels draw either sampler's numbers, as the render asks.
 #[cfg(feature = "render-bvh2-light")]
-placed_kernel!(camera render_placed_cs, ALL | INSTANCES | INDEPENDENT_NUMBERS);
+instanced_kernel!(camera render_instanced_cs, ALL | INSTANCES | INDEPENDENT_NUMBERS);
 #[cfg(feature = "render-bvh2-light")]
-placed_kernel!(camera render_placed_caustics_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);
+instanced_kernel!(camera render_instanced_caustics_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);
 #[cfg(feature = "render-bvh2-light")]
-placed_kernel!(light light_placed_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);
+instanced_kernel!(light light_instanced_cs, ALL | INSTANCES | CAUSTICS | INDEPENDENT_NUMBERS);

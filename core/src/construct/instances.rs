@@ -1,6 +1,6 @@
 //! The top level of an instanced scene, made on the device from what an
 //! engine gives each frame (a transform and a mesh per copy, as
-//! [`PlacedMesh`]) and what the scene keeps per mesh ([`MeshRecord`]: its
+//! [`InstanceDesc`]) and what the scene keeps per mesh ([`MeshRecord`]: its
 //! box, where its tree starts): each copy's [`InstanceRecord`] (the map
 //! that takes rays into the mesh's space) and its box in the world. The
 //! boxes feed the LBVH's first pass like primitive boxes
@@ -10,44 +10,44 @@ use glam::{BVec3, Vec3};
 
 use crate::construct::bounds::BoxSource;
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{InstanceRecord, MeshRecord, PlacedMesh};
+use crate::geometry::buffers::{InstanceRecord, MeshRecord, InstanceDesc};
 use crate::geometry::records::{RecordLoad, RecordStore};
 
 /// World boxes are widened by this much of their largest coordinate: the
 /// ray is taken into the mesh's space in f32, so a box only just touching
-/// the placed mesh in exact arithmetic could cull a hit the mesh's own
+/// the instanced mesh in exact arithmetic could cull a hit the mesh's own
 /// tree would find.
 pub const BOX_PAD: f32 = 1e-5;
 
 /// The instances' boxes, each computed with its record, which is written
 /// to `records` on the way.
 pub struct InstanceBoxes<'a, P: ?Sized, M: ?Sized, R: ?Sized> {
-    pub placed: &'a P,
+    pub descs: &'a P,
     pub meshes: &'a M,
     pub records: &'a mut R,
 }
 
 impl<P, M, R> BoxSource for InstanceBoxes<'_, P, M, R>
 where
-    P: RecordLoad<PlacedMesh> + ?Sized,
+    P: RecordLoad<InstanceDesc> + ?Sized,
     M: RecordLoad<MeshRecord> + ?Sized,
     R: RecordStore<InstanceRecord> + ?Sized,
 {
     #[inline]
     fn box_of(&mut self, i: u32) -> Aabb {
-        let placed = self.placed.load(i as usize);
-        let mesh = self.meshes.load(placed.mesh as usize);
-        self.records.store(i as usize, &instance_record(&placed, &mesh));
-        world_box(&placed, &mesh)
+        let desc = self.descs.load(i as usize);
+        let mesh = self.meshes.load(desc.mesh as usize);
+        self.records.store(i as usize, &instance_record(&desc, &mesh));
+        world_box(&desc, &mesh)
     }
 }
 
-/// The record of `placed`, a copy of `mesh`: the inverse of its transform
+/// The record of `desc`, an instance of `mesh`: the inverse of its transform
 /// (by the adjugate, in f32; the host has refused singular ones), and the
 /// mesh's bases.
 #[inline]
-pub fn instance_record(placed: &PlacedMesh, mesh: &MeshRecord) -> InstanceRecord {
-    let m = &placed.world_from_object;
+pub fn instance_record(desc: &InstanceDesc, mesh: &MeshRecord) -> InstanceRecord {
+    let m = &desc.world_from_object;
     let row = |r: usize| Vec3::new(m[r][0], m[r][1], m[r][2]);
     let (a, b, c) = (row(0), row(1), row(2));
     // The inverse of the linear part has rows (b x c, c x a, a x b)
@@ -67,15 +67,15 @@ pub fn instance_record(placed: &PlacedMesh, mesh: &MeshRecord) -> InstanceRecord
         node_base: mesh.node_base,
         leaf_base: mesh.leaf_base,
         triangle_base: mesh.triangle_base,
-        mesh: placed.mesh,
+        mesh: desc.mesh,
     }
 }
 
-/// The world box of `mesh`'s box under `placed`'s transform (its eight
+/// The world box of `mesh`'s box under `desc`'s transform (its eight
 /// corners'), widened by [`BOX_PAD`].
 #[inline]
-pub fn world_box(placed: &PlacedMesh, mesh: &MeshRecord) -> Aabb {
-    let m = &placed.world_from_object;
+pub fn world_box(desc: &InstanceDesc, mesh: &MeshRecord) -> Aabb {
+    let m = &desc.world_from_object;
     let (x, y, z) = (
         Vec3::new(m[0][0], m[0][1], m[0][2]),
         Vec3::new(m[1][0], m[1][1], m[1][2]),
@@ -98,8 +98,8 @@ pub fn world_box(placed: &PlacedMesh, mesh: &MeshRecord) -> Aabb {
 mod tests {
     use super::*;
 
-    fn placed(rows: [[f32; 4]; 3]) -> PlacedMesh {
-        PlacedMesh { world_from_object: rows, mesh: 3, _pad: [0; 3] }
+    fn desc(rows: [[f32; 4]; 3]) -> InstanceDesc {
+        InstanceDesc { world_from_object: rows, mesh: 3, _pad: [0; 3] }
     }
 
     const MESH: MeshRecord = MeshRecord {
@@ -114,7 +114,7 @@ mod tests {
     #[test]
     fn the_record_takes_world_points_back_into_the_mesh() {
         // A shear, unequal and mirroring scales, a translation.
-        let p = placed([[2.0, 0.5, 0.0, 10.0], [0.0, -3.0, 0.25, -4.0], [0.1, 0.0, 0.5, 1.5]]);
+        let p = desc([[2.0, 0.5, 0.0, 10.0], [0.0, -3.0, 0.25, -4.0], [0.1, 0.0, 0.5, 1.5]]);
         let r = instance_record(&p, &MESH);
         assert_eq!((r.node_base, r.leaf_base, r.triangle_base, r.mesh), (7, 11, 13, 3));
         for x in [Vec3::new(0.3, -2.0, 5.0), Vec3::new(-7.0, 1.0, 0.0)] {
@@ -127,7 +127,7 @@ mod tests {
 
     #[test]
     fn the_world_box_holds_every_placed_corner_and_little_more() {
-        let p = placed([[0.0, -1.0, 0.0, 5.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 2.0, -1.0]]);
+        let p = desc([[0.0, -1.0, 0.0, 5.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 2.0, -1.0]]);
         let b = world_box(&p, &MESH);
         // x' = 5 - y, y' = x, z' = 2 z - 1.
         let exact = Aabb::new(Vec3::new(2.0, -1.0, 3.0), Vec3::new(5.0, 1.0, 4.0));

@@ -266,11 +266,11 @@ pub struct RenderParams {
     /// Instances of an instanced scene's cast
     /// ([`crate::render::rays::cast_instances_kernel`]), or of the placed
     /// copies a render traces beside the scene's own primitives
-    /// ([`crate::trace::placed`]).
+    /// ([`crate::trace::with_instances`]).
     pub instances: u32,
     /// Triangles of every placed mesh, one mesh after another (a render
     /// with copies).
-    pub placed_triangles: u32,
+    pub instance_triangles: u32,
     /// [`INDEPENDENT`] or [`SOBOL`]: where camera paths draw their sample
     /// points ([`crate::render::sampler`]).
     pub sampler: u32,
@@ -427,21 +427,21 @@ impl InstanceRecord {
 }
 
 /// What the renderer knows of a placed copy of a mesh beside its
-/// [`InstanceRecord`] ([`crate::trace::placed`]): the index its first
+/// [`InstanceRecord`] ([`crate::trace::with_instances`]): the index its first
 /// triangle has among the render's primitives, counted from the scene's
 /// own, and its material ([`NO_MATERIAL`]: its mesh's, per triangle).
 /// repr(C), Pod, 16 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
-pub struct PlacedInfo {
+pub struct InstanceInfo {
     pub first: u32,
     pub material: u32,
     pub _pad: [u32; 2],
 }
-const _: () = assert!(core::mem::size_of::<PlacedInfo>() == 16);
+const _: () = assert!(core::mem::size_of::<InstanceInfo>() == 16);
 
-/// [`PlacedInfo::material`] of a copy that keeps its mesh's materials.
+/// [`InstanceInfo::material`] of a copy that keeps its mesh's materials.
 pub const NO_MATERIAL: u32 = u32::MAX;
 
 /// A placed copy of a mesh as an engine gives it, before the top level is
@@ -451,12 +451,12 @@ pub const NO_MATERIAL: u32 = u32::MAX;
 #[repr(C)]
 #[derive(Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 #[cfg_attr(not(target_arch = "spirv"), derive(Debug))]
-pub struct PlacedMesh {
+pub struct InstanceDesc {
     pub world_from_object: [[f32; 4]; 3],
     pub mesh: u32,
     pub _pad: [u32; 3],
 }
-const _: () = assert!(core::mem::size_of::<PlacedMesh>() == 64);
+const _: () = assert!(core::mem::size_of::<InstanceDesc>() == 64);
 
 /// A mesh of an instanced scene as the top level's build reads it: its box
 /// in its own space, and where its tree, leaf primitives and triangles

@@ -37,8 +37,8 @@ pub const ALL: u32 = SPHERES | TRIANGLES | MIRROR | GLASS | SHAPES | ENVIRONMENT
 /// the light paths' kernel. Outside [`ALL`], so that the kernels of every
 /// other render have none of that code (it cost cornell's NEE kernel 2%).
 pub const CAUSTICS: u32 = 32;
-/// Not of the primitives but of how they are held: placed copies of meshes
-/// beyond the scene's own primitives ([`crate::trace::placed`]), traced
+/// Not of the primitives but of how they are held: instances of meshes
+/// beyond the scene's own primitives ([`crate::trace::with_instances`]), traced
 /// through the instanced walk. Outside [`ALL`]: only the kernel of scenes
 /// with copies has that walk.
 pub const INSTANCES: u32 = 64;

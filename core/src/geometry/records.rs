@@ -12,7 +12,7 @@
 //! the CPU runner as records; the tests below check both give the same
 //! bytes.
 use crate::geometry::aabb::Aabb;
-use crate::geometry::buffers::{Bvh2Node, Bvh4Node, InstanceRecord, LeafPrim, MeshRecord, Node, PlacedMesh, WideNode};
+use crate::geometry::buffers::{Bvh2Node, Bvh4Node, InstanceRecord, LeafPrim, MeshRecord, Node, InstanceDesc, WideNode};
 use crate::gpu::unchecked::{at, put};
 /// The 16-byte vector records are read and written as on the GPU (also
 /// named by the kernel registry, `crate::registry`).
@@ -199,11 +199,11 @@ impl RecordStore<InstanceRecord> for [Vec4] {
     }
 }
 
-impl RecordLoad<PlacedMesh> for [Vec4] {
+impl RecordLoad<InstanceDesc> for [Vec4] {
     #[inline]
-    fn load(&self, i: usize) -> PlacedMesh {
+    fn load(&self, i: usize) -> InstanceDesc {
         let row = |k: usize| at(self, 4 * i + k).to_array();
-        PlacedMesh { world_from_object: [row(0), row(1), row(2)], mesh: at(self, 4 * i + 3).x.to_bits(), _pad: [0; 3] }
+        InstanceDesc { world_from_object: [row(0), row(1), row(2)], mesh: at(self, 4 * i + 3).x.to_bits(), _pad: [0; 3] }
     }
 }
 
@@ -298,9 +298,9 @@ mod tests {
         let loaded: WideNode = vectors[..].load(0);
         assert_eq!(bytemuck::bytes_of(&loaded), bytemuck::bytes_of(&wide[0]));
         // The instance inputs' unused words read as zero.
-        let mut placed = *bytemuck::from_bytes::<PlacedMesh>(bytemuck::cast_slice(&words[..16]));
+        let mut placed = *bytemuck::from_bytes::<InstanceDesc>(bytemuck::cast_slice(&words[..16]));
         placed._pad = [0; 3];
-        assert_eq!(RecordLoad::<PlacedMesh>::load(&vectors[..], 0), placed);
+        assert_eq!(RecordLoad::<InstanceDesc>::load(&vectors[..], 0), placed);
         let mut mesh = *bytemuck::from_bytes::<MeshRecord>(bytemuck::cast_slice(&words[12..24]));
         mesh._pad = [0; 3];
         assert_eq!(RecordLoad::<MeshRecord>::load(&vectors[..], 1), mesh);

@@ -148,7 +148,7 @@ fn light_path<T: ClosestHit, const F: u32, const S: usize, L: Landings + ?Sized>
             return;
         }
         let x = o + d * hit.t;
-        // A placed copy's triangle too (`crate::trace::placed`).
+        // A placed copy's triangle too (`crate::trace::with_instances`).
         let (m, n) = surface::<T, F>(scene, hit.prim, x, d);
         let nl = if n.dot(d) < 0.0 { n } else { -n };
         if m.kind == DIFFUSE && bounces == 0 {

@@ -601,11 +601,11 @@ fn sample_direct<T: ClosestHit>(
 /// The material and outward normal of primitive `prim` at its point `x`
 /// (hit along `d`): the scene's own ([`hit_normal_for`]), or, where `F`
 /// has [`features::INSTANCES`], a placed copy's past them
-/// ([`ClosestHit::placed_surface`]).
+/// ([`ClosestHit::instance_surface`]).
 #[inline]
 pub(crate) fn surface<T: ClosestHit, const F: u32>(scene: &SceneRefs<T>, prim: u32, x: Vec3, d: Vec3) -> (Material, Vec3) {
     if has(F, features::INSTANCES) && prim >= scene.prims.count() {
-        scene.tree.placed_surface(prim - scene.prims.count(), d)
+        scene.tree.instance_surface(prim - scene.prims.count(), d)
     } else {
         (scene.materials[prim as usize], hit_normal_for::<F>(&scene.prims, prim, x, d))
     }

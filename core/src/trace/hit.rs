@@ -39,10 +39,10 @@ pub trait ClosestHit {
 
     /// The material and outward normal (unit length) of the `k`-th
     /// primitive past the scene's own, hit along `d`: a placed copy's
-    /// triangle ([`crate::trace::placed`]). Only a tree over copies finds
+    /// triangle ([`crate::trace::with_instances`]). Only a tree over copies finds
     /// such primitives; the others never are asked.
     #[inline]
-    fn placed_surface(&self, _k: u32, d: Vec3) -> (Material, Vec3) {
+    fn instance_surface(&self, _k: u32, d: Vec3) -> (Material, Vec3) {
         (Material::default(), -d)
     }
 }

@@ -1,4 +1,4 @@
-//! Instanced scenes: a top-level tree over placed copies of meshes
+//! Instanced scenes: a top-level tree over instances of meshes
 //! ([`InstanceRecord`]), each copy entered with the ray taken into its
 //! mesh's space, where the mesh's own (bottom-level) tree is walked. Both
 //! levels are trees in the [`crate::trace::bvh2`] layout and share its walk

@@ -11,9 +11,9 @@
 //! - [`cwbvh`]: compressed 8-wide nodes with node and primitive groups
 //!   (Ylitie, Karras & Laine 2017).
 //!
-//! Two more walk placed copies of meshes: [`instances`] (a top-level tree
+//! Two more walk instances of meshes: [`instances`] (a top-level tree
 //! over copies, each entered with the ray in its mesh's space: the engine
-//! API's), and [`placed`] (a scene's own tree, then its copies: the
+//! API's), and [`with_instances`] (a scene's own tree, then its copies: the
 //! renderer's).
 //!
 //! Every layout finds exactly the scan's closest hit: ties go to the lower
@@ -24,4 +24,4 @@ pub mod classic;
 pub mod cwbvh;
 pub mod hit;
 pub mod instances;
-pub mod placed;
+pub mod with_instances;

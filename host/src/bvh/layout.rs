@@ -14,7 +14,7 @@ use crate::bvh::lbvh::{upload_or_placeholder, DeviceBvh};
 use crate::bvh::trbvh;
 use crate::runtime::backend::{check_fits, Backend, DeviceClass};
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::{Kernel, Method};
+use crate::runtime::kernels::{bind, Kernel, Method};
 use crate::scene::primitives::Primitives;
 
 /// How a tree is stored for traversal.
@@ -211,7 +211,8 @@ pub fn tree_depth<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>) -> Result<u32> {
     let params = LayoutParams { n: bvh.n, nodes: bvh.node_count, ..Default::default() };
     let p = b.upload("depth params", &[params])?;
     let deepest = b.zeroed("tree depth", 4)?;
-    b.dispatch(DepthKernels::of(b).depth, &[&p, &bvh.nodes, &bvh.parents, &deepest], groups_for(bvh.node_count, WORKGROUP_SIZE));
+    let depth = bind::TreeDepth { params: &p, nodes: &bvh.nodes, parents: &bvh.parents, deepest: &deepest };
+    b.dispatch_with(DepthKernels::of(b).depth, depth, groups_for(bvh.node_count, WORKGROUP_SIZE));
     Ok(b.read::<u32>(&deepest, 1)?[0])
 }
 
@@ -290,7 +291,7 @@ fn bvh4<B: Backend>(b: &mut B, two: TracedTree<B>) -> Result<TracedTree<B>> {
     check_fits(b, "4-wide nodes", bytes)?;
     let nodes = b.scratch("4-wide nodes", bytes)?;
     let p = b.upload("4-wide params", &[LayoutParams { nodes: two.node_count, ..Default::default() }])?;
-    b.dispatch(Bvh4Kernels::of(b).nodes, &[&p, &two.nodes, &nodes], groups_for(two.node_count, WORKGROUP_SIZE));
+    b.dispatch_with(Bvh4Kernels::of(b).nodes, bind::Bvh4Nodes { params: &p, nodes: &two.nodes, out: &nodes }, groups_for(two.node_count, WORKGROUP_SIZE));
     Ok(TracedTree { layout: Layout::Bvh4, nodes, prims: two.prims, node_count: two.node_count, collapsed: None })
 }
 
@@ -316,9 +317,9 @@ fn write_bvh2<B: Backend>(
 ) -> Result<()> {
     let p = write_bvh2_nodes(b, collapsed, prims, nodes)?;
     let n = collapsed.n;
-    b.dispatch(
+    b.dispatch_with(
         Bvh2Kernels::of(b).leaf_prims,
-        &[&p, &collapsed.prim_indices, &prims.spheres, &prims.triangles, leaf_prims],
+        bind::LeafPrims { params: &p, prim_indices: &collapsed.prim_indices, spheres: &prims.spheres, triangles: &prims.triangles, out: leaf_prims },
         groups_for(n, WORKGROUP_SIZE),
     );
     Ok(())
@@ -333,9 +334,9 @@ fn write_bvh2_nodes<B: Backend>(
     nodes: &B::Buffer,
 ) -> Result<B::Buffer> {
     let p = b.upload("layout params", &[params(collapsed, prims, &Aabb::EMPTY)])?;
-    b.dispatch(
+    b.dispatch_with(
         Bvh2Kernels::of(b).nodes,
-        &[&p, &collapsed.nodes, &collapsed.parents, nodes],
+        bind::Bvh2Nodes { params: &p, nodes: &collapsed.nodes, parents: &collapsed.parents, out: nodes },
         groups_for(collapsed.node_count, WORKGROUP_SIZE),
     );
     Ok(p)
@@ -365,16 +366,28 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let k = WideKernels::of(b);
     // A stage per step, so that `bench rays` shows where the time goes.
     b.stage("wide dp");
-    b.dispatch(k.dp, &[&p, &bvh.nodes, &bvh.parents, &flags, &counts, &costs, &decisions], groups_for(n, WORKGROUP_SIZE));
+    let (nodes, parents) = (&bvh.nodes, &bvh.parents);
+    let dp = bind::WideDp { params: &p, nodes, parents, flags: &flags, counts: &counts, costs: &costs, decisions: &decisions };
+    b.dispatch_with(k.dp, dp, groups_for(n, WORKGROUP_SIZE));
 
     let is_wide = b.scratch("wide node flags", internal as u64 * 4)?;
     let child_offsets = b.scratch("wide child offsets", internal as u64 * 4)?;
     let prim_offsets = b.scratch("wide primitive offsets", internal as u64 * 4)?;
     let groups = groups_for(internal, WORKGROUP_SIZE);
     b.stage("wide count");
-    b.dispatch(
+    b.dispatch_with(
         k.count,
-        &[&p, &bvh.nodes, &bvh.parents, &counts, &decisions, &is_wide, &child_offsets, &prim_offsets],
+        // Counts, scanned into offsets in place below.
+        bind::WideCount {
+            params: &p,
+            nodes,
+            parents,
+            counts: &counts,
+            decisions: &decisions,
+            is_wide: &is_wide,
+            child_counts: &child_offsets,
+            prim_counts: &prim_offsets,
+        },
         groups,
     );
     b.stage("wide scans");
@@ -383,26 +396,27 @@ fn cwbvh<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuffers<B>) -> R
     let positions = b.scratch("wide node positions", internal as u64 * 4)?;
     let slots = b.scratch("wide node slots", internal as u64 * 32)?;
     b.stage("wide place");
-    b.dispatch(k.place, &[&p, &bvh.nodes, &decisions, &is_wide, &child_offsets, &positions, &slots], groups);
+    let place = bind::WidePlace { params: &p, nodes, decisions: &decisions, is_wide: &is_wide, child_offsets: &child_offsets, positions: &positions, slots: &slots };
+    b.dispatch_with(k.place, place, groups);
     let out_nodes = b.scratch("wide nodes", internal as u64 * std::mem::size_of::<WideNode>() as u64)?;
     let out_prims = b.scratch("leaf primitives", n as u64 * std::mem::size_of::<LeafPrim>() as u64)?;
     b.stage("wide emit");
-    b.dispatch(
+    b.dispatch_with(
         k.emit,
-        &[
-            &p,
-            &bvh.nodes,
-            &slots,
-            &is_wide,
-            &child_offsets,
-            &prim_offsets,
-            &positions,
-            &bvh.prim_indices,
-            &prims.spheres,
-            &prims.triangles,
-            &out_nodes,
-            &out_prims,
-        ],
+        bind::WideEmit {
+            params: &p,
+            nodes,
+            slots: &slots,
+            is_wide: &is_wide,
+            child_offsets: &child_offsets,
+            prim_offsets: &prim_offsets,
+            positions: &positions,
+            prim_indices: &bvh.prim_indices,
+            spheres: &prims.spheres,
+            triangles: &prims.triangles,
+            out_nodes: &out_nodes,
+            out_prims: &out_prims,
+        },
         groups,
     );
     Ok(TracedTree { layout: Layout::Cwbvh, nodes: out_nodes, prims: out_prims, node_count: internal, collapsed: None })

@@ -12,7 +12,7 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 use crate::runtime::backend::{check_fits, Backend, StageTimes};
 use crate::bvh::sort::ScanKernels;
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 use crate::scene::primitives::Primitives;
 
 /// The stages of a build, in order, as named in timings and reports.
@@ -273,7 +273,7 @@ pub fn build_uploaded_split<B: Backend>(
     }
     // The boxes and their centroid bounds in one kernel.
     let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
-        b.dispatch(LbvhKernels::of(b).bounds, &[p, &spheres, &triangles, boxes, bounds], groups);
+        b.dispatch_with(LbvhKernels::of(b).bounds, bind::PrimitiveBounds { params: p, spheres: &spheres, triangles: &triangles, boxes, bounds }, groups);
         Ok(())
     };
     params.n = n;
@@ -320,7 +320,7 @@ fn build_split<B: Backend>(
     let p = b.upload("build params", &[params])?;
     let prim_boxes = b.scratch("primitive boxes", n as u64 * 32)?;
     let bounds = b.upload("centroid bounds", &BOUNDS_START)?;
-    b.dispatch(k.bounds, &[&p, spheres, triangles, &prim_boxes, &bounds], groups_for(n, REDUCE_TILE));
+    b.dispatch_with(k.bounds, bind::PrimitiveBounds { params: &p, spheres, triangles, boxes: &prim_boxes, bounds: &bounds }, groups_for(n, REDUCE_TILE));
     let words: [u32; BOUNDS_WORDS] = b.read::<u32>(&bounds, BOUNDS_WORDS)?.try_into().expect("six words read");
     b.release(&[&prim_boxes]);
     let frame = MortonFrame::new(&bounds_from_words(&words));
@@ -336,14 +336,14 @@ fn build_split<B: Backend>(
     let priorities = b.scratch("split priorities", n as u64 * 4)?;
     let tiles = groups_for(n, PRIORITY_TILE);
     let partials = b.scratch("split priority sums", tiles as u64 * 4)?;
-    b.dispatch(k.priority, &[&sp, triangles, &priorities, &partials], tiles);
+    b.dispatch_with(k.priority, bind::SplitPriority { params: &sp, triangles, priorities: &priorities, partials: &partials }, tiles);
     let sum: f64 = b.read::<f32>(&partials, tiles as usize)?.iter().map(|&s| s as f64).sum();
     let extra = (budget as f64 * triangle_count as f64).min((MAX_PRIMITIVES - n) as f64);
     split.scale = if sum > 0.0 && sum.is_finite() { (extra / sum) as f32 } else { 0.0 };
     // Pieces per primitive, scanned into offsets; the total after the last.
     let sp = b.upload("split params", &[split])?;
     let offsets = b.scratch("split offsets", (n as u64 + 1) * 4)?;
-    b.dispatch(k.count, &[&sp, &priorities, &offsets], groups_for(n + 1, WORKGROUP_SIZE));
+    b.dispatch_with(k.count, bind::SplitCount { params: &sp, priorities: &priorities, counts: &offsets }, groups_for(n + 1, WORKGROUP_SIZE));
     crate::bvh::sort::exclusive_scan(b, &offsets, n + 1)?;
     let total = b.scratch("split total", 4)?;
     b.copy_words((&offsets, n), (&total, 0), 1)?;
@@ -355,17 +355,18 @@ fn build_split<B: Backend>(
     b.release(&[&priorities, &partials]);
     let ref_boxes = b.scratch("split boxes", refs as u64 * 32)?;
     let ref_prims = b.scratch("split primitives", refs as u64 * 4)?;
-    b.dispatch(k.emit, &[&sp, spheres, triangles, &offsets, &ref_boxes, &ref_prims], groups_for(n, WORKGROUP_SIZE));
+    let emit = bind::SplitEmit { params: &sp, spheres, triangles, offsets: &offsets, ref_boxes: &ref_boxes, ref_prims: &ref_prims };
+    b.dispatch_with(k.emit, emit, groups_for(n, WORKGROUP_SIZE));
     let build = BuildParams { n: refs, spheres: params.spheres, ..Default::default() };
     let first_pass = |b: &mut B, p: &B::Buffer, boxes: &B::Buffer, bounds: &B::Buffer, groups| {
-        b.dispatch(k.piece_bounds, &[p, &ref_boxes, boxes, bounds], groups);
+        b.dispatch_with(k.piece_bounds, bind::SplitBounds { params: p, ref_boxes: &ref_boxes, boxes, bounds }, groups);
         Ok(())
     };
     let (bvh, mut times) = build_from_first_pass(b, build, hierarchy, first_pass)?;
     // Leaf slots name primitives from here on.
     b.stage("split");
     let p = b.upload("build params", &[build])?;
-    b.dispatch(k.remap, &[&p, &ref_prims, &bvh.prim_indices], groups_for(refs, WORKGROUP_SIZE));
+    b.dispatch_with(k.remap, bind::SplitRemap { params: &p, ref_prims: &ref_prims, values: &bvh.prim_indices }, groups_for(refs, WORKGROUP_SIZE));
     let more = b.take_times()?;
     for s in &more.order {
         times.add(s, more.get(s));
@@ -441,9 +442,9 @@ fn build_from_first_pass<B: Backend>(
         None => b.scratch("no words to zero", 4)?,
     };
     let p = b.upload("build params", &[params])?;
-    let morton = [&p, &boxes, &keys, &values, &slots, &zeroed];
+    let morton = bind::Morton { params: &p, boxes: &boxes, keys: &keys, values: &values, slots: &slots, zeroed: &zeroed };
     let morton_kernel = LbvhKernels::of(b).morton;
-    b.dispatch(morton_kernel, &morton, groups_for(n, WORKGROUP_SIZE));
+    b.dispatch_with(morton_kernel, morton, groups_for(n, WORKGROUP_SIZE));
 
     b.stage("sort");
     let sorted = if high_first {
@@ -456,7 +457,7 @@ fn build_from_first_pass<B: Backend>(
         None => {
             if high_first {
                 // Ties too long to settle: codes again, and every digit sorted.
-                b.dispatch(morton_kernel, &morton, groups_for(n, WORKGROUP_SIZE));
+                b.dispatch_with(morton_kernel, morton, groups_for(n, WORKGROUP_SIZE));
             }
             crate::bvh::sort::radix_sort(b, &keys, &values, n, key_bits)?
         }
@@ -468,14 +469,17 @@ fn build_from_first_pass<B: Backend>(
         Hierarchy::RadixTreeThenFit => {
             b.stage("tree");
             let k = RadixTreeKernels::of(b);
-            b.dispatch(k.tree, &[&p, &keys, &nodes, &parents], groups_for(n - 1, WORKGROUP_SIZE));
+            b.dispatch_with(k.tree, bind::RadixTree { params: &p, keys: &keys, nodes: &nodes, parents: &parents }, groups_for(n - 1, WORKGROUP_SIZE));
             b.stage("fit");
-            b.dispatch(k.fit, &[&p, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
+            let fit = bind::Fit { params: &p, sorted_prims: &values, prim_boxes: &boxes, nodes: &nodes, parents: &parents, flags: &slots };
+            b.dispatch_with(k.fit, fit, groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Agglomerative => {
             // One kernel makes both: its time is the fit's, the tree's is none.
             b.stage("fit");
-            b.dispatch(AgglomerateKernels::of(b).agglomerate, &[&p, &keys, &values, &boxes, &nodes, &parents, &slots], groups_for(n, WORKGROUP_SIZE));
+            let agglomerate =
+                bind::Agglomerate { params: &p, keys: &keys, sorted_prims: &values, prim_boxes: &boxes, nodes: &nodes, parents: &parents, ends: &slots };
+            b.dispatch_with(AgglomerateKernels::of(b).agglomerate, agglomerate, groups_for(n, WORKGROUP_SIZE));
         }
         Hierarchy::Hploc => {
             b.stage("fit");
@@ -504,7 +508,8 @@ fn build_from_first_pass<B: Backend>(
             let all = [&p, &keys, &values, &boxes, &nodes, &parents, &slots, &queue, &queued];
             let k = AgglomerateSubgroupKernels::of(b);
             b.dispatch(k.agglomerate, &all, groups_for(n, WORKGROUP_SIZE));
-            b.dispatch(k.climb, &[&p, &keys, &nodes, &parents, &slots, &queue, &queued], groups_for(places, WORKGROUP_SIZE));
+            let climb = bind::ClimbQueued { params: &p, keys: &keys, nodes: &nodes, parents: &parents, ends: &slots, queue: &queue, queued: &queued };
+            b.dispatch_with(k.climb, climb, groups_for(places, WORKGROUP_SIZE));
         }
     }
 

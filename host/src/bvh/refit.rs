@@ -12,7 +12,7 @@ use crate::bvh::layout::{PrimBuffers, TracedTree};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernels of [`refit`]: the primitives' boxes, then the fit's climb.
@@ -58,10 +58,12 @@ pub fn refit_uploaded<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, prims: &PrimBuf
     let params = BuildParams { n, spheres: prims.sphere_count, ..Default::default() };
     let p = b.upload("refit params", &[params])?;
     let boxes = b.scratch("primitive boxes", n as u64 * 32)?;
-    b.dispatch(RefitKernels::of(b).boxes, &[&p, &prims.spheres, &prims.triangles, &boxes], groups_for(n, WORKGROUP_SIZE));
+    let prim_boxes = bind::PrimitiveBoxes { params: &p, spheres: &prims.spheres, triangles: &prims.triangles, boxes: &boxes };
+    b.dispatch_with(RefitKernels::of(b).boxes, prim_boxes, groups_for(n, WORKGROUP_SIZE));
     b.stage("fit");
     let flags = b.zeroed("fit flags", (n as u64 - 1).max(1) * 4)?;
-    b.dispatch(RefitKernels::of(b).fit, &[&p, &bvh.prim_indices, &boxes, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+    let fit = bind::Fit { params: &p, sorted_prims: &bvh.prim_indices, prim_boxes: &boxes, nodes: &bvh.nodes, parents: &bvh.parents, flags: &flags };
+    b.dispatch_with(RefitKernels::of(b).fit, fit, groups_for(n, WORKGROUP_SIZE));
     b.take_times()
 }
 
@@ -105,13 +107,24 @@ pub fn refit_bvh2<B: Backend>(
         Some(kept) => kept,
         None => {
             let made = b.scratch("refit state", nodes as u64 * 8 + n as u64 * 4)?;
-            b.dispatch(RefitBvh2Kernels::of(b).state, &[&lp, &collapsed.nodes, &collapsed.parents, &made], groups_for(nodes, WORKGROUP_SIZE));
+            let state = bind::RefitState { params: &lp, nodes: &collapsed.nodes, parents: &collapsed.parents, state: &made };
+            b.dispatch_with(RefitBvh2Kernels::of(b).state, state, groups_for(nodes, WORKGROUP_SIZE));
             made
         }
     };
-    b.dispatch(
+    b.dispatch_with(
         RefitBvh2Kernels::of(b).leaves,
-        &[&lp, &collapsed.prim_indices, &prims.spheres, &prims.triangles, &collapsed.nodes, &collapsed.parents, &climb, &tree.prims, &tree.nodes],
+        bind::RefitLeaves {
+            params: &lp,
+            prim_indices: &collapsed.prim_indices,
+            spheres: &prims.spheres,
+            triangles: &prims.triangles,
+            nodes: &collapsed.nodes,
+            parents: &collapsed.parents,
+            state: &climb,
+            out_prims: &tree.prims,
+            out_nodes: &tree.nodes,
+        },
         groups_for(n, WORKGROUP_SIZE),
     );
     *state = Some(climb);

@@ -12,7 +12,7 @@ use treelet_core::Aabb;
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernels [`reinsert`] dispatches (relaxed refit counters where the
@@ -54,14 +54,17 @@ pub fn reinsert<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, root_box: &Aabb, iter
     let (move_groups, node_groups) = (groups_for(searched, WORKGROUP_SIZE), groups_for(node_count, WORKGROUP_SIZE));
     for iteration in 0..iterations {
         let p = b.upload("reinsertion params", &[ReinsertParams { n, iteration, inv_extent, max_climb }])?;
-        b.dispatch(k.search, &[&p, &bvh.nodes, &bvh.parents, &moves], move_groups);
+        let (nodes, parents) = (&bvh.nodes, &bvh.parents);
+        b.dispatch_with(k.search, bind::ReinsertSearch { params: &p, nodes, parents, moves: &moves }, move_groups);
         b.zero_words(&bids, node_count)?;
-        b.dispatch(k.fill, &[&unowned, &owners], node_groups);
-        b.dispatch(k.bid, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids], move_groups);
-        b.dispatch(k.claim, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners], move_groups);
-        b.dispatch(k.apply, &[&p, &bvh.nodes, &bvh.parents, &moves, &bids, &owners, &made], move_groups);
+        b.dispatch_with(k.fill, bind::Fill { params: &unowned, data: &owners }, node_groups);
+        b.dispatch_with(k.bid, bind::ReinsertBid { params: &p, nodes, parents, moves: &moves, bids: &bids }, move_groups);
+        let claim = bind::ReinsertClaim { params: &p, nodes, parents, moves: &moves, bids: &bids, owners: &owners };
+        b.dispatch_with(k.claim, claim, move_groups);
+        let apply = bind::ReinsertApply { params: &p, nodes, parents, moves: &moves, bids: &bids, owners: &owners, made: &made };
+        b.dispatch_with(k.apply, apply, move_groups);
         b.zero_words(&flags, n - 1)?;
-        b.dispatch(k.refit, &[&p, &bvh.nodes, &bvh.parents, &flags], groups_for(n, WORKGROUP_SIZE));
+        b.dispatch_with(k.refit, bind::ReinsertRefit { params: &p, nodes, parents, flags: &flags }, groups_for(n, WORKGROUP_SIZE));
     }
     Ok(Some(made))
 }

@@ -11,7 +11,7 @@ use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
 use crate::runtime::backend::Backend;
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernels of [`exclusive_scan`].
@@ -73,9 +73,10 @@ pub fn exclusive_scan<B: Backend>(b: &mut B, data: &B::Buffer, len: u32) -> Resu
     let params = b.upload("scan params", &[ScanParams { len, tiles, _pad0: [0; 2] }])?;
     let partials = b.scratch("scan partials", tiles as u64 * 4)?;
     let k = ScanKernels::of(b);
-    b.dispatch(k.reduce, &[&params, data, &partials], tiles);
-    b.dispatch(k.spine, &[&params, &partials], 1);
-    b.dispatch(k.downsweep, &[&params, data, &partials], tiles);
+    let (params, partials) = (&params, &partials);
+    b.dispatch_with(k.reduce, bind::ScanReduce { params, data, partials }, tiles);
+    b.dispatch_with(k.spine, bind::ScanSpine { params, partials }, 1);
+    b.dispatch_with(k.downsweep, bind::ScanDownsweep { params, data, partials }, tiles);
     Ok(())
 }
 
@@ -307,7 +308,8 @@ fn high_first<B: Backend>(
         None => b.zeroed("sort tie overflow", flag_words as u64 * 4)?,
     };
     let params = b.upload("sort params", &[SortParams { n, tiles: 0, pass: first, passes }])?;
-    b.dispatch(SettleKernels::of(b).settle_ties, &[&params, &sorted.0, &sorted.1, &sort_state], groups_for(n, WORKGROUP_SIZE));
+    let settle = bind::SortSettleTies { params: &params, keys: &sorted.0, values: &sorted.1, sort_state: &sort_state };
+    b.dispatch_with(SettleKernels::of(b).settle_ties, settle, groups_for(n, WORKGROUP_SIZE));
     let flags = b.read::<u32>(&sort_state, flag_words as usize)?;
     Ok((flags[state::TIE_OVERFLOW as usize] == 0).then_some(sorted))
 }
@@ -347,7 +349,7 @@ fn sort_passes<B: Backend>(
         let tile_counts = b.scratch("sort tile counts", RADIX as u64 * tiles as u64 * 4)?;
         for pass in first..passes {
             let p = b.upload("sort params", &[params(pass)])?;
-            b.dispatch(k.tile_counts, &[&p, &src.0, &tile_counts], tiles);
+            b.dispatch_with(k.tile_counts, bind::SortTileCounts { params: &p, keys: &src.0, tile_counts: &tile_counts }, tiles);
             exclusive_scan(b, &tile_counts, RADIX * tiles)?;
             b.dispatch(k.pass, &[&p, &src.0, &src.1, &dst.0, &dst.1, &tile_counts], tiles);
             std::mem::swap(&mut src, &mut dst);
@@ -371,8 +373,8 @@ fn sort_passes<B: Backend>(
     // The histogram counts the digits of passes `first..` (its `pass`).
     let p = b.upload("sort params", &[params(first)])?;
     let k = LookBackKernels::of(b);
-    b.dispatch(k.histogram, &[&p, &src.0, &sort_state], groups_for(n, histogram_tile(n)));
-    b.dispatch(k.offsets, &[&p, &sort_state], passes);
+    b.dispatch_with(k.histogram, bind::SortHistogram { params: &p, keys: &src.0, sort_state: &sort_state }, groups_for(n, histogram_tile(n)));
+    b.dispatch_with(k.offsets, bind::SortOffsets { params: &p, sort_state: &sort_state }, passes);
     for pass in first..passes {
         let p = b.upload("sort params", &[params(pass)])?;
         b.dispatch(kernel, &[&p, &src.0, &src.1, &dst.0, &dst.1, &sort_state], tiles);

@@ -20,7 +20,7 @@ use treelet_core::{Aabb, Node};
 use crate::bvh::lbvh::DeviceBvh;
 use crate::runtime::backend::{Backend, DeviceClass, StageTimes};
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernels of the treelet rounds ([`optimize`]).
@@ -230,7 +230,8 @@ fn rounds<B: Backend>(
         let p = b.upload("treelet params", &[TreeletParams { gamma, ..base }])?;
         let level_counts = b.zeroed("treelet level counts", MAX_LEVELS as u64 * 4)?;
         let (s, internal_groups) = (&scratch, groups_for(n - 1, WORKGROUP_SIZE));
-        b.dispatch(k.histogram, &[&p, &s.counts, &s.heights, &level_counts], internal_groups);
+        let histogram = bind::TreeletHistogram { params: &p, counts: &s.counts, heights: &s.heights, level_counts: &level_counts };
+        b.dispatch_with(k.histogram, histogram, internal_groups);
         let per_level = b.read::<u32>(&level_counts, MAX_LEVELS)?;
         if per_level[MAX_LEVELS - 1] > 0 {
             bail!("the BVH is deeper than {} levels: treelet optimization refuses it", MAX_LEVELS - 2);
@@ -249,7 +250,8 @@ fn rounds<B: Backend>(
         }
         let cursors = b.upload("treelet cursors", &offsets)?;
         let roots = b.scratch("treelet roots", total as u64 * 4)?;
-        b.dispatch(k.scatter, &[&p, &s.counts, &s.heights, &cursors, &roots], internal_groups);
+        let scatter = bind::TreeletScatter { params: &p, counts: &s.counts, heights: &s.heights, cursors: &cursors, roots: &roots };
+        b.dispatch_with(k.scatter, scatter, internal_groups);
         // ...then restructured height by height, bottom up: the treelets of
         // one height are disjoint, and each sees its subtrees finished.
         for (level, &count) in per_level.iter().enumerate().skip(1) {
@@ -272,8 +274,9 @@ fn rounds<B: Backend>(
             let single = level as u32 <= single_heights;
             let restructure = |b: &mut B, p: &B::Buffer| {
                 if single {
-                    let buffers = [p, &roots, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
-                    b.dispatch(k.single, &buffers, groups_for(count, WORKGROUP_SIZE));
+                    let (nodes, parents, counts, costs, heights) = (&bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights);
+                    let single = bind::TreeletRestructureSingle { params: p, roots: &roots, nodes, parents, counts, costs, heights, marks: &marks };
+                    b.dispatch_with(k.single, single, groups_for(count, WORKGROUP_SIZE));
                 } else {
                     let buffers =
                         [p, &roots, &subsets, &bvh.nodes, &bvh.parents, &s.counts, &s.costs, &s.heights, &marks];
@@ -355,9 +358,12 @@ fn init_pass<B: Backend>(b: &mut B, bvh: &DeviceBvh<B>, s: &Scratch<B>, base: &T
     let stride = treelet_core::construct::climb_queue::QUEUE_COUNTER_STRIDE;
     let queue = b.scratch("treelet init queues", (queues * capacity) as u64 * 4)?;
     let queued = b.zeroed("treelet init queue counts", (queues * stride) as u64 * 4)?;
-    let all = [&p, &bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves, &queue, &queued];
-    b.dispatch(init, &all, groups_for(n, WORKGROUP_SIZE));
-    b.dispatch(climb, &all, groups_for(queues * capacity, WORKGROUP_SIZE));
+    let (nodes, parents, flags, counts, costs, heights, tree_leaves) = (&bvh.nodes, &bvh.parents, &flags, &s.counts, &s.costs, &s.heights, &s.tree_leaves);
+    let (queue, queued) = (&queue, &queued);
+    let all = bind::TreeletInit { params: &p, nodes, parents, flags, counts, costs, heights, tree_leaves, queue, queued };
+    b.dispatch_with(init, all, groups_for(n, WORKGROUP_SIZE));
+    let all = bind::TreeletInitClimb { params: &p, nodes, parents, flags, counts, costs, heights, tree_leaves, queue, queued };
+    b.dispatch_with(climb, all, groups_for(queues * capacity, WORKGROUP_SIZE));
     Ok(())
 }
 
@@ -396,9 +402,20 @@ fn collapse_pass<B: Backend>(
     let parents = b.scratch("collapsed parents", node_count as u64 * 4)?;
     let prims = b.scratch("collapsed primitive indices", n as u64 * 4)?;
     let p = b.upload("treelet params", &[*base])?;
-    b.dispatch(
+    let (counts, tree_leaves) = (&s.counts, &s.tree_leaves);
+    b.dispatch_with(
         CollapseKernels::of(b).collapse,
-        &[&p, &bvh.nodes, &bvh.parents, &s.counts, &s.tree_leaves, &bvh.prim_indices, &nodes, &parents, &prims],
+        bind::Collapse {
+            params: &p,
+            nodes: &bvh.nodes,
+            parents: &bvh.parents,
+            counts,
+            tree_leaves,
+            prims: &bvh.prim_indices,
+            out_nodes: &nodes,
+            out_parents: &parents,
+            out_prims: &prims,
+        },
         groups_for(n, WORKGROUP_SIZE),
     );
     Ok(DeviceBvh {

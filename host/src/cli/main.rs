@@ -124,7 +124,7 @@ struct RenderArgs {
     scene: String,
     /// Trace a scene file's or glTF file's copies of meshes flattened into
     /// the scene's own triangles, as build does (by default a mesh placed
-    /// more than once keeps its copies placed: one tree per mesh).
+    /// more than once is traced as instances: one tree per mesh).
     #[arg(long)]
     flatten: bool,
     /// A glTF scene's camera N (its index in the file's cameras list),

@@ -11,7 +11,7 @@
 //! | `integrator_choice.rs` | `--integrator auto`: a pilot of NEE against light paths |
 //! | `variant.rs` | the plan: tree, layout and kernel variant for a scene and device |
 //! | `prepared.rs` | one device's tree, buffers and accumulation |
-//! | `placed.rs` | copies of meshes kept placed: their trees and what the kernel reads of them |
+//! | `instances.rs` | instances of meshes: their trees and what the kernel reads of them |
 //! | `queue.rs` | the samples handed out to devices, cut on a fixed grid |
 //! | `run.rs` | the one render loop: devices, checkpoints, stops, resumes |
 //! | `devices.rs` | opening devices (`--devices`) and rendering on them |
@@ -27,7 +27,7 @@ pub mod integrator_choice;
 pub mod lock;
 pub mod outcome;
 pub mod parts;
-pub mod placed;
+pub mod instances;
 pub mod prepared;
 pub mod queue;
 pub mod run;

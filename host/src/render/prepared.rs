@@ -61,9 +61,9 @@ pub struct Prepared<B: Backend> {
     /// lights: the light paths' kernel and the buffer they land in (its
     /// sums are added to `accum`'s when read).
     light_paths: Option<(Kernel, B::Buffer)>,
-    /// The scene's copies of meshes kept placed, if it has any (the kernel
-    /// is then [`Kernel::RenderPlaced`]).
-    placed: Option<super::placed::PlacedPart<B>>,
+    /// The scene's instances of meshes, if it has any (the kernel
+    /// is then [`Kernel::RenderInstanced`]).
+    instances: Option<super::instances::InstancesPart<B>>,
     /// Render parameters but for the samples of a dispatch.
     params: RenderParams,
     pixels: u64,
@@ -82,9 +82,9 @@ pub fn kernels<B: Backend>(b: &B, plan: &Plan) -> Vec<Kernel> {
 
 /// The render kernel of `plan`.
 fn render_kernel(plan: &Plan) -> Kernel {
-    match (plan.placed, plan.light_paths()) {
-        (true, true) => Kernel::RenderPlacedCaustics,
-        (true, false) => Kernel::RenderPlaced,
+    match (plan.instanced, plan.light_paths()) {
+        (true, true) => Kernel::RenderInstancedCaustics,
+        (true, false) => Kernel::RenderInstanced,
         _ => Kernel::Render(plan.method(), plan.variant as u8),
     }
 }
@@ -94,7 +94,7 @@ fn render_kernel(plan: &Plan) -> Kernel {
 /// [`variant::plan`], which then picks a variant with
 /// `treelet_core::geometry::features::CAUSTICS`).
 fn light_kernel(plan: &Plan, lights: bool) -> Option<Kernel> {
-    let kernel = if plan.placed { Kernel::LightPlaced } else { Kernel::Light(plan.method(), plan.variant as u8) };
+    let kernel = if plan.instanced { Kernel::LightInstanced } else { Kernel::Light(plan.method(), plan.variant as u8) };
     (plan.light_paths() && lights).then_some(kernel)
 }
 
@@ -127,7 +127,7 @@ const PILOT_LAYOUTS: [Layout; 2] = [Layout::Bvh2, Layout::Cwbvh];
 /// `class` times both layouts it pilots (`bvh2`, `cwbvh`) before it starts (see [`PILOT_MIN_SPP`]).
 pub fn pilots_layout(settings: &RenderSettings, plan: &Plan, class: DeviceClass) -> bool {
     settings.layout == Layout::Auto
-        && !plan.placed
+        && !plan.instanced
         && class != DeviceClass::CpuRunner
         && plan.accel != crate::bvh::tree::Accel::None
         && plan.method().specialized()
@@ -192,23 +192,23 @@ impl<B: Backend> Prepared<B> {
         let (tree, buffers, mut build_ms) = if pilots_layout(settings, &plan, b.class()) {
             let scene_buffers = (&materials, &lights, &params);
             faster_layout(b, all, &mut plan, scene_buffers, pixels)?
-        } else if plan.placed && all.is_empty() {
+        } else if plan.instanced && all.is_empty() {
             // No primitives of its own: placeholders the kernel never reads.
             traced_tree(b, all, crate::bvh::tree::Accel::None, plan.layout)?
         } else {
             traced_tree(b, all, plan.accel, plan.layout)?
         };
-        let placed = match &scene.placed {
+        let instances = match &scene.instances {
             Some(copies) => {
                 if plan.layout != Layout::Bvh2 || (plan.accel == crate::bvh::tree::Accel::None && !all.is_empty()) {
                     bail!(
-                        "{}: the scene keeps copies of meshes placed, and their kernel traces the scene's own primitives through a bvh2 tree (not --accel none, nor --layout {})",
+                        "{}: the scene keeps instances of meshes, and their kernel traces the scene's own primitives through a bvh2 tree (not --accel none, nor --layout {})",
                         scene.name,
                         plan.layout.name()
                     );
                 }
-                let quality = super::placed::mesh_quality(accel, settings.paths());
-                let part = super::placed::PlacedPart::build(b, copies, all.len() as u32, quality)?;
+                let quality = super::instances::mesh_quality(accel, settings.paths());
+                let part = super::instances::InstancesPart::build(b, copies, all.len() as u32, quality)?;
                 build_ms += part.build_ms;
                 Some(part)
             }
@@ -237,8 +237,8 @@ impl<B: Backend> Prepared<B> {
             accum,
             kernel: render_kernel(&plan),
             light_paths,
-            params: placed.as_ref().map_or(params, |p| p.params(params)),
-            placed,
+            params: instances.as_ref().map_or(params, |p| p.params(params)),
+            instances,
             pixels,
             build_ms,
             plan,
@@ -256,10 +256,10 @@ impl<B: Backend> Prepared<B> {
             largest = largest.max(samples);
             let params = RenderParams { samples, first_sample: first + done, ..self.params };
             let scene = (&self.materials, &self.lights, &params);
-            if let Some(placed) = &self.placed {
-                dispatch_placed(b, self.kernel, &self.tree, &self.buffers, scene, placed, &self.accum)?;
+            if let Some(instances) = &self.instances {
+                dispatch_instanced(b, self.kernel, &self.tree, &self.buffers, scene, instances, &self.accum)?;
                 if let Some((kernel, landings)) = &self.light_paths {
-                    dispatch_placed(b, *kernel, &self.tree, &self.buffers, scene, placed, landings)?;
+                    dispatch_instanced(b, *kernel, &self.tree, &self.buffers, scene, instances, landings)?;
                 }
                 done += samples;
                 continue;
@@ -314,19 +314,19 @@ fn dispatch_render<B: Backend>(
     Ok(())
 }
 
-/// [`dispatch_render`] of [`Kernel::RenderPlaced`] (or its caustics
+/// [`dispatch_render`] of [`Kernel::RenderInstanced`] (or its caustics
 /// kernels): the scene's own bindings, then the copies'.
-fn dispatch_placed<B: Backend>(
+fn dispatch_instanced<B: Backend>(
     b: &mut B,
     kernel: Kernel,
     tree: &TracedTree<B>,
     buffers: &PrimBuffers<B>,
     (materials, lights, params): (&B::Buffer, &B::Buffer, &RenderParams),
-    placed: &super::placed::PlacedPart<B>,
+    instances: &super::instances::InstancesPart<B>,
     accum: &B::Buffer,
 ) -> Result<()> {
     let p = b.upload("render params", &[*params])?;
-    let [records, info, nodes, leaves, triangles, placed_materials] = placed.bindings();
+    let [records, info, nodes, leaves, triangles, instance_materials] = instances.bindings();
     b.dispatch(
         kernel,
         &[
@@ -343,7 +343,7 @@ fn dispatch_placed<B: Backend>(
             nodes,
             leaves,
             triangles,
-            placed_materials,
+            instance_materials,
         ],
         groups_for(tiled_invocations(params.width, params.height), kernel.workgroup_size()),
     );

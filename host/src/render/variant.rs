@@ -29,7 +29,7 @@ pub struct SceneFeatures {
     pub glass: usize,
     /// Primitives that emit light (of any kind).
     pub emissive: usize,
-    /// Copies of meshes kept placed (`Scene::placed`), and their triangles.
+    /// Copies of meshes kept as instances (`Scene::instances`), and their triangles.
     pub copies: usize,
     pub copied_triangles: u64,
     /// Whether rays leaving the scene see a radiance (`Scene::environment`).
@@ -63,17 +63,17 @@ impl SceneFeatures {
             }
         };
         scene.materials.iter().for_each(&mut count_material);
-        if let Some(placed) = &scene.placed {
+        if let Some(copies) = &scene.instances {
             // A copy's triangles, each in its material (none emits).
-            for instance in &placed.instances {
-                let mesh = &placed.meshes[instance.mesh as usize];
+            for instance in &copies.instances {
+                let mesh = &copies.meshes[instance.mesh as usize];
                 match &instance.material {
                     Some(m) => (0..mesh.triangles.len()).for_each(|_| count_material(m)),
                     None => mesh.materials.iter().for_each(&mut count_material),
                 }
             }
-            f.copies = placed.instances.len();
-            f.copied_triangles = placed.triangles();
+            f.copies = copies.instances.len();
+            f.copied_triangles = copies.triangles();
         }
         f
     }
@@ -210,10 +210,10 @@ pub struct Plan {
     pub variant: usize,
     /// Name of the variant (entry points `render::<name>::<method>_cs`).
     pub kernel: &'static str,
-    /// The scene keeps copies of meshes placed: the kernel is
-    /// `render::render_placed_cs` (every feature, and the copies' walk),
+    /// The scene keeps instances of meshes: the kernel is
+    /// `render::render_instanced_cs` (every feature, and the copies' walk),
     /// over the scene's own primitives in `bvh2`.
-    pub placed: bool,
+    pub instanced: bool,
     pub kernel_features: String,
     pub kernel_reason: String,
 }
@@ -303,21 +303,21 @@ pub fn plan(scene: &Scene, paths: u64, accel: Accel, layout: Layout, kernel: Ker
         layout_reason,
         variant,
         kernel: name,
-        placed: false,
+        instanced: false,
         kernel_features: describe(VARIANTS[variant].0),
         kernel_reason,
     };
-    if features.copies > 0 { placed_plan(plan) } else { plan }
+    if features.copies > 0 { instanced_plan(plan) } else { plan }
 }
 
-/// [`plan`] for a scene with copies kept placed: one kernel traces them
-/// (`render::render_placed_cs`, or `render_placed_caustics_cs` and `render::light_placed_cs` for light
+/// [`plan`] for a scene with instances: one kernel traces them
+/// (`render::render_instanced_cs`, or `render_instanced_caustics_cs` and `render::light_instanced_cs` for light
 /// paths), with the scene's own primitives in a
 /// `bvh2` tree (an LBVH where a scan would do: the room's few primitives
 /// cost nothing to build). What was asked explicitly is kept, and refused
 /// by the render if that kernel cannot run it.
-fn placed_plan(mut plan: Plan) -> Plan {
-    let why = "the kernel of placed copies traces the scene's own primitives through a bvh2 tree";
+fn instanced_plan(mut plan: Plan) -> Plan {
+    let why = "the kernel of instances traces the scene's own primitives through a bvh2 tree";
     if plan.accel_reason.starts_with("as asked") {
     } else if plan.accel == Accel::None {
         plan.accel = Accel::Lbvh;
@@ -327,16 +327,16 @@ fn placed_plan(mut plan: Plan) -> Plan {
         plan.layout = Layout::Bvh2;
         plan.layout_reason = why.to_string();
     }
-    plan.placed = true;
+    plan.instanced = true;
     // Light paths, where the plan has them, run through the copies too
-    // (`render::light_placed_cs`).
+    // (`render::light_instanced_cs`).
     let caustics = plan.light_paths();
     let bits = features::ALL | if caustics { features::CAUSTICS } else { 0 };
     plan.variant = if caustics { smallest_variant(bits) } else { full_variant() };
-    plan.kernel = "placed";
-    plan.kernel_features = format!("{}, placed copies of meshes", describe(bits));
+    plan.kernel = "instanced";
+    plan.kernel_features = format!("{}, instances of meshes", describe(bits));
     plan.kernel_reason = format!(
-        "{} copies of meshes ({} triangles) kept placed, traced through their meshes' own trees",
+        "{} instances of meshes ({} triangles), traced through their meshes' own trees",
         plan.features.copies, plan.features.copied_triangles
     );
     plan
@@ -359,7 +359,7 @@ impl Plan {
                 .iter()
                 .filter(|(n, _)| *n > 0)
                 .map(|(n, what)| format!(", {n} {what}{}", if *n == 1 { "" } else { "s" }))
-                .chain((f.copies > 0).then(|| format!(", {} placed copies of meshes ({} triangles)", f.copies, f.copied_triangles)))
+                .chain((f.copies > 0).then(|| format!(", {} instances of meshes ({} triangles)", f.copies, f.copied_triangles)))
                 .collect::<String>(),
             f.diffuse,
             f.mirror,

@@ -10,16 +10,27 @@ use bytemuck::Pod;
 use treelet_core::geometry::buffers::{CopyParams, FillParams};
 use treelet_core::gpu::workgroup::{WORKGROUP_SIZE, groups_for};
 
-use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Bindings, Kernel};
 
-kernel_set! {
-    /// The kernels a backend dispatches of its own, for [`Backend::zeroed`],
-    /// [`Backend::zero_words`] and [`Backend::copy_words`]: built ahead with every list
-    /// ([`Backend::prepare_kernels`]).
-    pub struct BackendKernels for b {
-        fill: Kernel::Fill,
-        copy: Kernel::CopyWords,
+/// The kernels a backend dispatches of its own, for [`Backend::zeroed`],
+/// [`Backend::zero_words`] and [`Backend::copy_words`]: built ahead with
+/// every list ([`Backend::prepare_kernels`]). A kernel set as
+/// `crate::runtime::kernel_set` makes them, written out here, as that
+/// module builds on this one.
+#[derive(Clone, Copy, Debug)]
+pub struct BackendKernels {
+    pub fill: Kernel,
+    pub copy: Kernel,
+}
+
+impl BackendKernels {
+    /// The set as `_b` runs it.
+    pub fn of<B: Backend + ?Sized>(_b: &B) -> Self {
+        BackendKernels { fill: Kernel::Fill, copy: Kernel::CopyWords }
+    }
+    /// Both kernels, for building their pipelines ahead.
+    pub fn all(&self) -> Vec<Kernel> {
+        vec![self.fill, self.copy]
     }
 }
 
@@ -162,7 +173,7 @@ pub trait Backend: Send {
     /// current stage.
     fn zero_words(&mut self, buffer: &Self::Buffer, len: u32) -> Result<()> {
         let params = self.upload("fill params", &[FillParams { len, value: 0, _pad0: [0; 2] }])?;
-        self.dispatch(BackendKernels::of(self).fill, &[&params, buffer], groups_for(len, WORKGROUP_SIZE));
+        self.dispatch_with(BackendKernels::of(self).fill, bind::Fill { params: &params, data: buffer }, groups_for(len, WORKGROUP_SIZE));
         Ok(())
     }
     /// Starts a new build: buffers handed out for the previous one may be
@@ -178,7 +189,7 @@ pub trait Backend: Send {
     /// at word `dst_offset`, by a dispatch in the current stage.
     fn copy_words(&mut self, (src, src_offset): (&Self::Buffer, u32), (dst, dst_offset): (&Self::Buffer, u32), len: u32) -> Result<()> {
         let params = self.upload("copy params", &[CopyParams { len, src_offset, dst_offset, _pad0: 0 }])?;
-        self.dispatch(BackendKernels::of(self).copy, &[&params, src, dst], groups_for(len, WORKGROUP_SIZE));
+        self.dispatch_with(BackendKernels::of(self).copy, bind::CopyWords { params: &params, src, dst }, groups_for(len, WORKGROUP_SIZE));
         Ok(())
     }
 
@@ -199,6 +210,16 @@ pub trait Backend: Send {
     fn stage(&mut self, stage: &'static str);
     /// Runs `kernel` over `groups` workgroups with these bindings (params first).
     fn dispatch(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32);
+    /// [`Backend::dispatch`] of a registered kernel with its bindings named
+    /// (`crate::runtime::kernels::bind`): `kernel` is theirs, or its
+    /// relaxed twin (as a kernel set picks it).
+    fn dispatch_with<'a, K: Bindings<'a, Self::Buffer>>(&mut self, kernel: Kernel, bindings: K, groups: u32)
+    where
+        Self::Buffer: 'a,
+    {
+        assert!(kernel == K::KERNEL || kernel == K::KERNEL.relaxed(), "{kernel:?} dispatched with the bindings of {:?}", K::KERNEL);
+        self.dispatch(kernel, &bindings.list(), groups);
+    }
     /// Waits for all work so far and returns the first `count` elements.
     fn read<T: Pod>(&mut self, buffer: &Self::Buffer, count: usize) -> Result<Vec<T>>;
     /// Waits for all work so far and lends the first `count` elements to

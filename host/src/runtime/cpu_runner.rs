@@ -20,7 +20,7 @@ use treelet_core::render::lights::Light;
 use treelet_core::render::variants::VARIANTS;
 use treelet_core::trace::bvh2::{Bvh2Tree, Level};
 use treelet_core::trace::bvh4::Bvh4Tree;
-use treelet_core::trace::placed::PlacedScene;
+use treelet_core::trace::with_instances::SceneWithInstances;
 use treelet_core::trace::classic::{ClassicTree, Scan};
 use treelet_core::trace::cwbvh::{WORKGROUP_STACK_WORDS, WideTree};
 use treelet_core::trace::hit::ClosestHit;
@@ -739,8 +739,8 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             }
         }
         (
-            Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced,
-            [p, spheres, materials, nodes, prims, accum, triangles, lights, records, info, placed_nodes, placed_leaves, placed_triangles, placed_materials],
+            Kernel::RenderInstanced | Kernel::RenderInstancedCaustics | Kernel::LightInstanced,
+            [p, spheres, materials, nodes, prims, accum, triangles, lights, records, info, instance_nodes, instance_leaves, instance_triangles, instance_materials],
         ) => {
             use treelet_core::geometry::features::{ALL, INSTANCES};
             use treelet_core::{Bvh2Node, InstanceRecord, LeafPrim};
@@ -748,32 +748,32 @@ fn run_kernel(kernel: Kernel, b: &mut [&mut [u64]], groups: u32, subgroup_size: 
             let lights: &[Light] = view(lights);
             let (spheres, triangles, materials) = (view(spheres), Split::whole(view(triangles)), view(materials));
             let own = Bvh2Tree::new(view::<Bvh2Node>(nodes) as &[_], view::<LeafPrim>(prims) as &[_]);
-            let (placed_nodes, placed_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(placed_nodes), view(placed_leaves));
+            let (instance_nodes, instance_leaves): (&[Bvh2Node], &[LeafPrim]) = (view(instance_nodes), view(instance_leaves));
             let meshes = treelet_core::geometry::prims::Prims {
                 spheres: &[],
                 sphere_count: 0,
-                triangles: Split::whole(view(placed_triangles)),
-                triangle_count: p.placed_triangles,
+                triangles: Split::whole(view(instance_triangles)),
+                triangle_count: p.instance_triangles,
             };
-            let tree = PlacedScene {
+            let tree = SceneWithInstances {
                 own,
                 instances: view::<InstanceRecord>(records) as &[_],
                 info: view(info),
                 count: p.instances,
-                trees: Level { nodes: placed_nodes, leaves: placed_leaves },
+                trees: Level { nodes: instance_nodes, leaves: instance_leaves },
                 meshes,
-                materials: view(placed_materials),
+                materials: view(instance_materials),
             };
             let scene = SceneRefs::new(&p, spheres, triangles, materials, tree);
             // As the shader's entry points: light paths' split of path space only beside them.
             const F: u32 = ALL | INSTANCES | treelet_core::geometry::features::INDEPENDENT_NUMBERS;
             const C: u32 = F | treelet_core::geometry::features::CAUSTICS;
-            if kernel == Kernel::LightPlaced {
+            if kernel == Kernel::LightInstanced {
                 light_with::<_, C>(&p, &scene, lights, view(accum), groups);
             } else {
                 let accum: &mut [[f32; 4]] = view(accum);
                 let pixels = ((p.width * p.height) as usize).min(accum.len()).min((groups * WORKGROUP_SIZE) as usize);
-                let caustics = kernel == Kernel::RenderPlacedCaustics;
+                let caustics = kernel == Kernel::RenderInstancedCaustics;
                 accum[..pixels].par_iter_mut().enumerate().for_each(|(id, acc)| {
                     let sums = if caustics {
                         render_pixel::<_, C, 1>(id as u32, &p, &scene, lights, &mut [0u32; 1], 0)

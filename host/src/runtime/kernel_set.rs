@@ -67,9 +67,9 @@ mod tests {
         let (mut dispatches, mut named) = (0, Vec::new());
         for file in files {
             let text = std::fs::read_to_string(&file).unwrap();
-            for (at, _) in text.match_indices(".dispatch(") {
+            for (at, call) in text.match_indices(".dispatch(").chain(text.match_indices(".dispatch_with(")) {
                 dispatches += 1;
-                let first = text[at + ".dispatch(".len()..].trim_start();
+                let first = text[at + call.len()..].trim_start();
                 if first.starts_with("Kernel::") {
                     let line = text[..at].lines().count();
                     named.push(format!("{}:{line}", file.display()));

@@ -116,6 +116,15 @@ macro_rules! registration {
     };
 }
 
+/// A registered kernel's bindings, each named (the structs of [`bind`]),
+/// listed in the order its declaration gives.
+pub trait Bindings<'a, T> {
+    /// The kernel they bind (or its relaxed twin: [`Kernel::relaxed`]).
+    const KERNEL: Kernel;
+    /// The buffers in binding order.
+    fn list(&self) -> Vec<&'a T>;
+}
+
 // The enum: the kernels written out by hand below, then every kernel of
 // the two registries (`treelet_core::per_invocation_kernels!`, then
 // `treelet_core::per_workgroup_kernels!`), with their facts.
@@ -174,15 +183,15 @@ macro_rules! kernel_table {
     /// Path tracing with a closest-hit method, compiled for the feature set
     /// `treelet_core::render::variants::VARIANTS[i]` (binary layouts: the general one only).
     Render(Method, u8),
-    /// Path tracing of a scene with copies of meshes kept placed
-    /// (`treelet_core::trace::placed`): its own primitives in `bvh2`, the
+    /// Path tracing of a scene with instances of meshes
+    /// (`treelet_core::trace::with_instances`): its own primitives in `bvh2`, the
     /// copies through the instanced walk; every feature.
-    RenderPlaced,
-    /// [`Kernel::RenderPlaced`] beside light paths for caustics
-    /// ([`Kernel::LightPlaced`]): camera paths leave theirs to them.
-    RenderPlacedCaustics,
-    /// The light paths of [`Kernel::RenderPlaced`]'s scenes, for caustics.
-    LightPlaced,
+    RenderInstanced,
+    /// [`Kernel::RenderInstanced`] beside light paths for caustics
+    /// ([`Kernel::LightInstanced`]): camera paths leave theirs to them.
+    RenderInstancedCaustics,
+    /// The light paths of [`Kernel::RenderInstanced`]'s scenes, for caustics.
+    LightInstanced,
     /// The light paths of [`Kernel::Render`]'s method and feature set, for
     /// caustics (`treelet_core::render::caustics`; not for the seed layout).
     Light(Method, u8),
@@ -221,6 +230,51 @@ macro_rules! kernel_table {
                     _ => None,
                 }
             }
+        }
+
+        /// Each registered kernel's bindings by name, as its declaration in
+        /// `treelet_core::registry` names and orders them (binding 0,
+        /// `params`, first), for `Backend::dispatch_with`: a call site
+        /// names each buffer and the declaration orders them.
+        pub mod bind {
+            $(
+                #[doc = concat!("The bindings of [`Kernel::", stringify!($name), "`](super::Kernel::", stringify!($name), ").")]
+                pub struct $name<'a, T> {
+                    pub params: &'a T,
+                    $(pub $b: &'a T,)*
+                }
+                impl<'a, T> Clone for $name<'a, T> {
+                    fn clone(&self) -> Self {
+                        *self
+                    }
+                }
+                impl<'a, T> Copy for $name<'a, T> {}
+                impl<'a, T> super::Bindings<'a, T> for $name<'a, T> {
+                    const KERNEL: super::Kernel = super::Kernel::$name;
+                    fn list(&self) -> Vec<&'a T> {
+                        vec![self.params, $(self.$b),*]
+                    }
+                }
+            )*
+            $(
+                #[doc = concat!("The bindings of [`Kernel::", stringify!($wname), "`](super::Kernel::", stringify!($wname), ").")]
+                pub struct $wname<'a, T> {
+                    pub params: &'a T,
+                    $(pub $wb: &'a T,)*
+                }
+                impl<'a, T> Clone for $wname<'a, T> {
+                    fn clone(&self) -> Self {
+                        *self
+                    }
+                }
+                impl<'a, T> Copy for $wname<'a, T> {}
+                impl<'a, T> super::Bindings<'a, T> for $wname<'a, T> {
+                    const KERNEL: super::Kernel = super::Kernel::$wname;
+                    fn list(&self) -> Vec<&'a T> {
+                        vec![self.params, $(self.$wb),*]
+                    }
+                }
+            )*
         }
     };
 }
@@ -266,9 +320,9 @@ impl Kernel {
         let mut all = Self::FIXED.to_vec();
         all.extend_from_slice(Self::REGISTERED);
         all.push(Kernel::CastWideWorkgroupStack);
-        all.push(Kernel::RenderPlaced);
-        all.push(Kernel::RenderPlacedCaustics);
-        all.push(Kernel::LightPlaced);
+        all.push(Kernel::RenderInstanced);
+        all.push(Kernel::RenderInstancedCaustics);
+        all.push(Kernel::LightInstanced);
         for method in Method::ALL {
             for v in 0..VARIANTS.len() as u8 {
                 if method.specialized() || v == full {
@@ -306,9 +360,9 @@ impl Kernel {
             Kernel::HplocRelaxed => "hploc::hploc_relaxed_cs",
             Kernel::TreeletRestructure => "treelet::treelet_restructure_cs",
             Kernel::Render(method, v) => render_entry_point(method, v, false),
-            Kernel::RenderPlaced => "render::render_placed_cs",
-            Kernel::RenderPlacedCaustics => "render::render_placed_caustics_cs",
-            Kernel::LightPlaced => "render::light_placed_cs",
+            Kernel::RenderInstanced => "render::render_instanced_cs",
+            Kernel::RenderInstancedCaustics => "render::render_instanced_caustics_cs",
+            Kernel::LightInstanced => "render::light_instanced_cs",
             Kernel::Light(Method::Classic, _) => panic!("no light paths through the seed's layout"),
             Kernel::Light(method, v) => render_entry_point(method, v, true),
             Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
@@ -337,7 +391,7 @@ impl Kernel {
             Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletRestructure => &[3],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
-            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[6, 3, 4],
+            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderInstanced | Kernel::RenderInstancedCaustics | Kernel::LightInstanced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
@@ -352,9 +406,9 @@ impl Kernel {
         match self {
             Kernel::Render(..)
             | Kernel::Light(..)
-            | Kernel::RenderPlaced
-            | Kernel::RenderPlacedCaustics
-            | Kernel::LightPlaced
+            | Kernel::RenderInstanced
+            | Kernel::RenderInstancedCaustics
+            | Kernel::LightInstanced
             | Kernel::Cast(..)
             | Kernel::CastInstances => RAY_WORKGROUP_SIZE,
             _ => WORKGROUP_SIZE,
@@ -384,8 +438,8 @@ impl Kernel {
                 &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite]
             }
             Kernel::Render(..) | Kernel::Light(..) => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read],
-            // The render's, then the copies' (`render::render_placed_cs`).
-            Kernel::RenderPlaced | Kernel::RenderPlacedCaustics | Kernel::LightPlaced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
+            // The render's, then the copies' (`render::render_instanced_cs`).
+            Kernel::RenderInstanced | Kernel::RenderInstancedCaustics | Kernel::LightInstanced => &[Read, Read, Read, Read, Read, ReadWrite, Read, Read, Read, Read, Read, Read, Read, Read],
             Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[Read, Read, Read, Read, Read, ReadWrite, Read],
             _ => unreachable!("{self:?} is registered"),
         }

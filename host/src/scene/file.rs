@@ -405,7 +405,7 @@ pub fn parse_instanced_in(text: &str, name: &str, dir: &Path) -> Result<Instance
     let mut materials = sphere_materials;
     materials.extend(triangle_materials);
     let loose =
-        Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, environment: file.environment, triangles, placed: None };
+        Scene { name: name.into(), spheres, materials, room: 0, camera: file.camera, environment: file.environment, triangles, instances: None };
     Ok(InstancedScene { loose, meshes, instances })
 }
 

@@ -98,7 +98,7 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
         (None, None, Some(node)) => bail!(
             "{name}: node {node}: orthographic cameras are not supported (perspective only); remove it to get a camera that frames the scene"
         ),
-        (None, None, None) => framing(placed_bounds(&out.meshes, &out.instances)),
+        (None, None, None) => framing(instances_bounds(&out.meshes, &out.instances)),
     };
     // A file without lights would render black: a uniform sky lights it,
     // as glTF viewers light such files by a default environment.
@@ -113,7 +113,7 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
         eprintln!("note: {name}: nothing in it emits light; a uniform white sky lights it (render --environment R,G,B sets another)");
         DEFAULT_SKY
     };
-    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, environment, triangles: Vec::new(), placed: None };
+    let loose = Scene { name, spheres: Vec::new(), materials: Vec::new(), room: 0, camera, environment, triangles: Vec::new(), instances: None };
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
 }
 
@@ -123,7 +123,7 @@ pub const DEFAULT_SKY: [f32; 3] = [1.0; 3];
 
 /// The box of every instance's mesh box, placed (each placed box's eight
 /// corners; the triangles' own box where the transforms keep axes).
-fn placed_bounds(meshes: &[SceneMesh], instances: &[SceneInstance]) -> (Vec3, Vec3) {
+fn instances_bounds(meshes: &[SceneMesh], instances: &[SceneInstance]) -> (Vec3, Vec3) {
     let boxes: Vec<(Vec3, Vec3)> = meshes
         .iter()
         .map(|m| {

@@ -10,14 +10,15 @@
 //! ([`InstancedScene::flatten`]), and refuse, naming the counts, a
 //! flattening past the primitive limit or the memory the machine has: a
 //! thousand copies of a million-triangle mesh are 36 GB flattened.
+
 use anyhow::{bail, Result};
 use glam::Vec3;
 use treelet_core::geometry::buffers::Material;
 use treelet_core::geometry::triangle::Triangle;
 
 use super::model::Scene;
-use super::placed::PlacedCopies;
-pub use super::placed::{SceneInstance, SceneMesh};
+use super::instances::SceneInstances;
+pub use super::instances::{SceneInstance, SceneMesh};
 use super::primitives::{Primitives, MAX_PRIMITIVES};
 use crate::runtime::memory;
 
@@ -50,38 +51,38 @@ impl InstancedScene {
     }
 
     /// The scene as `render` traces it: where a mesh is placed more than
-    /// once, the copies stay placed ([`Scene::placed`], traced through
-    /// their meshes' own trees: `treelet_core::trace::placed`), but for
+    /// once, the copies stay placed ([`Scene::instances`], traced through
+    /// their meshes' own trees: `treelet_core::trace::with_instances`), but for
     /// copies that emit light, flattened among the scene's own triangles
     /// (the light table samples emitters one by one). Without a mesh
     /// placed twice, flattened as [`Self::flatten`] does.
     pub fn for_render(self) -> Result<Scene> {
         let InstancedScene { loose, meshes, instances } = self;
         let repeated = instances.len() > meshes.len();
-        let (lit, kept): (Vec<_>, Vec<_>) = instances.into_iter().partition(|i| !repeated || PlacedCopies::emits(&meshes, i));
+        let (lit, kept): (Vec<_>, Vec<_>) = instances.into_iter().partition(|i| !repeated || SceneInstances::emits(&meshes, i));
         if kept.is_empty() {
-            return flatten_into(loose, &meshes, &lit, "no copy is kept placed");
+            return flatten_into(loose, &meshes, &lit, "no mesh is instanced more than once");
         }
         let name = loose.name.clone();
         let own = flatten_into(loose, &meshes, &lit, "the lamps among them, flattened")?;
-        let copies = PlacedCopies { meshes, instances: kept };
+        let copies = SceneInstances { meshes, instances: kept };
         let placed = copies.triangles();
         let numbered = own.spheres.len() as u64 + own.triangles.len() as u64 + placed;
         if numbered >= u32::MAX as u64 {
             bail!(
-                "{name}: {} copies place {placed} triangles beside the scene's own {}: the renderer numbers primitives in 32 bits (at most {})",
+                "{name}: {} instances place {placed} triangles beside the scene's own {}: the renderer numbers primitives in 32 bits (at most {})",
                 copies.instances.len(),
                 own.spheres.len() + own.triangles.len(),
                 u32::MAX - 1
             );
         }
         eprintln!(
-            "note: {name}: {} copies of {} kept placed ({placed} triangles, traced through each mesh's own tree{})",
+            "note: {name}: {} instances of {} ({placed} triangles, traced through each mesh's own tree{})",
             copies.instances.len(),
             plural(copies.meshes.len(), "mesh", "meshes"),
             if lit.is_empty() { String::new() } else { format!("; {} that emit light flattened", lit.len()) }
         );
-        Ok(Scene { placed: Some(std::sync::Arc::new(copies)), ..own })
+        Ok(Scene { instances: Some(std::sync::Arc::new(copies)), ..own })
     }
 
     /// A scene of loose primitives alone (no meshes to place).

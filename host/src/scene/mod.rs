@@ -6,18 +6,18 @@
 //! spheres-then-triangles view a build takes (and its checks), [`mesh`]
 //! reads `.obj` / `.ply` ([`ply`] writes one), [`file`](mod@file) reads JSON scene files,
 //! [`gltf`](mod@gltf) glTF 2.0 ones, [`instanced`] keeps their meshes placed by
-//! reference (and flattens them), [`placed`] the copies a render keeps
-//! placed, and [`spec`]
+//! reference (and flattens them), [`instances`] the meshes and
+//! instances a render keeps, and [`spec`]
 //! parses the names the command line takes ([`Scene::from_spec`]).
 pub mod builtin;
 pub mod city;
 pub mod file;
 pub mod gltf;
 pub mod instanced;
+pub mod instances;
 pub mod json_keys;
 pub mod mesh;
 pub mod model;
-pub mod placed;
 pub mod ply;
 mod obj_plain;
 mod ply_binary;

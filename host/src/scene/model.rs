@@ -7,7 +7,7 @@ use treelet_core::geometry::buffers::{Camera, DIFFUSE, GLASS, MIRROR, Material, 
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::render::integrator::SMALLPT_FOV;
 
-use crate::scene::placed::PlacedCopies;
+use crate::scene::instances::SceneInstances;
 use crate::scene::primitives::Primitives;
 
 /// Where random scenes place sphere centres: smallpt's room, short of the
@@ -34,12 +34,12 @@ pub struct Scene {
     /// Triangles of a mesh scene (`treelet build` builds over them; they
     /// are not rendered yet).
     pub triangles: Vec<Triangle>,
-    /// Copies of meshes beside the primitives above, kept placed by
-    /// reference: only `render` takes a scene with them
+    /// Instances of meshes beside the primitives above (each mesh stored
+    /// once): only `render` takes a scene with them
     /// ([`crate::scene::instanced::InstancedScene::for_render`]); every
     /// other command loads scenes flattened ([`Scene::from_spec`]), with
     /// none.
-    pub placed: Option<std::sync::Arc<PlacedCopies>>,
+    pub instances: Option<std::sync::Arc<SceneInstances>>,
 }
 
 /// Where the camera is; the image size comes from the render.
@@ -126,7 +126,7 @@ pub fn cornell() -> Scene {
             light,
         ])
         .unzip();
-    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), placed: None }
+    Scene { name: "cornell".into(), spheres, materials, room: 0, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), instances: None }
 }
 
 /// `terrain:N`: a height field of about N triangles (a square grid, two per
@@ -168,7 +168,7 @@ pub fn mesh_scene(name: &str, mesh: &[Triangle]) -> Scene {
     let (spheres, mut materials): (Vec<_>, Vec<_>) = cornell_room().into_iter().unzip();
     let room = spheres.len();
     materials.extend(std::iter::repeat_n(diffuse([0.8, 0.78, 0.72]), triangles.len()));
-    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles, placed: None }
+    Scene { name: name.into(), spheres, materials, room, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles, instances: None }
 }
 
 /// smallpt's walls and light (radius 600, poking 0.27 through the ceiling),
@@ -205,14 +205,14 @@ impl Scene {
         if self.environment != [0.0; 3] {
             field(bytemuck::cast_slice(&self.environment));
         }
-        // Copies kept placed: each mesh, then each copy's mesh, transform
+        // Instances: each mesh, then each copy's mesh, transform
         // and material.
-        if let Some(placed) = &self.placed {
-            for mesh in &placed.meshes {
+        if let Some(copies) = &self.instances {
+            for mesh in &copies.meshes {
                 field(bytemuck::cast_slice(&mesh.triangles));
                 field(bytemuck::cast_slice(&mesh.materials));
             }
-            for instance in &placed.instances {
+            for instance in &copies.instances {
                 field(&instance.mesh.to_le_bytes());
                 field(bytemuck::cast_slice(&instance.rows()));
                 field(instance.material.as_ref().map_or(&[][..], bytemuck::bytes_of));
@@ -221,15 +221,15 @@ impl Scene {
         h.finish()
     }
 
-    /// Primitives a render builds trees over: the scene's own, each placed
+    /// Primitives a render builds trees over: the scene's own, each instanced
     /// mesh's triangles once, and a top-level leaf per copy (what memory
     /// estimates count).
     pub fn traced_primitives(&self) -> u64 {
         let own = (self.spheres.len() + self.triangles.len()) as u64;
-        let placed = self.placed.as_ref().map_or(0, |p| {
+        let copied = self.instances.as_ref().map_or(0, |p| {
             p.meshes.iter().map(|m| m.triangles.len() as u64).sum::<u64>() + p.instances.len() as u64
         });
-        own + placed
+        own + copied
     }
 
     /// The spheres `treelet build` builds over: all but the room.
@@ -256,7 +256,7 @@ impl Scene {
             camera,
             environment: [0.0; 3],
             triangles: self.triangles.clone(),
-            placed: None,
+            instances: None,
         })
     }
 
@@ -292,7 +292,7 @@ pub fn random_scene(name: &str, n: usize, seed: u64) -> Scene {
         spheres.push(s);
         materials.push(m);
     }
-    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), placed: None }
+    Scene { name: name.into(), spheres, materials, room: room_len, camera: CameraSpec::SMALLPT, environment: [0.0; 3], triangles: Vec::new(), instances: None }
 }
 
 /// `n` spheres with uniform random centres inside the Cornell box and random

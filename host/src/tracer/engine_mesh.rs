@@ -14,7 +14,7 @@ use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use crate::bvh::layout::PrimBuffers;
 use crate::runtime::backend::Backend;
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernel gathering an engine's mesh into triangles.
@@ -153,7 +153,8 @@ pub(super) fn gather<B: Backend>(b: &mut B, mesh: &MeshBuffers<B>, into: Option<
     };
     let p = b.upload("gather params", &[mesh.params(b, index_base)?])?;
     let flags = b.upload("gather flags", &[u32::MAX; 2])?;
-    b.dispatch(GatherKernels::of(b).gather, &[&p, mesh.vertices, &indices, &triangles, &flags], groups_for(n, WORKGROUP_SIZE));
+    let gather = bind::GatherTriangles { params: &p, vertices: mesh.vertices, indices: &indices, out: &triangles, flags: &flags };
+    b.dispatch_with(GatherKernels::of(b).gather, gather, groups_for(n, WORKGROUP_SIZE));
     let flags = b.read::<u32>(&flags, 2)?;
     if flags[0] != u32::MAX {
         return Err(crate::error::input(format!("engine mesh: triangle {} names a vertex past the {} vertices", flags[0], mesh.vertex_count)));

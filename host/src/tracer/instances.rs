@@ -1,7 +1,7 @@
 //! Instanced scenes for engines: each mesh gets its own (bottom-level)
 //! tree, built once and refit or rebuilt only when the mesh changes; the
 //! scene places meshes many times with 3x4 transforms, and a top-level tree
-//! over the placed copies, cheap to rebuild every frame, finds which copies
+//! over the instances, cheap to rebuild every frame, finds which copies
 //! a ray meets. Both levels are traced in one kernel
 //! (`treelet_core::trace::instances`), on the GPU or the CPU runner.
 //!
@@ -21,7 +21,7 @@
 //! # anyhow::Ok(())
 //! ```
 use anyhow::{Context, Result};
-use treelet_core::geometry::buffers::{LayoutParams, MeshRecord, PlacedMesh, RenderParams};
+use treelet_core::geometry::buffers::{LayoutParams, MeshRecord, InstanceDesc, RenderParams};
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{groups_for, WORKGROUP_SIZE};
 use treelet_core::render::integrator::tiled_invocations;
@@ -35,7 +35,7 @@ use super::rays::{batch_dims, Ray, RayHit};
 use crate::bvh::lbvh;
 use crate::runtime::backend::{Backend, StageTimes};
 use crate::runtime::kernel_set::kernel_set;
-use crate::runtime::kernels::Kernel;
+use crate::runtime::kernels::{bind, Kernel};
 
 kernel_set! {
     /// The kernels of an instanced world's top level and walk (the meshes'
@@ -101,12 +101,12 @@ struct TopLevel<B: Backend> {
     count: u32,
 }
 
-/// The buffers a render binds for its placed copies
-/// ([`InstancedTracer::placed_bindings`]): the instances' records (a
+/// The buffers a render binds for its instances
+/// ([`InstancedTracer::instance_bindings`]): the instances' records (a
 /// placeholder without any), every node (the top level, then each mesh's
 /// tree), leaf primitive and triangle, and where each mesh's triangles
 /// start.
-pub(crate) struct PlacedBindings<'a, B: Backend> {
+pub(crate) struct InstanceBindings<'a, B: Backend> {
     pub records: &'a B::Buffer,
     pub nodes: &'a B::Buffer,
     pub leaves: &'a B::Buffer,
@@ -247,20 +247,20 @@ impl<B: Backend> InstancedTracer<B> {
     /// rebuilds the top-level tree only.
     pub fn set_instances(&mut self, b: &mut B, instances: &[Instance]) -> crate::error::Result<()> {
         crate::error::typed(|| {
-            let placed = self.placed(instances)?;
+            let descs = self.descs(instances)?;
             self.instances = instances.to_vec();
             self.top = None;
             self.update_ms = 0.0;
             if instances.is_empty() {
                 return Ok(());
             }
-            let needed = top_nodes_for(placed.len());
+            let needed = top_nodes_for(descs.len());
             if needed > self.gathered.top_capacity {
                 // Room for twice as many, so that a growing scene gathers its
                 // meshes again only now and then.
                 self.gathered = gather(b, &self.meshes, &self.bounds, needed.saturating_mul(2))?;
             }
-            let (top, stages) = build_top_level(b, &placed, &self.gathered)?;
+            let (top, stages) = build_top_level(b, &descs, &self.gathered)?;
             self.top = Some(top);
             self.update_ms = stages.total();
             self.top_stages = stages;
@@ -398,10 +398,10 @@ impl<B: Backend> InstancedTracer<B> {
     }
 
     /// What a render kernel binds of these copies
-    /// (`treelet_core::trace::placed`).
-    pub(crate) fn placed_bindings(&self) -> PlacedBindings<'_, B> {
+    /// (`treelet_core::trace::with_instances`).
+    pub(crate) fn instance_bindings(&self) -> InstanceBindings<'_, B> {
         let g = &self.gathered;
-        PlacedBindings {
+        InstanceBindings {
             records: self.top.as_ref().map_or(&self.no_instances, |t| &t.records),
             nodes: &g.nodes,
             leaves: &g.leaves,
@@ -413,7 +413,7 @@ impl<B: Backend> InstancedTracer<B> {
     }
 
     /// `instances` as the top level's build reads them, after checking them.
-    fn placed(&self, instances: &[Instance]) -> Result<Vec<PlacedMesh>> {
+    fn descs(&self, instances: &[Instance]) -> Result<Vec<InstanceDesc>> {
         if instances.len() > (u32::MAX / 2) as usize {
             return Err(crate::error::too_large(format!("{} instances: at most {} are supported", instances.len(), u32::MAX / 2)));
         }
@@ -425,25 +425,26 @@ impl<B: Backend> InstancedTracer<B> {
                     return Err(crate::error::input(format!("instances[{k}] places mesh {}, but there are {} meshes", i.mesh, self.meshes.len())));
                 }
                 check_transform(&i.transform).with_context(|| format!("instances[{k}]"))?;
-                Ok(PlacedMesh { world_from_object: i.transform, mesh: i.mesh, _pad: [0; 3] })
+                Ok(InstanceDesc { world_from_object: i.transform, mesh: i.mesh, _pad: [0; 3] })
             })
             .collect()
     }
 }
 
-/// The top level over `placed` (at least one), on the device: the
+/// The top level over `descs` (at least one), on the device: the
 /// instances' records and world boxes (`treelet_core::construct::instances`)
 /// as the LBVH's first pass, the LBVH (one instance a leaf), and its `bvh2`
 /// nodes in the LBVH's order (no compaction: leaves refer to instances),
 /// written at the start of the gathered nodes, its depth checked against
 /// the walk's stack in the same dispatch.
-fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>) -> Result<(TopLevel<B>, StageTimes)> {
-    let n = placed.len() as u32;
+fn build_top_level<B: Backend>(b: &mut B, descs: &[InstanceDesc], g: &Gathered<B>) -> Result<(TopLevel<B>, StageTimes)> {
+    let n = descs.len() as u32;
     let mut records = None;
     let (bvh, mut stages) = lbvh::build_over_boxes(b, n, |b, p, boxes, bounds, groups| {
-        let input = b.upload("placed meshes", placed)?;
+        let input = b.upload("instance descs", descs)?;
         let out = b.scratch("instance records", n as u64 * 64)?;
-        b.dispatch(InstanceKernels::of(b).bounds, &[p, &input, &g.meshes, &out, boxes, bounds], groups);
+        let bounds = bind::InstanceBounds { params: p, descs: &input, meshes: &g.meshes, records: &out, boxes, bounds };
+        b.dispatch_with(InstanceKernels::of(b).bounds, bounds, groups);
         records = Some(out);
         Ok(())
     })?;
@@ -451,12 +452,12 @@ fn build_top_level<B: Backend>(b: &mut B, placed: &[PlacedMesh], g: &Gathered<B>
     // The nodes, and the depth checked in the same dispatch (the scene is
     // refused after, if too deep: nothing traces the nodes before).
     b.stage("layout");
-    let internal = top_nodes_for(placed.len());
+    let internal = top_nodes_for(descs.len());
     anyhow::ensure!(internal <= g.top_capacity, "internal: no room for the top level");
     let p = b.upload("layout params", &[LayoutParams { n, nodes: bvh.node_count, ..Default::default() }])?;
     let deepest = b.zeroed("tree depth", 4)?;
-    let bindings = [&p, &bvh.nodes, &bvh.prim_indices, &g.nodes, &bvh.parents, &deepest];
-    b.dispatch(InstanceKernels::of(b).top_nodes, &bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
+    let bindings = bind::TopLevelNodes { params: &p, nodes: &bvh.nodes, prim_indices: &bvh.prim_indices, out: &g.nodes, parents: &bvh.parents, deepest: &deepest };
+    b.dispatch_with(InstanceKernels::of(b).top_nodes, bindings, groups_for(bvh.node_count.max(internal), WORKGROUP_SIZE));
     let deepest = b.read::<u32>(&deepest, 1)?[0];
     if deepest as usize + 1 > STACK_DEPTH {
         return Err(crate::error::too_large(format!("the top level is {deepest} or more levels deep; traversal supports {}", STACK_DEPTH - 1)));

@@ -23,7 +23,7 @@ mod figure;
 mod instances;
 mod load;
 mod measure;
-mod placed;
+mod file_instances;
 mod rays_suite;
 pub mod results;
 mod suite;
@@ -246,8 +246,10 @@ pub enum BenchCommand {
     },
     /// A scene file's or glTF file's own instances (meshes placed by
     /// reference) through the engine API, against the same scene
-    /// flattened: memory, build time, rays per second, top-level rebuild.
-    Placed {
+    /// flattened: memory, build time, rays per second, top-level rebuild
+    /// (also named placed, its name before).
+    #[command(alias = "placed")]
+    FileInstances {
         /// A .gltf/.glb or .json scene that places meshes.
         #[arg(long)]
         scene: std::path::PathBuf,
@@ -378,14 +380,14 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
             }
             Ok(())
         }
-        BenchCommand::Placed { scene, width, height, device, repeats, json } => {
+        BenchCommand::FileInstances { scene, width, height, device, repeats, json } => {
             let scene = treelet::scene::instanced::InstancedScene::load(&scene)?;
             let device = device.open()?;
             let before = clocks::read();
-            let (adapter, row) = treelet::with_backend!(&device, |b| (b.adapter(), placed::bench_placed(b, &scene, (width, height), repeats)?));
+            let (adapter, row) = treelet::with_backend!(&device, |b| (b.adapter(), file_instances::bench_file_instances(b, &scene, (width, height), repeats)?));
             let clocks = matches!(device, Device::Gpu(_)).then(|| (before, clocks::read()));
             println!(
-                "{}: {} mesh(es) placed {} times ({} triangles kept, {} flattened), {width}x{height}, {adapter}, median of {repeats}",
+                "{}: {} mesh(es), {} instances ({} triangles kept, {} flattened), {width}x{height}, {adapter}, median of {repeats}",
                 scene.loose.name, row.meshes, row.instances, row.triangles_kept, row.triangles_flattened
             );
             if let Some((before, after)) = clocks {

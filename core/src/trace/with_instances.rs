@@ -1,4 +1,4 @@
-//! Scenes with placed copies of meshes, as the renderer traces them: the
+//! Scenes with instances of meshes, as the renderer traces them: the
 //! scene's own primitives through their tree (any [`ClosestHit`]), then the
 //! copies through the instanced walk ([`crate::trace::instances`]) up to
 //! the hit found, so that a copy is never flattened into the scene's
@@ -7,35 +7,35 @@
 //! Primitives keep one index space, so that the path tracer shades, skips
 //! and samples by index as it does without copies: the scene's own first
 //! (`0..prims.count()`), then each copy's triangles in turn, from its
-//! [`PlacedInfo::first`] on. Lamps are never placed: the host keeps the
+//! [`InstanceInfo::first`] on. Lamps are never placed: the host keeps the
 //! copies of an emitting mesh among the scene's own triangles, where the
 //! light table samples them one by one.
 use glam::Vec3;
 
-use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, Material, PlacedInfo, NO_MATERIAL};
+use crate::geometry::buffers::{Bvh2Node, InstanceRecord, LeafPrim, Material, InstanceInfo, NO_MATERIAL};
 use crate::geometry::prims::{Origin, Prims};
 use crate::geometry::records::RecordLoad;
 use crate::trace::bvh2::Level;
 use crate::trace::hit::{ClosestHit, Hit, Query};
 use crate::trace::instances::trace_instances;
 
-/// A scene's own tree (`own`) and the placed copies beside it: `count`
-/// instances (records and [`PlacedInfo`]s, in the same order, `first`
+/// A scene's own tree (`own`) and the instances beside it: `count`
+/// instances (records and [`InstanceInfo`]s, in the same order, `first`
 /// rising), the top level and every mesh's tree in `trees` (as
 /// [`trace_instances`] walks them), every mesh's triangles in `meshes`
 /// (no spheres), and `materials`: one per mesh triangle (at the mesh's
 /// `triangle_base`), then the copies' own.
-pub struct PlacedScene<'a, T, I: ?Sized, N: ?Sized, L: ?Sized> {
+pub struct SceneWithInstances<'a, T, I: ?Sized, N: ?Sized, L: ?Sized> {
     pub own: T,
     pub instances: &'a I,
-    pub info: &'a [PlacedInfo],
+    pub info: &'a [InstanceInfo],
     pub count: u32,
     pub trees: Level<'a, N, L>,
     pub meshes: Prims<'a>,
     pub materials: &'a [Material],
 }
 
-impl<T, I, N, L> ClosestHit for PlacedScene<'_, T, I, N, L>
+impl<T, I, N, L> ClosestHit for SceneWithInstances<'_, T, I, N, L>
 where
     T: ClosestHit,
     I: RecordLoad<InstanceRecord> + ?Sized,
@@ -69,18 +69,18 @@ where
             return own;
         }
         let copies = Query { t_max: own.t, skip: u32::MAX, any: query.any };
-        let placed = trace_instances(o, d, copies, self.instances, self.trees.nodes, self.trees.leaves, &self.meshes);
-        let beats = placed.t < own.t || (placed.t == own.t && !prims.is_sphere::<F>(own.prim));
-        if placed.is_hit() && beats {
-            let first = self.info[placed.instance as usize].first;
-            Hit { t: placed.t, prim: prims.count() + first + placed.prim }
+        let inst = trace_instances(o, d, copies, self.instances, self.trees.nodes, self.trees.leaves, &self.meshes);
+        let beats = inst.t < own.t || (inst.t == own.t && !prims.is_sphere::<F>(own.prim));
+        if inst.is_hit() && beats {
+            let first = self.info[inst.instance as usize].first;
+            Hit { t: inst.t, prim: prims.count() + first + inst.prim }
         } else {
             own
         }
     }
 
     #[inline]
-    fn placed_surface(&self, k: u32, d: Vec3) -> (Material, Vec3) {
+    fn instance_surface(&self, k: u32, d: Vec3) -> (Material, Vec3) {
         // The copy holding triangle k: the last whose first is k or less.
         let (mut lo, mut hi) = (0u32, self.count);
         while hi - lo > 1 {

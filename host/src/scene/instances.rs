@@ -1,8 +1,10 @@
-//! Meshes placed by reference: each mesh once, in its own space, and its
-//! copies (a transform each). [`crate::scene::instanced::InstancedScene`]
-//! holds them as a glTF file or a scene file gives them; a [`Scene`](super::Scene)
-//! that `render` traces may keep them placed ([`Scene::placed`](super::Scene::placed):
-//! `treelet_core::trace::placed`) instead of flattened.
+//! Instances of meshes, as scenes hold them: each mesh once, in its own
+//! space ([`SceneMesh`]), and its instances (a transform each,
+//! [`SceneInstance`]). [`crate::scene::instanced::InstancedScene`] holds them
+//! as a glTF file or a scene file gives them; a [`Scene`](super::Scene)
+//! that `render` traces may keep them ([`SceneInstances`] in
+//! [`Scene::instances`](super::Scene::instances):
+//! `treelet_core::trace::with_instances`) instead of flattened.
 use glam::Affine3A;
 use treelet_core::geometry::buffers::Material;
 use treelet_core::geometry::triangle::Triangle;
@@ -19,7 +21,7 @@ pub struct SceneMesh {
 /// A placed copy of a mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneInstance {
-    /// Index into the meshes it places ([`PlacedCopies::meshes`],
+    /// Index into the meshes it places ([`SceneInstances::meshes`],
     /// [`crate::scene::instanced::InstancedScene::meshes`]).
     pub mesh: u32,
     /// Mesh space to world space (affine).
@@ -43,12 +45,12 @@ impl SceneInstance {
 /// place `meshes`. None of them emits light (lamps stay among the scene's
 /// own primitives, where the light table samples them).
 #[derive(Clone, Debug, Default)]
-pub struct PlacedCopies {
+pub struct SceneInstances {
     pub meshes: Vec<SceneMesh>,
     pub instances: Vec<SceneInstance>,
 }
 
-impl PlacedCopies {
+impl SceneInstances {
     /// Triangles of every copy, as many as the scene has flattened.
     pub fn triangles(&self) -> u64 {
         self.instances.iter().map(|i| self.meshes[i.mesh as usize].triangles.len() as u64).sum()

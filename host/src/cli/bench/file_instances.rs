@@ -1,4 +1,4 @@
-//! `bench placed`: a scene file's or glTF file's own instances (meshes
+//! `bench file-instances`: a scene file's or glTF file's own instances (meshes
 //! placed by reference, `treelet::scene::instanced`) through the engine
 //! API, against the same scene flattened into one mesh: what the instances
 //! save in memory and build time, what they cost in rays per second, and
@@ -19,7 +19,7 @@ use super::measure::median;
 
 /// Medians (ms: device time on a GPU, wall clock on the CPU runner).
 #[derive(Debug, serde::Serialize)]
-pub(crate) struct PlacedRow {
+pub(crate) struct FileInstancesRow {
     pub(crate) meshes: usize,
     pub(crate) instances: usize,
     /// Triangles kept (each mesh once) and once flattened.
@@ -42,23 +42,23 @@ pub(crate) struct PlacedRow {
     pub(crate) hits_differ: usize,
 }
 
-/// `bench placed` on `b`: see the module doc.
-pub(crate) fn bench_placed<B: Backend>(
+/// `bench file-instances` on `b`: see the module doc.
+pub(crate) fn bench_file_instances<B: Backend>(
     b: &mut B,
     scene: &InstancedScene,
     size: (u32, u32),
     repeats: usize,
-) -> Result<PlacedRow> {
+) -> Result<FileInstancesRow> {
     if scene.instances.is_empty() {
-        bail!("bench placed traces a file's instances: `{}` places no mesh (give a .gltf/.glb or .json scene with meshes)", scene.loose.name);
+        bail!("bench file-instances traces a file's instances: `{}` places no mesh (give a .gltf/.glb or .json scene with meshes)", scene.loose.name);
     }
     if repeats == 0 || size.0 == 0 || size.1 == 0 {
-        bail!("bench placed needs one repeat and one ray");
+        bail!("bench file-instances needs one repeat and one ray");
     }
     let flat = scene.clone().flatten()?;
     let kept = scene.meshes.iter().map(|m| m.triangles.len()).sum::<usize>() + scene.loose.triangles.len();
-    let placed = InstancedTracer::build_scene(b, scene, Quality::High)?;
-    let build_instanced_ms = placed.last_update_ms();
+    let instanced = InstancedTracer::build_scene(b, scene, Quality::High)?;
+    let build_instanced_ms = instanced.last_update_ms();
     let whole = Tracer::build(b, &flat.spheres, &flat.triangles, Quality::High)?;
     let build_flattened_ms = whole.last_update_ms();
 
@@ -72,8 +72,8 @@ pub(crate) fn bench_placed<B: Backend>(
         extent,
         repeats,
         &Traced {
-            closest: &|b, r| Ok(placed.closest_hits(b, r)?),
-            on_device: &|b, r, n| Ok(placed.closest_hits_on_device(b, r, n)?),
+            closest: &|b, r| Ok(instanced.closest_hits(b, r)?),
+            on_device: &|b, r, n| Ok(instanced.closest_hits_on_device(b, r, n)?),
         },
     )?;
     let (fp, fd, _, _) = rays_per_second(
@@ -89,7 +89,7 @@ pub(crate) fn bench_placed<B: Backend>(
     )?;
 
     // The same hits: flattened triangle k is instance i's triangle p.
-    let owner: Vec<(u32, u32)> = placed
+    let owner: Vec<(u32, u32)> = instanced
         .instances()
         .iter()
         .enumerate()
@@ -103,7 +103,7 @@ pub(crate) fn bench_placed<B: Backend>(
         })
         .collect();
     let rays = camera_rays(framing, OBLIQUE, size);
-    let a = placed.closest_hits(b, &rays)?;
+    let a = instanced.closest_hits(b, &rays)?;
     let f = whole.closest_hits(b, &rays)?;
     let hits_differ = a
         .iter()
@@ -116,20 +116,20 @@ pub(crate) fn bench_placed<B: Backend>(
     drop(whole);
 
     // The top level again over the same placements (one warm-up).
-    let mut placed = placed;
-    let instances: Vec<Instance> = placed.instances().to_vec();
+    let mut instanced = instanced;
+    let instances: Vec<Instance> = instanced.instances().to_vec();
     let (mut device, mut wall) = (Vec::new(), Vec::new());
     for k in 0..=repeats {
         b.take_times()?;
         let start = Instant::now();
-        placed.set_instances(b, &instances)?;
+        instanced.set_instances(b, &instances)?;
         b.take_times()?;
         if k > 0 {
-            device.push(placed.last_update_ms());
+            device.push(instanced.last_update_ms());
             wall.push(start.elapsed().as_secs_f64() * 1e3);
         }
     }
-    Ok(PlacedRow {
+    Ok(FileInstancesRow {
         meshes: scene.meshes.len(),
         instances: scene.instances.len(),
         triangles_kept: kept,
