@@ -188,7 +188,10 @@ fn round_trip<B: Backend>(b: &mut B, seed: u64, quality: Quality) -> Vec<RayHit>
 fn instanced_scenes_hit_what_the_flattened_scene_hits() {
     let seed = fresh_seed();
     for quality in [Quality::Fast, Quality::High] {
-        let cpu = round_trip(&mut CpuBackend::new(), seed, quality);
+        let mut b = CpuBackend::new();
+        let cpu = round_trip(&mut b, seed, quality);
+        // Builds prepared every pipeline the scene then used.
+        assert!(b.kernels_not_prepared().is_empty(), "{quality:?}: not built ahead: {:?}", b.kernels_not_prepared());
         if let Some(ctx) = gpu() {
             let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);
             // Same kernels, same trees: the same hits but for rounding.

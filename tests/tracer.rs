@@ -147,7 +147,11 @@ fn tracer_finds_the_scans_hits_before_and_after_a_refit() {
     let seed = fresh_seed();
     // ForRays: every device class picks the LBVH for one ray and the treelets for 2^40.
     for quality in [Quality::Fast, Quality::High, Quality::Balanced, Quality::ForRays(1), Quality::ForRays(1 << 40)] {
-        let cpu = round_trip(&mut CpuBackend::new(), seed, quality);
+        let mut b = CpuBackend::new();
+        let cpu = round_trip(&mut b, seed, quality);
+        // The build prepared every pipeline the tracer then used (on a GPU:
+        // none compiled in the middle of a frame).
+        assert!(b.kernels_not_prepared().is_empty(), "{quality:?}: not built ahead: {:?}", b.kernels_not_prepared());
         if let Some(ctx) = gpu() {
             let gpu = round_trip(&mut GpuBackend::new(ctx), seed, quality);
             // Same kernels, same tree: the same primitives, distances within rounding.

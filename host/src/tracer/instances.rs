@@ -197,6 +197,8 @@ impl<B: Backend> InstancedTracer<B> {
     /// The scene over meshes whose trees are built: their layouts gathered,
     /// then the top level over `instances`.
     fn from_trees(b: &mut B, trees: Vec<Tracer<B>>, bounds: Vec<[[f64; 3]; 2]>, instances: &[Instance], update_ms: f64) -> Result<Self> {
+        // The top level's kernels (the meshes' trees prepared theirs).
+        b.prepare_kernels(&[lbvh::kernels(b), InstanceKernels::of(b).all()].concat());
         let gathered = gather(b, &trees, &bounds, top_nodes_for(instances.len()))?;
         let no_spheres = b.upload("no spheres", &[treelet_core::Sphere::default()])?;
         let no_instances = b.zeroed("no instances", 64)?;

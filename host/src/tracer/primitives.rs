@@ -14,7 +14,31 @@ use crate::bvh::layout::{Layout, PrimBuffers, TracedTree};
 use crate::bvh::refit::{refit_bvh2, refit_uploaded};
 use crate::bvh::tree::{binary_tree, binary_tree_uploaded, split_budget, Builder, BuiltTree};
 use crate::runtime::backend::{Backend, DeviceClass};
+use crate::runtime::kernel_set::kernel_set;
 use crate::runtime::kernels::{Kernel, Method};
+
+kernel_set! {
+    /// The kernels casting an engine's rays through a tracer's `bvh2` tree.
+    pub struct CastKernels for b {
+        /// Every kind of primitive.
+        any: Kernel::Cast(Method::Bvh2, false),
+        /// Triangles alone (no spheres: a mesh).
+        triangles: Kernel::Cast(Method::Bvh2, true),
+    }
+}
+
+/// The kernels a tracer with trees of `builder` dispatches on `b`: its
+/// build, the `bvh2` layout, refits and gathers from an engine's buffers,
+/// and casts. A build prepares them all at once, so that a GPU's driver
+/// compiles them side by side rather than one at a time as first used.
+pub(crate) fn kernels<B: Backend>(b: &B, builder: Builder) -> Vec<Kernel> {
+    let mut k = crate::bvh::tree::build_kernels(b, builder, split_budget(builder), &crate::bvh::trbvh::TreeletConfig::default());
+    k.extend(crate::bvh::layout::kernels(b, Layout::Bvh2));
+    k.extend(crate::bvh::refit::RefitBvh2Kernels::of(b).all());
+    k.extend(super::engine_mesh::GatherKernels::of(b).all());
+    k.extend(CastKernels::of(b).all());
+    k
+}
 use crate::scene::primitives::Primitives;
 
 /// How much build time to spend for faster rays.
@@ -81,7 +105,9 @@ impl<B: Backend> Tracer<B> {
         crate::error::typed(|| {
             let all = Primitives { spheres, triangles };
             all.check()?;
-            let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, quality.builder(b.class(), all.len()))?) };
+            let builder = quality.builder(b.class(), all.len());
+            b.prepare_kernels(&kernels(b, builder));
+            let built = if all.len() == 0 { None } else { Some(binary_tree(b, all, builder)?) };
             let prims = match &built {
                 Some(t) => t.prim_buffers(b, all)?,
                 None => PrimBuffers::upload(b, all)?,
@@ -114,19 +140,17 @@ impl<B: Backend> Tracer<B> {
     /// seen unless submitted before.
     pub fn build_from_buffers(b: &mut B, mesh: &MeshBuffers<B>, quality: Quality) -> crate::error::Result<Self> {
         crate::error::typed(|| {
+            let n = mesh.triangle_count as usize;
+            let builder = match quality.builder(b.class(), n) {
+                // The CPU builders take host primitives: the device's best instead.
+                Builder::Sweep | Builder::Reference => Builder::Trbvh,
+                builder => builder,
+            };
+            b.prepare_kernels(&kernels(b, builder));
             b.begin_build();
             let prims = gather(b, mesh, None)?;
             let n = prims.triangle_count as usize;
-            let built = if n == 0 {
-                None
-            } else {
-                let builder = match quality.builder(b.class(), n) {
-                    // The CPU builders take host primitives: the device's best instead.
-                    Builder::Sweep | Builder::Reference => Builder::Trbvh,
-                    builder => builder,
-                };
-                Some(binary_tree_uploaded(b, &prims, builder, split_budget(builder))?)
-            };
+            let built = if n == 0 { None } else { Some(binary_tree_uploaded(b, &prims, builder, split_budget(builder))?) };
             let mut tracer = Tracer { built, prims, tree: None, counts: (0, n), update_ms: 0.0, refit_state: None, spare: None };
             let build_ms = tracer.built.as_ref().map_or(0.0, |t| t.build_ms);
             tracer.update_ms = build_ms + tracer.lay_out(b)?;
@@ -318,7 +342,8 @@ impl<B: Backend> Tracer<B> {
         let Some(tree) = &self.tree else {
             return Err(crate::error::input(format!("this tracer has no primitives: there is nothing on the device to trace against (closest_hits answers misses)")));
         };
-        let kernel = Kernel::Cast(Method::Bvh2, self.counts.0 == 0);
+        let k = CastKernels::of(b);
+        let kernel = if self.counts.0 == 0 { k.triangles } else { k.any };
         b.stage("trace");
         b.dispatch(
             kernel,
