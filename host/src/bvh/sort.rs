@@ -23,7 +23,7 @@ kernel_set! {
 }
 
 kernel_set! {
-    /// The kernels of the sort with look-back, but its passes' ([`pass_kernel`]).
+    /// The kernels of the sort with look-back, but its passes' (`pass_kernel`).
     pub struct LookBackKernels for b {
         histogram: Kernel::SortHistogram,
         offsets: Kernel::SortOffsets,

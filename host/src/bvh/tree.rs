@@ -181,8 +181,8 @@ pub fn kernels_of<B: Backend>(b: &B, accel: Accel, layout: Layout) -> Vec<crate:
 }
 
 /// The kernels a device build of `builder` over pieces within `budget`,
-/// optimized as `config` says, dispatches on `b` (as [`optimize_built`]
-/// and [`built_within_stack`] choose them), before any layout.
+/// optimized as `config` says, dispatches on `b` (as `optimize_built`
+/// and `built_within_stack` choose them), before any layout.
 pub fn build_kernels<B: Backend>(b: &B, builder: Builder, budget: f32, config: &TreeletConfig) -> Vec<crate::runtime::kernels::Kernel> {
     let config = settled(config, builder, b.class());
     let mut k = match builder {

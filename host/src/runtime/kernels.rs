@@ -116,6 +116,29 @@ macro_rules! registration {
     };
 }
 
+/// One kernel's struct of bindings by name (see `bind`).
+macro_rules! bindings_struct {
+    ($name:ident $($b:ident)*) => {
+        #[doc = concat!("The bindings of [`Kernel::", stringify!($name), "`](super::Kernel::", stringify!($name), ").")]
+        pub struct $name<'a, T> {
+            pub params: &'a T,
+            $(pub $b: &'a T,)*
+        }
+        impl<'a, T> Clone for $name<'a, T> {
+            fn clone(&self) -> Self {
+                *self
+            }
+        }
+        impl<'a, T> Copy for $name<'a, T> {}
+        impl<'a, T> super::Bindings<'a, T> for $name<'a, T> {
+            const KERNEL: super::Kernel = super::Kernel::$name;
+            fn list(&self) -> Vec<&'a T> {
+                vec![self.params, $(self.$b),*]
+            }
+        }
+    };
+}
+
 /// A registered kernel's bindings, each named (the structs of [`bind`]),
 /// listed in the order its declaration gives.
 pub trait Bindings<'a, T> {
@@ -237,44 +260,8 @@ macro_rules! kernel_table {
         /// `params`, first), for `Backend::dispatch_with`: a call site
         /// names each buffer and the declaration orders them.
         pub mod bind {
-            $(
-                #[doc = concat!("The bindings of [`Kernel::", stringify!($name), "`](super::Kernel::", stringify!($name), ").")]
-                pub struct $name<'a, T> {
-                    pub params: &'a T,
-                    $(pub $b: &'a T,)*
-                }
-                impl<'a, T> Clone for $name<'a, T> {
-                    fn clone(&self) -> Self {
-                        *self
-                    }
-                }
-                impl<'a, T> Copy for $name<'a, T> {}
-                impl<'a, T> super::Bindings<'a, T> for $name<'a, T> {
-                    const KERNEL: super::Kernel = super::Kernel::$name;
-                    fn list(&self) -> Vec<&'a T> {
-                        vec![self.params, $(self.$b),*]
-                    }
-                }
-            )*
-            $(
-                #[doc = concat!("The bindings of [`Kernel::", stringify!($wname), "`](super::Kernel::", stringify!($wname), ").")]
-                pub struct $wname<'a, T> {
-                    pub params: &'a T,
-                    $(pub $wb: &'a T,)*
-                }
-                impl<'a, T> Clone for $wname<'a, T> {
-                    fn clone(&self) -> Self {
-                        *self
-                    }
-                }
-                impl<'a, T> Copy for $wname<'a, T> {}
-                impl<'a, T> super::Bindings<'a, T> for $wname<'a, T> {
-                    const KERNEL: super::Kernel = super::Kernel::$wname;
-                    fn list(&self) -> Vec<&'a T> {
-                        vec![self.params, $(self.$wb),*]
-                    }
-                }
-            )*
+            $(bindings_struct!($name $($b)*);)*
+            $(bindings_struct!($wname $($wb)*);)*
         }
     };
 }
