@@ -208,17 +208,28 @@ pub trait Backend: Send {
     }
     /// Dispatches that follow belong to `stage` (for timing).
     fn stage(&mut self, stage: &'static str);
-    /// Runs `kernel` over `groups` workgroups with these bindings (params first).
-    fn dispatch(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32);
-    /// [`Backend::dispatch`] of a registered kernel with its bindings named
-    /// (`crate::runtime::kernels::bind`): `kernel` is theirs, or its
-    /// relaxed twin (as a kernel set picks it).
+    /// Runs `kernel` over `groups` workgroups with these bindings (params
+    /// first): what each backend implements, called through
+    /// [`Backend::dispatch`] or [`Backend::dispatch_with`].
+    fn dispatch_listed(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32);
+    /// Runs a kernel written out in the shader crate (not in the registry)
+    /// over `groups` workgroups with these bindings (params first). A
+    /// registered kernel is refused: it takes its bindings by name
+    /// ([`Backend::dispatch_with`]).
+    fn dispatch(&mut self, kernel: Kernel, bindings: &[&Self::Buffer], groups: u32) {
+        assert!(kernel.registration().is_none(), "{kernel:?} is registered: dispatch it with its bindings by name (dispatch_with)");
+        self.dispatch_listed(kernel, bindings, groups);
+    }
+    /// Runs a registered kernel with its bindings named
+    /// (`crate::runtime::kernels::bind`), in the order its declaration
+    /// gives: `kernel` is theirs, or its relaxed twin (as a kernel set
+    /// picks it).
     fn dispatch_with<'a, K: Bindings<'a, Self::Buffer>>(&mut self, kernel: Kernel, bindings: K, groups: u32)
     where
         Self::Buffer: 'a,
     {
         assert!(kernel == K::KERNEL || kernel == K::KERNEL.relaxed(), "{kernel:?} dispatched with the bindings of {:?}", K::KERNEL);
-        self.dispatch(kernel, &bindings.list(), groups);
+        self.dispatch_listed(kernel, &bindings.list(), groups);
     }
     /// Waits for all work so far and returns the first `count` elements.
     fn read<T: Pod>(&mut self, buffer: &Self::Buffer, count: usize) -> Result<Vec<T>>;

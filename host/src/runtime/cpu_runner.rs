@@ -412,7 +412,7 @@ impl Backend for CpuBackend {
         self.current = Some((stage, Instant::now()));
     }
 
-    fn dispatch(&mut self, kernel: Kernel, bindings: &[&CpuBuffer], groups: u32) {
+    fn dispatch_listed(&mut self, kernel: Kernel, bindings: &[&CpuBuffer], groups: u32) {
         assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
         let mut guards: Vec<_> = bindings.iter().map(|b| b.borrow_mut()).collect();
         let mut b: Vec<&mut [u64]> = guards.iter_mut().map(|g| g.as_mut_slice()).collect();

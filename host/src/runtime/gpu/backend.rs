@@ -468,7 +468,7 @@ impl Backend for GpuBackend {
         self.stage = stage;
     }
 
-    fn dispatch(&mut self, kernel: Kernel, bindings: &[&wgpu::Buffer], groups: u32) {
+    fn dispatch_listed(&mut self, kernel: Kernel, bindings: &[&wgpu::Buffer], groups: u32) {
         assert_eq!(bindings.len(), kernel.bindings().len(), "{kernel:?}: wrong number of bindings");
         if groups == 0 {
             return;
