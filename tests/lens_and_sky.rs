@@ -235,3 +235,44 @@ fn gpu_renders_lens_and_sky_as_the_cpu_does() {
         assert!(gpu_cpu < 0.25 * noise, "{integrator:?}: GPU and CPU differ by {gpu_cpu}, noise is {noise}");
     }
 }
+
+/// A mesh file alone (issue 65): in its own coordinates far from the origin,
+/// seen whole from above under the white sky. The image's border sees only
+/// the sky (radiance 1 exactly: camera rays that miss), no pixel is brighter,
+/// and the middle of the picture is the mesh, grey and lit by the sky alone.
+#[test]
+fn a_mesh_file_alone_is_seen_whole_under_the_sky() {
+    let dir = std::env::temp_dir().join(format!("treelet-mesh-alone-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("octahedron.obj");
+    // An octahedron of radius 3 around (1000, -500, 2000).
+    let (c, r) = (Vec3::new(1000.0, -500.0, 2000.0), 3.0);
+    let mut obj = String::new();
+    for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+        let v = c + d * r;
+        obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+    }
+    for f in ["1 3 5", "3 2 5", "2 4 5", "4 1 5", "3 1 6", "2 3 6", "4 2 6", "1 4 6"] {
+        obj += &format!("f {f}\n");
+    }
+    std::fs::write(&path, obj).unwrap();
+    let scene = Scene::from_spec(path.to_str().unwrap()).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!((scene.spheres.len(), scene.triangles.len()), (0, 8), "the mesh alone, no room");
+    assert_eq!(scene.triangles[0].v0, (c + Vec3::X * r).to_array(), "in the file's coordinates");
+    let seed = fresh_seed();
+    let (w, h) = (48usize, 36usize);
+    let p = pixels(&mut CpuBackend::new(), &scene, &settings(w as u32, h as u32, 32, seed as u32, Integrator::Nee));
+    assert!(p.iter().all(|q| q.iter().all(|&x| x <= 1.0 + 1e-5 && x >= 0.0)), "a pixel brighter than the sky");
+    for x in 0..w {
+        for y in [0, h - 1] {
+            assert!(p[y * w + x].iter().all(|&v| (v - 1.0).abs() < 1e-5), "border pixel ({x}, {y}) is not the sky: {:?}", p[y * w + x]);
+        }
+    }
+    let middle = p[(h / 2) * w + w / 2];
+    assert!(middle[0] > 0.05 && middle[0] < 0.5 + 1e-3, "the middle pixel should be the grey mesh: {middle:?}");
+    // Whole in view: the mesh covers a good part of the picture, and none of
+    // its pixels touch the border (checked above).
+    let covered = p.iter().filter(|q| q[0] < 0.9).count();
+    assert!(covered > w * h / 20 && covered < w * h / 2, "{covered} of {} pixels show the mesh", w * h);
+}

@@ -119,7 +119,7 @@ enum Command {
 #[derive(clap::Args)]
 #[command(allow_negative_numbers = true)]
 struct RenderArgs {
-    /// Scene: cornell, room_disk, cornell_diffuse or cornell_mirrors (built in), random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh.
+    /// Scene: cornell, room_disk, cornell_diffuse or cornell_mirrors (built in), random:N[:SEED] (N spheres in the Cornell box), terrain:N (N triangles), city:N[:SEED] (N triangles of a city), a .json scene file, a .gltf/.glb scene, or an .obj/.ply mesh (alone under a white sky, seen from above).
     #[arg(long, default_value = "cornell")]
     scene: String,
     /// Trace a scene file's or glTF file's copies of meshes flattened into

@@ -117,9 +117,8 @@ pub fn load_instanced_with_camera(path: &Path, camera: Option<usize>) -> Result<
     Ok(InstancedScene { loose, meshes: out.meshes, instances: out.instances })
 }
 
-/// The sky of a glTF scene in which nothing emits light: a white one of
-/// radiance 1 (a diffuse surface open to it shows its colour).
-pub const DEFAULT_SKY: [f32; 3] = [1.0; 3];
+/// The sky of a glTF scene in which nothing emits light.
+pub use super::model::DEFAULT_SKY;
 
 /// The box of every instance's mesh box, placed (each placed box's eight
 /// corners; the triangles' own box where the transforms keep axes).

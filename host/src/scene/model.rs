@@ -159,6 +159,54 @@ pub fn mesh_placement(mesh: &[Triangle]) -> impl Fn([f32; 3]) -> [f32; 3] {
     move |v: [f32; 3]| (Vec3::from_array(v) * scale + shift).to_array()
 }
 
+/// How far a camera [`framed_from_above`] stands from its mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Framing {
+    /// At the mesh's largest extent from its centre: the mesh fills most of
+    /// the view, so most rays meet it (`bench rays --mesh-only`, and OptiX's
+    /// peer, frame a mesh so).
+    FillsTheView,
+    /// Far enough that the mesh's bounding sphere fits the image's height,
+    /// with a margin: the whole mesh in view, as a viewer shows it.
+    WholeInView,
+}
+
+/// smallpt's lens above and in front of `mesh`, looking at the centre of its
+/// box along -(0, 0.6, 0.8), at the distance `framing` says. Refused for a
+/// mesh so small that the direction's squared length is no normal f32
+/// (GPUs flush such numbers to zero, and the camera would look nowhere).
+pub fn framed_from_above(name: &str, mesh: &[Triangle], framing: Framing) -> Result<CameraSpec> {
+    let bounds = mesh.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
+    let (center, size) = (bounds.centroid(), bounds.extent().max_element());
+    if !(size * size >= f32::MIN_POSITIVE) {
+        bail!("{name}: the mesh spans {size:e} units, too small to frame with a camera (scale it up in the file)");
+    }
+    let distance = match framing {
+        Framing::FillsTheView => size,
+        // The image is SMALLPT_FOV high at unit distance; a tenth of margin.
+        Framing::WholeInView => 1.1 * (bounds.extent().length() / 2.0) / (SMALLPT_FOV / 2.0),
+    };
+    let origin = center + Vec3::new(0.0, 0.6, 0.8) * distance;
+    Ok(CameraSpec::pinhole(origin.to_array(), (center - origin).to_array(), 0.0, SMALLPT_FOV))
+}
+
+/// The sky of a scene in which nothing else gives light (a glTF file without
+/// emitters, a mesh file alone): a white one of radiance 1, as mesh and
+/// glTF viewers light such files by a default environment (a diffuse
+/// surface open to it shows its colour).
+pub const DEFAULT_SKY: [f32; 3] = [1.0; 3];
+
+/// A mesh file alone, as a mesh viewer shows it: in its own coordinates,
+/// seen whole from above ([`framed_from_above`]), mid-grey, under the white
+/// [`DEFAULT_SKY`]; no room around it. (A scene file places a mesh in
+/// smallpt's room, or anywhere, with lamps of its own.)
+pub fn mesh_alone(name: &str, triangles: Vec<Triangle>) -> Result<Scene> {
+    let camera = framed_from_above(name, &triangles, Framing::WholeInView)?;
+    // Mid-grey: its shading stands out against the white sky behind it.
+    let materials = vec![diffuse([0.5, 0.49, 0.46]); triangles.len()];
+    Ok(Scene { name: name.into(), spheres: Vec::new(), materials, room: 0, camera, environment: DEFAULT_SKY, triangles, instances: None })
+}
+
 /// A mesh alone in smallpt's room, under its light and camera: scaled to fit
 /// a 60-unit cube, centred in the room and standing on the floor, in a
 /// light diffuse grey. (`treelet build` builds over the triangles alone.)
@@ -244,10 +292,7 @@ impl Scene {
         if self.triangles.is_empty() {
             bail!("scene `{}` has no triangles", self.name);
         }
-        let bounds = self.triangles.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
-        let (center, size) = (bounds.centroid(), bounds.extent().max_element().max(f32::MIN_POSITIVE));
-        let origin = center + Vec3::new(0.0, 0.6, 0.8) * size;
-        let camera = CameraSpec::pinhole(origin.to_array(), (center - origin).to_array(), 0.0, SMALLPT_FOV);
+        let camera = framed_from_above(&self.name, &self.triangles, Framing::FillsTheView)?;
         Ok(Scene {
             name: format!("{} (mesh only)", self.name),
             spheres: Vec::new(),

@@ -5,7 +5,7 @@ use anyhow::{bail, Context as _, Result};
 
 use super::city::city;
 use super::instanced::InstancedScene;
-use super::model::{cornell, mesh_scene, random_scene, terrain, CameraSpec, Scene};
+use super::model::{cornell, mesh_alone, mesh_scene, random_scene, terrain, Scene};
 use super::primitives::MAX_PRIMITIVES;
 use crate::runtime::memory;
 use treelet_core::geometry::buffers::{Material, Sphere};
@@ -31,14 +31,8 @@ impl Scene {
             return super::gltf::load(std::path::Path::new(spec));
         }
         if super::mesh::mesh_kind(std::path::Path::new(spec)).is_some() {
-            let triangles = super::mesh::load(std::path::Path::new(spec))?;
-            // A mesh alone is scaled to fit the room: one too small for that
-            // scale in f32 became NaN coordinates, blamed on the file's triangle 0.
-            let size = triangles.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb())).extent().max_element();
-            if size > 0.0 && !(60.0 / size).is_finite() {
-                bail!("{spec}: the mesh spans {size:e} units, too small to scale into the room (scale it up in the file, or place it with a scene file)");
-            }
-            return Ok(mesh_scene(spec, &triangles));
+            // In its own coordinates, under a sky: nothing is scaled.
+            return mesh_alone(spec, super::mesh::load(std::path::Path::new(spec))?);
         }
         let mut parts = spec.split(':');
         match parts.next() {
@@ -102,19 +96,6 @@ fn check_generated_mesh(spec: &str, n: usize) -> Result<()> {
 }
 
 impl Scene {
-    /// smallpt's lens at `eye`, looking at `target`, both in the coordinates
-    /// of the scene `spec` names: an `.obj` or `.ply` mesh is moved into
-    /// smallpt's room when loaded ([`super::model::mesh_placement`]), and the
-    /// camera with it (the mesh is read again for its bounds: a command's
-    /// set-up, not a hot path); other scenes keep their coordinates.
-    pub fn camera_in_file(spec: &str, eye: [f32; 3], target: [f32; 3]) -> Result<CameraSpec> {
-        if super::mesh::mesh_kind(std::path::Path::new(spec)).is_some() {
-            let place = super::model::mesh_placement(&super::mesh::load(std::path::Path::new(spec))?);
-            return CameraSpec::looking_at(place(eye), place(target));
-        }
-        CameraSpec::looking_at(eye, target)
-    }
-
     /// [`Scene::from_spec`] for `render`: a glTF or scene file keeps the
     /// copies of meshes it places more than once placed
     /// ([`InstancedScene::for_render`]); every other scene as `from_spec`
@@ -165,11 +146,12 @@ mod tests {
     use glam::Vec3;
     use treelet_core::geometry::prims::{Origin, Prims};
     use treelet_core::trace::classic::closest_hit_linear;
+    use crate::scene::model::CameraSpec;
 
-    /// A camera given in a mesh file's coordinates looks at what it looked at
-    /// there once the loader has moved the mesh: its centre ray hits the
-    /// triangle it was aimed at, for each of a row of small triangles far
-    /// from the room.
+    /// A mesh file keeps its coordinates: a camera given in them looks at
+    /// what it aimed at (its centre ray hits the triangle it was aimed at,
+    /// for each of a row of small triangles far from the origin), and the
+    /// mesh alone is seen from above under the default sky.
     #[test]
     fn a_camera_in_file_coordinates_hits_what_it_aimed_at() {
         let dir = tempfile::tempdir().unwrap();
@@ -190,12 +172,19 @@ mod tests {
         for k in 0..10 {
             let aim = corner(k) + Vec3::new(3.0, 3.0, 0.0);
             let eye = aim - Vec3::new(5.0, -2.0, 400.0);
-            let camera = Scene::camera_in_file(spec, eye.to_array(), aim.to_array()).unwrap();
+            let camera = CameraSpec::looking_at(eye.to_array(), aim.to_array()).unwrap();
             let (o, d) = (Vec3::from_array(camera.origin), Vec3::from_array(camera.direction).normalize());
             let hit = closest_hit_linear(o, d, Origin::NONE, &prims);
             assert!(hit.is_hit() && hit.prim == k as u32, "aimed at triangle {k}, hit {} at {}", hit.prim, hit.t);
         }
         // Refused: a camera that looks nowhere.
-        assert!(Scene::camera_in_file(spec, [1.0; 3], [1.0; 3]).is_err());
+        assert!(CameraSpec::looking_at([1.0; 3], [1.0; 3]).is_err());
+        assert_eq!((scene.room, scene.spheres.len(), scene.environment), (0, 0, crate::scene::model::DEFAULT_SKY));
+        assert_eq!(scene.triangles[3].v0, corner(3).to_array(), "the file's coordinates");
+        // The framing sees the mesh: the centre ray meets the row's box.
+        let (o, d) = (Vec3::from_array(scene.camera.origin), Vec3::from_array(scene.camera.direction));
+        let (lo, hi) = (corner(0), corner(9) + Vec3::new(10.0, 10.0, 0.0));
+        let at = o + d * ((lo.z - o.z) / d.z);
+        assert!(at.x >= lo.x && at.x <= hi.x && at.y >= lo.y - 1.0 && at.y <= hi.y + 1.0, "the centre ray meets the mesh's plane at {at}");
     }
 }

@@ -9,7 +9,7 @@ use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::GpuBackend;
 use treelet::bvh::layout::Layout;
 use treelet::bvh::tree::{Accel, Builder};
-use treelet::scene::Scene;
+use treelet::scene::{CameraSpec, Scene};
 use treelet::bvh::trbvh::TreeletConfig;
 
 use figure::{Figure, Suite};
@@ -149,9 +149,8 @@ pub enum BenchCommand {
         mesh_only: bool,
         /// The camera instead of the scene's (or the mesh-only framing): its
         /// eye and the point it looks at, EX,EY,EZ,TX,TY,TZ (a camera
-        /// inside a building, say), in the coordinates of the scene's file
-        /// (an .obj or .ply mesh is moved into smallpt's room when loaded,
-        /// and the camera with it); peers/mitsuba/rays.py takes the same.
+        /// inside a building, say), in the coordinates of the scene's file;
+        /// peers/mitsuba/rays.py takes the same.
         #[arg(long, allow_hyphen_values = true)]
         camera: Option<String>,
         #[arg(long)]
@@ -492,7 +491,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
                 let c: Vec<f32> = text.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().ok().filter(|c: &Vec<f32>| c.len() == 6).ok_or_else(|| {
                     anyhow::anyhow!("--camera {text}: expected six numbers EX,EY,EZ,TX,TY,TZ (eye, then the point looked at)")
                 })?;
-                scene.camera = Scene::camera_in_file(&spec, [c[0], c[1], c[2]], [c[3], c[4], c[5]])?;
+                scene.camera = CameraSpec::looking_at([c[0], c[1], c[2]], [c[3], c[4], c[5]])?;
             }
             if let Some(p) = &peer {
                 tradeoff::check_peer(p, scene.triangles.len(), (width, height))?;
