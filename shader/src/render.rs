@@ -8,7 +8,7 @@ use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 use treelet_core::geometry::buffers::{Material, Node, InstanceInfo, RenderParams, Sphere};
 use treelet_core::geometry::prims::Prims;
-use treelet_core::geometry::features::{ALL, CAUSTICS, INDEPENDENT_NUMBERS, INSTANCES, TRIANGLES};
+use treelet_core::geometry::features::{ALL, CAUSTICS, INDEPENDENT_NUMBERS, INSTANCES};
 use treelet_core::geometry::split::Split;
 use treelet_core::geometry::triangle::Triangle;
 use treelet_core::gpu::workgroup::{RAY_WORKGROUP_SIZE, linear_id, linear_id_in};
@@ -136,12 +136,23 @@ treelet_core::for_each_render_variant!(render_entry_points);
 #[cfg(feature = "render-linear")]
 render_kernel!(camera whole classic_cs, Node, u32, ClassicTree::new, ALL);
 
+/// The binding element types of a layout's nodes and leaf primitives:
+/// 16-byte vectors (`records`) or the seed's `Node`s and `u32`s (`classic`).
+macro_rules! node_type {
+    (records) => { Vec4 };
+    (classic) => { Node };
+}
+macro_rules! prim_type {
+    (records) => { Vec4 };
+    (classic) => { u32 };
+}
+
 /// Ray-casting throughput: one primary or one diffuse ray per pixel,
-/// through one layout (`$tree` from bindings 3 and 4), its stack private,
+/// through one layout (`$new` over bindings 3 and 4), its stack private,
 /// testing the primitive kinds of `$features`.
 macro_rules! cast_kernel {
     // As `render_kernel!`: the `bvh2` layout's buffers in one or two parts.
-    ($name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+    (split $records:ident $name:ident, $new:path, $features:expr) => {
         #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -149,21 +160,21 @@ macro_rules! cast_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
             #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[node_type!($records)],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[prim_type!($records)],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &[$node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] prims_hi: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 8)] nodes_hi: &[node_type!($records)],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 9)] prims_hi: &[prim_type!($records)],
         ) {
             let id = linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE);
-            let tree = $tree(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
+            let tree = $new(Split::new(nodes, nodes_hi), Split::new(prims, prims_hi));
             let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, tree);
             treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
-    (whole $name:ident, $node:ty, $prim:ty, $tree:path, $features:expr) => {
+    (whole $records:ident $name:ident, $new:path, $features:expr) => {
         #[spirv(compute(threads(64)))]
         pub fn $name(
             #[spirv(global_invocation_id)] gid: UVec3,
@@ -171,36 +182,30 @@ macro_rules! cast_kernel {
             #[spirv(storage_buffer, descriptor_set = 0, binding = 0)] params: &RenderParams,
             #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] spheres: &[Sphere],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] materials: &[Material],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[$node],
-            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[$prim],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 3)] nodes: &[node_type!($records)],
+            #[spirv(storage_buffer, descriptor_set = 0, binding = 4)] prims: &[prim_type!($records)],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 5)] rays: &mut [[f32; 4]],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 6)] triangles: &[Triangle],
             #[spirv(storage_buffer, descriptor_set = 0, binding = 7)] triangles_hi: &[Triangle],
         ) {
             let id = linear_id_in(gid.x, gid.y, groups.x, RAY_WORKGROUP_SIZE);
-            let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $tree(nodes, prims));
+            let scene = SceneRefs::new(params, spheres, Split::new(triangles, triangles_hi), materials, $new(nodes, prims));
             treelet_core::render::rays::cast_kernel::<_, { $features }, 1>(id, params, &scene, rays, &mut [0u32; 1], 0);
         }
     };
 }
 
-// Every kind of primitive, and triangles alone (meshes).
-#[cfg(feature = "render-linear")]
-cast_kernel!(whole cast_classic_cs, Node, u32, ClassicTree::new, ALL);
-#[cfg(feature = "render-bvh2")]
-cast_kernel!(cast_bvh2_cs, Vec4, Vec4, Bvh2Tree::new, ALL);
-#[cfg(feature = "render-bvh4")]
-cast_kernel!(whole cast_bvh4_cs, Vec4, Vec4, Bvh4Tree::new, ALL);
-#[cfg(feature = "render-cwbvh")]
-cast_kernel!(whole cast_cwbvh_cs, Vec4, Vec4, WideTree::new, ALL);
-#[cfg(feature = "render-linear")]
-cast_kernel!(whole cast_classic_triangles_cs, Node, u32, ClassicTree::new, TRIANGLES);
-#[cfg(feature = "render-bvh2")]
-cast_kernel!(cast_bvh2_triangles_cs, Vec4, Vec4, Bvh2Tree::new, TRIANGLES);
-#[cfg(feature = "render-bvh4")]
-cast_kernel!(whole cast_bvh4_triangles_cs, Vec4, Vec4, Bvh4Tree::new, TRIANGLES);
-#[cfg(feature = "render-cwbvh")]
-cast_kernel!(whole cast_cwbvh_triangles_cs, Vec4, Vec4, WideTree::new, TRIANGLES);
+/// The cast entry points of `treelet_core::for_each_cast_kernel!`, each in
+/// its build group.
+macro_rules! cast_entry_points {
+    ([] $($method:ident $triangles:literal $group:literal $bound:ident $records:ident $name:ident $new:path, $features:path;)*) => {
+        $(
+            #[cfg(feature = $group)]
+            cast_kernel!($bound $records $name, $new, $features);
+        )*
+    };
+}
+treelet_core::for_each_cast_kernel!(cast_entry_points);
 
 /// As `cast_cwbvh_cs`, the top of each ray's stack in workgroup memory.
 #[cfg(feature = "render-cwbvh")]

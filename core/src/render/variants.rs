@@ -1,5 +1,6 @@
 //! The render kernel variants: the feature sets the shader crate compiles
-//! render kernels for, listed once ([`for_each_render_variant!`](crate::for_each_render_variant)). The
+//! render kernels for, listed once ([`for_each_render_variant!`](crate::for_each_render_variant)),
+//! and the ray-casting kernels ([`for_each_cast_kernel!`](crate::for_each_cast_kernel)). The
 //! shader's entry points, the host's kernel names and the CPU runner's
 //! dispatch are all expanded from that list, so a new variant is one line.
 
@@ -32,6 +33,40 @@ macro_rules! for_each_render_variant {
             9 full_independent [$crate::geometry::features::ALL, $crate::geometry::features::INDEPENDENT_NUMBERS];
             10 full_caustics_independent [$crate::geometry::features::ALL, $crate::geometry::features::CAUSTICS, $crate::geometry::features::INDEPENDENT_NUMBERS];
             11 full [$crate::geometry::features::ALL];
+        }
+    };
+}
+
+/// Calls `$callback!` with the one list of ray-casting kernels
+/// ([`crate::render::rays::cast_kernel`] through one layout, for every
+/// primitive kind or triangles alone), as `[extra args] method triangles
+/// "shader feature" bound records entry_point tree_constructor, features;`:
+///
+/// - `method`: the host's `Method` variant; `triangles`: compiled for
+///   triangles alone (meshes);
+/// - the shader crate's feature (build group) that compiles it;
+/// - `split`: the layout's nodes and leaf primitives bound in one or two
+///   parts each (`crate::geometry::split`), `whole`: in one;
+/// - `records`: nodes and primitives bound as 16-byte vectors, `classic`:
+///   as the seed's `Node`s and `u32`s;
+/// - the entry point's name (in the shader crate's `render` module), the
+///   tree's constructor, and the feature set.
+///
+/// The shader's entry points, and the host's kernels, entry-point names
+/// and split bindings, are all expanded from it.
+#[macro_export]
+macro_rules! for_each_cast_kernel {
+    ($callback:ident $(, $arg:tt)*) => {
+        $callback! {
+            [$($arg),*]
+            Classic false "render-linear" whole classic cast_classic_cs $crate::trace::classic::ClassicTree::new, $crate::geometry::features::ALL;
+            Bvh2 false "render-bvh2" split records cast_bvh2_cs $crate::trace::bvh2::Bvh2Tree::new, $crate::geometry::features::ALL;
+            Bvh4 false "render-bvh4" whole records cast_bvh4_cs $crate::trace::bvh4::Bvh4Tree::new, $crate::geometry::features::ALL;
+            Cwbvh false "render-cwbvh" whole records cast_cwbvh_cs $crate::trace::cwbvh::WideTree::new, $crate::geometry::features::ALL;
+            Classic true "render-linear" whole classic cast_classic_triangles_cs $crate::trace::classic::ClassicTree::new, $crate::geometry::features::TRIANGLES;
+            Bvh2 true "render-bvh2" split records cast_bvh2_triangles_cs $crate::trace::bvh2::Bvh2Tree::new, $crate::geometry::features::TRIANGLES;
+            Bvh4 true "render-bvh4" whole records cast_bvh4_triangles_cs $crate::trace::bvh4::Bvh4Tree::new, $crate::geometry::features::TRIANGLES;
+            Cwbvh true "render-cwbvh" whole records cast_cwbvh_triangles_cs $crate::trace::cwbvh::WideTree::new, $crate::geometry::features::TRIANGLES;
         }
     };
 }

@@ -274,8 +274,36 @@ macro_rules! with_per_workgroup {
 }
 treelet_core::per_invocation_kernels!(with_per_workgroup);
 
+/// `whole` or `split` (`treelet_core::for_each_cast_kernel!`): whether the
+/// layout's nodes and leaf primitives may be bound in two parts.
+macro_rules! bound_in_parts {
+    (whole) => {
+        false
+    };
+    (split) => {
+        true
+    };
+}
+
+/// The cast kernels' table from their one list.
+macro_rules! cast_table {
+    ([] $($method:ident $triangles:literal $group:literal $bound:ident $records:ident $name:ident $new:path, $features:path;)*) => {
+        /// Each cast kernel of `treelet_core::for_each_cast_kernel!`: the
+        /// kernel, its entry point, and whether its layout's nodes and leaf
+        /// primitives may be bound in two parts.
+        const CAST_KERNELS: &[(Kernel, &str, bool)] =
+            &[$((Kernel::Cast(Method::$method, $triangles), concat!("render::", stringify!($name)), bound_in_parts!($bound))),*];
+    };
+}
+treelet_core::for_each_cast_kernel!(cast_table);
+
+/// The facts of cast kernel `k` in [`CAST_KERNELS`].
+fn cast_kernel(k: Kernel) -> &'static (Kernel, &'static str, bool) {
+    CAST_KERNELS.iter().find(|c| c.0 == k).unwrap_or_else(|| panic!("{k:?}: no such cast kernel"))
+}
+
 impl Kernel {
-    const FIXED: [Kernel; 23] = [
+    const FIXED: [Kernel; 15] = [
         Kernel::CastInstances,
         Kernel::SortOnesweep,
         Kernel::SortOnesweepSmall,
@@ -291,14 +319,6 @@ impl Kernel {
         Kernel::Hploc,
         Kernel::HplocRelaxed,
         Kernel::TreeletRestructure,
-        Kernel::Cast(Method::Classic, false),
-        Kernel::Cast(Method::Bvh2, false),
-        Kernel::Cast(Method::Bvh4, false),
-        Kernel::Cast(Method::Cwbvh, false),
-        Kernel::Cast(Method::Classic, true),
-        Kernel::Cast(Method::Bvh2, true),
-        Kernel::Cast(Method::Bvh4, true),
-        Kernel::Cast(Method::Cwbvh, true),
     ];
 
     /// Every kernel: the fixed ones and each render kernel the shader has.
@@ -306,6 +326,7 @@ impl Kernel {
         let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::geometry::features::ALL).unwrap() as u8;
         let mut all = Self::FIXED.to_vec();
         all.extend_from_slice(Self::REGISTERED);
+        all.extend(CAST_KERNELS.iter().map(|c| c.0));
         all.push(Kernel::CastWideWorkgroupStack);
         all.push(Kernel::RenderInstanced);
         all.push(Kernel::RenderInstancedCaustics);
@@ -352,15 +373,7 @@ impl Kernel {
             Kernel::LightInstanced => "render::light_instanced_cs",
             Kernel::Light(Method::Classic, _) => panic!("no light paths through the seed's layout"),
             Kernel::Light(method, v) => render_entry_point(method, v, true),
-            Kernel::Cast(Method::Classic, false) => "render::cast_classic_cs",
-            Kernel::Cast(Method::Bvh2, false) => "render::cast_bvh2_cs",
-            Kernel::Cast(Method::Bvh4, false) => "render::cast_bvh4_cs",
-            Kernel::Cast(Method::Cwbvh, false) => "render::cast_cwbvh_cs",
-            Kernel::Cast(Method::Classic, true) => "render::cast_classic_triangles_cs",
-            Kernel::Cast(Method::Bvh2, true) => "render::cast_bvh2_triangles_cs",
-            Kernel::Cast(Method::Bvh4, true) => "render::cast_bvh4_triangles_cs",
-            Kernel::Cast(Method::Cwbvh, true) => "render::cast_cwbvh_triangles_cs",
-            Kernel::Cast(Method::Scan, _) => panic!("no cast kernel scans"),
+            Kernel::Cast(..) => cast_kernel(self).1,
             Kernel::CastWideWorkgroupStack => "render::cast_cwbvh_workgroup_cs",
             _ => unreachable!("{self:?} is registered"),
         }
@@ -378,7 +391,8 @@ impl Kernel {
             Kernel::AgglomerateSubgroup | Kernel::Hploc | Kernel::HplocRelaxed => &[4],
             Kernel::TreeletRestructure => &[3],
             // Traversal: the `bvh2` layout's nodes and leaf primitives too.
-            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::Cast(Method::Bvh2, _) | Kernel::RenderInstanced | Kernel::RenderInstancedCaustics | Kernel::LightInstanced => &[6, 3, 4],
+            Kernel::Cast(..) if cast_kernel(self).2 => &[6, 3, 4],
+            Kernel::Render(Method::Bvh2, _) | Kernel::Light(Method::Bvh2, _) | Kernel::RenderInstanced | Kernel::RenderInstancedCaustics | Kernel::LightInstanced => &[6, 3, 4],
             Kernel::Render(..) | Kernel::Light(..) | Kernel::Cast(..) | Kernel::CastWideWorkgroupStack => &[6],
             _ => &[],
         }
