@@ -2,8 +2,7 @@ use spirv_std::glam::UVec3;
 use spirv_std::spirv;
 use treelet_core::construct::sort;
 use treelet_core::construct::sort::multisplit::{
-    MEDIUM_MULTISPLIT_SORT_ITEMS, MULTISPLIT_SORT_ITEMS, MultisplitPassLane, SMALL_MULTISPLIT_SORT_ITEMS, SUBGROUP_COUNTS, multisplit_pass_phase,
-    multisplit_pass_phases, multisplit_pass_sync,
+    MultisplitPassLane, SUBGROUP_COUNTS, multisplit_pass_phase, multisplit_pass_phases, multisplit_pass_sync,
 };
 use treelet_core::gpu::subgroup::{Lane, apply_with};
 use treelet_core::geometry::buffers::SortParams;
@@ -77,10 +76,6 @@ macro_rules! onesweep_kernel {
     };
 }
 
-onesweep_kernel!(sort_onesweep_cs, true, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23]);
-onesweep_kernel!(sort_onesweep_small_cs, true, sort::SMALL_SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11]);
-onesweep_kernel!(sort_onesweep_scanned_cs, false, sort::SORT_ITEMS, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23]);
-
 /// A sort pass ranked by subgroups, `$items` keys per lane: each lane's
 /// state stays in registers, and only the phases that need it end in a
 /// workgroup barrier. The phases unrolled, each with its number a
@@ -143,12 +138,20 @@ macro_rules! multisplit_kernel {
     };
 }
 
-multisplit_kernel!(sort_multisplit_cs, MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
-multisplit_kernel!(sort_multisplit_small_cs, SMALL_MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
-multisplit_kernel!(sort_multisplit_medium_cs, MEDIUM_MULTISPLIT_SORT_ITEMS, false, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21]);
-// The same passes with the byte match by NVIDIA's partition instruction,
-// for devices on which the host enabled `VK_NV_shader_subgroup_partitioned`.
-multisplit_kernel!(sort_multisplit_partitioned_cs, MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25]);
-multisplit_kernel!(sort_multisplit_small_partitioned_cs, SMALL_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17]);
-multisplit_kernel!(sort_multisplit_medium_partitioned_cs, MEDIUM_MULTISPLIT_SORT_ITEMS, true, [0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21]);
-
+/// The sort pass entry points of `treelet_core::for_each_sort_pass!`.
+macro_rules! sort_entry_points {
+    ([] $($kernel:ident $kind:ident $name:ident $items:path, $flag:literal, $phases:tt;)*) => {
+        $(sort_pass!($kind $name, $items, $flag, $phases);)*
+    };
+}
+macro_rules! sort_pass {
+    (onesweep $name:ident, $items:path, $look_back:literal, $phases:tt) => {
+        onesweep_kernel!($name, $look_back, $items, $phases);
+    };
+    // With `$partitioned`, the byte match by NVIDIA's partition instruction,
+    // for devices on which the host enabled `VK_NV_shader_subgroup_partitioned`.
+    (multisplit $name:ident, $items:path, $partitioned:literal, $phases:tt) => {
+        multisplit_kernel!($name, $items, $partitioned, $phases);
+    };
+}
+treelet_core::for_each_sort_pass!(sort_entry_points);

@@ -297,23 +297,29 @@ macro_rules! cast_table {
 }
 treelet_core::for_each_cast_kernel!(cast_table);
 
+/// The sort passes' table from their one list.
+macro_rules! sort_table {
+    ([] $($kernel:ident $kind:ident $name:ident $items:path, $flag:literal, $phases:tt;)*) => {
+        /// Each sort pass of `treelet_core::for_each_sort_pass!`: the kernel
+        /// and its entry point.
+        const SORT_PASSES: &[(Kernel, &str)] = &[$((Kernel::$kernel, concat!("sort::", stringify!($name)))),*];
+    };
+}
+treelet_core::for_each_sort_pass!(sort_table);
+
+/// The entry point of `k` if it is a sort pass of [`SORT_PASSES`].
+fn sort_pass(k: Kernel) -> Option<&'static str> {
+    SORT_PASSES.iter().find(|s| s.0 == k).map(|s| s.1)
+}
+
 /// The facts of cast kernel `k` in [`CAST_KERNELS`].
 fn cast_kernel(k: Kernel) -> &'static (Kernel, &'static str, bool) {
     CAST_KERNELS.iter().find(|c| c.0 == k).unwrap_or_else(|| panic!("{k:?}: no such cast kernel"))
 }
 
 impl Kernel {
-    const FIXED: [Kernel; 15] = [
+    const FIXED: [Kernel; 6] = [
         Kernel::CastInstances,
-        Kernel::SortOnesweep,
-        Kernel::SortOnesweepSmall,
-        Kernel::SortMultisplit,
-        Kernel::SortMultisplitSmall,
-        Kernel::SortMultisplitMedium,
-        Kernel::SortMultisplitPartitioned,
-        Kernel::SortMultisplitSmallPartitioned,
-        Kernel::SortMultisplitMediumPartitioned,
-        Kernel::SortOnesweepScanned,
         Kernel::Multisplit,
         Kernel::AgglomerateSubgroup,
         Kernel::Hploc,
@@ -326,6 +332,7 @@ impl Kernel {
         let full = VARIANTS.iter().position(|(f, _)| *f == treelet_core::geometry::features::ALL).unwrap() as u8;
         let mut all = Self::FIXED.to_vec();
         all.extend_from_slice(Self::REGISTERED);
+        all.extend(SORT_PASSES.iter().map(|s| s.0));
         all.extend(CAST_KERNELS.iter().map(|c| c.0));
         all.push(Kernel::CastWideWorkgroupStack);
         all.push(Kernel::RenderInstanced);
@@ -351,17 +358,11 @@ impl Kernel {
         if let Some(r) = self.registration() {
             return r.entry_point;
         }
+        if let Some(name) = sort_pass(self) {
+            return name;
+        }
         match self {
             Kernel::CastInstances => "render::cast_instances_cs",
-            Kernel::SortOnesweep => "sort::sort_onesweep_cs",
-            Kernel::SortOnesweepSmall => "sort::sort_onesweep_small_cs",
-            Kernel::SortMultisplit => "sort::sort_multisplit_cs",
-            Kernel::SortMultisplitSmall => "sort::sort_multisplit_small_cs",
-            Kernel::SortMultisplitMedium => "sort::sort_multisplit_medium_cs",
-            Kernel::SortMultisplitPartitioned => "sort::sort_multisplit_partitioned_cs",
-            Kernel::SortMultisplitSmallPartitioned => "sort::sort_multisplit_small_partitioned_cs",
-            Kernel::SortMultisplitMediumPartitioned => "sort::sort_multisplit_medium_partitioned_cs",
-            Kernel::SortOnesweepScanned => "sort::sort_onesweep_scanned_cs",
             Kernel::Multisplit => "multisplit_rank::multisplit_rank_cs",
             Kernel::AgglomerateSubgroup => "agglomerate_subgroup::agglomerate_subgroup_cs",
             Kernel::Hploc => "hploc::hploc_cs",
@@ -423,15 +424,7 @@ impl Kernel {
         }
         match self {
             Kernel::CastInstances => &[Read, Read, Read, Read, Read, Read, ReadWrite],
-            Kernel::SortOnesweep
-            | Kernel::SortOnesweepSmall
-            | Kernel::SortOnesweepScanned
-            | Kernel::SortMultisplit
-            | Kernel::SortMultisplitSmall
-            | Kernel::SortMultisplitMedium
-            | Kernel::SortMultisplitPartitioned
-            | Kernel::SortMultisplitSmallPartitioned
-            | Kernel::SortMultisplitMediumPartitioned => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
+            _ if sort_pass(self).is_some() => &[Read, Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Multisplit => &[Read, Read, ReadWrite, ReadWrite, ReadWrite],
             Kernel::AgglomerateSubgroup => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
             Kernel::Hploc | Kernel::HplocRelaxed => &[Read, Read, Read, Read, ReadWrite, ReadWrite, ReadWrite, ReadWrite],
