@@ -18,11 +18,14 @@
 //! - the CPU runner makes its dispatch (`treelet::runtime::cpu_runner`).
 //!
 //! So the GPU and the CPU run the same call on the same bindings, and
-//! adding such a kernel is one entry here. Kernels with subgroup
-//! operations, teams within a workgroup, workgroup sizes of their own or
-//! compile-time variants (the sort passes, H-PLOC, the treelet teams, the
-//! ray kernels) are still written out in the shader crate and the CPU
-//! runner.
+//! adding such a kernel is one entry here. The families with compile-time
+//! variants have lists of their own: the render kernels
+//! ([`for_each_render_variant!`](crate::for_each_render_variant)), the sort
+//! passes ([`for_each_sort_pass!`](crate::for_each_sort_pass)) and the
+//! ray-casting kernels ([`for_each_cast_kernel!`](crate::for_each_cast_kernel)).
+//! The few others with subgroup operations or teams within a workgroup
+//! (H-PLOC, the treelet teams) are written out in the shader crate and the
+//! CPU runner.
 //!
 //! An entry reads:
 //!
