@@ -19,7 +19,7 @@ use treelet::bvh::tree::{binary_tree_split, Accel};
 use treelet::runtime::backend::Backend;
 use treelet::runtime::cpu_runner::CpuBackend;
 use treelet::runtime::gpu::{GpuBackend, GpuContext};
-use treelet::scene::Scene;
+use treelet::scene::{CameraSpec, Scene};
 use treelet_core::geometry::buffers::{Bvh2Node, LeafPrim, WideNode};
 use treelet_core::geometry::features::ALL;
 use treelet_core::geometry::intersect::surface_offset;
@@ -66,7 +66,7 @@ fn count<B: Backend>(b: &mut B) -> Result<()> {
     let mut scene = Scene::from_spec(spec)?.mesh_only()?;
     if let Some(c) = args.get(3) {
         let c: Vec<f32> = c.split(',').map(|x| x.parse()).collect::<Result<_, _>>()?;
-        scene.camera = Scene::camera_in_file(spec, [c[0], c[1], c[2]], [c[3], c[4], c[5]])?;
+        scene.camera = CameraSpec::looking_at([c[0], c[1], c[2]], [c[3], c[4], c[5]])?;
     }
     let prims_host = scene.primitives();
     let prims = Prims::new(&scene.spheres, &scene.triangles);
