@@ -558,10 +558,13 @@ mod tests {
     }
 
     #[test]
-    fn a_mesh_too_small_to_frame_is_refused_as_such() {
+    fn a_mesh_too_small_or_too_large_to_frame_is_refused_as_such() {
         let path = write("tiny.obj", b"v 0 0 0\nv 1e-42 0 0\nv 0 1e-42 0\nf 1 2 3\n");
         let e = format!("{:#}", crate::scene::Scene::from_spec(path.to_str().unwrap()).unwrap_err());
         assert!(e.contains("tiny.obj") && e.contains("too small to frame"), "{e}");
+        let path = write("huge.obj", b"v -1e38 0 0\nv 1e38 0 0\nv 0 1e38 0\nf 1 2 3\n");
+        let e = format!("{:#}", crate::scene::Scene::from_spec(path.to_str().unwrap()).unwrap_err());
+        assert!(e.contains("huge.obj") && e.contains("too large to frame"), "{e}");
     }
 
     #[test]

@@ -174,7 +174,8 @@ pub enum Framing {
 /// smallpt's lens above and in front of `mesh`, looking at the centre of its
 /// box along -(0, 0.6, 0.8), at the distance `framing` says. Refused for a
 /// mesh so small that the direction's squared length is no normal f32
-/// (GPUs flush such numbers to zero, and the camera would look nowhere).
+/// (GPUs flush such numbers to zero, and the camera would look nowhere), or
+/// so large that the camera's place is past f32.
 pub fn framed_from_above(name: &str, mesh: &[Triangle], framing: Framing) -> Result<CameraSpec> {
     let bounds = mesh.iter().fold(treelet_core::Aabb::EMPTY, |b, t| b.union(&t.aabb()));
     let (center, size) = (bounds.centroid(), bounds.extent().max_element());
@@ -187,6 +188,9 @@ pub fn framed_from_above(name: &str, mesh: &[Triangle], framing: Framing) -> Res
         Framing::WholeInView => 1.1 * (bounds.extent().length() / 2.0) / (SMALLPT_FOV / 2.0),
     };
     let origin = center + Vec3::new(0.0, 0.6, 0.8) * distance;
+    if !origin.is_finite() || !(center - origin).is_finite() {
+        bail!("{name}: the mesh spans {size:e} units, too large to frame with a camera in f32 (scale it down in the file)");
+    }
     Ok(CameraSpec::pinhole(origin.to_array(), (center - origin).to_array(), 0.0, SMALLPT_FOV))
 }
 
