@@ -8,7 +8,7 @@
 //! | large triangles split into pieces (optional) | [`presplit`] | Karras & Aila 2013, section 5.1 |
 //! | centroid bounds | [`bounds`] | parallel reduction |
 //! | Morton codes | [`morton`] | Karras 2012, section 4 |
-//! | sort | [`sort`] (the Onesweep pass), [`sort::scan`]; [`sort::multisplit`] (the pass ranked by subgroups), [`sort::multisplit_rank`] (its ranking alone), [`sort::ties`] (high digits first, then ties) | Adinets & Merrill 2022 (Onesweep) |
+//! | sort | [`sort`] (the Onesweep pass), [`sort::scan`]; [`sort::multisplit`] (the pass ranked by subgroups), [`sort::multisplit_rank`] (its ranking alone), [`sort::ties`] (high digits first, then ties); [`sort::passes`] (their kernels, listed once) | Adinets & Merrill 2022 (Onesweep) |
 //! | radix tree | [`radix_tree`] | Karras 2012, section 3, figure 4 |
 //! | bottom-up climb (fit, agglomerate, treelet counts, wide DP) | [`climb`]; [`climb_queue`] (climbs handed from one kernel to the next) | Karras 2012, section 4; Apetrei 2014 |
 //! | bottom-up boxes | [`fit`] | Karras 2012, section 4 |
